@@ -1,0 +1,61 @@
+#include "cli/tool.hpp"
+
+#include <cstdio>
+#include <iostream>
+#include <new>
+#include <unistd.h>
+
+#include "cli/errors.hpp"
+#include "formats/json_pull.hpp"
+
+namespace hemotree {
+
+namespace {
+std::string tool_name = "hemotree";
+
+void say(const std::string& kind, const std::string& message) {
+  std::fprintf(stderr, "%s: %s%s\n", tool_name.c_str(), kind.c_str(), message.c_str());
+}
+}  // namespace
+
+void warn(const std::string& message) { say("warning: ", message); }
+void note(const std::string& message) { say("", message); }
+
+bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
+
+int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+  tool_name = app.get_name();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line, not CLI11's usage dump: the user sees what is wrong at once.
+    say("error: ", std::string(e.what()) + " (see --help)");
+    return 2;
+  }
+  try {
+    return body();
+  } catch (const InputError& e) {
+    say("error: ", e.what());
+    return 2;
+  } catch (const JsonError& e) {
+    say("error: ", e.what());
+    return 2;
+  } catch (const IoError& e) {
+    say("error: ", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    say("error: ", "out of memory");
+    return 1;
+  } catch (const std::exception& e) {
+    say("internal error: ", e.what());
+    return 70;
+  }
+}
+
+}  // namespace hemotree

@@ -1,0 +1,23 @@
+// The common frame of every hemotree command: one clear line on stderr and a non-zero exit
+// for anything that goes wrong, never an uncaught exception.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace hemotree {
+
+// Parses the command line with app, then runs body. Exit status: 0 success, 2 bad input
+// (flags, values, file contents), 1 input/output failure, 70 internal error.
+int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+
+// "vgen: warning: ..." / "vgen: ..." on stderr.
+void warn(const std::string& message);
+void note(const std::string& message);
+
+// True when stderr is a terminal: progress lines are shown only then.
+bool stderr_is_terminal();
+
+}  // namespace hemotree

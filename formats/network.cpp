@@ -1,0 +1,75 @@
+#include "formats/network.hpp"
+
+#include <numbers>
+
+namespace hemotree {
+
+VesselClass classify(double diameter) {
+  if (diameter >= artery_min_diameter) return VesselClass::artery;
+  if (diameter >= small_artery_min_diameter) return VesselClass::small_artery;
+  if (diameter >= arteriole_min_diameter) return VesselClass::arteriole;
+  return VesselClass::capillary;
+}
+
+std::string_view to_string(VesselClass c) {
+  switch (c) {
+    case VesselClass::artery: return "artery";
+    case VesselClass::small_artery: return "small_artery";
+    case VesselClass::arteriole: return "arteriole";
+    case VesselClass::capillary: return "capillary";
+  }
+  return "unknown";
+}
+
+std::optional<VesselClass> parse_vessel_class(std::string_view name) {
+  for (int c = 0; c < vessel_class_count; ++c)
+    if (to_string(static_cast<VesselClass>(c)) == name) return static_cast<VesselClass>(c);
+  return std::nullopt;
+}
+
+void Network::reserve(std::size_t vessels, std::size_t nodes) {
+  node_id.reserve(nodes);
+  id.reserve(vessels);
+  from.reserve(vessels);
+  to.reserve(vessels);
+  length.reserve(vessels);
+  diameter.reserve(vessels);
+  wall_thickness.reserve(vessels);
+  youngs_modulus.reserve(vessels);
+  generation.reserve(vessels);
+  vessel_class.reserve(vessels);
+}
+
+std::int32_t Network::add_node(std::int64_t node_id_value) {
+  node_id.push_back(node_id_value);
+  return static_cast<std::int32_t>(node_id.size() - 1);
+}
+
+std::int32_t Network::add_node(std::int64_t node_id_value, double px, double py, double pz) {
+  x.push_back(px);
+  y.push_back(py);
+  z.push_back(pz);
+  return add_node(node_id_value);
+}
+
+std::size_t Network::add_vessel(std::int64_t vessel_id, std::int32_t from_node,
+                                std::int32_t to_node, double length_m, double diameter_m,
+                                double wall_thickness_m, double youngs_modulus_pa,
+                                std::int32_t generation_index) {
+  id.push_back(vessel_id);
+  from.push_back(from_node);
+  to.push_back(to_node);
+  length.push_back(length_m);
+  diameter.push_back(diameter_m);
+  wall_thickness.push_back(wall_thickness_m);
+  youngs_modulus.push_back(youngs_modulus_pa);
+  generation.push_back(generation_index);
+  vessel_class.push_back(classify(diameter_m));
+  return id.size() - 1;
+}
+
+double Network::volume(std::size_t v) const {
+  return std::numbers::pi / 4.0 * diameter[v] * diameter[v] * length[v];
+}
+
+}  // namespace hemotree

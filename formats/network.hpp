@@ -1,0 +1,63 @@
+// The vascular network: nodes joined by straight vessels, stored as flat arrays
+// (structure of arrays) so that every stage can sweep millions of vessels cheaply.
+// SI units throughout: metres, pascals.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace hemotree {
+
+// Vessel classes by reference lumen diameter (the paper's Table 1 ranges).
+enum class VesselClass : std::uint8_t { artery, small_artery, arteriole, capillary };
+inline constexpr int vessel_class_count = 4;
+
+inline constexpr double artery_min_diameter = 500e-6;       // D >= 500 um
+inline constexpr double small_artery_min_diameter = 100e-6; // 100 <= D < 500 um
+inline constexpr double arteriole_min_diameter = 10e-6;     // 10 <= D < 100 um; below: capillary
+
+VesselClass classify(double diameter);
+std::string_view to_string(VesselClass c);
+std::optional<VesselClass> parse_vessel_class(std::string_view name);
+
+struct Network {
+  // Nodes. Coordinates are optional: either all nodes have them or none.
+  std::vector<std::int64_t> node_id;
+  std::vector<double> x, y, z;
+
+  // Vessels. `from` and `to` index the node arrays; flow is positive from -> to.
+  std::vector<std::int64_t> id;
+  std::vector<std::int32_t> from, to;
+  std::vector<double> length;          // [m]
+  std::vector<double> diameter;        // reference lumen diameter [m]
+  std::vector<double> wall_thickness;  // [m]
+  std::vector<double> youngs_modulus;  // [Pa]
+  std::vector<std::int32_t> generation;  // root = 0
+  std::vector<VesselClass> vessel_class;
+
+  // Small metadata kept as JSON: who made the file and how, and top-level fields
+  // that later stages add (inlet, blood, ...) which this stage passes through untouched.
+  nlohmann::json provenance = nlohmann::json::object();
+  nlohmann::json extra = nlohmann::json::object();
+
+  std::size_t vessel_count() const { return id.size(); }
+  std::size_t node_count() const { return node_id.size(); }
+  bool has_coordinates() const { return !x.empty(); }
+
+  void reserve(std::size_t vessels, std::size_t nodes);
+  std::int32_t add_node(std::int64_t node_id_value);
+  std::int32_t add_node(std::int64_t node_id_value, double px, double py, double pz);
+  // Appends a vessel between node indices; the class follows from the diameter.
+  std::size_t add_vessel(std::int64_t vessel_id, std::int32_t from_node, std::int32_t to_node,
+                         double length_m, double diameter_m, double wall_thickness_m,
+                         double youngs_modulus_pa, std::int32_t generation_index);
+
+  double volume(std::size_t vessel) const;  // pi D^2 / 4 * l [m^3]
+};
+
+}  // namespace hemotree

@@ -1,0 +1,105 @@
+// Writes the vnet format: one node or vessel per line, so that the file greps and diffs
+// well. Lines are formatted in parallel blocks and written in order, so the output is
+// byte-identical whatever the number of threads.
+#include <algorithm>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "formats/network_io.hpp"
+
+namespace hemotree {
+
+namespace {
+
+constexpr std::size_t block = 1 << 16;  // lines formatted per task
+
+void append_real(std::string& s, double v) {
+  char text[32];
+  s.append(text, format_real(text, v));
+}
+
+void append_integer(std::string& s, long long v) { s += std::to_string(v); }
+
+void append_node(std::string& s, const Network& net, std::size_t n) {
+  s += "{\"id\":";
+  append_integer(s, net.node_id[n]);
+  if (net.has_coordinates()) {
+    s += ",\"x\":";
+    append_real(s, net.x[n]);
+    s += ",\"y\":";
+    append_real(s, net.y[n]);
+    s += ",\"z\":";
+    append_real(s, net.z[n]);
+  }
+  s += '}';
+}
+
+void append_vessel(std::string& s, const Network& net, std::size_t v) {
+  s += "{\"id\":";
+  append_integer(s, net.id[v]);
+  s += ",\"from\":";
+  append_integer(s, net.node_id[net.from[v]]);
+  s += ",\"to\":";
+  append_integer(s, net.node_id[net.to[v]]);
+  s += ",\"length\":";
+  append_real(s, net.length[v]);
+  s += ",\"diameter\":";
+  append_real(s, net.diameter[v]);
+  s += ",\"wall_thickness\":";
+  append_real(s, net.wall_thickness[v]);
+  s += ",\"youngs_modulus\":";
+  append_real(s, net.youngs_modulus[v]);
+  s += ",\"generation\":";
+  append_integer(s, net.generation[v]);
+  s += ",\"class\":\"";
+  s += to_string(net.vessel_class[v]);
+  s += "\"}";
+}
+
+// Writes count lines produced by append_line, comma-separated, in parallel blocks.
+template <class AppendLine>
+void write_lines(OutputStream& out, std::size_t count, AppendLine append_line) {
+  const std::size_t blocks = (count + block - 1) / block;
+  std::string text;
+  std::exception_ptr error;
+#pragma omp parallel for ordered schedule(static, 1) firstprivate(text)
+  for (std::size_t b = 0; b < blocks; ++b) {
+    text.clear();
+    const std::size_t end = std::min(count, (b + 1) * block);
+    for (std::size_t i = b * block; i < end; ++i) {
+      append_line(text, i);
+      text += i + 1 < count ? ",\n" : "\n";
+    }
+#pragma omp ordered
+    {
+      // Exceptions must not cross the parallel region: keep the first, rethrow after.
+      if (!error) {
+        try {
+          out.write(text);
+        } catch (...) {
+          error = std::current_exception();
+        }
+      }
+    }
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace
+
+void write_network(const Network& net, OutputStream& out) {
+  out << "{\n\"format\": \"vnet\",\n\"version\": " << vnet_version << ",\n";
+  out << "\"provenance\": " << net.provenance.dump() << ",\n";
+  for (const auto& [key, value] : net.extra.items())
+    out << nlohmann::json(key).dump() << ": " << value.dump() << ",\n";
+  out << "\"nodes\": [\n";
+  write_lines(out, net.node_count(),
+              [&](std::string& s, std::size_t n) { append_node(s, net, n); });
+  out << "],\n\"vessels\": [\n";
+  write_lines(out, net.vessel_count(),
+              [&](std::string& s, std::size_t v) { append_vessel(s, net, v); });
+  out << "]\n}\n";
+}
+
+}  // namespace hemotree

@@ -1,0 +1,41 @@
+// The network as a directed graph (nodes = vertices, vessels = edges from -> to), built
+// with Boost.Graph's compressed sparse row graph: compact for millions of vessels.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <boost/graph/compressed_sparse_row_graph.hpp>
+
+#include "formats/network.hpp"
+
+namespace hemotree {
+
+// Edge bundle: the vessel index, so that edge properties map onto the network's arrays.
+struct VesselEdge {
+  std::int32_t vessel = -1;
+};
+using NetworkGraph =
+    boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, VesselEdge>;
+
+NetworkGraph make_graph(const Network& net);
+
+// Generation of every vessel: vessels leaving a node that no vessel enters are generation
+// 0; each vessel downstream is one more than the vessel that feeds it (breadth-first).
+// Vessels not reached from such a node (a closed loop) get -1.
+std::vector<std::int32_t> generations_from_inlets(const Network& net);
+
+// Checks that the network is one rooted tree: a single inlet vessel, every node entered by
+// at most one vessel, every vessel reached from the inlet. Throws InputError naming the
+// first vessel at fault. Returns the index of the root vessel.
+std::size_t check_rooted_tree(const Network& net);
+
+// For every vessel, the indices of the vessels leaving its distal node (CSR layout:
+// children[offset[v] .. offset[v+1]) ).
+struct Children {
+  std::vector<std::int64_t> offset;
+  std::vector<std::int32_t> index;
+};
+Children children_of(const Network& net);
+
+}  // namespace hemotree

@@ -1,0 +1,260 @@
+#include "stats/network_stats.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+#include "cli/errors.hpp"
+
+namespace hemotree {
+
+namespace {
+
+// Generations are array indices here; a label far beyond any real tree depth means a
+// corrupt file, and would otherwise make us allocate a table of that many rows.
+constexpr std::int64_t max_supported_generation = 1'000'000;
+
+std::string vessel_name(const Network& net, std::size_t v) {
+  return "vessel " + std::to_string(net.id[v]);
+}
+
+// One pass that makes the arrays safe to index with: every later loop trusts them.
+void check_network(const Network& net) {
+  const std::size_t n = net.vessel_count();
+  if (net.from.size() != n || net.to.size() != n || net.length.size() != n ||
+      net.diameter.size() != n || net.generation.size() != n || net.vessel_class.size() != n)
+    throw std::invalid_argument("compute_stats: vessel arrays of unequal length");
+
+  const auto nodes = static_cast<std::int64_t>(net.node_count());
+  for (std::size_t v = 0; v < n; ++v) {
+    if (net.from[v] < 0 || net.from[v] >= nodes || net.to[v] < 0 || net.to[v] >= nodes)
+      throw InputError(vessel_name(net, v) + ": node index out of range");
+    if (net.generation[v] < 0 || net.generation[v] > max_supported_generation)
+      throw InputError(vessel_name(net, v) + ": generation " +
+                       std::to_string(net.generation[v]) + " out of range 0.." +
+                       std::to_string(max_supported_generation));
+    if (static_cast<int>(net.vessel_class[v]) >= vessel_class_count)
+      throw InputError(vessel_name(net, v) + ": unknown vessel class");
+    if (std::isnan(net.diameter[v]))  // NaN has no place in an ordering: quartiles need one
+      throw InputError(vessel_name(net, v) + ": diameter is not a number");
+  }
+}
+
+// Puts the values that belong at the sorted, distinct positions `ranks` (all within
+// [lo, hi)) where a full sort would put them, given that v[lo, hi) already holds the values
+// of those positions in some order. nth_element on the middle rank splits the range and
+// each side is handled alone; a rank at either end of its range is just the range's
+// minimum or maximum, found by a scan, which is cheaper than a partition.
+void place_ranks(std::span<double> v, std::size_t lo, std::size_t hi,
+                 std::span<const std::size_t> ranks) {
+  const auto at = [&](std::size_t i) { return v.begin() + static_cast<std::ptrdiff_t>(i); };
+  while (!ranks.empty()) {
+    if (ranks.front() == lo) {
+      std::iter_swap(at(lo), std::min_element(at(lo), at(hi)));
+      ++lo;
+      ranks = ranks.subspan(1);
+    } else if (ranks.back() == hi - 1) {
+      std::iter_swap(at(hi - 1), std::max_element(at(lo), at(hi)));
+      --hi;
+      ranks = ranks.first(ranks.size() - 1);
+    } else {
+      const std::size_t m = ranks.size() / 2;
+      std::nth_element(at(lo), at(ranks[m]), at(hi));
+      place_ranks(v, lo, ranks[m], ranks.first(m));
+      lo = ranks[m] + 1;
+      ranks = ranks.subspan(m + 1);
+    }
+  }
+}
+
+// Quartiles of the values in v, which it reorders.
+//
+// Percentile p follows numpy's default (method "linear"): with the values sorted,
+// x_0 <= ... <= x_{n-1}, let h = (n-1) p, k = floor(h); then
+//   P(p) = x_k + (h - k) (x_{k+1} - x_k).
+// E.g. 10, 20, 30, 40 give q1 = 17.5, median = 25, q3 = 32.5.
+// Only the order statistics that formula reads are put in place, so a generation costs a
+// few linear passes instead of the O(n log n) of a full sort.
+Quartiles quartiles(std::span<double> v) {
+  const std::size_t n = v.size();
+  if (n == 0) return {};
+
+  const auto lower_rank = [&](double p) {
+    return static_cast<std::size_t>(std::floor(static_cast<double>(n - 1) * p));
+  };
+  std::vector<std::size_t> ranks = {0, n - 1};
+  for (double p : {0.25, 0.5, 0.75}) {
+    ranks.push_back(lower_rank(p));
+    ranks.push_back(std::min(lower_rank(p) + 1, n - 1));
+  }
+  std::sort(ranks.begin(), ranks.end());
+  ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
+  place_ranks(v, 0, n, ranks);
+
+  const auto percentile = [&](double p) {
+    const std::size_t k = lower_rank(p);
+    const double h = static_cast<double>(n - 1) * p;
+    return v[k] + (h - static_cast<double>(k)) * (v[std::min(k + 1, n - 1)] - v[k]);
+  };
+  return {v[0], percentile(0.25), percentile(0.5), percentile(0.75), v[n - 1]};
+}
+
+nlohmann::json class_counts_json(const std::array<std::size_t, vessel_class_count>& counts) {
+  nlohmann::json out = nlohmann::json::object();
+  for (int c = 0; c < vessel_class_count; ++c)
+    out[std::string(to_string(static_cast<VesselClass>(c)))] = counts[c];
+  return out;
+}
+
+// printf into a std::string: the table is a few hundred short lines at most.
+template <typename... Args>
+std::string format(const char* pattern, Args... args) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, pattern, args...);
+  return buffer;
+}
+
+}  // namespace
+
+NetworkStats compute_stats(const Network& net) {
+  check_network(net);
+  NetworkStats stats;
+  const std::size_t n = net.vessel_count();
+  stats.vessels = n;
+
+  // Branching: how many vessels end at and begin at each node.
+  std::vector<std::uint32_t> ending(net.node_count(), 0), beginning(net.node_count(), 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    ++beginning[static_cast<std::size_t>(net.from[v])];
+    ++ending[static_cast<std::size_t>(net.to[v])];
+  }
+  for (std::size_t node = 0; node < net.node_count(); ++node)
+    if (ending[node] >= 1 && beginning[node] >= 2) ++stats.bifurcations;
+
+  int max_generation = -1;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (beginning[static_cast<std::size_t>(net.to[v])] == 0) ++stats.terminals;
+    stats.total_length += net.length[v];
+    stats.total_volume += net.volume(v);
+    max_generation = std::max(max_generation, static_cast<int>(net.generation[v]));
+  }
+
+  // Counts per generation and class (the class as stored, so a file's own classification
+  // is what is counted); every generation up to the deepest gets a row, so an unpopulated
+  // one shows as zeros rather than vanishing.
+  const auto generations = static_cast<std::size_t>(max_generation + 1);
+  stats.generations.resize(generations);
+  for (std::size_t g = 0; g < generations; ++g)
+    stats.generations[g].generation = static_cast<int>(g);
+  for (std::size_t v = 0; v < n; ++v) {
+    auto& row = stats.generations[static_cast<std::size_t>(net.generation[v])];
+    ++row.vessels;
+    ++row.by_class[static_cast<std::size_t>(net.vessel_class[v])];
+  }
+
+  // Counting sort of the diameters into one bucket per generation (one pass), then the
+  // quartiles of each bucket in place.
+  std::vector<std::size_t> next(generations + 1, 0);
+  for (std::size_t g = 0; g < generations; ++g)
+    next[g + 1] = next[g] + stats.generations[g].vessels;
+  std::vector<double> bucketed(n);
+  for (std::size_t v = 0; v < n; ++v)
+    bucketed[next[static_cast<std::size_t>(net.generation[v])]++] = net.diameter[v];
+  // After the scatter next[g] is the end of bucket g, and so the start of bucket g + 1.
+  std::size_t start = 0;
+  for (std::size_t g = 0; g < generations; ++g) {
+    auto& row = stats.generations[g];
+    row.diameter = quartiles(std::span<double>(bucketed).subspan(start, row.vessels));
+    start = next[g];
+  }
+
+  const auto capillary = static_cast<std::size_t>(VesselClass::capillary);
+  for (const auto& row : stats.generations) {
+    for (int c = 0; c < vessel_class_count; ++c) stats.by_class[c] += row.by_class[c];
+    if (row.by_class[capillary] > 0) {
+      if (stats.capillary_generation_min < 0) stats.capillary_generation_min = row.generation;
+      stats.capillary_generation_max = row.generation;
+    }
+  }
+  return stats;
+}
+
+nlohmann::json to_json(const NetworkStats& stats) {
+  nlohmann::json out = nlohmann::json::object();
+  out["vessels"] = stats.vessels;
+  out["bifurcations"] = stats.bifurcations;
+  out["terminals"] = stats.terminals;
+  out["total_length"] = stats.total_length;
+  out["total_volume"] = stats.total_volume;
+  out["classes"] = class_counts_json(stats.by_class);
+  if (stats.capillary_generation_min < 0) {
+    out["capillary_generations"] = nullptr;
+  } else {
+    out["capillary_generations"] = {
+        {"min", stats.capillary_generation_min},
+        {"max", stats.capillary_generation_max},
+        {"span", stats.capillary_generation_max - stats.capillary_generation_min + 1}};
+  }
+  nlohmann::json generations = nlohmann::json::array();
+  for (const auto& row : stats.generations) {
+    const auto& d = row.diameter;
+    generations.push_back({{"generation", row.generation},
+                           {"vessels", row.vessels},
+                           {"classes", class_counts_json(row.by_class)},
+                           {"diameter",
+                            {{"min", d.min},
+                             {"q1", d.q1},
+                             {"median", d.median},
+                             {"q3", d.q3},
+                             {"max", d.max}}}});
+  }
+  out["generations"] = std::move(generations);
+  return out;
+}
+
+void print_table(const NetworkStats& stats, std::ostream& out) {
+  const double m3_per_ml = 1e-6;
+  const double um_per_m = 1e6;
+  const auto percent = [&](std::size_t count) {
+    if (stats.vessels == 0) return 0.0;
+    return 100.0 * static_cast<double>(count) / static_cast<double>(stats.vessels);
+  };
+
+  out << format("%-22s %12zu\n", "vessels", stats.vessels)
+      << format("%-22s %12zu\n", "bifurcations", stats.bifurcations)
+      << format("%-22s %12zu\n", "terminals", stats.terminals)
+      << format("%-22s %12.6g m\n", "total length", stats.total_length)
+      << format("%-22s %12.6g m^3  (%.6g ml)\n", "total volume", stats.total_volume,
+                stats.total_volume / m3_per_ml);
+  for (int c = 0; c < vessel_class_count; ++c) {
+    const std::string name(to_string(static_cast<VesselClass>(c)));
+    out << format("%-22s %12zu  (%6.2f %%)\n", name.c_str(), stats.by_class[c],
+                  percent(stats.by_class[c]));
+  }
+  if (stats.capillary_generation_min < 0)
+    out << format("%-22s %12s\n", "capillary generations", "none");
+  else
+    out << format("%-22s %5d to %3d  (%d generations)\n", "capillary generations",
+                  stats.capillary_generation_min, stats.capillary_generation_max,
+                  stats.capillary_generation_max - stats.capillary_generation_min + 1);
+
+  // Class columns in VesselClass order, abbreviated so a row fits 110 characters.
+  out << '\n'
+      << format("%5s %10s %9s %9s %9s %9s | %9s %9s %9s %9s %9s\n", "gen", "vessels", "artery",
+                "small_art", "arteriole", "capillary", "D_min", "D_q1", "D_median", "D_q3",
+                "D_max")
+      << format("%5s %10s %9s %9s %9s %9s | %49s\n", "", "", "", "", "", "", "diameters in um");
+  for (const auto& row : stats.generations) {
+    const auto& d = row.diameter;
+    out << format("%5d %10zu %9zu %9zu %9zu %9zu | %9.2f %9.2f %9.2f %9.2f %9.2f\n",
+                  row.generation, row.vessels, row.by_class[0], row.by_class[1], row.by_class[2],
+                  row.by_class[3], d.min * um_per_m, d.q1 * um_per_m, d.median * um_per_m,
+                  d.q3 * um_per_m, d.max * um_per_m);
+  }
+}
+
+}  // namespace hemotree

@@ -1,0 +1,43 @@
+// Descriptive statistics of a network: the paper's Figure 4 per-generation statistics
+// (counts by class, diameter quartiles) and whole-network totals.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <ostream>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "formats/network.hpp"
+
+namespace hemotree {
+
+struct Quartiles {
+  double min = 0, q1 = 0, median = 0, q3 = 0, max = 0;
+};
+
+struct GenerationStats {
+  int generation = 0;
+  std::size_t vessels = 0;
+  std::array<std::size_t, vessel_class_count> by_class{};
+  Quartiles diameter;  // [m]
+};
+
+struct NetworkStats {
+  std::size_t vessels = 0;
+  std::size_t bifurcations = 0;  // nodes where one vessel ends and two or more begin
+  std::size_t terminals = 0;     // vessels whose distal node starts no vessel
+  double total_length = 0;       // [m]
+  double total_volume = 0;       // [m^3]
+  std::array<std::size_t, vessel_class_count> by_class{};
+  std::vector<GenerationStats> generations;  // generation 0 first, none skipped
+  int capillary_generation_min = -1;         // -1 when there are no capillaries
+  int capillary_generation_max = -1;
+};
+
+NetworkStats compute_stats(const Network& net);
+nlohmann::json to_json(const NetworkStats& stats);
+void print_table(const NetworkStats& stats, std::ostream& out);
+
+}  // namespace hemotree

@@ -1,0 +1,201 @@
+// The vnet format: round trips, streaming through files, and clear refusals.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "cli/errors.hpp"
+#include "formats/json_pull.hpp"
+#include "formats/network_io.hpp"
+#include "formats/topology.hpp"
+#include "generator/growth_rules.hpp"
+#include "generator/tree_growth.hpp"
+#include "generator/tree_layout.hpp"
+
+using namespace hemotree;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path temp_path(const std::string& name) {
+  return fs::temp_directory_path() / ("hemotree-test-" + std::to_string(::getpid()) + "-" + name);
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+Network grown_tree() {
+  GrowthParameters p;
+  p.root_diameter = 120e-6;
+  p.min_diameter = 7e-6;
+  Network net = grow_tree(default_rules(), p);
+  lay_out_tree(net);
+  net.provenance = {{"tool", "test"}, {"seed", 1}};
+  return net;
+}
+
+std::string write_to_string(const Network& net, const std::string& name) {
+  const fs::path path = temp_path(name);
+  {
+    OutputStream out(path.string());
+    write_network(net, out);
+    out.commit();
+  }
+  std::string text = slurp(path);
+  fs::remove(path);
+  return text;
+}
+
+// Expects parse_network(text) to throw an error whose message contains fragment.
+void expect_refusal(const std::string& text, const std::string& fragment) {
+  try {
+    parse_network(text, "net.json");
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos)
+        << "message: " << e.what() << "\nwanted: " << fragment;
+    return;
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+}
+
+const char* minimal = R"({"format": "vnet", "version": 1,
+ "nodes": [{"id": 10}, {"id": 11}, {"id": 12}, {"id": 13}],
+ "vessels": [
+  {"id": 1, "from": 10, "to": 11, "length": 0.01, "diameter": 1e-3,
+   "wall_thickness": 1e-4, "youngs_modulus": 2e5},
+  {"id": 2, "from": 11, "to": 12, "length": 0.01, "diameter": 6e-4,
+   "wall_thickness": 1e-4, "youngs_modulus": 2e5},
+  {"id": 3, "from": 11, "to": 13, "length": 0.01, "diameter": 5e-5,
+   "wall_thickness": 1e-5, "youngs_modulus": 2e5}]})";
+
+}  // namespace
+
+TEST(NetworkFormat, RoundTripKeepsEveryValueAndRewritesByteIdentically) {
+  const Network net = grown_tree();
+  const std::string text = write_to_string(net, "a.json");
+  const Network back = parse_network(text);
+  ASSERT_EQ(back.vessel_count(), net.vessel_count());
+  ASSERT_EQ(back.node_count(), net.node_count());
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    EXPECT_EQ(back.id[v], net.id[v]);
+    EXPECT_EQ(back.node_id[back.from[v]], net.node_id[net.from[v]]);
+    EXPECT_EQ(back.node_id[back.to[v]], net.node_id[net.to[v]]);
+    EXPECT_NEAR(back.length[v], net.length[v], 5e-9 * net.length[v]);  // 9 significant digits
+    EXPECT_NEAR(back.diameter[v], net.diameter[v], 5e-9 * net.diameter[v]);
+    EXPECT_EQ(back.generation[v], net.generation[v]);
+    EXPECT_EQ(back.vessel_class[v], net.vessel_class[v]);
+  }
+  EXPECT_EQ(back.provenance, net.provenance);
+  EXPECT_EQ(write_to_string(back, "b.json"), text);
+}
+
+TEST(NetworkFormat, StreamsFromAFile) {
+  const Network net = grown_tree();
+  const fs::path path = temp_path("stream.json");
+  {
+    OutputStream out(path.string());
+    write_network(net, out);
+    out.commit();
+  }
+  const Network back = read_network(path.string());
+  EXPECT_EQ(back.vessel_count(), net.vessel_count());
+  fs::remove(path);
+}
+
+TEST(NetworkFormat, NodesMayBeLeftOutAndGenerationsAreComputed) {
+  const Network net = parse_network(R"({"format":"vnet","version":1,"vessels":[
+    {"id":5,"from":0,"to":1,"length":0.01,"diameter":1e-3},
+    {"id":6,"from":1,"to":2,"length":0.01,"diameter":6e-4},
+    {"id":7,"from":1,"to":3,"length":0.01,"diameter":6e-4},
+    {"id":8,"from":3,"to":4,"length":0.01,"diameter":6e-4}]})");
+  EXPECT_EQ(net.node_count(), 5u);
+  EXPECT_FALSE(net.has_coordinates());
+  EXPECT_EQ(net.generation, (std::vector<std::int32_t>{0, 1, 1, 2}));
+  EXPECT_EQ(net.vessel_class[1], VesselClass::artery);
+}
+
+TEST(NetworkFormat, UnknownMembersAreIgnoredAndLaterStagesFieldsPassThrough) {
+  std::string text = minimal;
+  text.insert(text.find("\"id\": 2"), "\"colour\": [1, {\"a\": null}], ");
+  text.insert(1, "\"inlet\": {\"vessel\": 1, \"type\": \"flow\"}, ");
+  const Network net = parse_network(text);
+  EXPECT_EQ(net.vessel_count(), 3u);
+  EXPECT_EQ(net.extra.at("inlet").at("vessel"), 1);
+  const Network again = parse_network(write_to_string(net, "extra.json"));
+  EXPECT_EQ(again.extra, net.extra);
+}
+
+TEST(NetworkFormat, SyntaxErrorsGiveTheirPosition) {
+  expect_refusal("{\"format\": \"vnet\",\n \"version\": 1,,", "net.json:2:15");
+  expect_refusal("{\"format\": \"vnet\", \"vessels\": [", "end of input");
+  expect_refusal("", "net.json:1:1");
+}
+
+TEST(NetworkFormat, ContentErrorsNameTheVessel) {
+  auto replaced = [](std::string from, std::string to) {
+    std::string t = minimal;
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  expect_refusal(replaced("\"length\": 0.01, \"diameter\": 6e-4", "\"length\": -1, \"diameter\": 6e-4"),
+                 "vessel 2: length must be positive");
+  expect_refusal(replaced("\"diameter\": 5e-5,", ""), "vessel 3: missing \"diameter\"");
+  expect_refusal(replaced("\"to\": 13", "\"to\": 99"), "vessel 3: unknown node 99");
+  expect_refusal(replaced("\"length\": 0.01, \"diameter\": 6e-4", "\"length\": \"long\", \"diameter\": 6e-4"),
+                 "vessel 2: \"length\" must be a number");
+  expect_refusal(replaced("\"diameter\": 5e-5,", "\"diameter\": 5e-5, \"class\": \"artery\","),
+                 "does not match its diameter");
+  expect_refusal(replaced("\"vnet\"", "\"other\""), "not a hemotree network");
+  expect_refusal(replaced("\"version\": 1", "\"version\": 7"), "version 7 is not supported");
+  expect_refusal(replaced("{\"id\": 13}", "{\"id\": 12}"), "node id 12 appears twice");
+  expect_refusal(R"({"format":"vnet","version":1})", "missing \"vessels\"");
+}
+
+TEST(Topology, RootedTreeChecksNameTheVesselAtFault) {
+  auto tree_error = [](const std::string& vessels) {
+    const Network net = parse_network(R"({"format":"vnet","version":1,"vessels":[)" + vessels + "]}");
+    try {
+      check_rooted_tree(net);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string v1 = R"({"id":1,"from":0,"to":1,"length":1,"diameter":1e-3})";
+  const std::string v2 = R"({"id":2,"from":1,"to":2,"length":1,"diameter":1e-3})";
+  EXPECT_EQ(tree_error(v1 + "," + v2), "accepted");
+  EXPECT_NE(tree_error(v1 + "," + v2 + R"(,{"id":3,"from":7,"to":8,"length":1,"diameter":1e-3})")
+                .find("several roots"), std::string::npos);
+  EXPECT_NE(tree_error(v1 + "," + v2 + R"(,{"id":3,"from":0,"to":2,"length":1,"diameter":1e-3})")
+                .find("vessel 3"), std::string::npos);
+  // A loop hanging off the tree: 5 -> 6 -> 5 is fed by no root.
+  EXPECT_NE(tree_error(v1 + "," + v2 + R"(,{"id":3,"from":5,"to":6,"length":1,"diameter":1e-3},)" +
+                       R"({"id":4,"from":6,"to":5,"length":1,"diameter":1e-3})")
+                .find("not reached from the root"), std::string::npos);
+}
+
+TEST(OutputStream, AnUncommittedFileIsRemovedAndFullDisksAreReported) {
+  const fs::path path = temp_path("partial.json");
+  {
+    OutputStream out(path.string());
+    out << "{\"format\": ";
+  }  // no commit: as if the writer failed half-way
+  EXPECT_FALSE(fs::exists(path));
+  for (const auto& entry : fs::directory_iterator(path.parent_path()))
+    EXPECT_EQ(entry.path().string().find(path.filename().string()), std::string::npos);
+  if (fs::is_character_file("/dev/full")) {
+    EXPECT_THROW(
+        {
+          OutputStream out("/dev/full");
+          for (int i = 0; i < 100000; ++i) out << "0123456789";
+          out.commit();
+        },
+        IoError);
+  }
+}
