@@ -40,6 +40,11 @@ constexpr std::array units{
     Unit{"s", Dimension::time},
     Unit{"ms", Dimension::time, 1, 1e3},
     Unit{"us", Dimension::time, 1, 1e6},
+    Unit{"Pa s", Dimension::viscosity},
+    Unit{"Pas", Dimension::viscosity},
+    Unit{"mPa s", Dimension::viscosity, 1, 1e3},
+    Unit{"mPas", Dimension::viscosity, 1, 1e3},
+    Unit{"cP", Dimension::viscosity, 1, 1e3},
 };
 
 std::string_view si_name(Dimension d) {
@@ -48,6 +53,7 @@ std::string_view si_name(Dimension d) {
     case Dimension::pressure: return "Pa, kPa, mmHg";
     case Dimension::flow: return "m3/s, ml/s, ml/min, ul/min, nl/min";
     case Dimension::time: return "s, ms, us";
+    case Dimension::viscosity: return "Pa s, mPa s, cP";
     case Dimension::dimensionless: return "none";
   }
   return "";

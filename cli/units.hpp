@@ -7,7 +7,7 @@
 
 namespace hemotree {
 
-enum class Dimension { length, pressure, flow, time, dimensionless };
+enum class Dimension { length, pressure, flow, time, viscosity, dimensionless };
 
 // Throws InputError("<what>: ...") when the text is not a number with a unit of dim.
 double parse_quantity(std::string_view text, Dimension dim, std::string_view what);

@@ -68,6 +68,15 @@ std::size_t Network::add_vessel(std::int64_t vessel_id, std::int32_t from_node,
   return id.size() - 1;
 }
 
+std::int64_t Network::index_of(std::int64_t vessel_id) const {
+  if (vessel_id >= 0 && static_cast<std::size_t>(vessel_id) < id.size() &&
+      id[static_cast<std::size_t>(vessel_id)] == vessel_id)
+    return vessel_id;
+  for (std::size_t v = 0; v < id.size(); ++v)
+    if (id[v] == vessel_id) return static_cast<std::int64_t>(v);
+  return -1;
+}
+
 double Network::volume(std::size_t v) const {
   return std::numbers::pi / 4.0 * diameter[v] * diameter[v] * length[v];
 }

@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "formats/boundary_conditions.hpp"
+
 namespace hemotree {
 
 // Vessel classes by reference lumen diameter (the paper's Table 1 ranges).
@@ -39,9 +41,19 @@ struct Network {
   std::vector<double> youngs_modulus;  // [Pa]
   std::vector<std::int32_t> generation;  // root = 0
   std::vector<VesselClass> vessel_class;
+  // A tube law given directly, p = p_ref + beta (sqrt(A) - sqrt(A_ref)) with A_ref from the
+  // diameter (benchmark cases): empty when no vessel has one, NaN for a vessel without.
+  std::vector<double> beta;                // [Pa/m]
+  std::vector<double> reference_pressure;  // [Pa]
 
-  // Small metadata kept as JSON: who made the file and how, and top-level fields
-  // that later stages add (inlet, blood, ...) which this stage passes through untouched.
+  // For flow computations (vprune adds them): blood, inflow, and the 0D outlets of the
+  // terminal vessels (sparse: one entry per outlet, sorted by vessel index).
+  std::optional<Blood> blood;
+  std::optional<Inlet> inlet;
+  std::vector<Outlet> outlets;
+
+  // Small metadata kept as JSON: who made the file and how, and top-level members this
+  // version does not know, passed through untouched.
   nlohmann::json provenance = nlohmann::json::object();
   nlohmann::json extra = nlohmann::json::object();
 
@@ -58,6 +70,8 @@ struct Network {
                          double youngs_modulus_pa, std::int32_t generation_index);
 
   double volume(std::size_t vessel) const;  // pi D^2 / 4 * l [m^3]
+  // Vessel index of an id (linear search unless ids equal indices); -1 when absent.
+  std::int64_t index_of(std::int64_t vessel_id) const;
 };
 
 }  // namespace hemotree

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -87,6 +88,12 @@ class Reader {
       } else if (key == "provenance") {
         in_.next();
         net_.provenance = in_.read_value();
+      } else if (key == "blood") {
+        in_.next();
+        net_.blood = blood_from_json(in_.read_value());
+      } else if (key == "inlet") {
+        in_.next();
+        net_.inlet = inlet_from_json(in_.read_value());
       } else if (key == "nodes") {
         read_nodes();
         seen_nodes = true;
@@ -104,6 +111,12 @@ class Reader {
     if (!seen_vessels) throw InputError(in_source() + ": missing \"vessels\"");
     resolve_nodes(seen_nodes);
     finish_generations();
+    if (!net_.beta.empty()) {
+      net_.beta.resize(net_.vessel_count(), unset);
+      net_.reference_pressure.resize(net_.vessel_count(), unset);
+    }
+    if (net_.inlet && net_.index_of(net_.inlet->vessel) < 0)
+      throw InputError(source_ + ": inlet: unknown vessel " + std::to_string(net_.inlet->vessel));
     return std::move(net_);
   }
 
@@ -158,7 +171,9 @@ class Reader {
   void read_vessel(std::size_t n) {
     std::int64_t vid = 0, from = 0, to = 0, generation = -1;
     double length = unset, diameter = unset, wall = unset, modulus = unset;
+    double beta = unset, reference_pressure = unset;
     bool has_id = false, has_from = false, has_to = false, has_class = false;
+    std::optional<nlohmann::json> outlet;
     VesselClass given_class{};
     auto where = [&] {
       return has_id ? "vessel " + std::to_string(vid) : "vessels[" + std::to_string(n) + "]";
@@ -173,12 +188,18 @@ class Reader {
       else if (key == "wall_thickness") wall = read_number(in_, "wall_thickness", where());
       else if (key == "youngs_modulus") modulus = read_number(in_, "youngs_modulus", where());
       else if (key == "generation") generation = read_integer(in_, "generation", where());
+      else if (key == "beta") beta = read_number(in_, "beta", where());
+      else if (key == "reference_pressure")
+        reference_pressure = read_number(in_, "reference_pressure", where());
       else if (key == "class") {
         if (in_.next() != Token::string) in_.fail(where() + ": \"class\" must be a string");
         auto c = parse_vessel_class(in_.text());
         if (!c) in_.fail(where() + ": unknown class \"" + std::string(in_.text()) + "\"");
         given_class = *c;
         has_class = true;
+      } else if (key == "outlet") {
+        in_.next();
+        outlet = in_.read_value();
       } else {
         in_.next();
         in_.skip_value();
@@ -198,12 +219,29 @@ class Reader {
       in_.fail(where() + ": class \"" + std::string(to_string(given_class)) +
                "\" does not match its diameter (" + std::string(to_string(classify(diameter))) +
                ")");
+    if (!std::isnan(beta) && !(beta > 0)) in_.fail(where() + ": beta must be positive");
+    if (std::isnan(beta) != std::isnan(reference_pressure))
+      in_.fail(where() + ": give \"beta\" and \"reference_pressure\" together");
     if ((generation >= 0) != generations_given_ && n > 0)
       in_.fail(where() + ": either every vessel has a \"generation\" or none does");
     generations_given_ = generation >= 0;
     // Node ids for now; resolve_nodes() turns them into indices.
-    net_.add_vessel(vid, 0, 0, length, diameter, wall, modulus,
-                    static_cast<std::int32_t>(generation));
+    const std::size_t index = net_.add_vessel(vid, 0, 0, length, diameter, wall, modulus,
+                                              static_cast<std::int32_t>(generation));
+    if (!std::isnan(beta) || !net_.beta.empty()) {
+      net_.beta.resize(index, unset);
+      net_.reference_pressure.resize(index, unset);
+      net_.beta.push_back(beta);
+      net_.reference_pressure.push_back(reference_pressure);
+    }
+    if (outlet) {
+      try {
+        net_.outlets.push_back(outlet_from_json(*outlet, where() + ": outlet"));
+      } catch (const InputError& e) {
+        in_.fail(e.what());
+      }
+      net_.outlets.back().vessel = static_cast<std::int32_t>(index);
+    }
     from_id_.push_back(from);
     to_id_.push_back(to);
   }

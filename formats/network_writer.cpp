@@ -2,6 +2,7 @@
 // well. Lines are formatted in parallel blocks and written in order, so the output is
 // byte-identical whatever the number of threads.
 #include <algorithm>
+#include <cmath>
 #include <exception>
 #include <string>
 #include <vector>
@@ -35,7 +36,8 @@ void append_node(std::string& s, const Network& net, std::size_t n) {
   s += '}';
 }
 
-void append_vessel(std::string& s, const Network& net, std::size_t v) {
+void append_vessel(std::string& s, const Network& net, std::size_t v,
+                   const std::vector<std::int32_t>& outlet_of) {
   s += "{\"id\":";
   append_integer(s, net.id[v]);
   s += ",\"from\":";
@@ -46,15 +48,31 @@ void append_vessel(std::string& s, const Network& net, std::size_t v) {
   append_real(s, net.length[v]);
   s += ",\"diameter\":";
   append_real(s, net.diameter[v]);
-  s += ",\"wall_thickness\":";
-  append_real(s, net.wall_thickness[v]);
-  s += ",\"youngs_modulus\":";
-  append_real(s, net.youngs_modulus[v]);
+  // Optional members a hand-written file may lack (NaN here) are left out again.
+  if (!std::isnan(net.wall_thickness[v])) {
+    s += ",\"wall_thickness\":";
+    append_real(s, net.wall_thickness[v]);
+  }
+  if (!std::isnan(net.youngs_modulus[v])) {
+    s += ",\"youngs_modulus\":";
+    append_real(s, net.youngs_modulus[v]);
+  }
   s += ",\"generation\":";
   append_integer(s, net.generation[v]);
   s += ",\"class\":\"";
   s += to_string(net.vessel_class[v]);
-  s += "\"}";
+  s += '"';
+  if (!net.beta.empty() && !std::isnan(net.beta[v])) {
+    s += ",\"beta\":";
+    append_real(s, net.beta[v]);
+    s += ",\"reference_pressure\":";
+    append_real(s, net.reference_pressure[v]);
+  }
+  if (!outlet_of.empty() && outlet_of[v] >= 0) {
+    s += ",\"outlet\":";
+    s += to_json(net.outlets[static_cast<std::size_t>(outlet_of[v])]).dump();
+  }
+  s += '}';
 }
 
 // Writes count lines produced by append_line, comma-separated, in parallel blocks.
@@ -91,14 +109,22 @@ void write_lines(OutputStream& out, std::size_t count, AppendLine append_line) {
 void write_network(const Network& net, OutputStream& out) {
   out << "{\n\"format\": \"vnet\",\n\"version\": " << vnet_version << ",\n";
   out << "\"provenance\": " << net.provenance.dump() << ",\n";
+  if (net.blood) out << "\"blood\": " << to_json(*net.blood).dump() << ",\n";
+  if (net.inlet) out << "\"inlet\": " << to_json(*net.inlet).dump() << ",\n";
   for (const auto& [key, value] : net.extra.items())
     out << nlohmann::json(key).dump() << ": " << value.dump() << ",\n";
   out << "\"nodes\": [\n";
   write_lines(out, net.node_count(),
               [&](std::string& s, std::size_t n) { append_node(s, net, n); });
   out << "],\n\"vessels\": [\n";
+  std::vector<std::int32_t> outlet_of;  // outlet index per vessel, -1 for none
+  if (!net.outlets.empty()) {
+    outlet_of.assign(net.vessel_count(), -1);
+    for (std::size_t k = 0; k < net.outlets.size(); ++k)
+      outlet_of[static_cast<std::size_t>(net.outlets[k].vessel)] = static_cast<std::int32_t>(k);
+  }
   write_lines(out, net.vessel_count(),
-              [&](std::string& s, std::size_t v) { append_vessel(s, net, v); });
+              [&](std::string& s, std::size_t v) { append_vessel(s, net, v, outlet_of); });
   out << "]\n}\n";
 }
 

@@ -107,4 +107,15 @@ Children children_of(const Network& net) {
   return c;
 }
 
+std::vector<std::int32_t> breadth_first_order(const Children& children, std::size_t root) {
+  std::vector<std::int32_t> order{static_cast<std::int32_t>(root)};
+  order.reserve(children.offset.size() - 1);
+  for (std::size_t head = 0; head < order.size(); ++head) {
+    const auto v = static_cast<std::size_t>(order[head]);
+    for (auto k = children.offset[v]; k < children.offset[v + 1]; ++k)
+      order.push_back(children.index[k]);
+  }
+  return order;
+}
+
 }  // namespace hemotree

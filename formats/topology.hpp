@@ -38,4 +38,7 @@ struct Children {
 };
 Children children_of(const Network& net);
 
+// Vessels breadth first from the root: every parent before its daughters.
+std::vector<std::int32_t> breadth_first_order(const Children& children, std::size_t root);
+
 }  // namespace hemotree

@@ -1,4 +1,5 @@
 // The vnet format: round trips, streaming through files, and clear refusals.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -123,12 +124,27 @@ TEST(NetworkFormat, NodesMayBeLeftOutAndGenerationsAreComputed) {
 TEST(NetworkFormat, UnknownMembersAreIgnoredAndLaterStagesFieldsPassThrough) {
   std::string text = minimal;
   text.insert(text.find("\"id\": 2"), "\"colour\": [1, {\"a\": null}], ");
-  text.insert(1, "\"inlet\": {\"vessel\": 1, \"type\": \"flow\"}, ");
+  text.insert(1, "\"annotations\": {\"vessel\": 1, \"note\": \"from a newer tool\"}, ");
   const Network net = parse_network(text);
   EXPECT_EQ(net.vessel_count(), 3u);
-  EXPECT_EQ(net.extra.at("inlet").at("vessel"), 1);
+  EXPECT_EQ(net.extra.at("annotations").at("vessel"), 1);
   const Network again = parse_network(write_to_string(net, "extra.json"));
   EXPECT_EQ(again.extra, net.extra);
+}
+
+TEST(NetworkFormat, DirectTubeLawsAndMissingWallDataRoundTrip) {
+  const Network net = parse_network(R"({"format":"vnet","version":1,"vessels":[
+    {"id":1,"from":0,"to":1,"length":0.126,"diameter":0.006,"beta":3.2e6,"reference_pressure":10933},
+    {"id":2,"from":1,"to":2,"length":0.1,"diameter":0.005}]})");
+  ASSERT_EQ(net.beta.size(), 2u);
+  EXPECT_DOUBLE_EQ(net.beta[0], 3.2e6);
+  EXPECT_DOUBLE_EQ(net.reference_pressure[0], 10933);
+  EXPECT_TRUE(std::isnan(net.beta[1]));
+  const Network back = parse_network(write_to_string(net, "beta.json"));
+  EXPECT_DOUBLE_EQ(back.beta[0], 3.2e6);
+  EXPECT_TRUE(std::isnan(back.wall_thickness[1]));
+  expect_refusal(R"({"format":"vnet","version":1,"vessels":[
+    {"id":1,"from":0,"to":1,"length":0.1,"diameter":0.006,"beta":3.2e6}]})", "together");
 }
 
 TEST(NetworkFormat, SyntaxErrorsGiveTheirPosition) {

@@ -1,0 +1,52 @@
+// The tube law p = p_ref + beta (sqrt(A) - sqrt(A_ref)) of a vessel, with beta and p_ref
+// from the thin- or thick-walled models of Causin et al. (the paper's eqs. wall and
+// h_undeformed), chosen per vessel by its wall thickness to diameter ratio.
+#pragma once
+
+namespace hemotree {
+
+enum class WallModel { thin, thick };
+
+struct TubeLaw {
+  double beta = 0;                // [Pa/m]
+  double reference_pressure = 0;  // p_ref [Pa]
+  double reference_area = 0;      // A_ref [m^2]
+
+  double pressure(double area) const;
+  // The inverse of pressure(); 0 (collapsed lumen) below p_ref - beta sqrt(A_ref), where the
+  // linear law has no root.
+  double area(double pressure) const;
+  double compliance_per_length(double area) const;  // dA/dp = 2 sqrt(A) / beta [m^2/Pa]
+  double wave_speed(double area, double density) const;  // c = sqrt(A/rho dp/dA)
+};
+
+struct WallProperties {
+  double diameter = 0;          // lumen diameter at zero transmural pressure [m]
+  double wall_thickness = 0;    // [m]
+  double youngs_modulus = 0;    // [Pa]
+};
+
+inline constexpr double default_poisson_ratio = 0.5;
+// h/D at or below which a wall is thin (capillaries, h = 10 % D); above it, thick.
+inline constexpr double default_thick_wall_ratio = 0.1;
+
+// Thin when h <= thick_ratio D, with a relative tolerance of 1e-9 so that h = 10 % D given in
+// decimal stays thin whatever binary rounding does to h / D. Throws InputError unless D, h > 0.
+WallModel choose_wall_model(const WallProperties& wall, double thick_ratio = default_thick_wall_ratio);
+
+// Thin wall: p_ref = p_ext, A_ref = A(dp_t = 0), beta = E h / ((1 - nu^2) sqrt(pi) R^2).
+TubeLaw thin_wall_tube_law(const WallProperties& wall, double external_pressure,
+                           double poisson_ratio = default_poisson_ratio);
+// Thick wall: the unloaded (R_ref, h_ref) from the measured geometry taken at zero
+// transmural pressure, then p_ref and beta from Causin et al. The result gives
+// p(pi (D/2)^2) = p_ext exactly. It is not the thin-wall law in the limit h -> 0 (beta
+// differs by 1 - nu^2: ERRATA.md s. 4). Requires (1 - nu) p_ext < E.
+// All the tube-law factories throw InputError for non-positive or non-finite D, h or E, for
+// nu outside (-1, 1/2], or for a non-finite p_ext.
+TubeLaw thick_wall_tube_law(const WallProperties& wall, double external_pressure,
+                            double poisson_ratio = default_poisson_ratio);
+TubeLaw tube_law(const WallProperties& wall, double external_pressure,
+                 double thick_ratio = default_thick_wall_ratio,
+                 double poisson_ratio = default_poisson_ratio);
+
+}  // namespace hemotree
