@@ -1,0 +1,46 @@
+// Steady flow through a network of rigid vessels at their reference diameters: Poiseuille's
+// law with the apparent viscosity of the blood (Pries in vivo or Newtonian) in every vessel,
+// the outlets' resistances to their outflow pressures, and the mean inflow at the inlet.
+// vprune checks its outlets with it; hemosolve starts from it instead of from rest.
+#pragma once
+
+#include <vector>
+
+#include "formats/network.hpp"
+
+namespace hemotree {
+
+struct SteadyFlow {
+  std::vector<double> flow;           // per vessel, positive from -> to [m^3/s]
+  std::vector<double> node_pressure;  // [Pa]
+  double inlet_pressure = 0;          // at the inlet vessel's `from` node [Pa]
+};
+
+// Poiseuille resistance of every vessel [Pa s/m^3] with the blood's apparent viscosity at
+// its reference diameter and its velocity profile (alpha).
+std::vector<double> vessel_resistances(const Network& net, const Blood& blood);
+
+// Thevenin equivalent of what lies beyond a vessel's distal node: the flow into it is
+// (p - pressure) / resistance.
+struct Equivalent {
+  double resistance = 0;  // [Pa s/m^3]
+  double pressure = 0;    // [Pa]
+};
+
+// For every vessel of a rooted tree, what lies beyond its distal node (its daughters'
+// subtrees in parallel, or its outlet) reduced to a Thevenin equivalent.
+std::vector<Equivalent> reduce_beyond(const Network& net, const std::vector<double>& resistance);
+
+// Solves the steady flow of a rooted tree (check_rooted_tree) fed by inlet_flow [m^3/s] at
+// the root, every terminal vessel ending in an outlet (RCR or R: their total resistance to
+// p_out). Series and parallel reduction from the leaves up, then flows and pressures from
+// the root down: O(vessels), exact up to rounding. InputError names a terminal vessel
+// without an outlet, an outlet on a vessel that is not terminal, or a reflection outlet
+// (which has no steady resistance).
+SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
+                             double inlet_flow);
+
+// The same with the network's own blood (defaults if absent) and inlet (mean flow).
+SteadyFlow solve_steady_flow(const Network& net);
+
+}  // namespace hemotree

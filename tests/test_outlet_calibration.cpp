@@ -1,0 +1,138 @@
+// Outlets stand exactly for what pruning removed.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "formats/network_io.hpp"
+#include "formats/topology.hpp"
+#include "generator/growth_rules.hpp"
+#include "generator/tree_growth.hpp"
+#include "physics/wall_law.hpp"
+#include "pruner/outlet_calibration.hpp"
+#include "pruner/pruning_strategies.hpp"
+#include "solver/steady_flow.hpp"
+
+using namespace hemotree;
+
+namespace {
+
+Network full_tree() {
+  GrowthParameters p;
+  p.root_diameter = 400e-6;
+  p.min_diameter = 8.5e-6;
+  p.seed = 11;
+  Network net = grow_tree(default_rules(), p);
+  net.blood = Blood{};
+  Inlet inlet;
+  inlet.vessel = 0;
+  inlet.waveform.mean = 0.05e-6 / 60;  // 0.05 ml/min into a 400 um artery
+  net.inlet = inlet;
+  return net;
+}
+
+}  // namespace
+
+TEST(OutletCalibration, CapillaryResistanceGivesTheMeanDropExactly) {
+  Network full = full_tree();
+  KeepMask keep(full.vessel_count(), 1);
+  Network pruned = extract(full, keep);
+  const OutletParameters p;
+  const OutletReport report = calibrate_outlets(full, keep, pruned, p);
+  const SteadyFlow s = solve_steady_flow(full);
+  double drop = 0;
+  for (const Outlet& o : full.outlets) drop += s.flow[o.vessel] * o.r;
+  EXPECT_NEAR(drop / static_cast<double>(full.outlets.size()), p.capillary_pressure_drop, 1e-9);
+  EXPECT_EQ(report.leaf, full.outlets.size());
+}
+
+TEST(OutletCalibration, PrunedNetworkReproducesTheFullTreesInletPressure) {
+  for (int max_generation : {2, 5, 9}) {
+    Network full = full_tree();
+    const KeepMask keep = prune_by_generation(full, max_generation);
+    Network pruned = extract(full, keep);
+    const OutletReport report = calibrate_outlets(full, keep, pruned, OutletParameters{});
+    EXPECT_NEAR(report.steady_inlet_pressure_pruned / report.steady_inlet_pressure_full, 1.0, 1e-12);
+    // And the flow into each terminal vessel is the flow the full tree sends there.
+    const SteadyFlow fs = solve_steady_flow(full), ps = solve_steady_flow(pruned);
+    std::size_t k = 0;
+    for (std::size_t v = 0; v < full.vessel_count(); ++v) {
+      if (!keep[v]) continue;
+      EXPECT_NEAR(ps.flow[k++], fs.flow[v], 1e-9 * fs.flow[0]);
+    }
+  }
+}
+
+TEST(OutletCalibration, OutletTypesFollowTheDiameterAndRcrMatchesTheImpedance) {
+  Network full = full_tree();
+  const KeepMask keep = prune_by_generation(full, 6);
+  Network pruned = extract(full, keep);
+  const OutletParameters p;
+  calibrate_outlets(full, keep, pruned, p);
+  const Children children = children_of(pruned);
+  std::size_t terminals = 0;
+  for (std::size_t v = 0; v < pruned.vessel_count(); ++v)
+    terminals += children.offset[v] == children.offset[v + 1];
+  ASSERT_EQ(pruned.outlets.size(), terminals);
+  std::size_t rcr = 0;
+  for (const Outlet& o : pruned.outlets) {
+    const double d = pruned.diameter[o.vessel];
+    EXPECT_DOUBLE_EQ(o.p_out, p.venous_pressure);
+    if (o.type == OutletType::rcr) {
+      ++rcr;
+      EXPECT_GE(d, 100e-6);
+      const TubeLaw law = tube_law({d, pruned.wall_thickness[o.vessel], pruned.youngs_modulus[o.vessel]},
+                                   p.external_pressure);
+      const double a = law.reference_area;
+      EXPECT_NEAR(o.r1, 1050 * law.wave_speed(a, 1050) / a, 1e-9 * o.r1);
+      EXPECT_GT(o.r2, 0);
+      EXPECT_GT(o.c, 0);
+    } else {
+      EXPECT_EQ(o.type, OutletType::resistance);
+    }
+  }
+  EXPECT_GT(rcr, 0u);
+}
+
+TEST(OutletCalibration, CompliancesSumTheRemovedVessels) {
+  // Keep only the root: its RCR's C is the compliance of every other vessel.
+  Network full = full_tree();
+  KeepMask keep(full.vessel_count(), 0);
+  keep[0] = 1;
+  Network pruned = extract(full, keep);
+  const OutletParameters p;
+  calibrate_outlets(full, keep, pruned, p);
+  double c = 0;
+  for (std::size_t v = 1; v < full.vessel_count(); ++v) {
+    const TubeLaw law = tube_law({full.diameter[v], full.wall_thickness[v], full.youngs_modulus[v]},
+                                 p.external_pressure);
+    c += 2 * full.length[v] * std::sqrt(law.reference_area) / law.beta;
+  }
+  ASSERT_EQ(pruned.outlets.size(), 1u);
+  EXPECT_NEAR(pruned.outlets[0].c, c, 1e-9 * c);
+}
+
+TEST(OutletCalibration, OutletsInletAndBloodSurviveTheFile) {
+  Network full = full_tree();
+  const KeepMask keep = prune_by_generation(full, 4);
+  Network pruned = extract(full, keep);
+  calibrate_outlets(full, keep, pruned, OutletParameters{});
+  const char* path = "/tmp/hemotree-test-outlets.json";
+  {
+    OutputStream out(path);
+    write_network(pruned, out);
+    out.commit();
+  }
+  const Network back = read_network(path);
+  std::remove(path);
+  ASSERT_EQ(back.outlets.size(), pruned.outlets.size());
+  for (std::size_t k = 0; k < back.outlets.size(); ++k) {
+    EXPECT_EQ(back.outlets[k].vessel, pruned.outlets[k].vessel);
+    EXPECT_EQ(back.outlets[k].type, pruned.outlets[k].type);
+    EXPECT_NEAR(back.outlets[k].resistance(), pruned.outlets[k].resistance(),
+                1e-12 * pruned.outlets[k].resistance());
+  }
+  ASSERT_TRUE(back.inlet && back.blood);
+  EXPECT_DOUBLE_EQ(back.inlet->waveform.mean, pruned.inlet->waveform.mean);
+  EXPECT_NEAR(solve_steady_flow(back).inlet_pressure, solve_steady_flow(pruned).inlet_pressure,
+              1e-9 * solve_steady_flow(pruned).inlet_pressure);
+}
