@@ -1,0 +1,247 @@
+// hemosolve: pulsatile flow in a compliant network by the spectral/hp DG method.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/errors.hpp"
+#include "cli/tool.hpp"
+#include "cli/units.hpp"
+#include "formats/network_io.hpp"
+#include "solver/cycle_statistics.hpp"
+#include "solver/pulse_solver.hpp"
+#include "solver/solution_breakdown.hpp"
+
+using namespace hemotree;
+
+namespace {
+
+struct Probe {
+  std::size_t vessel;
+  std::int64_t id;
+  double x;
+};
+
+Probe parse_probe(const std::string& text, const Network& net) {
+  const auto colon = text.find(':');
+  Probe p{0, 0, 0.5};
+  try {
+    std::size_t used = 0;
+    p.id = std::stoll(text.substr(0, colon), &used);
+    if (used != (colon == std::string::npos ? text.size() : colon)) throw std::invalid_argument("");
+    if (colon != std::string::npos) p.x = std::stod(text.substr(colon + 1));
+  } catch (const std::exception&) {
+    throw InputError("--probe: '" + text + "' is not ID or ID:x");
+  }
+  if (!(p.x >= 0 && p.x <= 1)) throw InputError("--probe: x must lie in [0, 1] in '" + text + "'");
+  const std::int64_t index = net.index_of(p.id);
+  if (index < 0) throw InputError("--probe: no vessel " + std::to_string(p.id));
+  p.vessel = static_cast<std::size_t>(index);
+  return p;
+}
+
+std::string number(double v) {
+  char text[32];
+  return std::string(text, format_real(text, v));
+}
+
+void write_summary(const std::filesystem::path& dir, const Network& net, const PulseSolver& solver,
+                   const nlohmann::json& run, const std::vector<VesselCycle>& last) {
+  nlohmann::json vessels = nlohmann::json::array();
+  for (std::size_t v = 0; v < last.size(); ++v) {
+    const VesselCycle& c = last[v];
+    vessels.push_back({{"id", net.id[v]},
+                       {"diameter", net.diameter[v]},
+                       {"length", net.length[v]},
+                       {"class", to_string(net.vessel_class[v])},
+                       {"mean_flow", c.mean_flow},
+                       {"mean_pressure", c.mean_pressure},
+                       {"systolic_pressure", c.systolic_pressure},
+                       {"diastolic_pressure", c.diastolic_pressure},
+                       {"pulsatility_index", c.pulsatility_index()}});
+  }
+  nlohmann::json summary = run;
+  summary["time_step"] = solver.dt();
+  summary["time_step_limit"] = solver.dt_reason();
+  summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}};
+  summary["vessels"] = vessels;
+  OutputStream out((dir / "summary.json").string());
+  out << summary.dump(1) << '\n';
+  out.commit();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Solve 1D pulsatile blood flow in a compliant vascular network (spectral/hp "
+               "discontinuous Galerkin) and report flows, pressures and pulsatility.",
+               "hemosolve"};
+  std::string input, out_dir, rheology, scheme = "ab2", start = "steady", dt_text, sample_text = "1ms",
+              external_text = "10mmHg";
+  int cycles = 0, max_cycles = 50;
+  double periodic_tol = 0;
+  std::vector<std::string> probe_texts;
+  bool quiet = false;
+  SolverOptions options;
+  app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
+  app.add_option("--out", out_dir, "folder for summary.json and probes.csv")->required();
+  app.add_option("--cycles", cycles, "cardiac cycles to run");
+  app.add_option("--until-periodic", periodic_tol,
+                 "run until every vessel's mean pressure changes less than this from one cycle to the next");
+  app.add_option("--max-cycles", max_cycles, "upper bound for --until-periodic")->capture_default_str();
+  app.add_option("--probe", probe_texts, "record p, Q, A, u at vessel ID, fraction x along it (ID[:x], x 0.5 by default)");
+  app.add_option("--sample-interval", sample_text, "time between probe samples")->capture_default_str();
+  app.add_option("--degree", options.degree, "polynomial degree p")->capture_default_str();
+  app.add_option("--elements", options.elements, "elements per vessel")->capture_default_str();
+  app.add_option("--dt", dt_text, "time step (default: from the CFL and friction limits)");
+  app.add_option("--cfl", options.cfl, "safety factor on the wave-speed limit")->capture_default_str();
+  app.add_option("--scheme", scheme, "time scheme: ab2 (Adams-Bashforth 2) or rk4")->capture_default_str();
+  app.add_option("--rheology", rheology, "pries or newtonian (default: the network's blood)");
+  app.add_option("--start", start, "initial state: steady (Poiseuille solution) or rest")->capture_default_str();
+  app.add_option("--external-pressure", external_text, "interstitial pressure for the wall laws")->capture_default_str();
+  app.add_option("--thick-wall-ratio", options.thick_wall_ratio, "h/D above which a wall is thick")->capture_default_str();
+  app.add_flag("--quiet", quiet, "no progress line");
+  app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
+
+  return run_tool(app, argc, argv, [&] {
+    if (cycles < 0) throw InputError("--cycles must be positive");
+    if (cycles == 0 && periodic_tol <= 0) cycles = 1;
+    if (scheme == "rk4") options.scheme = TimeScheme::runge_kutta4;
+    else if (scheme != "ab2") throw InputError("--scheme must be ab2 or rk4");
+    if (start == "rest") options.steady_start = false;
+    else if (start != "steady") throw InputError("--start must be steady or rest");
+    if (!rheology.empty()) {
+      if (rheology == "pries") options.rheology_override = static_cast<int>(Rheology::pries);
+      else if (rheology == "newtonian") options.rheology_override = static_cast<int>(Rheology::newtonian);
+      else throw InputError("--rheology must be pries or newtonian");
+    }
+    if (!dt_text.empty()) {
+      options.dt = parse_quantity(dt_text, Dimension::time, "--dt");
+      if (!(options.dt > 0)) throw InputError("--dt must be positive");
+    }
+    if (!(options.cfl > 0)) throw InputError("--cfl must be positive");
+    options.external_pressure = parse_quantity(external_text, Dimension::pressure, "--external-pressure");
+    const double sample_interval = parse_quantity(sample_text, Dimension::time, "--sample-interval");
+
+    const Network net = read_network(input);
+    std::vector<Probe> probes;
+    for (const auto& t : probe_texts) probes.push_back(parse_probe(t, net));
+    PulseSolver solver(net, options);
+    const double period = net.inlet->waveform.period;
+    const auto steps_per_cycle = static_cast<std::size_t>(std::ceil(period / solver.dt() - 1e-9));
+    const double dt = period / static_cast<double>(steps_per_cycle);  // a whole number per cycle
+    if (!quiet)
+      note("time step " + number(dt) + " s (" + solver.dt_reason() + "), " +
+           std::to_string(steps_per_cycle) + " steps per cycle, " +
+           std::to_string(solver.element_count()) + " elements of degree " +
+           std::to_string(options.degree));
+    // Rebuild with the rounded step so that cycles end exactly on a step.
+    options.dt = dt;
+    PulseSolver run(net, options);
+
+    std::filesystem::path dir(out_dir);
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw IoError("cannot create " + out_dir + ": " + ec.message());
+
+    // Probe samples are kept in memory and written at the end (or at a breakdown).
+    std::ostringstream probe_rows;
+    auto sample_probes = [&] {
+      probe_rows << number(run.time());
+      for (const Probe& p : probes) {
+        const double a = run.area_at(p.vessel, p.x), q = run.flow_at(p.vessel, p.x);
+        probe_rows << ',' << number(run.law(p.vessel).pressure(a)) << ',' << number(q) << ','
+                   << number(a) << ',' << number(q / a);
+      }
+      probe_rows << '\n';
+    };
+    auto write_probes = [&] {
+      if (probes.empty()) return;
+      OutputStream out((dir / "probes.csv").string());
+      out << "t [s]";
+      for (const Probe& p : probes) {
+        const std::string at = " vessel " + std::to_string(p.id) + " x " + number(p.x);
+        out << ",p" << at << " [Pa],Q" << at << " [m^3/s],A" << at << " [m^2],u" << at << " [m/s]";
+      }
+      out << '\n' << probe_rows.str();
+      out.commit();
+    };
+
+    const auto sample_every = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(sample_interval / dt)));
+    CycleStatistics stats(net.vessel_count());
+    std::vector<VesselCycle> last, previous;
+    PeriodicityChange change;
+    int done = 0;
+    const bool until_periodic = periodic_tol > 0;
+    const int planned = until_periodic ? max_cycles : cycles;
+    const bool show = !quiet && stderr_is_terminal();
+    const auto started = std::chrono::steady_clock::now();
+    nlohmann::json run_info = {{"tool", "hemosolve"}, {"version", HEMOTREE_VERSION},
+                               {"network", input}, {"degree", options.degree},
+                               {"elements_per_vessel", options.elements}, {"scheme", scheme},
+                               {"rheology", to_string(run.blood().rheology)},
+                               {"start", start}, {"period", period}};
+    try {
+      sample_probes();
+      for (; done < planned; ++done) {
+        for (std::size_t k = 0; k < steps_per_cycle; ++k) {
+          run.step();
+          stats.sample(run, dt);
+          if (run.steps() % sample_every == 0) sample_probes();
+          if (show && k % 256 == 0) {
+            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+            const double rate = static_cast<double>(run.steps()) / std::max(elapsed, 1e-9);
+            const double left = static_cast<double>(planned * steps_per_cycle - run.steps()) / rate;
+            std::fprintf(stderr, "\rhemosolve: cycle %d/%d  t = %.4f s  %.0f steps/s  %.0f s left   ",
+                         done + 1, planned, run.time(), rate, left);
+          }
+        }
+        run.check_solution();
+        previous = std::move(last);
+        last = stats.close();
+        if (!previous.empty()) change = cycle_change(previous, last);
+        if (until_periodic && !previous.empty() && change.change < periodic_tol) {
+          ++done;
+          break;
+        }
+      }
+    } catch (const SolutionBreakdown& e) {
+      if (show) std::fprintf(stderr, "\r\033[K");
+      run_info["status"] = "broken down";
+      run_info["error"] = e.what();
+      run_info["cycles"] = done;
+      write_probes();
+      if (!last.empty()) write_summary(dir, net, run, run_info, last);
+      throw InputError(e.what());
+    }
+    if (show) std::fprintf(stderr, "\r\033[K");
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    run_info["status"] = until_periodic && !(change.change < periodic_tol) ? "not periodic" : "complete";
+    run_info["cycles"] = done;
+    run_info["steps"] = run.steps();
+    run_info["wall_time"] = wall;
+    if (!previous.empty()) {
+      run_info["periodic_change"] = change.change;
+      run_info["slowest_vessel"] = net.id[change.vessel];
+    }
+    write_probes();
+    write_summary(dir, net, run, run_info, last);
+    if (!quiet) {
+      std::ostringstream m;
+      m << done << " cycles in " << wall << " s";
+      if (!previous.empty())
+        m << "; last cycle-to-cycle change " << change.change << " (vessel " << net.id[change.vessel] << ")";
+      m << "; results in " << out_dir;
+      note(m.str());
+    }
+    if (until_periodic && !(change.change < periodic_tol))
+      warn("not periodic within " + std::to_string(max_cycles) + " cycles (--max-cycles)");
+    return 0;
+  });
+}

@@ -1,0 +1,49 @@
+// Where the vessels' ends meet: junctions, the inlet and the outlets of a network, in flat
+// lists the solver sweeps every stage. Built once from the network; refuses, naming the
+// vessel, a network it cannot run.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "formats/network.hpp"
+#include "solver/riemann.hpp"
+#include "solver/vessel_equations.hpp"
+
+namespace hemotree {
+
+// One end of a vessel: its distal end (the `to` node, right trace of its last element) or
+// its proximal end (`from` node, left trace of its first element).
+struct VesselEnd {
+  std::int32_t vessel = 0;
+  std::int32_t element = 0;
+  bool distal = false;
+};
+
+struct NetworkBoundaries {
+  // Junctions: ends of junction j are ends[offset[j] .. offset[j+1]).
+  std::vector<std::int64_t> junction_offset{0};
+  std::vector<VesselEnd> junction_ends;
+  std::vector<std::int64_t> junction_node;  // node id, for messages
+
+  VesselEnd inlet;
+  Waveform inflow;
+
+  struct OutletEnd {
+    VesselEnd end;
+    Outlet outlet;
+    std::int32_t capacitor = -1;  // index of its RCR state, or -1
+    double rest_area = 0, rest_flow = 0;  // for the reflection coefficient
+  };
+  std::vector<OutletEnd> outlets;
+  std::size_t capacitors = 0;
+
+  // The end states of the last solve, per vessel end: [2 v] proximal, [2 v + 1] distal.
+  std::vector<EndState> end_state;
+};
+
+// first_element[v] .. first_element[v + 1] are vessel v's elements.
+NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element);
+
+}  // namespace hemotree

@@ -1,0 +1,414 @@
+#include "solver/pulse_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include "cli/errors.hpp"
+#include "physics/rheology.hpp"
+#include "physics/wall_law.hpp"
+#include "solver/solution_breakdown.hpp"
+#include "solver/steady_flow.hpp"
+
+namespace hemotree {
+
+void PulseState::set_zero_like(const PulseState& other) {
+  area.setZero(other.area.rows(), other.area.cols());
+  flow.setZero(other.flow.rows(), other.flow.cols());
+  capacitor.setZero(other.capacitor.size());
+}
+
+void PulseState::add_scaled(double factor, const PulseState& other) {
+  area += factor * other.area;
+  flow += factor * other.flow;
+  capacitor += factor * other.capacitor;
+}
+
+PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
+    : net_(net), blood_(net.blood.value_or(Blood{})),
+      basis_(modal_basis(options.degree, options.quadrature_points)), scheme_(options.scheme) {
+  if (options.degree < 0) throw InputError("--degree must be at least 0");
+  if (options.elements < 1) throw InputError("--elements must be at least 1");
+  if (options.rheology_override >= 0) blood_.rheology = static_cast<Rheology>(options.rheology_override);
+  friction_k_ = friction_coefficient(blood_.alpha);
+  const std::size_t n = net.vessel_count();
+
+  // Each vessel's tube law: given directly, or from its wall by the thin/thick model.
+  laws_.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const std::string name = "vessel " + std::to_string(net.id[v]);
+    VesselLaw& law = laws_[v];
+    law.density = blood_.density;
+    law.alpha = blood_.alpha;
+    if (!net.beta.empty() && !std::isnan(net.beta[v])) {
+      law.beta = net.beta[v];
+      law.reference_area = std::numbers::pi / 4 * net.diameter[v] * net.diameter[v];
+      law.reference_pressure = net.reference_pressure[v];
+    } else {
+      if (std::isnan(net.wall_thickness[v]) || std::isnan(net.youngs_modulus[v]))
+        throw InputError(name + ": needs wall_thickness and youngs_modulus (or beta and reference_pressure)");
+      const TubeLaw t = tube_law({net.diameter[v], net.wall_thickness[v], net.youngs_modulus[v]},
+                                 options.external_pressure, options.thick_wall_ratio);
+      law.beta = t.beta;
+      law.reference_area = t.reference_area;
+      law.reference_pressure = t.reference_pressure;
+    }
+  }
+
+  // Elements: vessel v owns first_element_[v] .. first_element_[v + 1].
+  const auto e = static_cast<std::size_t>(options.elements);
+  first_element_.resize(n + 1);
+  for (std::size_t v = 0; v <= n; ++v) first_element_[v] = static_cast<std::int32_t>(v * e);
+  const std::size_t elements = n * e;
+  element_vessel_.resize(elements);
+  half_length_.resize(static_cast<Eigen::Index>(elements));
+  element_beta_.resize(static_cast<Eigen::Index>(elements));
+  for (std::size_t v = 0; v < n; ++v)
+    for (std::size_t k = 0; k < e; ++k) {
+      const std::size_t el = v * e + k;
+      element_vessel_[el] = static_cast<std::int32_t>(v);
+      half_length_(static_cast<Eigen::Index>(el)) = net.length[v] / (2.0 * static_cast<double>(e));
+      element_beta_(static_cast<Eigen::Index>(el)) = laws_[v].beta;
+    }
+  boundaries_ = build_boundaries(net, first_element_);
+
+  const auto rows = static_cast<Eigen::Index>(elements);
+  const Eigen::Index modes = basis_.degree + 1, points = basis_.points;
+  state_.area.setZero(rows, modes);
+  state_.flow.setZero(rows, modes);
+  state_.capacitor.setZero(static_cast<Eigen::Index>(boundaries_.capacitors));
+  area_q_.resize(rows, points);
+  flow_q_.resize(rows, points);
+  flux_q_.resize(rows, points);
+  source_q_.resize(rows, points);
+
+  bool started = false;
+  if (options.steady_start) {
+    try {
+      start_from_steady_flow(net);
+      started = true;
+    } catch (const InputError&) {
+      // Networks with reflection outlets or loops have no steady solution here: rest.
+    }
+  }
+  if (!started) start_at_rest();
+  choose_time_step(options);
+  if (options.dt > 0) {
+    dt_ = options.dt;
+    dt_reason_ = "given by --dt";
+  }
+}
+
+// ---- initial states --------------------------------------------------------------------
+
+void PulseSolver::start_at_rest() {
+  // Every vessel at its reference area and no flow: p = p_ref.
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
+    for (auto el = first_element_[v]; el < first_element_[v + 1]; ++el)
+      state_.area(el, 0) = laws_[v].reference_area;
+  for (auto& o : boundaries_.outlets) {
+    if (o.capacitor >= 0) state_.capacitor(o.capacitor) = o.outlet.p_out;
+    o.rest_area = laws_[static_cast<std::size_t>(o.end.vessel)].reference_area;
+    o.rest_flow = 0;
+  }
+}
+
+void PulseSolver::start_from_steady_flow(const Network& net) {
+  Network steady_net = net;  // the steady solver reads blood from the network
+  steady_net.blood = blood_;
+  const SteadyFlow s = solve_steady_flow(steady_net);
+  const Eigen::Index points = basis_.points;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    const double p0 = s.node_pressure[net.from[v]], p1 = s.node_pressure[net.to[v]];
+    const auto e = first_element_[v + 1] - first_element_[v];
+    for (auto k = 0; k < e; ++k) {
+      // Pressure falls linearly along the vessel; project A(p(x)) onto the modes.
+      Eigen::VectorXd a(points);
+      for (Eigen::Index q = 0; q < points; ++q) {
+        const double x = (k + 0.5 * (basis_.rule.nodes(q) + 1)) / e;
+        a(q) = laws_[v].area(p0 + (p1 - p0) * x);
+      }
+      const auto el = first_element_[v] + k;
+      state_.area.row(el) = (basis_.projection * a).transpose();
+      state_.flow(el, 0) = s.flow[v];
+    }
+  }
+  for (auto& o : boundaries_.outlets) {
+    const auto v = static_cast<std::size_t>(o.end.vessel);
+    const double q = s.flow[v], p = s.node_pressure[net.to[v]];
+    if (o.capacitor >= 0) state_.capacitor(o.capacitor) = p - o.outlet.r1 * q;
+    o.rest_area = laws_[v].area(p);
+    o.rest_flow = q;
+  }
+}
+
+// ---- time step ---------------------------------------------------------------------------
+
+void PulseSolver::choose_time_step(const SolverOptions& options) {
+  // Waves: dt <= cfl h / (lambda_max (2p + 1)); friction (explicit): dt <= safety / (k mu / (rho A)).
+  const double p = basis_.degree;
+  double wave = std::numeric_limits<double>::infinity(), friction = wave;
+  std::size_t wave_vessel = 0, friction_vessel = 0;
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    const VesselLaw& law = laws_[v];
+    const auto el = first_element_[v];
+    const double a = state_.area(el, 0), q = state_.flow(el, 0);
+    const double h = 2 * half_length_(el);
+    const double lambda = std::max(std::abs(law.lambda_forward(a, q)), std::abs(law.lambda_backward(a, q)));
+    const double dt_wave = options.cfl * h / (lambda * (2 * p + 1));
+    if (dt_wave < wave) {
+      wave = dt_wave;
+      wave_vessel = v;
+    }
+    const double rate = friction_k_ * viscosity(v, a) / (blood_.density * a);
+    const double stability = scheme_ == TimeScheme::runge_kutta4 ? 2.78 : 1.0;
+    const double dt_friction = options.friction_safety * stability / rate;
+    if (dt_friction < friction) {
+      friction = dt_friction;
+      friction_vessel = v;
+    }
+  }
+  std::ostringstream why;
+  if (wave <= friction) {
+    dt_ = wave;
+    why << "wave speed (CFL) in vessel " << net_.id[wave_vessel];
+  } else {
+    dt_ = friction;
+    why << "friction stiffness in vessel " << net_.id[friction_vessel];
+  }
+  dt_reason_ = why.str();
+}
+
+void PulseSolver::step() {
+  if (scheme_ == TimeScheme::runge_kutta4) {
+    // Classical fourth-order Runge-Kutta.
+    evaluate(time_, state_, stage_[0]);
+    PulseState y = state_;
+    y.add_scaled(0.5 * dt_, stage_[0]);
+    evaluate(time_ + 0.5 * dt_, y, stage_[1]);
+    y = state_;
+    y.add_scaled(0.5 * dt_, stage_[1]);
+    evaluate(time_ + 0.5 * dt_, y, stage_[2]);
+    y = state_;
+    y.add_scaled(dt_, stage_[2]);
+    evaluate(time_ + dt_, y, stage_[3]);
+    state_.add_scaled(dt_ / 6, stage_[0]);
+    state_.add_scaled(dt_ / 3, stage_[1]);
+    state_.add_scaled(dt_ / 3, stage_[2]);
+    state_.add_scaled(dt_ / 6, stage_[3]);
+  } else {
+    // Second-order Adams-Bashforth (the paper's); its first step is Heun's, second order too.
+    evaluate(time_, state_, rate_);
+    if (!have_previous_rate_) {
+      PulseState y = state_;
+      y.add_scaled(dt_, rate_);
+      evaluate(time_ + dt_, y, stage_[0]);
+      state_.add_scaled(0.5 * dt_, rate_);
+      state_.add_scaled(0.5 * dt_, stage_[0]);
+      have_previous_rate_ = true;
+    } else {
+      state_.add_scaled(1.5 * dt_, rate_);
+      state_.add_scaled(-0.5 * dt_, previous_rate_);
+    }
+    std::swap(previous_rate_, rate_);
+  }
+  time_ += dt_;
+  ++steps_;
+}
+
+// ---- the right-hand side -------------------------------------------------------------------
+
+double PulseSolver::viscosity(std::size_t, double area) const {
+  if (blood_.rheology == Rheology::newtonian) return blood_.newtonian_viscosity;
+  return apparent_viscosity(blood_, std::sqrt(4 * area / std::numbers::pi));
+}
+
+void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
+  const Eigen::Index elements = s.area.rows();
+  rate.set_zero_like(s);
+
+  // Values at the quadrature points of all elements at once.
+  area_q_.noalias() = s.area * basis_.at_points.transpose();
+  flow_q_.noalias() = s.flow * basis_.at_points.transpose();
+  if ((area_q_.array() <= 0).any() || !area_q_.allFinite()) {
+    // Locate the first bad element for the message.
+    for (Eigen::Index el = 0; el < elements; ++el)
+      if (!(area_q_.row(el).array() > 0).all() || !area_q_.row(el).allFinite())
+        throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], t);
+  }
+
+  // Volume term: (F(U), dphi/dx) for both equations.
+  const double rho = blood_.density, alpha = blood_.alpha;
+  const auto sqrt_a = area_q_.array().sqrt();
+  flux_q_.array() = alpha * flow_q_.array().square() / area_q_.array() +
+                    (element_beta_.array() / (3 * rho)).replicate(1, area_q_.cols()) * area_q_.array() * sqrt_a;
+  rate.area.noalias() = flow_q_ * basis_.weak_derivative.transpose();
+  rate.flow.noalias() = flux_q_ * basis_.weak_derivative.transpose();
+
+  // Friction source -k mu Q / (rho A), mu at the local diameter (Pries) or constant.
+  if (blood_.rheology == Rheology::newtonian) {
+    source_q_.array() = (-friction_k_ * blood_.newtonian_viscosity / rho) * flow_q_.array() / area_q_.array();
+  } else {
+    for (Eigen::Index el = 0; el < elements; ++el)
+      for (Eigen::Index q = 0; q < area_q_.cols(); ++q) {
+        const double a = area_q_(el, q);
+        source_q_(el, q) = -friction_k_ * viscosity(0, a) / rho * flow_q_(el, q) / a;
+      }
+  }
+
+  // Traces at both ends of every element.
+  area_left_.noalias() = s.area * basis_.left.transpose();
+  area_right_.noalias() = s.area * basis_.right.transpose();
+  flow_left_.noalias() = s.flow * basis_.left.transpose();
+  flow_right_.noalias() = s.flow * basis_.right.transpose();
+  flux_a_left_.resize(elements);
+  flux_a_right_.resize(elements);
+  flux_q_left_.resize(elements);
+  flux_q_right_.resize(elements);
+
+  // Interfaces inside vessels.
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    const VesselLaw& law = laws_[v];
+    for (auto el = first_element_[v]; el + 1 < first_element_[v + 1]; ++el) {
+      double fa, fq;
+      upwind_flux(law, area_right_(el), flow_right_(el), area_left_(el + 1), flow_left_(el + 1), fa, fq);
+      flux_a_right_(el) = flux_a_left_(el + 1) = fa;
+      flux_q_right_(el) = flux_q_left_(el + 1) = fq;
+    }
+  }
+
+  // Vessel ends: the node supplies U*, the flux is F(U*).
+  auto set_end_flux = [&](const VesselEnd& end, const EndState& u) {
+    const VesselLaw& law = laws_[static_cast<std::size_t>(end.vessel)];
+    const double fa = u.flow, fq = law.flux_flow(u.area, u.flow);
+    if (end.distal) {
+      flux_a_right_(end.element) = fa;
+      flux_q_right_(end.element) = fq;
+    } else {
+      flux_a_left_(end.element) = fa;
+      flux_q_left_(end.element) = fq;
+    }
+    boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)] = u;
+  };
+  auto trace = [&](const VesselEnd& end, double& a, double& q) {
+    a = end.distal ? area_right_(end.element) : area_left_(end.element);
+    q = end.distal ? flow_right_(end.element) : flow_left_(end.element);
+  };
+
+  {
+    double a, q;
+    const VesselEnd& end = boundaries_.inlet;
+    trace(end, a, q);
+    set_end_flux(end, inflow_state(laws_[static_cast<std::size_t>(end.vessel)], a, q, boundaries_.inflow(t)));
+  }
+  for (const auto& o : boundaries_.outlets) {
+    double a, q;
+    trace(o.end, a, q);
+    const VesselLaw& law = laws_[static_cast<std::size_t>(o.end.vessel)];
+    EndState u;
+    switch (o.outlet.type) {
+      case OutletType::resistance:
+        u = resistance_state(law, a, q, o.outlet.r, o.outlet.p_out);
+        break;
+      case OutletType::rcr:
+        if (o.capacitor < 0) {  // no compliance: R1 and R2 in series
+          u = resistance_state(law, a, q, o.outlet.r1 + o.outlet.r2, o.outlet.p_out);
+        } else {
+          const double pc = s.capacitor(o.capacitor);
+          u = resistance_state(law, a, q, o.outlet.r1, pc);
+          // C dp_c/dt = Q* - (p_c - p_out) / R2
+          rate.capacitor(o.capacitor) = (u.flow - (pc - o.outlet.p_out) / o.outlet.r2) / o.outlet.c;
+        }
+        break;
+      case OutletType::reflection:
+        u = reflection_state(law, a, q, o.rest_area, o.rest_flow, o.outlet.reflection);
+        break;
+    }
+    set_end_flux(o.end, u);
+  }
+  std::array<const VesselLaw*, 16> laws{};
+  std::array<double, 16> ja{}, jq{};
+  std::array<int, 16> sign{};
+  std::array<EndState, 16> out{};
+  for (std::size_t j = 0; j + 1 < boundaries_.junction_offset.size(); ++j) {
+    const auto first = boundaries_.junction_offset[j], last = boundaries_.junction_offset[j + 1];
+    const auto count = static_cast<std::size_t>(last - first);
+    for (std::size_t i = 0; i < count; ++i) {
+      const VesselEnd& end = boundaries_.junction_ends[static_cast<std::size_t>(first) + i];
+      laws[i] = &laws_[static_cast<std::size_t>(end.vessel)];
+      trace(end, ja[i], jq[i]);
+      sign[i] = end.distal ? 1 : -1;
+    }
+    if (!junction_state({laws.data(), count}, {ja.data(), count}, {jq.data(), count},
+                        {sign.data(), count}, {out.data(), count}))
+      throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);
+    for (std::size_t i = 0; i < count; ++i)
+      set_end_flux(boundaries_.junction_ends[static_cast<std::size_t>(first) + i], out[i]);
+  }
+
+  // Surface term and scaling: dC/dt = (volume - M^-1 (phi(1) F*_R - phi(-1) F*_L)) / J + source.
+  const Eigen::RowVectorXd right = basis_.inverse_mass.cwiseProduct(basis_.right);
+  const Eigen::RowVectorXd left = basis_.inverse_mass.cwiseProduct(basis_.left);
+  rate.area.noalias() -= flux_a_right_ * right;
+  rate.area.noalias() += flux_a_left_ * left;
+  rate.flow.noalias() -= flux_q_right_ * right;
+  rate.flow.noalias() += flux_q_left_ * left;
+  const Eigen::VectorXd inverse_jacobian = half_length_.cwiseInverse();
+  rate.area = inverse_jacobian.asDiagonal() * rate.area;
+  rate.flow = inverse_jacobian.asDiagonal() * rate.flow;
+  rate.flow.noalias() += source_q_ * basis_.projection.transpose();
+}
+
+// ---- evaluation --------------------------------------------------------------------------
+
+void PulseSolver::locate(std::size_t vessel, double x, std::size_t& element, double& xi) const {
+  const auto first = first_element_[vessel], count = first_element_[vessel + 1] - first;
+  const double s = std::clamp(x, 0.0, 1.0) * count;
+  const auto k = std::min(static_cast<std::int32_t>(s), count - 1);
+  element = static_cast<std::size_t>(first + k);
+  xi = 2 * (s - k) - 1;
+}
+
+double PulseSolver::evaluate_modes(const Eigen::MatrixXd& c, std::size_t element, double xi) const {
+  double value = 0;
+  for (int j = 0; j <= basis_.degree; ++j) value += c(static_cast<Eigen::Index>(element), j) * legendre(j, xi);
+  return value;
+}
+
+double PulseSolver::area_at(std::size_t vessel, double x) const {
+  std::size_t el;
+  double xi;
+  locate(vessel, x, el, xi);
+  return evaluate_modes(state_.area, el, xi);
+}
+
+double PulseSolver::flow_at(std::size_t vessel, double x) const {
+  std::size_t el;
+  double xi;
+  locate(vessel, x, el, xi);
+  return evaluate_modes(state_.flow, el, xi);
+}
+
+double PulseSolver::pressure_at(std::size_t vessel, double x) const {
+  return laws_[vessel].pressure(area_at(vessel, x));
+}
+
+double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
+  return viscosity(vessel, area_at(vessel, x));
+}
+
+double PulseSolver::mean_flow(std::size_t vessel) const {
+  double sum = 0;
+  for (auto el = first_element_[vessel]; el < first_element_[vessel + 1]; ++el) sum += state_.flow(el, 0);
+  return sum / (first_element_[vessel + 1] - first_element_[vessel]);
+}
+
+void PulseSolver::check_solution() const {
+  for (Eigen::Index el = 0; el < state_.area.rows(); ++el)
+    if (!(state_.area(el, 0) > 0) || !state_.area.row(el).allFinite() || !state_.flow.row(el).allFinite())
+      throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], time_);
+}
+
+}  // namespace hemotree

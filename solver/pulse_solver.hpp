@@ -1,0 +1,106 @@
+// The spectral/hp discontinuous Galerkin solver of pulsatile flow in a compliant network
+// (the paper's "Numerical approximation method"): modal Legendre elements in every vessel,
+// upwind (Roe) fluxes between elements, junctions and boundaries solved through the
+// characteristics, second-order Adams-Bashforth (or classical Runge-Kutta) in time.
+// The state of all elements lives in flat matrices (one row per element), and each stage
+// of the right-hand side acts on all of them at once.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "formats/network.hpp"
+#include "solver/legendre_basis.hpp"
+#include "solver/network_boundaries.hpp"
+#include "solver/vessel_equations.hpp"
+
+namespace hemotree {
+
+enum class TimeScheme { adams_bashforth2, runge_kutta4 };
+
+struct SolverOptions {
+  int degree = 7;           // p
+  int elements = 1;         // per vessel
+  int quadrature_points = 0;  // 0: the default over-integration
+  TimeScheme scheme = TimeScheme::adams_bashforth2;
+  double dt = 0;            // 0: chosen from the stability limits
+  double cfl = 0.3;         // safety on the wave-speed limit
+  double friction_safety = 0.5;  // safety on the friction-stiffness limit
+  double external_pressure = 10 * 133.322;  // p_ext for the wall laws [Pa]
+  double thick_wall_ratio = 0.1;
+  bool steady_start = true; // start from the steady Poiseuille solution when it exists
+  int rheology_override = -1;  // -1: the file's; else static_cast<int>(Rheology)
+};
+
+// The discrete state: modal coefficients of A and Q per element, and the pressures of the
+// RCR outlets' capacitors.
+struct PulseState {
+  Eigen::MatrixXd area, flow;  // elements x modes
+  Eigen::VectorXd capacitor;   // one per RCR outlet [Pa]
+
+  void set_zero_like(const PulseState& other);
+  void add_scaled(double factor, const PulseState& other);  // this += factor * other
+};
+
+class PulseSolver {
+ public:
+  PulseSolver(const Network& net, const SolverOptions& options);
+
+  void step();  // advances one time step
+  double time() const { return time_; }
+  double dt() const { return dt_; }
+  const std::string& dt_reason() const { return dt_reason_; }
+  std::size_t steps() const { return steps_; }
+
+  // The solution at fraction x in [0, 1] along a vessel (index).
+  double area_at(std::size_t vessel, double x) const;
+  double flow_at(std::size_t vessel, double x) const;
+  double pressure_at(std::size_t vessel, double x) const;
+  // Mean flow over the vessel (its mode-0 coefficients, averaged over its elements).
+  double mean_flow(std::size_t vessel) const;
+  double viscosity_at(std::size_t vessel, double x) const;  // [Pa s]
+
+  const VesselLaw& law(std::size_t vessel) const { return laws_[vessel]; }
+  const Blood& blood() const { return blood_; }
+  const ModalBasis& basis() const { return basis_; }
+  std::size_t element_count() const { return static_cast<std::size_t>(state_.area.rows()); }
+  const PulseState& state() const { return state_; }
+  // Throws SolutionBreakdown when A <= 0 or a value is not finite.
+  void check_solution() const;
+
+ private:
+  void evaluate(double t, const PulseState& s, PulseState& rate);
+  void choose_time_step(const SolverOptions& options);
+  void start_from_steady_flow(const Network& net);
+  void start_at_rest();
+  void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
+  double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;
+  double viscosity(std::size_t vessel, double area) const;
+
+  const Network& net_;
+  Blood blood_;
+  ModalBasis basis_;
+  std::vector<VesselLaw> laws_;            // per vessel
+  std::vector<std::int32_t> first_element_;  // per vessel, and one past the last
+  std::vector<std::int32_t> element_vessel_; // per element
+  Eigen::VectorXd half_length_;            // per element: the Jacobian J = h / 2
+  Eigen::VectorXd element_beta_;           // per element
+  double friction_k_ = 0;                  // 2 pi alpha / (alpha - 1)
+  NetworkBoundaries boundaries_;
+
+  PulseState state_, rate_, previous_rate_, stage_[4];
+  bool have_previous_rate_ = false;
+  TimeScheme scheme_;
+  double time_ = 0, dt_ = 0;
+  std::string dt_reason_;
+  std::size_t steps_ = 0;
+
+  // Scratch, sized once: values at quadrature points and traces.
+  Eigen::MatrixXd area_q_, flow_q_, flux_q_, source_q_;
+  Eigen::VectorXd area_left_, area_right_, flow_left_, flow_right_;
+  Eigen::VectorXd flux_a_left_, flux_a_right_, flux_q_left_, flux_q_right_;
+};
+
+}  // namespace hemotree

@@ -1,0 +1,122 @@
+#include "solver/riemann.hpp"
+
+#include <array>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+namespace hemotree {
+
+void upwind_flux(const VesselLaw& law, double a_l, double q_l, double a_r, double q_r,
+                 double& flux_area, double& flux_flow) {
+  const double a = 0.5 * (a_l + a_r), q = 0.5 * (q_l + q_r);
+  const double u = q / a, c = law.wave_speed(a);
+  // H = [[0, 1], [c^2 - alpha u^2, 2 alpha u]]; |H| = (|l1| (H - l2 I) - |l2| (H - l1 I)) / (l1 - l2)
+  const double h21 = c * c - law.alpha * u * u, h22 = 2 * law.alpha * u;
+  const double l1 = law.lambda_forward(a, q), l2 = law.lambda_backward(a, q);
+  const double m1 = std::abs(l1), m2 = std::abs(l2), d = l1 - l2;
+  const double abs11 = (m1 * (-l2) - m2 * (-l1)) / d;
+  const double abs12 = (m1 - m2) / d;
+  const double abs21 = (m1 - m2) * h21 / d;
+  const double abs22 = (m1 * (h22 - l2) - m2 * (h22 - l1)) / d;
+  const double da = a_r - a_l, dq = q_r - q_l;
+  flux_area = 0.5 * (q_l + q_r) - 0.5 * (abs11 * da + abs12 * dq);
+  flux_flow = 0.5 * (law.flux_flow(a_l, q_l) + law.flux_flow(a_r, q_r)) -
+              0.5 * (abs21 * da + abs22 * dq);
+}
+
+double incoming_speed(const VesselLaw& law, double a, double q, bool distal) {
+  return distal ? law.lambda_backward(a, q) : law.lambda_forward(a, q);
+}
+
+EndState inflow_state(const VesselLaw& law, double a, double q, double q_in) {
+  return {a + (q_in - q) / incoming_speed(law, a, q, false), q_in};
+}
+
+EndState resistance_state(const VesselLaw& law, double a, double q, double r, double p_beyond) {
+  // Q* = q + mu (A* - a); solve g(A*) = p(A*) - r Q*(A*) - p_beyond = 0 by Newton.
+  const double mu = incoming_speed(law, a, q, true);
+  double x = a;
+  for (int it = 0; it < 50; ++it) {
+    const double qs = q + mu * (x - a);
+    const double g = law.pressure(x) - r * qs - p_beyond;
+    const double dg = law.beta / (2 * std::sqrt(x)) - r * mu;
+    const double step = g / dg;
+    x -= step;
+    if (x <= 0) x = 0.5 * (x + step);  // stay in the physical range
+    if (std::abs(step) <= 1e-14 * x) break;
+  }
+  return {x, q + mu * (x - a)};
+}
+
+EndState reflection_state(const VesselLaw& law, double a, double q, double a0, double q0, double rt) {
+  // Outgoing: Q* - q = mu_in (A* - a) (linearised at the trace).
+  // Incoming, measured from rest: w_in = -rt w_out with w_k = l_k(U0) . (U* - U0),
+  // l_out(U0) = (-lambda_in0, 1), l_in(U0) = (-lambda_out0, 1).
+  const double mu = incoming_speed(law, a, q, true);
+  const double lin0 = law.lambda_backward(a0, q0), lout0 = law.lambda_forward(a0, q0);
+  // Unknowns (dA, dQ) = U* - U0:
+  //   dQ - mu dA = q - q0 - mu (a - a0)
+  //   (-lout0 dA + dQ) + rt (-lin0 dA + dQ) = 0
+  Eigen::Matrix2d m;
+  m << -mu, 1, -(lout0 + rt * lin0), 1 + rt;
+  const Eigen::Vector2d rhs(q - q0 - mu * (a - a0), 0.0);
+  const Eigen::Vector2d d = m.partialPivLu().solve(rhs);
+  return {a0 + d(0), q0 + d(1)};
+}
+
+bool junction_state(std::span<const VesselLaw* const> laws, std::span<const double> a,
+                    std::span<const double> q, std::span<const int> sign,
+                    std::span<EndState> out) {
+  const std::size_t n = laws.size();
+  constexpr std::size_t max_ends = 16;
+  if (n > max_ends) return false;
+  std::array<double, max_ends> mu{}, x{};
+  for (std::size_t i = 0; i < n; ++i) {
+    mu[i] = incoming_speed(*laws[i], a[i], q[i], sign[i] > 0);
+    x[i] = a[i];
+  }
+  Eigen::MatrixXd jac(n, n);
+  Eigen::VectorXd f(n);
+  for (int it = 0; it < 50; ++it) {
+    // f_0: mass; f_i: total pressure of end i minus that of end 0.
+    double pt0 = 0, dpt0 = 0;
+    jac.setZero();
+    for (std::size_t i = 0; i < n; ++i) {
+      const VesselLaw& law = *laws[i];
+      const double qs = q[i] + mu[i] * (x[i] - a[i]);
+      const double u = qs / x[i];
+      const double pt = law.pressure(x[i]) + 0.5 * law.density * u * u;
+      const double dpt = law.beta / (2 * std::sqrt(x[i])) +
+                         law.density * u * (mu[i] * x[i] - qs) / (x[i] * x[i]);
+      jac(0, static_cast<Eigen::Index>(i)) = sign[i] * mu[i];
+      if (i == 0) {
+        pt0 = pt;
+        dpt0 = dpt;
+      } else {
+        f(static_cast<Eigen::Index>(i)) = pt;
+        jac(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = dpt;
+      }
+    }
+    f(0) = 0;
+    for (std::size_t i = 0; i < n; ++i) f(0) += sign[i] * (q[i] + mu[i] * (x[i] - a[i]));
+    for (std::size_t i = 1; i < n; ++i) {
+      f(static_cast<Eigen::Index>(i)) -= pt0;
+      jac(static_cast<Eigen::Index>(i), 0) = -dpt0;
+    }
+    const Eigen::VectorXd step = jac.partialPivLu().solve(f);
+    double largest = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      x[i] -= step(static_cast<Eigen::Index>(i));
+      if (!(x[i] > 0)) return false;
+      largest = std::max(largest, std::abs(step(static_cast<Eigen::Index>(i))) / x[i]);
+    }
+    if (largest <= 1e-13) {
+      for (std::size_t i = 0; i < n; ++i) out[i] = {x[i], q[i] + mu[i] * (x[i] - a[i])};
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace hemotree

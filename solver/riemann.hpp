@@ -1,0 +1,51 @@
+// The Riemann problems of the 1D model: between two elements of a vessel (an upwind flux),
+// and at the ends of vessels, where the characteristic leaving each vessel is kept and the
+// node supplies the rest: a junction (mass and total pressure conserved), a prescribed
+// inflow, a resistance or RCR outlet, or a reflection coefficient.
+//
+// Characteristics are linearised about the trace inside the vessel: the state U* at the end
+// satisfies l_out . (U* - U) = 0 with the left eigenvector l_out = (-lambda_in, 1) of the
+// flux Jacobian, i.e. Q* - Q = lambda_in (A* - A). It holds for any alpha (the exact Riemann
+// invariants u +- 4c exist only for alpha = 1), and its error is quadratic in the jump
+// between the trace and the end state, which vanishes as the solution converges.
+#pragma once
+
+#include <span>
+
+#include "solver/vessel_equations.hpp"
+
+namespace hemotree {
+
+struct EndState {
+  double area = 0, flow = 0;
+};
+
+// Upwind flux between a left state (a_l, q_l) and a right state: the Roe-type flux
+// F* = (F_l + F_r)/2 - |H|(U_r - U_l)/2 with the Jacobian at the mean state.
+void upwind_flux(const VesselLaw& law, double a_l, double q_l, double a_r, double q_r,
+                 double& flux_area, double& flux_flow);
+
+// The speed lambda_in of the characteristic entering a vessel at an end: forward speed at
+// the proximal end, backward at the distal end.
+double incoming_speed(const VesselLaw& law, double a, double q, bool distal);
+
+// Prescribed inflow q_in at a vessel's proximal end.
+EndState inflow_state(const VesselLaw& law, double a, double q, double q_in);
+
+// Distal end into a resistance R to the pressure p_beyond: p(A*) - R Q* = p_beyond.
+// (An RCR outlet is this with R = R1 and p_beyond the capacitor pressure.)
+EndState resistance_state(const VesselLaw& law, double a, double q, double r, double p_beyond);
+
+// Distal end with reflection coefficient rt of the wave leaving the vessel, measured from
+// the rest state (a0, q0): rt = 0 lets waves leave without reflection.
+EndState reflection_state(const VesselLaw& law, double a, double q, double a0, double q0, double rt);
+
+// A junction of n vessel ends: traces (a, q) in, end states out; sign +1 for a vessel
+// whose distal end meets the node (its flow enters the node), -1 for a proximal end.
+// Newton on the areas: sum sign Q* = 0 and equal total pressure p + rho u^2 / 2.
+// Returns false if Newton did not converge.
+bool junction_state(std::span<const VesselLaw* const> laws, std::span<const double> a,
+                    std::span<const double> q, std::span<const int> sign,
+                    std::span<EndState> out);
+
+}  // namespace hemotree
