@@ -1,0 +1,43 @@
+// Step rate of hemosolve's solver on a network: time step, steps per second (median of
+// several timed batches) and the wall time per cardiac cycle that follows from them.
+// usage: solver_step_rate NET [degree] [steps per batch] [batches]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "formats/network_io.hpp"
+#include "solver/pulse_solver.hpp"
+
+using namespace hemotree;
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: solver_step_rate NET [degree] [steps per batch] [batches]\n");
+    return 2;
+  }
+  const Network net = read_network(argv[1]);
+  SolverOptions options;
+  options.degree = argc > 2 ? std::atoi(argv[2]) : 7;
+  const int steps = argc > 3 ? std::atoi(argv[3]) : 200;
+  const int batches = argc > 4 ? std::atoi(argv[4]) : 5;
+  PulseSolver solver(net, options);
+  std::vector<double> rates;
+  for (int b = 0; b < batches; ++b) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < steps; ++k) solver.step();
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    rates.push_back(steps / wall);
+  }
+  std::sort(rates.begin(), rates.end());
+  const double rate = rates[rates.size() / 2];
+  const double period = net.inlet->waveform.period;
+  std::printf("vessels %zu, elements %zu, degree %d, dt %.3g s (%s)\n", net.vessel_count(),
+              solver.element_count(), options.degree, solver.dt(), solver.dt_reason().c_str());
+  std::printf("median %.1f steps/s over %d batches of %d steps (min %.1f, max %.1f)\n", rate,
+              batches, steps, rates.front(), rates.back());
+  std::printf("wall time per %.3g s cycle: %.3g s (%.3g h)\n", period, period / solver.dt() / rate,
+              period / solver.dt() / rate / 3600);
+  return 0;
+}
