@@ -1,10 +1,11 @@
 // Step rate of hemosolve's solver on a network: time step, steps per second (median of
 // several timed batches) and the wall time per cardiac cycle that follows from them.
-// usage: solver_step_rate NET [degree] [steps per batch] [batches]
+// usage: solver_step_rate NET [degree] [steps per batch] [batches] [etd2|ab2|rk4]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "formats/network_io.hpp"
@@ -20,6 +21,12 @@ int main(int argc, char** argv) {
   const Network net = read_network(argv[1]);
   SolverOptions options;
   options.degree = argc > 2 ? std::atoi(argv[2]) : 7;
+  if (argc > 5) {
+    const std::string scheme = argv[5];
+    options.scheme = scheme == "ab2"   ? TimeScheme::adams_bashforth2
+                     : scheme == "rk4" ? TimeScheme::runge_kutta4
+                                       : TimeScheme::exponential_ab2;
+  }
   const int steps = argc > 3 ? std::atoi(argv[3]) : 200;
   const int batches = argc > 4 ? std::atoi(argv[4]) : 5;
   PulseSolver solver(net, options);

@@ -68,7 +68,7 @@ void write_summary(const std::filesystem::path& dir, const Network& net, const P
   }
   nlohmann::json summary = run;
   summary["time_step"] = solver.dt();
-  summary["time_step_limit"] = solver.dt_reason();
+  summary["time_step_limit"] = run.value("time_step_limit", solver.dt_reason());
   summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}};
   summary["vessels"] = vessels;
   OutputStream out((dir / "summary.json").string());
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Solve 1D pulsatile blood flow in a compliant vascular network (spectral/hp "
                "discontinuous Galerkin) and report flows, pressures and pulsatility.",
                "hemosolve"};
-  std::string input, out_dir, rheology, scheme = "ab2", start = "steady", dt_text, sample_text = "1ms",
+  std::string input, out_dir, rheology, scheme = "etd2", start = "steady", dt_text, sample_text = "1ms",
               external_text = "10mmHg";
   int cycles = 0, max_cycles = 50;
   double periodic_tol = 0;
@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
   app.add_option("--elements", options.elements, "elements per vessel")->capture_default_str();
   app.add_option("--dt", dt_text, "time step (default: from the CFL and friction limits)");
   app.add_option("--cfl", options.cfl, "safety factor on the wave-speed limit")->capture_default_str();
-  app.add_option("--scheme", scheme, "time scheme: ab2 (Adams-Bashforth 2) or rk4")->capture_default_str();
+  app.add_option("--scheme", scheme, "time scheme: etd2 (Adams-Bashforth 2 with exact friction), ab2 (the paper's) or rk4")->capture_default_str();
   app.add_option("--rheology", rheology, "pries or newtonian (default: the network's blood)");
   app.add_option("--start", start, "initial state: steady (Poiseuille solution) or rest")->capture_default_str();
   app.add_option("--external-pressure", external_text, "interstitial pressure for the wall laws")->capture_default_str();
@@ -113,7 +113,9 @@ int main(int argc, char** argv) {
     if (cycles < 0) throw InputError("--cycles must be positive");
     if (cycles == 0 && periodic_tol <= 0) cycles = 1;
     if (scheme == "rk4") options.scheme = TimeScheme::runge_kutta4;
-    else if (scheme != "ab2") throw InputError("--scheme must be ab2 or rk4");
+    else if (scheme == "ab2") options.scheme = TimeScheme::adams_bashforth2;
+    else if (scheme == "etd2") options.scheme = TimeScheme::exponential_ab2;
+    else throw InputError("--scheme must be etd2, ab2 or rk4");
     if (start == "rest") options.steady_start = false;
     else if (start != "steady") throw InputError("--start must be steady or rest");
     if (!rheology.empty()) {
@@ -143,6 +145,7 @@ int main(int argc, char** argv) {
            std::to_string(options.degree));
     // Rebuild with the rounded step so that cycles end exactly on a step.
     options.dt = dt;
+    const std::string dt_reason = solver.dt_reason();
     PulseSolver run(net, options);
 
     std::filesystem::path dir(out_dir);
@@ -186,7 +189,8 @@ int main(int argc, char** argv) {
                                {"network", input}, {"degree", options.degree},
                                {"elements_per_vessel", options.elements}, {"scheme", scheme},
                                {"rheology", to_string(run.blood().rheology)},
-                               {"start", start}, {"period", period}};
+                               {"start", start}, {"period", period},
+                               {"time_step_limit", dt_reason}};
     try {
       sample_probes();
       for (; done < planned; ++done) {

@@ -30,7 +30,7 @@ struct ModalBasis {
   Eigen::RowVectorXd inverse_mass;     // (2j + 1) / 2
 };
 
-// Degree p with the paper's over-integration factor 3/2: ceil(3 p / 2) + 1 points by
+// Degree p with the paper's over-integration factor 3/2: ceil(3 p / 2) points by
 // default (at least p + 1; 11 for p = 7, as in the paper's table), for the flux's quadratic and A^(3/2)
 // nonlinearities.
 ModalBasis modal_basis(int degree, int points = 0);

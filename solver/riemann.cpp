@@ -70,47 +70,44 @@ bool junction_state(std::span<const VesselLaw* const> laws, std::span<const doub
                     std::span<EndState> out) {
   const std::size_t n = laws.size();
   constexpr std::size_t max_ends = 16;
-  if (n > max_ends) return false;
-  std::array<double, max_ends> mu{}, x{};
+  if (n > max_ends || n < 2) return false;
+  std::array<double, max_ends> mu{}, x{}, f{}, dpt{};
   for (std::size_t i = 0; i < n; ++i) {
     mu[i] = incoming_speed(*laws[i], a[i], q[i], sign[i] > 0);
     x[i] = a[i];
   }
-  Eigen::MatrixXd jac(n, n);
-  Eigen::VectorXd f(n);
   for (int it = 0; it < 50; ++it) {
-    // f_0: mass; f_i: total pressure of end i minus that of end 0.
-    double pt0 = 0, dpt0 = 0;
-    jac.setZero();
+    // f_0 = sum sign Q* (mass); f_i = P_t,i - P_t,0 (total pressure), i >= 1. The Jacobian
+    // is an arrowhead (row 0 full, then a diagonal and column 0): eliminated in O(n).
+    double pt0 = 0, mass = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const VesselLaw& law = *laws[i];
       const double qs = q[i] + mu[i] * (x[i] - a[i]);
       const double u = qs / x[i];
       const double pt = law.pressure(x[i]) + 0.5 * law.density * u * u;
-      const double dpt = law.beta / (2 * std::sqrt(x[i])) +
-                         law.density * u * (mu[i] * x[i] - qs) / (x[i] * x[i]);
-      jac(0, static_cast<Eigen::Index>(i)) = sign[i] * mu[i];
-      if (i == 0) {
-        pt0 = pt;
-        dpt0 = dpt;
-      } else {
-        f(static_cast<Eigen::Index>(i)) = pt;
-        jac(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = dpt;
-      }
+      dpt[i] = law.beta / (2 * std::sqrt(x[i])) + law.density * u * (mu[i] * x[i] - qs) / (x[i] * x[i]);
+      mass += sign[i] * qs;
+      if (i == 0) pt0 = pt;
+      f[i] = pt;
     }
-    f(0) = 0;
-    for (std::size_t i = 0; i < n; ++i) f(0) += sign[i] * (q[i] + mu[i] * (x[i] - a[i]));
+    f[0] = mass;
+    for (std::size_t i = 1; i < n; ++i) f[i] -= pt0;
+    // Row i >= 1: dpt_i dx_i - dpt_0 dx_0 = f_i; row 0: sum sign_i mu_i dx_i = f_0.
+    double numerator = f[0], denominator = sign[0] * mu[0];
     for (std::size_t i = 1; i < n; ++i) {
-      f(static_cast<Eigen::Index>(i)) -= pt0;
-      jac(static_cast<Eigen::Index>(i), 0) = -dpt0;
+      numerator -= sign[i] * mu[i] * f[i] / dpt[i];
+      denominator += sign[i] * mu[i] * dpt[0] / dpt[i];
     }
-    const Eigen::VectorXd step = jac.partialPivLu().solve(f);
-    double largest = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      x[i] -= step(static_cast<Eigen::Index>(i));
+    const double dx0 = numerator / denominator;
+    double largest = std::abs(dx0) / x[0];
+    x[0] -= dx0;
+    for (std::size_t i = 1; i < n; ++i) {
+      const double dx = (f[i] + dpt[0] * dx0) / dpt[i];
+      x[i] -= dx;
+      largest = std::max(largest, std::abs(dx) / x[i]);
+    }
+    for (std::size_t i = 0; i < n; ++i)
       if (!(x[i] > 0)) return false;
-      largest = std::max(largest, std::abs(step(static_cast<Eigen::Index>(i))) / x[i]);
-    }
     if (largest <= 1e-13) {
       for (std::size_t i = 0; i < n; ++i) out[i] = {x[i], q[i] + mu[i] * (x[i] - a[i])};
       return true;

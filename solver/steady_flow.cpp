@@ -84,8 +84,8 @@ std::vector<Equivalent> reduce_beyond(const Network& net, const std::vector<doub
 }
 
 SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
-                             double inlet_flow) {
-  const Reduction red = reduce(net, resistance);
+                             double inlet_flow, std::vector<Equivalent>* beyond) {
+  Reduction red = reduce(net, resistance);
   const std::size_t root = red.root;
   const std::size_t n = net.vessel_count();
   const Children& children = red.children;
@@ -108,6 +108,7 @@ SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resi
       s.flow[d] = (p_distal - through[d].pressure) / through[d].resistance;
     }
   }
+  if (beyond) *beyond = std::move(red.beyond);
   return s;
 }
 

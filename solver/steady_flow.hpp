@@ -37,8 +37,9 @@ std::vector<Equivalent> reduce_beyond(const Network& net, const std::vector<doub
 // the root down: O(vessels), exact up to rounding. InputError names a terminal vessel
 // without an outlet, an outlet on a vessel that is not terminal, or a reflection outlet
 // (which has no steady resistance).
+// beyond, when given, receives reduce_beyond's equivalents (computed on the way).
 SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
-                             double inlet_flow);
+                             double inlet_flow, std::vector<Equivalent>* beyond = nullptr);
 
 // The same with the network's own blood (defaults if absent) and inlet (mean flow).
 SteadyFlow solve_steady_flow(const Network& net);
