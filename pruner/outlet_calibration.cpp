@@ -53,8 +53,12 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
       full.outlets.push_back(leaf_outlet);
     }
 
+  // One reduction of the full tree gives both its steady inlet pressure and, for every
+  // vessel, the resistance of everything beyond it.
   const std::vector<double> resistance = vessel_resistances(full, blood);
-  const std::vector<Equivalent> beyond = reduce_beyond(full, resistance);
+  std::vector<Equivalent> beyond;
+  report.steady_inlet_pressure_full =
+      solve_steady_flow(full, resistance, full.inlet->waveform.mean_flow(), &beyond).inlet_pressure;
 
   // Compliance beyond each vessel's distal node: dV/dp = 2 l sqrt(A_ref) / beta per vessel.
   std::vector<double> compliance_beyond(n, 0.0);
@@ -114,7 +118,6 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
   pruned.blood = full.blood;
   pruned.inlet = full.inlet;
 
-  report.steady_inlet_pressure_full = solve_steady_flow(full).inlet_pressure;
   report.steady_inlet_pressure_pruned = solve_steady_flow(pruned).inlet_pressure;
   return report;
 }
