@@ -6,6 +6,8 @@
 #include <numbers>
 #include <sstream>
 
+#include <omp.h>
+
 #include "cli/errors.hpp"
 #include "physics/rheology.hpp"
 #include "physics/wall_law.hpp"
@@ -273,59 +275,76 @@ void PulseSolver::step() {
 
 double PulseSolver::viscosity(std::size_t, double area) const { return viscosity_(area); }
 
-void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
-  const Eigen::Index elements = s.area.rows();
-  rate.set_zero_like(s);
-
-  // Values at the quadrature points of all elements at once.
-  area_q_.noalias() = s.area * basis_.at_points.transpose();
-  flow_q_.noalias() = s.flow * basis_.at_points.transpose();
-  if ((area_q_.array() <= 0).any() || !area_q_.allFinite()) {
-    // Locate the first bad element for the message.
-    for (Eigen::Index el = 0; el < elements; ++el)
-      if (!(area_q_.row(el).array() > 0).all() || !area_q_.row(el).allFinite())
-        throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], t);
-  }
+// The element-local part of the right-hand side for elements [first, first + count): point
+// values, volume fluxes, friction, traces. Rows are independent, so blocks run in parallel
+// and give the same bits whatever the number of threads.
+Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, Eigen::Index first,
+                                        Eigen::Index count) {
+  const double rho = blood_.density, alpha = blood_.alpha;
+  auto area_q = area_q_.middleRows(first, count);
+  auto flow_q = flow_q_.middleRows(first, count);
+  auto flux_q = flux_q_.middleRows(first, count);
+  auto source_q = source_q_.middleRows(first, count);
+  area_q.noalias() = s.area.middleRows(first, count) * basis_.at_points.transpose();
+  flow_q.noalias() = s.flow.middleRows(first, count) * basis_.at_points.transpose();
+  for (Eigen::Index el = 0; el < count; ++el)
+    if (!(area_q.row(el).array() > 0).all() || !area_q.row(el).allFinite()) return first + el;
 
   // Volume term: (F(U), dphi/dx) for both equations.
-  const double rho = blood_.density, alpha = blood_.alpha;
-  const auto sqrt_a = area_q_.array().sqrt();
-  flux_q_.array() = alpha * flow_q_.array().square() / area_q_.array() +
-                    (element_beta_.array() / (3 * rho)).replicate(1, area_q_.cols()) * area_q_.array() * sqrt_a;
-  rate.area.noalias() = flow_q_ * basis_.weak_derivative.transpose();
-  rate.flow.noalias() = flux_q_ * basis_.weak_derivative.transpose();
+  flux_q.array() = alpha * flow_q.array().square() / area_q.array() +
+                   (element_beta_.segment(first, count).array() / (3 * rho)).replicate(1, area_q.cols()) *
+                       area_q.array() * area_q.array().sqrt();
+  rate.area.middleRows(first, count).noalias() = flow_q * basis_.weak_derivative.transpose();
+  rate.flow.middleRows(first, count).noalias() = flux_q * basis_.weak_derivative.transpose();
 
   // Each element's friction rate at its mean area: the exponential scheme integrates
   // -r Q exactly and leaves only the variation of r within the element explicit.
-  friction_rate_.resize(elements);
-  for (Eigen::Index el = 0; el < elements; ++el) {
+  for (Eigen::Index el = first; el < first + count; ++el) {
     const double a = s.area(el, 0);
     friction_rate_(el) = a > 0 ? friction_k_ * viscosity_(a) / (rho * a) : 0.0;
   }
-
   // Friction source -k mu Q / (rho A), mu at the local diameter (Pries) or constant.
-  if (blood_.rheology == Rheology::newtonian) {
-    source_q_.array() = (-friction_k_ * blood_.newtonian_viscosity / rho) * flow_q_.array() / area_q_.array();
-  } else {
-    for (Eigen::Index el = 0; el < elements; ++el)
-      for (Eigen::Index q = 0; q < area_q_.cols(); ++q) {
-        const double a = area_q_(el, q);
-        source_q_(el, q) = -friction_k_ * viscosity(0, a) / rho * flow_q_(el, q) / a;
-      }
-  }
+  for (Eigen::Index el = 0; el < count; ++el)
+    for (Eigen::Index q = 0; q < area_q.cols(); ++q) {
+      const double a = area_q(el, q);
+      source_q(el, q) = -friction_k_ * viscosity_(a) / rho * flow_q(el, q) / a;
+    }
 
   // Traces at both ends of every element.
-  area_left_.noalias() = s.area * basis_.left.transpose();
-  area_right_.noalias() = s.area * basis_.right.transpose();
-  flow_left_.noalias() = s.flow * basis_.left.transpose();
-  flow_right_.noalias() = s.flow * basis_.right.transpose();
-  flux_a_left_.resize(elements);
-  flux_a_right_.resize(elements);
-  flux_q_left_.resize(elements);
-  flux_q_right_.resize(elements);
+  area_left_.segment(first, count).noalias() = s.area.middleRows(first, count) * basis_.left.transpose();
+  area_right_.segment(first, count).noalias() = s.area.middleRows(first, count) * basis_.right.transpose();
+  flow_left_.segment(first, count).noalias() = s.flow.middleRows(first, count) * basis_.left.transpose();
+  flow_right_.segment(first, count).noalias() = s.flow.middleRows(first, count) * basis_.right.transpose();
+  return -1;
+}
+
+void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
+  const Eigen::Index elements = s.area.rows();
+  rate.set_zero_like(s);
+  friction_rate_.resize(elements);
+  for (Eigen::VectorXd* v : {&area_left_, &area_right_, &flow_left_, &flow_right_, &flux_a_left_,
+                             &flux_a_right_, &flux_q_left_, &flux_q_right_})
+    v->resize(elements);
+
+  // Element terms in one block per thread.
+  Eigen::Index bad = -1;
+#pragma omp parallel
+  {
+    const int threads = omp_get_num_threads(), me = omp_get_thread_num();
+    const Eigen::Index first = elements * me / threads, last = elements * (me + 1) / threads;
+    const Eigen::Index found = element_terms(s, rate, first, last - first);
+    if (found >= 0) {
+#pragma omp critical
+      bad = bad < 0 ? found : std::min(bad, found);
+    }
+  }
+  if (bad >= 0) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad])], t);
 
   // Interfaces inside vessels.
-  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+  const auto vessels = static_cast<std::int64_t>(net_.vessel_count());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t vi = 0; vi < vessels; ++vi) {
+    const auto v = static_cast<std::size_t>(vi);
     const VesselLaw& law = laws_[v];
     for (auto el = first_element_[v]; el + 1 < first_element_[v + 1]; ++el) {
       double fa, fq;
@@ -359,7 +378,10 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     trace(end, a, q);
     set_end_flux(end, inflow_state(laws_[static_cast<std::size_t>(end.vessel)], a, q, boundaries_.inflow(t)));
   }
-  for (const auto& o : boundaries_.outlets) {
+  const auto outlets = static_cast<std::int64_t>(boundaries_.outlets.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < outlets; ++k) {
+    const auto& o = boundaries_.outlets[static_cast<std::size_t>(k)];
     double a, q;
     trace(o.end, a, q);
     const VesselLaw& law = laws_[static_cast<std::size_t>(o.end.vessel)];
@@ -384,11 +406,16 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     }
     set_end_flux(o.end, u);
   }
-  std::array<const VesselLaw*, 16> laws{};
-  std::array<double, 16> ja{}, jq{};
-  std::array<int, 16> sign{};
-  std::array<EndState, 16> out{};
-  for (std::size_t j = 0; j + 1 < boundaries_.junction_offset.size(); ++j) {
+  // Junctions are independent: each writes only its own ends' fluxes.
+  const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
+  std::int64_t failed_junction = -1;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t jj = 0; jj < junctions; ++jj) {
+    const auto j = static_cast<std::size_t>(jj);
+    std::array<const VesselLaw*, 16> laws{};
+    std::array<double, 16> ja{}, jq{};
+    std::array<int, 16> sign{};
+    std::array<EndState, 16> out{};
     const auto first = boundaries_.junction_offset[j], last = boundaries_.junction_offset[j + 1];
     const auto count = static_cast<std::size_t>(last - first);
     for (std::size_t i = 0; i < count; ++i) {
@@ -398,23 +425,37 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
       sign[i] = end.distal ? 1 : -1;
     }
     if (!junction_state({laws.data(), count}, {ja.data(), count}, {jq.data(), count},
-                        {sign.data(), count}, {out.data(), count}))
-      throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);
+                        {sign.data(), count}, {out.data(), count})) {
+#pragma omp critical
+      failed_junction = failed_junction < 0 ? jj : std::min(failed_junction, jj);
+      continue;
+    }
     for (std::size_t i = 0; i < count; ++i)
       set_end_flux(boundaries_.junction_ends[static_cast<std::size_t>(first) + i], out[i]);
+  }
+  if (failed_junction >= 0) {
+    const auto first = boundaries_.junction_offset[static_cast<std::size_t>(failed_junction)];
+    throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);
   }
 
   // Surface term and scaling: dC/dt = (volume - M^-1 (phi(1) F*_R - phi(-1) F*_L)) / J + source.
   const Eigen::RowVectorXd right = basis_.inverse_mass.cwiseProduct(basis_.right);
   const Eigen::RowVectorXd left = basis_.inverse_mass.cwiseProduct(basis_.left);
-  rate.area.noalias() -= flux_a_right_ * right;
-  rate.area.noalias() += flux_a_left_ * left;
-  rate.flow.noalias() -= flux_q_right_ * right;
-  rate.flow.noalias() += flux_q_left_ * left;
-  const Eigen::VectorXd inverse_jacobian = half_length_.cwiseInverse();
-  rate.area = inverse_jacobian.asDiagonal() * rate.area;
-  rate.flow = inverse_jacobian.asDiagonal() * rate.flow;
-  rate.flow.noalias() += source_q_ * basis_.projection.transpose();
+#pragma omp parallel
+  {
+    const int threads = omp_get_num_threads(), me = omp_get_thread_num();
+    const Eigen::Index first = elements * me / threads, count = elements * (me + 1) / threads - first;
+    auto ra = rate.area.middleRows(first, count);
+    auto rq = rate.flow.middleRows(first, count);
+    ra.noalias() -= flux_a_right_.segment(first, count) * right;
+    ra.noalias() += flux_a_left_.segment(first, count) * left;
+    rq.noalias() -= flux_q_right_.segment(first, count) * right;
+    rq.noalias() += flux_q_left_.segment(first, count) * left;
+    const auto inverse_jacobian = half_length_.segment(first, count).cwiseInverse().asDiagonal();
+    ra = inverse_jacobian * ra;
+    rq = inverse_jacobian * rq;
+    rq.noalias() += source_q_.middleRows(first, count) * basis_.projection.transpose();
+  }
 }
 
 // ---- evaluation --------------------------------------------------------------------------

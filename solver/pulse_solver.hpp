@@ -77,6 +77,8 @@ class PulseSolver {
 
  private:
   void evaluate(double t, const PulseState& s, PulseState& rate);
+  // Returns the first element whose area is not positive and finite, or -1.
+  Eigen::Index element_terms(const PulseState& s, PulseState& rate, Eigen::Index first, Eigen::Index count);
   void step_exponential();
   void choose_time_step(const SolverOptions& options);
   void start_from_steady_flow(const Network& net);
