@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "cli/errors.hpp"
+
 #include <Eigen/Eigenvalues>
 
 namespace hemotree {
@@ -42,7 +44,7 @@ double legendre_derivative(int n, double x) {
 }
 
 ModalBasis modal_basis(int degree, int points) {
-  if (degree < 0 || degree > 30) throw std::invalid_argument("polynomial degree out of range");
+  if (degree < 0 || degree > 30) throw InputError("the polynomial degree must lie in 0..30");
   ModalBasis b;
   b.degree = degree;
   b.points = points > 0 ? points : std::max(degree + 1, (3 * degree + 1) / 2);
