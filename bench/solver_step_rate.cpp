@@ -1,6 +1,6 @@
 // Step rate of hemosolve's solver on a network: time step, steps per second (median of
 // several timed batches) and the wall time per cardiac cycle that follows from them.
-// usage: solver_step_rate NET [degree] [steps per batch] [batches] [etd2|ab2|rk4]
+// usage: [HEMOTREE_THREADS=n] solver_step_rate NET [degree] [steps per batch] [batches] [etd2|ab2|rk4]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   const Network net = read_network(argv[1]);
   SolverOptions options;
   options.degree = argc > 2 ? std::atoi(argv[2]) : 7;
+  if (const char* t = std::getenv("HEMOTREE_THREADS")) options.threads = std::atoi(t);
   if (argc > 5) {
     const std::string scheme = argv[5];
     options.scheme = scheme == "ab2"   ? TimeScheme::adams_bashforth2
@@ -40,8 +41,9 @@ int main(int argc, char** argv) {
   std::sort(rates.begin(), rates.end());
   const double rate = rates[rates.size() / 2];
   const double period = net.inlet->waveform.period;
-  std::printf("vessels %zu, elements %zu, degree %d, dt %.3g s (%s)\n", net.vessel_count(),
-              solver.element_count(), options.degree, solver.dt(), solver.dt_reason().c_str());
+  std::printf("vessels %zu, elements %zu, degree %d, threads %d, dt %.3g s (%s)\n",
+              net.vessel_count(), solver.element_count(), options.degree, options.threads, solver.dt(),
+              solver.dt_reason().c_str());
   std::printf("median %.1f steps/s over %d batches of %d steps (min %.1f, max %.1f)\n", rate,
               batches, steps, rates.front(), rates.back());
   std::printf("wall time per %.3g s cycle: %.3g s (%.3g h)\n", period, period / solver.dt() / rate,

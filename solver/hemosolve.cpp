@@ -35,7 +35,11 @@ Probe parse_probe(const std::string& text, const Network& net) {
     std::size_t used = 0;
     p.id = std::stoll(text.substr(0, colon), &used);
     if (used != (colon == std::string::npos ? text.size() : colon)) throw std::invalid_argument("");
-    if (colon != std::string::npos) p.x = std::stod(text.substr(colon + 1));
+    if (colon != std::string::npos) {
+      const std::string x = text.substr(colon + 1);
+      p.x = std::stod(x, &used);
+      if (used != x.size()) throw std::invalid_argument("");
+    }
   } catch (const std::exception&) {
     throw InputError("--probe: '" + text + "' is not ID or ID:x");
   }
@@ -106,6 +110,8 @@ int main(int argc, char** argv) {
   app.add_option("--start", start, "initial state: steady (Poiseuille solution) or rest")->capture_default_str();
   app.add_option("--external-pressure", external_text, "interstitial pressure for the wall laws")->capture_default_str();
   app.add_option("--thick-wall-ratio", options.thick_wall_ratio, "h/D above which a wall is thick")->capture_default_str();
+  app.add_option("--threads", options.threads, "threads over elements (use the idle cores; results agree to round-off)")
+      ->capture_default_str();
   app.add_flag("--quiet", quiet, "no progress line");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
@@ -188,6 +194,7 @@ int main(int argc, char** argv) {
     nlohmann::json run_info = {{"tool", "hemosolve"}, {"version", HEMOTREE_VERSION},
                                {"network", input}, {"degree", options.degree},
                                {"elements_per_vessel", options.elements}, {"scheme", scheme},
+                               {"threads", options.threads},
                                {"rheology", to_string(run.blood().rheology)},
                                {"start", start}, {"period", period},
                                {"time_step_limit", dt_reason}};

@@ -41,6 +41,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
       basis_(modal_basis(options.degree, options.quadrature_points)), scheme_(options.scheme) {
   if (options.degree < 0) throw InputError("--degree must be at least 0");
   if (options.elements < 1) throw InputError("--elements must be at least 1");
+  if (options.threads < 1) throw InputError("--threads must be at least 1");
+  threads_ = options.threads;
   friction_k_ = friction_coefficient(blood_.alpha);
   const std::size_t n = net.vessel_count();
 
@@ -215,26 +217,29 @@ void phi_functions(double z, double& phi1, double& phi2) {
 void PulseSolver::step_exponential() {
   // ETD2 (Cox & Matthews 2002): Q+ = e^z Q + h (phi1(z) N + phi2(z) (N - N_prev)), z = -r h,
   // with N = rate + r Q the non-stiff part; A and the capacitors (r = 0) take plain AB2.
+  // Both N are taken with this step's r (N_prev = rate_prev + r Q_prev): with the previous
+  // step's r the scheme falls to first order wherever the area, and so r, pulsates.
   evaluate(time_, state_, rate_);
   const double h = dt_;
-  Eigen::MatrixXd nonstiff = rate_.flow + friction_rate_.asDiagonal() * state_.flow;
   if (!have_previous_rate_) {
     previous_rate_ = rate_;
-    previous_nonstiff_ = nonstiff;
+    previous_flow_ = state_.flow;
     have_previous_rate_ = true;
   }
+  Eigen::MatrixXd next_flow(state_.flow.rows(), state_.flow.cols());
   for (Eigen::Index el = 0; el < state_.flow.rows(); ++el) {
+    const double r = friction_rate_(el), z = -r * h;
     double phi1, phi2;
-    const double z = -friction_rate_(el) * h;
     phi_functions(z, phi1, phi2);
-    state_.flow.row(el) = std::exp(z) * state_.flow.row(el) +
-                          h * (phi1 * nonstiff.row(el) +
-                               phi2 * (nonstiff.row(el) - previous_nonstiff_.row(el)));
+    const auto n_now = rate_.flow.row(el) + r * state_.flow.row(el);
+    const auto n_before = previous_rate_.flow.row(el) + r * previous_flow_.row(el);
+    next_flow.row(el) = std::exp(z) * state_.flow.row(el) + h * (phi1 * n_now + phi2 * (n_now - n_before));
   }
+  previous_flow_ = std::move(state_.flow);
+  state_.flow = std::move(next_flow);
   state_.area += h * (1.5 * rate_.area - 0.5 * previous_rate_.area);
   state_.capacitor += h * (1.5 * rate_.capacitor - 0.5 * previous_rate_.capacitor);
   std::swap(previous_rate_, rate_);
-  std::swap(previous_nonstiff_, nonstiff);
 }
 
 void PulseSolver::step() {
@@ -333,7 +338,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
 
   // Element terms in one block per thread.
   Eigen::Index bad = -1;
-#pragma omp parallel
+#pragma omp parallel num_threads(threads_)
   {
     const int threads = omp_get_num_threads(), me = omp_get_thread_num();
     const Eigen::Index first = elements * me / threads, last = elements * (me + 1) / threads;
@@ -347,7 +352,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
 
   // Interfaces inside vessels.
   const auto vessels = static_cast<std::int64_t>(net_.vessel_count());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads_)
   for (std::int64_t vi = 0; vi < vessels; ++vi) {
     const auto v = static_cast<std::size_t>(vi);
     const VesselLaw& law = laws_[v];
@@ -384,7 +389,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     set_end_flux(end, inflow_state(laws_[static_cast<std::size_t>(end.vessel)], a, q, boundaries_.inflow(t)));
   }
   const auto outlets = static_cast<std::int64_t>(boundaries_.outlets.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads_)
   for (std::int64_t k = 0; k < outlets; ++k) {
     const auto& o = boundaries_.outlets[static_cast<std::size_t>(k)];
     double a, q;
@@ -414,7 +419,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Junctions are independent: each writes only its own ends' fluxes.
   const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
   std::int64_t failed_junction = -1;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads_)
   for (std::int64_t jj = 0; jj < junctions; ++jj) {
     const auto j = static_cast<std::size_t>(jj);
     std::array<const VesselLaw*, 16> laws{};
@@ -446,7 +451,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Surface term and scaling: dC/dt = (volume - M^-1 (phi(1) F*_R - phi(-1) F*_L)) / J + source.
   const Eigen::RowVectorXd right = basis_.inverse_mass.cwiseProduct(basis_.right);
   const Eigen::RowVectorXd left = basis_.inverse_mass.cwiseProduct(basis_.left);
-#pragma omp parallel
+#pragma omp parallel num_threads(threads_)
   {
     const int threads = omp_get_num_threads(), me = omp_get_thread_num();
     const Eigen::Index first = elements * me / threads, count = elements * (me + 1) / threads - first;

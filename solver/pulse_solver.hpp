@@ -37,6 +37,10 @@ struct SolverOptions {
   double thick_wall_ratio = 0.1;
   bool steady_start = true; // start from the steady Poiseuille solution when it exists
   int rheology_override = -1;  // -1: the file's; else static_cast<int>(Rheology)
+  // Threads over elements. One by default: a step has several parallel sections, and a
+  // thread that the system deschedules stalls every barrier (measured on the shared 2-core
+  // machine: 1001 vessels ran 35x slower with 2 threads while another job ran).
+  int threads = 1;
 };
 
 // The discrete state: modal coefficients of A and Q per element, and the pressures of the
@@ -100,12 +104,13 @@ class PulseSolver {
   NetworkBoundaries boundaries_;
 
   PulseState state_, rate_, previous_rate_, stage_[4];
-  // Per element: the friction rate r = k mu(A_mean) / (rho A_mean) the last evaluate() used,
-  // and, for the exponential scheme, the previous step's rate + r Q (the non-stiff part).
+  // Per element: the friction rate r = k mu(A_mean) / (rho A_mean) the last evaluate() used;
+  // for the exponential scheme, the previous step's flow coefficients.
   Eigen::VectorXd friction_rate_;
-  Eigen::MatrixXd previous_nonstiff_;
+  Eigen::MatrixXd previous_flow_;
   bool have_previous_rate_ = false;
   TimeScheme scheme_;
+  int threads_ = 1;
   double time_ = 0, dt_ = 0;
   std::string dt_reason_;
   std::size_t steps_ = 0;

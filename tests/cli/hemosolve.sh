@@ -1,0 +1,163 @@
+# vgen | vprune | hemosolve through a real pipe; hemosolve's summary.json and probes.csv; its
+# refusals (one line on stderr, non-zero exit, no summary.json left behind).
+source "$(dirname "$0")/lib.sh"
+VPRUNE=$BUILD/pruner/vprune
+HEMOSOLVE=$BUILD/solver/hemosolve
+EXAMPLES=$(cd "$(dirname "$0")/../../examples/boileau2015" && pwd)
+PY=/usr/bin/python3
+
+# ---- the pipeline: a 31-vessel microvascular tree, one cycle at p = 2 (about 4 s) ----------
+
+"$VGEN" --root-diameter 150um --min-diameter 8.5um \
+  | "$VPRUNE" --budget 31 --mean-flow 0.01ml/min 2>"$WORK/prune.log" \
+  | tee "$WORK/net.json" \
+  | "$HEMOSOLVE" - --out "$WORK/run" --cycles 1 --degree 2 --quiet --probe 0:0 --probe 1:1 \
+    >"$WORK/solve.out" 2>"$WORK/solve.err"
+status=("${PIPESTATUS[@]}")
+if [ "${status[0]}" -eq 0 ] && [ "${status[1]}" -eq 0 ] && [ "${status[2]}" -eq 0 ] && [ "${status[3]}" -eq 0 ]; then
+  pass "vgen | vprune | hemosolve -"
+else
+  fail "pipe status ${status[*]}: $(cat "$WORK/prune.log" "$WORK/solve.err")"
+fi
+[ ! -s "$WORK/solve.err" ] && [ ! -s "$WORK/solve.out" ] && pass "--quiet prints nothing" \
+  || fail "--quiet printed: $(cat "$WORK/solve.out" "$WORK/solve.err")"
+
+"$PY" - "$WORK/net.json" "$WORK/run/summary.json" <<'PY' && pass "summary.json: run fields and every vessel's statistics" || fail "summary.json"
+import json, math, sys
+net = json.load(open(sys.argv[1]))
+s = json.load(open(sys.argv[2]))
+assert s["tool"] == "hemosolve" and s["status"] == "complete", s.get("status")
+assert s["cycles"] == 1 and s["degree"] == 2 and s["elements_per_vessel"] == 1
+assert s["network"] == "-" and s["start"] == "steady"
+assert s["period"] == net["inlet"]["waveform"]["period"]
+assert s["time_step"] > 0
+assert abs(s["steps"] * s["time_step"] - s["period"]) <= 1e-9 * s["period"], (s["steps"], s["time_step"])
+# The real limit, not the rebuild's "given by --dt".
+assert "wave speed" in s["time_step_limit"] or "friction" in s["time_step_limit"], s["time_step_limit"]
+assert s["units"] == {"flow": "m^3/s", "pressure": "Pa", "length": "m"}, s["units"]
+
+keys = {"id", "diameter", "length", "class", "mean_flow", "mean_pressure", "systolic_pressure",
+        "diastolic_pressure", "pulsatility_index"}
+by_id = {v["id"]: v for v in net["vessels"]}
+rows = s["vessels"]
+assert len(rows) == len(net["vessels"]) == len(by_id), (len(rows), len(net["vessels"]))
+assert [r["id"] for r in rows] == [v["id"] for v in net["vessels"]]
+for r in rows:
+    assert set(r) == keys, (r["id"], set(r) ^ keys)
+    v = by_id[r["id"]]
+    assert r["diameter"] == v["diameter"] and r["length"] == v["length"], r["id"]
+    d = r["diameter"]
+    expected = ("artery" if d >= 500e-6 else "small_artery" if d >= 100e-6
+                else "arteriole" if d >= 10e-6 else "capillary")
+    assert r["class"] == expected, (r["id"], r["class"], d)
+    for k in keys - {"id", "class"}:
+        assert isinstance(r[k], (int, float)) and math.isfinite(r[k]), (r["id"], k, r[k])
+    assert 0 < r["diastolic_pressure"] <= r["mean_pressure"] <= r["systolic_pressure"] < 40000, r
+    pi = (r["systolic_pressure"] - r["diastolic_pressure"]) / r["mean_pressure"]
+    assert abs(r["pulsatility_index"] - pi) <= 1e-12 * max(1, pi), r
+    assert r["mean_flow"] > 0, r  # a tree fed at its root: every vessel carries flow forward
+# One cycle from the steady start: the root carries the inflow's mean within 10 %.
+root = rows[0]
+q_in = net["inlet"]["waveform"]["mean"]
+assert abs(root["mean_flow"] - q_in) <= 0.1 * q_in, (root["mean_flow"], q_in)
+# Pressure falls from the root to every terminal vessel.
+assert all(r["mean_pressure"] < root["mean_pressure"] for r in rows[1:])
+PY
+
+"$PY" - "$WORK/run/probes.csv" "$WORK/run/summary.json" <<'PY' && pass "probes.csv: header, units and samples" || fail "probes.csv"
+import csv, json, math, sys
+rows = list(csv.reader(open(sys.argv[1])))
+s = json.load(open(sys.argv[2]))
+header = rows[0]
+expected = ["t [s]"]
+for vessel, x in ((0, "0"), (1, "1")):
+    at = f" vessel {vessel} x {x}"
+    expected += [f"p{at} [Pa]", f"Q{at} [m^3/s]", f"A{at} [m^2]", f"u{at} [m/s]"]
+assert header == expected, header
+data = [[float(x) for x in r] for r in rows[1:]]
+assert all(len(r) == 9 for r in data)
+assert all(math.isfinite(x) for r in data for x in r)
+t = [r[0] for r in data]
+assert t[0] == 0 and all(b > a for a, b in zip(t, t[1:]))
+assert abs(t[-1] - s["period"]) <= 2e-3 and 900 <= len(t) <= 1100, (t[-1], len(t))  # every 1 ms
+for r in data:
+    for k in (1, 5):
+        p, q, a, u = r[k:k + 4]
+        assert p > 0 and a > 0
+        assert abs(u - q / a) <= 1e-7 * abs(q / a) + 1e-300, r
+# The inlet probe (vessel 0, x = 0) sees the prescribed half sine: zero in diastole.
+q_inlet = [r[2] for r in data]
+assert max(q_inlet) > 0 and abs(q_inlet[-2]) < 1e-3 * max(q_inlet)
+PY
+
+# ---- refusals ------------------------------------------------------------------------------
+
+"$PY" - "$EXAMPLES" "$WORK" <<'PY'
+import copy, json, sys
+examples, work = sys.argv[1], sys.argv[2]
+cca = json.load(open(f"{examples}/cca.json"))
+ibif = json.load(open(f"{examples}/ibif.json"))
+def save(net, name):
+    json.dump(net, open(f"{work}/{name}.json", "w"))
+n = copy.deepcopy(cca); del n["inlet"]; save(n, "no-inlet")
+n = copy.deepcopy(ibif); del n["vessels"][2]["outlet"]; save(n, "no-outlet")       # vessel 3
+n = copy.deepcopy(cca); n["vessels"][0]["length"] = 0; save(n, "zero-length")
+n = copy.deepcopy(cca); n["vessels"][0]["length"] = -0.1; save(n, "negative-length")
+n = copy.deepcopy(cca)
+for k in ("beta", "reference_pressure", "wall_thickness"):
+    del n["vessels"][0][k]
+save(n, "no-wall")
+PY
+CCA=$EXAMPLES/cca.json
+refusal=0
+# refuse "description" STATUS FRAGMENT -- command...: expect_error, and no summary.json or
+# probes.csv in the run's folder (its --out is $WORK/refused-N, given by the caller).
+refuse() {
+  local what=$1 out=$WORK/refused-$refusal
+  expect_error "$@"
+  if [ -e "$out/summary.json" ] || [ -e "$out/probes.csv" ]; then fail "$what: left output in $out"
+  else pass "$what: no output left"; fi
+  refusal=$((refusal + 1))
+}
+out() { echo "$WORK/refused-$refusal"; }
+
+refuse "no inlet" 2 "no inlet" -- "$HEMOSOLVE" "$WORK/no-inlet.json" --out "$(out)" --probe 1
+refuse "terminal vessel without outlet" 2 "vessel 3 is terminal but has no outlet" -- \
+  "$HEMOSOLVE" "$WORK/no-outlet.json" --out "$(out)"
+refuse "zero length (reader)" 2 "vessel 1: length must be positive" -- \
+  "$HEMOSOLVE" "$WORK/zero-length.json" --out "$(out)"
+refuse "negative length (reader)" 2 "vessel 1: length must be positive" -- \
+  "$HEMOSOLVE" "$WORK/negative-length.json" --out "$(out)"
+refuse "no wall and no beta" 2 "vessel 1" -- "$HEMOSOLVE" "$WORK/no-wall.json" --out "$(out)"
+refuse "--probe of an unknown vessel" 2 "--probe: no vessel 7" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 7
+refuse "--probe x beyond the vessel" 2 "x must lie in [0, 1]" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 1:1.5
+refuse "--probe not ID:x" 2 "is not ID or ID:x" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe abc
+refuse "--probe with a bad x" 2 "is not ID or ID:x" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 1:x
+refuse "missing network file" 1 "cannot open" -- "$HEMOSOLVE" "$WORK/missing.json" --out "$(out)"
+refuse "empty standard input" 2 "standard input" -- \
+  bash -c '"$0" - --out "$1" </dev/null' "$HEMOSOLVE" "$(out)"
+refuse "no inlet through standard input" 2 "no inlet" -- \
+  bash -c '"$0" - --out "$1" <"$2"' "$HEMOSOLVE" "$(out)" "$WORK/no-inlet.json"
+# A run that breaks down in its first cycle: one line naming the vessel, no summary.
+refuse "breakdown (time step far too long)" 2 "broke down in vessel 1" -- \
+  "$HEMOSOLVE" "$CCA" --out "$(out)" --dt 20ms --quiet
+# A failed upstream stage: hemosolve refuses the empty pipe on its own line.
+"$VPRUNE" --budget 0 "$WORK/net.json" 2>/dev/null | "$HEMOSOLVE" - --out "$WORK/after-vprune" 2>"$WORK/err"
+status=("${PIPESTATUS[@]}")
+[ "${status[0]}" -eq 2 ] && [ "${status[1]}" -eq 2 ] && [ "$(wc -l <"$WORK/err")" -eq 1 ] \
+  && [ ! -e "$WORK/after-vprune/summary.json" ] && pass "refused vprune | hemosolve: both fail, one line" \
+  || fail "vprune --budget 0 | hemosolve: status ${status[*]}: $(cat "$WORK/err")"
+
+# A degree outside 0..30 is bad input, not an internal error (it was exit 70 before b442c97).
+refuse "--degree -1" 2 "degree" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --degree -1
+refuse "--degree 31" 2 "degree" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --degree 31
+# High degree on coupled elements runs with the defaults (it broke down at t = 3 ms before the
+# step followed (p + 1)^2 above p = 7).
+"$HEMOSOLVE" "$CCA" --out "$WORK/high-degree" --degree 12 --elements 8 --cycles 1 --quiet 2>"$WORK/err" \
+  && [ -s "$WORK/high-degree/summary.json" ] && pass "p = 12 with 8 elements runs with the defaults" \
+  || fail "p = 12, 8 elements: $(cat "$WORK/err")"
+
+# Trailing characters after x are refused, not ignored.
+refuse "--probe 1:0.5x is refused" 2 "--probe" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 1:0.5x
+refuse "--probe 1:0.5:3 is refused" 2 "--probe" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 1:0.5:3
+finish
