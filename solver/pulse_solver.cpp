@@ -433,6 +433,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
       laws[i] = &laws_[static_cast<std::size_t>(end.vessel)];
       trace(end, ja[i], jq[i]);
       sign[i] = end.distal ? 1 : -1;
+      out[i] = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
     }
     if (!junction_state({laws.data(), count}, {ja.data(), count}, {jq.data(), count},
                         {sign.data(), count}, {out.data(), count})) {

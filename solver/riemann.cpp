@@ -74,7 +74,7 @@ bool junction_state(std::span<const VesselLaw* const> laws, std::span<const doub
   std::array<double, max_ends> mu{}, x{}, f{}, dpt{};
   for (std::size_t i = 0; i < n; ++i) {
     mu[i] = incoming_speed(*laws[i], a[i], q[i], sign[i] > 0);
-    x[i] = a[i];
+    x[i] = out[i].area > 0 ? out[i].area : a[i];
   }
   for (int it = 0; it < 50; ++it) {
     // f_0 = sum sign Q* (mass); f_i = P_t,i - P_t,0 (total pressure), i >= 1. The Jacobian

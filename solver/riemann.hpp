@@ -43,7 +43,8 @@ EndState reflection_state(const VesselLaw& law, double a, double q, double a0, d
 // A junction of n vessel ends: traces (a, q) in, end states out; sign +1 for a vessel
 // whose distal end meets the node (its flow enters the node), -1 for a proximal end.
 // Newton on the areas: sum sign Q* = 0 and equal total pressure p + rho u^2 / 2.
-// Returns false if Newton did not converge.
+// Returns false if Newton did not converge. out's areas, where positive, are taken as the
+// first guess (the previous step's solution saves an iteration or two).
 bool junction_state(std::span<const VesselLaw* const> laws, std::span<const double> a,
                     std::span<const double> q, std::span<const int> sign,
                     std::span<EndState> out);
