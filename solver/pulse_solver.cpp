@@ -9,7 +9,6 @@
 #include <omp.h>
 
 #include "cli/errors.hpp"
-#include "physics/rheology.hpp"
 #include "physics/wall_law.hpp"
 #include "solver/solution_breakdown.hpp"
 #include "solver/steady_flow.hpp"
@@ -178,7 +177,7 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
       wave = dt_wave;
       wave_vessel = v;
     }
-    const double rate = friction_k_ * viscosity(v, a) / (blood_.density * a);
+    const double rate = friction_k_ * viscosity_(a) / (blood_.density * a);
     const double stability = scheme_ == TimeScheme::runge_kutta4 ? 2.78 : 1.0;
     const double dt_friction = scheme_ == TimeScheme::exponential_ab2
                                    ? std::numeric_limits<double>::infinity()
@@ -283,7 +282,6 @@ void PulseSolver::step() {
 
 // ---- the right-hand side -------------------------------------------------------------------
 
-double PulseSolver::viscosity(std::size_t, double area) const { return viscosity_(area); }
 
 // The element-local part of the right-hand side for elements [first, first + count): point
 // values, volume fluxes, friction, traces. Rows are independent, so blocks run in parallel
@@ -504,7 +502,7 @@ double PulseSolver::pressure_at(std::size_t vessel, double x) const {
 }
 
 double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
-  return viscosity(vessel, area_at(vessel, x));
+  return viscosity_(area_at(vessel, x));
 }
 
 double PulseSolver::mean_flow(std::size_t vessel) const {

@@ -89,7 +89,6 @@ class PulseSolver {
   void start_at_rest();
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
   double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;
-  double viscosity(std::size_t vessel, double area) const;
 
   const Network& net_;
   Blood blood_;
