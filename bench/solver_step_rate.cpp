@@ -1,6 +1,6 @@
 // Step rate of hemosolve's solver on a network: time step, steps per second (median of
 // several timed batches) and the wall time per cardiac cycle that follows from them.
-// usage: [HEMOTREE_THREADS=n] solver_step_rate NET [degree] [steps per batch] [batches] [etd2|ab2|rk4]
+// usage: [HEMOTREE_THREADS=n] solver_step_rate NET [degree|auto|auto:LOW:RAISE] [steps per batch] [batches] [etd2|ab2|rk4]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -20,7 +20,16 @@ int main(int argc, char** argv) {
   }
   const Network net = read_network(argv[1]);
   SolverOptions options;
-  options.degree = argc > 2 ? std::atoi(argv[2]) : 7;
+  const std::string degree = argc > 2 ? argv[2] : "auto";
+  if (degree.starts_with("auto")) {
+    if (degree.size() > 4 && std::sscanf(degree.c_str(), "auto:%d:%d", &options.degree_rule.low,
+                                         &options.degree_rule.raise_to) != 2) {
+      std::fprintf(stderr, "degree: auto, auto:LOW:RAISE or a number\n");
+      return 2;
+    }
+  } else {
+    options.degree = std::atoi(degree.c_str());
+  }
   if (const char* t = std::getenv("HEMOTREE_THREADS")) options.threads = std::atoi(t);
   if (argc > 5) {
     const std::string scheme = argv[5];
@@ -41,8 +50,8 @@ int main(int argc, char** argv) {
   std::sort(rates.begin(), rates.end());
   const double rate = rates[rates.size() / 2];
   const double period = net.inlet->waveform.period;
-  std::printf("vessels %zu, elements %zu, degree %d, threads %d, dt %.3g s (%s)\n",
-              net.vessel_count(), solver.element_count(), options.degree, options.threads, solver.dt(),
+  std::printf("vessels %zu, elements %zu, degree %s, threads %d, dt %.3g s (%s)\n",
+              net.vessel_count(), solver.element_count(), degree.c_str(), options.threads, solver.dt(),
               solver.dt_reason().c_str());
   std::printf("median %.1f steps/s over %d batches of %d steps (min %.1f, max %.1f)\n", rate,
               batches, steps, rates.front(), rates.back());

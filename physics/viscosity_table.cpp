@@ -32,19 +32,6 @@ ViscosityTable::ViscosityTable(const Blood& blood) : blood_(blood) {
         pries_relative_viscosity(std::exp(log_d_min_ + (k - 2) * step_), blood.hematocrit);
 }
 
-double ViscosityTable::operator()(double area) const {
-  if (constant_) return value_;
-  const double log_d = 0.5 * std::log(4 * area / std::numbers::pi);
-  if (log_d >= log_d_max_) return value_;
-  if (log_d < log_d_min_) return apparent_viscosity(blood_, std::exp(log_d));
-  // 4-point Lagrange interpolation on nodes k-1, k, k+1, k+2 around s = k + t.
-  const double s = (log_d - log_d_min_) / step_;
-  const auto k = static_cast<std::size_t>(s);
-  const double t = s - static_cast<double>(k);
-  const double* f = &table_[k + 1];  // f[0..3] = nodes k-1 .. k+2 (table offset by 2)
-  const double w0 = -t * (t - 1) * (t - 2) / 6, w1 = (t + 1) * (t - 1) * (t - 2) / 2;
-  const double w2 = -(t + 1) * t * (t - 2) / 2, w3 = (t + 1) * t * (t - 1) / 6;
-  return w0 * f[0] + w1 * f[1] + w2 * f[2] + w3 * f[3];
-}
+double ViscosityTable::below_table(double log_d) const { return apparent_viscosity(blood_, std::exp(log_d)); }
 
 }  // namespace hemotree

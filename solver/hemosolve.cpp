@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -64,6 +65,7 @@ void write_summary(const std::filesystem::path& dir, const Network& net, const P
                        {"diameter", net.diameter[v]},
                        {"length", net.length[v]},
                        {"class", to_string(net.vessel_class[v])},
+                       {"degree", solver.degree(v)},
                        {"mean_flow", c.mean_flow},
                        {"mean_pressure", c.mean_pressure},
                        {"systolic_pressure", c.systolic_pressure},
@@ -87,7 +89,7 @@ int main(int argc, char** argv) {
                "discontinuous Galerkin) and report flows, pressures and pulsatility.",
                "hemosolve"};
   std::string input, out_dir, rheology, scheme = "etd2", start = "steady", dt_text, sample_text = "1ms",
-              external_text = "10mmHg";
+              external_text = "10mmHg", degree_text = "auto";
   int cycles = 0, max_cycles = 50;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
@@ -101,10 +103,21 @@ int main(int argc, char** argv) {
   app.add_option("--max-cycles", max_cycles, "upper bound for --until-periodic")->capture_default_str();
   app.add_option("--probe", probe_texts, "record p, Q, A, u at vessel ID, fraction x along it (ID[:x], x 0.5 by default)");
   app.add_option("--sample-interval", sample_text, "time between probe samples")->capture_default_str();
-  app.add_option("--degree", options.degree, "polynomial degree p")->capture_default_str();
+  app.add_option("--degree", degree_text,
+                 "polynomial degree p in every vessel, or auto: per vessel, --low-degree in vessels much "
+                 "shorter than the pulse's wavelength (raised up to --raise-degree where the time step "
+                 "allows), --high-degree elsewhere")
+      ->capture_default_str();
+  app.add_option("--low-degree", options.degree_rule.low, "auto: degree of acoustically short vessels")
+      ->capture_default_str();
+  app.add_option("--raise-degree", options.degree_rule.raise_to,
+                 "auto: the most a short vessel is raised to at no cost in time step")
+      ->capture_default_str();
+  app.add_option("--high-degree", options.degree_rule.high, "auto: degree of the other vessels")
+      ->capture_default_str();
   app.add_option("--elements", options.elements, "elements per vessel")->capture_default_str();
   app.add_option("--dt", dt_text, "time step (default: from the CFL and friction limits)");
-  app.add_option("--cfl", options.cfl, "safety factor on the wave-speed limit")->capture_default_str();
+  app.add_option("--cfl", options.cfl, "fraction of the wave-speed (Courant) stability limit of the degree and scheme")->capture_default_str();
   app.add_option("--scheme", scheme, "time scheme: etd2 (Adams-Bashforth 2 with exact friction), ab2 (the paper's) or rk4")->capture_default_str();
   app.add_option("--rheology", rheology, "pries or newtonian (default: the network's blood)");
   app.add_option("--start", start, "initial state: steady (Poiseuille solution) or rest")->capture_default_str();
@@ -134,25 +147,38 @@ int main(int argc, char** argv) {
       if (!(options.dt > 0)) throw InputError("--dt must be positive");
     }
     if (!(options.cfl > 0)) throw InputError("--cfl must be positive");
+    if (degree_text != "auto") {
+      std::size_t used = 0;
+      try {
+        options.degree = std::stoi(degree_text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != degree_text.size() || options.degree < 0)
+        throw InputError("--degree must be auto or a whole number from 0 to 30");
+    }
+    for (const int p : {options.degree_rule.low, options.degree_rule.raise_to, options.degree_rule.high})
+      if (p < 0 || p > 30) throw InputError("--low-degree, --raise-degree and --high-degree must lie in 0..30");
     options.external_pressure = parse_quantity(external_text, Dimension::pressure, "--external-pressure");
     const double sample_interval = parse_quantity(sample_text, Dimension::time, "--sample-interval");
 
     const Network net = read_network(input);
     std::vector<Probe> probes;
     for (const auto& t : probe_texts) probes.push_back(parse_probe(t, net));
-    PulseSolver solver(net, options);
-    const double period = net.inlet->waveform.period;
-    const auto steps_per_cycle = static_cast<std::size_t>(std::ceil(period / solver.dt() - 1e-9));
-    const double dt = period / static_cast<double>(steps_per_cycle);  // a whole number per cycle
-    if (!quiet)
-      note("time step " + number(dt) + " s (" + solver.dt_reason() + "), " +
-           std::to_string(steps_per_cycle) + " steps per cycle, " +
-           std::to_string(solver.element_count()) + " elements of degree " +
-           std::to_string(options.degree));
-    // Rebuild with the rounded step so that cycles end exactly on a step.
-    options.dt = dt;
-    const std::string dt_reason = solver.dt_reason();
     PulseSolver run(net, options);
+    const double period = net.inlet->waveform.period;
+    const auto steps_per_cycle = static_cast<std::size_t>(std::ceil(period / run.dt() - 1e-9));
+    const double dt = period / static_cast<double>(steps_per_cycle);  // a whole number per cycle
+    const std::string dt_reason = run.dt_reason();
+    run.set_time_step(dt);  // slightly smaller, so that cycles end exactly on a step
+    std::map<int, std::size_t> degrees;  // elements per degree
+    for (std::size_t v = 0; v < net.vessel_count(); ++v) degrees[run.degree(v)] += static_cast<std::size_t>(options.elements);
+    std::string degree_list;
+    for (const auto& [p, count] : degrees)
+      degree_list += (degree_list.empty() ? "" : ", ") + std::to_string(count) + " of degree " + std::to_string(p);
+    if (!quiet)
+      note("time step " + number(dt) + " s (" + dt_reason + "), " + std::to_string(steps_per_cycle) +
+           " steps per cycle, " + std::to_string(run.element_count()) + " elements: " + degree_list);
 
     std::filesystem::path dir(out_dir);
     std::error_code ec;
@@ -192,12 +218,15 @@ int main(int argc, char** argv) {
     const bool show = !quiet && stderr_is_terminal();
     const auto started = std::chrono::steady_clock::now();
     nlohmann::json run_info = {{"tool", "hemosolve"}, {"version", HEMOTREE_VERSION},
-                               {"network", input}, {"degree", options.degree},
+                               {"network", input},
+                               {"degree", options.degree == SolverOptions::automatic ? nlohmann::json("auto")
+                                                                                     : nlohmann::json(options.degree)},
                                {"elements_per_vessel", options.elements}, {"scheme", scheme},
                                {"threads", options.threads},
                                {"rheology", to_string(run.blood().rheology)},
                                {"start", start}, {"period", period},
                                {"time_step_limit", dt_reason}};
+    for (const auto& [p, count] : degrees) run_info["elements_of_degree"][std::to_string(p)] = count;
     try {
       sample_probes();
       for (; done < planned; ++done) {

@@ -6,7 +6,8 @@
 
 namespace hemotree {
 
-NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element) {
+NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element,
+                                   int elements_per_vessel) {
   auto name = [&](std::size_t v) { return "vessel " + std::to_string(net.id[v]); };
   const std::size_t n = net.vessel_count();
   if (n == 0) throw InputError("the network has no vessels");
@@ -18,7 +19,7 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
   std::vector<std::vector<VesselEnd>> at_node(net.node_count());
   for (std::size_t v = 0; v < n; ++v) {
     at_node[net.from[v]].push_back({static_cast<std::int32_t>(v), first_element[v], false});
-    at_node[net.to[v]].push_back({static_cast<std::int32_t>(v), first_element[v + 1] - 1, true});
+    at_node[net.to[v]].push_back({static_cast<std::int32_t>(v), first_element[v] + elements_per_vessel - 1, true});
   }
   std::vector<std::int32_t> outlet_of(n, -1);
   for (std::size_t k = 0; k < net.outlets.size(); ++k) outlet_of[net.outlets[k].vessel] = static_cast<std::int32_t>(k);

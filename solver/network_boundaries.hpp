@@ -43,7 +43,8 @@ struct NetworkBoundaries {
   std::vector<EndState> end_state;
 };
 
-// first_element[v] .. first_element[v + 1] are vessel v's elements.
-NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element);
+// Vessel v's elements are first_element[v] .. first_element[v] + elements_per_vessel - 1.
+NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element,
+                                   int elements_per_vessel);
 
 }  // namespace hemotree

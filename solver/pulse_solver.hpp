@@ -13,25 +13,23 @@
 
 #include "formats/network.hpp"
 #include "physics/viscosity_table.hpp"
+#include "solver/degree_choice.hpp"
 #include "solver/legendre_basis.hpp"
 #include "solver/network_boundaries.hpp"
+#include "solver/time_scheme.hpp"
 #include "solver/vessel_equations.hpp"
 
 namespace hemotree {
 
-// adams_bashforth2: the paper's explicit scheme, time step bounded by the friction stiffness
-// of the smallest vessels; exponential_ab2: the same with the linear friction -r Q of each
-// element integrated exactly (Cox & Matthews 2002 ETD2), so only the wave speed bounds the
-// step; runge_kutta4: classical, explicit.
-enum class TimeScheme { adams_bashforth2, exponential_ab2, runge_kutta4 };
-
 struct SolverOptions {
-  int degree = 7;           // p
+  static constexpr int automatic = -1;
+  int degree = automatic;   // p in every vessel, or chosen per vessel by degree_rule
+  DegreeRule degree_rule;
   int elements = 1;         // per vessel
   int quadrature_points = 0;  // 0: the default over-integration
   TimeScheme scheme = TimeScheme::exponential_ab2;
   double dt = 0;            // 0: chosen from the stability limits
-  double cfl = 0.2;         // safety on the wave-speed limit (AB2 needs <= 0.25 at p = 7, e = 2)
+  double cfl = 0.9;         // fraction of the wave-speed (Courant) limit of the degree and scheme
   double friction_safety = 0.5;  // safety on the friction-stiffness limit
   double external_pressure = 10 * 133.322;  // p_ext for the wall laws [Pa]
   double thick_wall_ratio = 0.1;
@@ -60,6 +58,8 @@ class PulseSolver {
   void step();  // advances one time step
   double time() const { return time_; }
   double dt() const { return dt_; }
+  // Replaces the chosen step (e.g. by one that divides the period); the reason stays.
+  void set_time_step(double dt) { dt_ = dt; }
   const std::string& dt_reason() const { return dt_reason_; }
   std::size_t steps() const { return steps_; }
 
@@ -73,7 +73,8 @@ class PulseSolver {
 
   const VesselLaw& law(std::size_t vessel) const { return laws_[vessel]; }
   const Blood& blood() const { return blood_; }
-  const ModalBasis& basis() const { return basis_; }
+  int degree(std::size_t vessel) const { return vessel_degree_[vessel]; }
+  int max_degree() const { return static_cast<int>(bases_.size()) - 1; }
   std::size_t element_count() const { return static_cast<std::size_t>(state_.area.rows()); }
   const PulseState& state() const { return state_; }
   // Throws SolutionBreakdown when A <= 0 or a value is not finite.
@@ -82,20 +83,33 @@ class PulseSolver {
  private:
   void evaluate(double t, const PulseState& s, PulseState& rate);
   // Returns the first element whose area is not positive and finite, or -1.
-  Eigen::Index element_terms(const PulseState& s, PulseState& rate, Eigen::Index first, Eigen::Index count);
+  Eigen::Index element_terms(const PulseState& s, PulseState& rate, const ModalBasis& basis, Eigen::Index first,
+                             Eigen::Index count);
   void step_exponential();
   void choose_time_step(const SolverOptions& options);
   void start_from_steady_flow(const Network& net);
   void start_at_rest();
+  void choose_degrees_and_elements(const SolverOptions& options);
+  std::int32_t end_element(std::size_t vessel) const { return first_element_[vessel] + elements_per_vessel_; }
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
   double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;
 
   const Network& net_;
   Blood blood_;
   ViscosityTable viscosity_;
-  ModalBasis basis_;
   std::vector<VesselLaw> laws_;            // per vessel
-  std::vector<std::int32_t> first_element_;  // per vessel, and one past the last
+  // Elements are numbered by degree, so that each degree is one block of rows that the
+  // basis of that degree acts on at once; rows have the columns of the highest degree
+  // (unused modes stay zero).
+  struct DegreeBlock {
+    int degree;
+    Eigen::Index first, count;
+  };
+  std::vector<ModalBasis> bases_;          // by degree; empty where unused
+  std::vector<DegreeBlock> blocks_;
+  std::vector<int> vessel_degree_;         // per vessel
+  int elements_per_vessel_ = 1;
+  std::vector<std::int32_t> first_element_;  // per vessel: its elements are consecutive
   std::vector<std::int32_t> element_vessel_; // per element
   Eigen::VectorXd half_length_;            // per element: the Jacobian J = h / 2
   Eigen::VectorXd element_beta_;           // per element

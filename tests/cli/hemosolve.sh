@@ -36,7 +36,7 @@ assert abs(s["steps"] * s["time_step"] - s["period"]) <= 1e-9 * s["period"], (s[
 assert "wave speed" in s["time_step_limit"] or "friction" in s["time_step_limit"], s["time_step_limit"]
 assert s["units"] == {"flow": "m^3/s", "pressure": "Pa", "length": "m"}, s["units"]
 
-keys = {"id", "diameter", "length", "class", "mean_flow", "mean_pressure", "systolic_pressure",
+keys = {"id", "diameter", "length", "class", "degree", "mean_flow", "mean_pressure", "systolic_pressure",
         "diastolic_pressure", "pulsatility_index"}
 by_id = {v["id"]: v for v in net["vessels"]}
 rows = s["vessels"]
@@ -50,7 +50,8 @@ for r in rows:
     expected = ("artery" if d >= 500e-6 else "small_artery" if d >= 100e-6
                 else "arteriole" if d >= 10e-6 else "capillary")
     assert r["class"] == expected, (r["id"], r["class"], d)
-    for k in keys - {"id", "class"}:
+    assert r["degree"] == 2, r
+    for k in keys - {"id", "class", "degree"}:
         assert isinstance(r[k], (int, float)) and math.isfinite(r[k]), (r["id"], k, r[k])
     assert 0 < r["diastolic_pressure"] <= r["mean_pressure"] <= r["systolic_pressure"] < 40000, r
     pi = (r["systolic_pressure"] - r["diastolic_pressure"]) / r["mean_pressure"]
