@@ -3,36 +3,104 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace hemotree {
 
-CycleStatistics::CycleStatistics(std::size_t vessels)
-    : flow_(vessels, 0.0), pressure_(vessels, 0.0),
-      p_min_(vessels, std::numeric_limits<double>::infinity()),
-      p_max_(vessels, -std::numeric_limits<double>::infinity()) {}
-
-void CycleStatistics::sample(const PulseSolver& solver, double dt) {
-  // Rectangle rule over the steps: second order is not needed for means over thousands.
-  for (std::size_t v = 0; v < flow_.size(); ++v) {
-    const double p = solver.pressure_at(v, 0.5);
-    flow_[v] += dt * solver.mean_flow(v);
-    pressure_[v] += dt * p;
-    p_min_[v] = std::min(p_min_[v], p);
-    p_max_[v] = std::max(p_max_[v], p);
-  }
-  duration_ += dt;
+double wall_shear_stress(double viscosity, double mean_velocity, double radius, double alpha) {
+  return viscosity * mean_velocity * alpha / ((alpha - 1) * radius);
 }
 
-std::vector<VesselCycle> CycleStatistics::close() {
-  std::vector<VesselCycle> out(flow_.size());
+double phase_velocity(std::complex<double> z0, std::complex<double> z1, double omega, double dx) {
+  // A wave exp(i(omega t - k x)) has z(x) ~ exp(-i k x): z0 conj(z1) = |.| exp(i k dx).
+  const double lag = std::arg(z0 * std::conj(z1));
+  if (!(lag > 0) || !(std::abs(z0) > 0) || !(std::abs(z1) > 0)) return std::numeric_limits<double>::quiet_NaN();
+  return omega * dx / lag;
+}
+
+CycleStatistics::CycleStatistics(const Network& net, double analysis_frequency, std::size_t inlet,
+                                 std::vector<std::size_t> outlets)
+    : net_(net), omega_(2 * std::numbers::pi * analysis_frequency), inlet_(inlet), outlets_(std::move(outlets)),
+      flow_(net.vessel_count(), 0.0), pressure_(net.vessel_count(), 0.0),
+      p_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
+      p_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()), wss_(net.vessel_count(), 0.0),
+      reynolds_(net.vessel_count(), 0.0), p_in_(net.vessel_count()), p_out_(net.vessel_count()),
+      u_in_(net.vessel_count()), u_out_(net.vessel_count()), first_(4 * net.vessel_count()),
+      last_(4 * net.vessel_count()) {}
+
+void CycleStatistics::sample(const PulseSolver& solver, double t, double weight) {
+  // Rectangle rule: spectrally accurate for the means of periodic signals.
+  const double rho = solver.blood().density, alpha = solver.blood().alpha;
+  solver.sample_all(0.5, area_, q_);
+  for (std::size_t v = 0; v < flow_.size(); ++v) {
+    const double a = area_[v], q = q_[v], u = q / a;
+    const double p = solver.law(v).pressure(a), mu = solver.viscosity(a);
+    const double radius = std::sqrt(a / std::numbers::pi);
+    flow_[v] += weight * solver.mean_flow(v);
+    pressure_[v] += weight * p;
+    p_min_[v] = std::min(p_min_[v], p);
+    p_max_[v] = std::max(p_max_[v], p);
+    wss_[v] += weight * wall_shear_stress(mu, u, radius, alpha);
+    reynolds_[v] += weight * rho * u * 2 * radius / mu;
+  }
+  const std::complex<double> phase = weight * std::polar(1.0, -omega_ * t);
+  const bool first = duration_ == 0;
+  if (first) first_time_ = t;
+  last_time_ = t;
+  auto record = [&](std::size_t k, double value) {
+    if (first) first_[k] = value;
+    last_[k] = value;
+  };
+  solver.sample_all(0.0, area_end_, q_end_);
+  for (std::size_t v = 0; v < flow_.size(); ++v) {
+    const double p = solver.law(v).pressure(area_end_[v]), u = q_end_[v] / area_end_[v];
+    p_in_[v] += phase * p;
+    u_in_[v] += phase * u;
+    record(4 * v, p);
+    record(4 * v + 2, u);
+  }
+  inlet_flow_ += weight * q_end_[inlet_];
+  solver.sample_all(1.0, area_end_, q_end_);
+  for (std::size_t v = 0; v < flow_.size(); ++v) {
+    const double p = solver.law(v).pressure(area_end_[v]), u = q_end_[v] / area_end_[v];
+    p_out_[v] += phase * p;
+    u_out_[v] += phase * u;
+    record(4 * v + 1, p);
+    record(4 * v + 3, u);
+  }
+  for (const std::size_t v : outlets_) outlets_flow_ += weight * q_end_[v];
+  duration_ += weight;
+}
+
+CycleSummary CycleStatistics::close() {
+  CycleSummary summary;
+  summary.inlet_mean_flow = inlet_flow_ / duration_;
+  summary.outlets_mean_flow = outlets_flow_ / duration_;
+  inlet_flow_ = outlets_flow_ = 0;
+  std::vector<VesselCycle>& out = summary.vessels;
+  out.resize(flow_.size());
+  // A linear drift s(t) = slope (t - t0) over the cycle [t0, t0 + T] has the Fourier sum
+  // slope e^(-i omega t0) i T / omega at a harmonic omega = 2 pi k / T; it is taken out.
+  const double slope_span = last_time_ > first_time_ ? duration_ / (last_time_ - first_time_) : 0.0;
+  const std::complex<double> drift = std::polar(1.0, -omega_ * (last_time_ - duration_)) * std::complex<double>(0, 1 / omega_);
+  auto detrended = [&](std::complex<double> sum, std::size_t k) { return sum - (last_[k] - first_[k]) * slope_span * drift; };
   for (std::size_t v = 0; v < out.size(); ++v) {
-    out[v] = {flow_[v] / duration_, pressure_[v] / duration_, p_max_[v], p_min_[v]};
-    flow_[v] = pressure_[v] = 0;
+    VesselCycle& c = out[v];
+    c.mean_flow = flow_[v] / duration_;
+    c.mean_pressure = pressure_[v] / duration_;
+    c.systolic_pressure = p_max_[v];
+    c.diastolic_pressure = p_min_[v];
+    c.mean_wss = wss_[v] / duration_;
+    c.reynolds = reynolds_[v] / duration_;
+    c.pwv_pressure = phase_velocity(detrended(p_in_[v], 4 * v), detrended(p_out_[v], 4 * v + 1), omega_, net_.length[v]);
+    c.pwv_velocity = phase_velocity(detrended(u_in_[v], 4 * v + 2), detrended(u_out_[v], 4 * v + 3), omega_, net_.length[v]);
+    flow_[v] = pressure_[v] = wss_[v] = reynolds_[v] = 0;
+    p_in_[v] = p_out_[v] = u_in_[v] = u_out_[v] = 0;
     p_min_[v] = std::numeric_limits<double>::infinity();
     p_max_[v] = -std::numeric_limits<double>::infinity();
   }
   duration_ = 0;
-  return out;
+  return summary;
 }
 
 PeriodicityChange cycle_change(const std::vector<VesselCycle>& previous,

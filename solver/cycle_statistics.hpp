@@ -1,12 +1,15 @@
-// Per-vessel statistics over one cardiac cycle, sampled every time step at each vessel's
-// centre: mean flow, mean, systolic and diastolic pressure, pulsatility index; and the
-// cycle-to-cycle change that decides when the solution is periodic.
+// Per-vessel statistics over one cardiac cycle, sampled every few steps:
+// - at each vessel's centre: mean, systolic and diastolic pressure, pulsatility index, mean
+//   wall shear stress (the paper's eq. WSS) and Reynolds number;
+// - over the vessel: mean flow (its mode-0 coefficients);
+// - at both ends: one Fourier coefficient of pressure and velocity, whose phase lag along
+//   the vessel gives the measured pulse wave speeds;
+// and the cycle-to-cycle change that decides when the solution is periodic.
 #pragma once
 
+#include <complex>
 #include <cstdint>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "solver/pulse_solver.hpp"
 
@@ -15,20 +18,56 @@ namespace hemotree {
 struct VesselCycle {
   double mean_flow = 0, mean_pressure = 0;
   double systolic_pressure = 0, diastolic_pressure = 0;
+  double mean_wss = 0;   // [Pa]
+  double reynolds = 0;   // rho u D / mu, cycle mean
+  // Phase velocity omega L / (phase lag from inlet end to outlet end) at the analysis
+  // frequency [m/s]; NaN where the lag is not positive (standing or backward waves).
+  double pwv_pressure = 0, pwv_velocity = 0;
   double pulsatility_index() const {
     return (systolic_pressure - diastolic_pressure) / mean_pressure;
   }
 };
 
+// Wall shear stress of the axisymmetric profile of the momentum-flux coefficient alpha,
+// u(r) ~ 1 - (r/R)^zeta with alpha = (zeta + 2)/(zeta + 1): tau = mu u alpha / ((alpha - 1) R),
+// 4 mu u / R for Poiseuille (alpha = 4/3).
+double wall_shear_stress(double viscosity, double mean_velocity, double radius, double alpha);
+
+// The phase velocity omega dx / arg(z0 conj(z1)) of a wave whose Fourier coefficients at
+// two points dx apart are z0 (upstream) and z1; NaN unless the lag lies in (0, pi).
+double phase_velocity(std::complex<double> z0, std::complex<double> z1, double omega, double dx);
+
+struct CycleSummary {
+  std::vector<VesselCycle> vessels;
+  // Mean flow in at the inlet and out through all outlets: over a periodic cycle the
+  // compliances store nothing, so they agree to the discretization's mass balance.
+  double inlet_mean_flow = 0, outlets_mean_flow = 0;
+};
+
 class CycleStatistics {
  public:
-  explicit CycleStatistics(std::size_t vessels);
-  void sample(const PulseSolver& solver, double dt);  // after a step of length dt
+  // analysis_frequency: the harmonic [Hz] at which the pulse wave speeds are measured;
+  // inlet: the inlet vessel's index; outlets: the outlet vessels' indices.
+  CycleStatistics(const Network& net, double analysis_frequency, std::size_t inlet,
+                  std::vector<std::size_t> outlets);
+  // Samples the solver's state at time t, standing for the `weight` seconds before it.
+  void sample(const PulseSolver& solver, double t, double weight);
   // Closes the cycle: returns the statistics and starts the next cycle.
-  std::vector<VesselCycle> close();
+  CycleSummary close();
 
  private:
-  std::vector<double> flow_, pressure_, p_min_, p_max_;
+  const Network& net_;
+  double omega_;
+  std::size_t inlet_;
+  std::vector<std::size_t> outlets_;
+  double inlet_flow_ = 0, outlets_flow_ = 0;
+  std::vector<double> flow_, pressure_, p_min_, p_max_, wss_, reynolds_;
+  // Fourier sums at the ends, and each signal's first and last sample of the cycle: a
+  // cycle that is not yet periodic drifts, and the drift's own Fourier component is removed.
+  std::vector<std::complex<double>> p_in_, p_out_, u_in_, u_out_;
+  std::vector<double> first_, last_;  // per vessel: p_in, p_out, u_in, u_out
+  double first_time_ = 0, last_time_ = 0;
+  std::vector<double> area_, q_, area_end_, q_end_;  // scratch
   double duration_ = 0;
 };
 

@@ -16,7 +16,9 @@
 #include "cli/units.hpp"
 #include "formats/network_io.hpp"
 #include "solver/cycle_statistics.hpp"
+#include "formats/vtk_series.hpp"
 #include "solver/pulse_solver.hpp"
+#include "solver/run_report.hpp"
 #include "solver/solution_breakdown.hpp"
 
 using namespace hemotree;
@@ -56,32 +58,6 @@ std::string number(double v) {
   return std::string(text, format_real(text, v));
 }
 
-void write_summary(const std::filesystem::path& dir, const Network& net, const PulseSolver& solver,
-                   const nlohmann::json& run, const std::vector<VesselCycle>& last) {
-  nlohmann::json vessels = nlohmann::json::array();
-  for (std::size_t v = 0; v < last.size(); ++v) {
-    const VesselCycle& c = last[v];
-    vessels.push_back({{"id", net.id[v]},
-                       {"diameter", net.diameter[v]},
-                       {"length", net.length[v]},
-                       {"class", to_string(net.vessel_class[v])},
-                       {"degree", solver.degree(v)},
-                       {"mean_flow", c.mean_flow},
-                       {"mean_pressure", c.mean_pressure},
-                       {"systolic_pressure", c.systolic_pressure},
-                       {"diastolic_pressure", c.diastolic_pressure},
-                       {"pulsatility_index", c.pulsatility_index()}});
-  }
-  nlohmann::json summary = run;
-  summary["time_step"] = solver.dt();
-  summary["time_step_limit"] = run.value("time_step_limit", solver.dt_reason());
-  summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}};
-  summary["vessels"] = vessels;
-  OutputStream out((dir / "summary.json").string());
-  out << summary.dump(1) << '\n';
-  out.commit();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -93,7 +69,8 @@ int main(int argc, char** argv) {
   int cycles = 0, max_cycles = 50;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
-  bool quiet = false;
+  bool quiet = false, vtk = false;
+  int frames = 0;
   SolverOptions options;
   app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
   app.add_option("--out", out_dir, "folder for summary.json and probes.csv")->required();
@@ -125,6 +102,10 @@ int main(int argc, char** argv) {
   app.add_option("--thick-wall-ratio", options.thick_wall_ratio, "h/D above which a wall is thick")->capture_default_str();
   app.add_option("--threads", options.threads, "threads over elements (use the idle cores; results agree to round-off)")
       ->capture_default_str();
+  app.add_flag("--vtk", vtk, "also write the network with every per-vessel result as VTK (results.vtp, for ParaView)");
+  app.add_option("--frames", frames,
+                 "write N frames of the last cycle (p, Q, A, u per vessel) as a ParaView time series "
+                 "(frames/frames.pvd)");
   app.add_flag("--quiet", quiet, "no progress line");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
@@ -162,7 +143,10 @@ int main(int argc, char** argv) {
     options.external_pressure = parse_quantity(external_text, Dimension::pressure, "--external-pressure");
     const double sample_interval = parse_quantity(sample_text, Dimension::time, "--sample-interval");
 
+    if (frames < 0) throw InputError("--frames must be positive");
     const Network net = read_network(input);
+    if ((vtk || frames > 0) && net.x.empty())
+      throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
     std::vector<Probe> probes;
     for (const auto& t : probe_texts) probes.push_back(parse_probe(t, net));
     PulseSolver run(net, options);
@@ -209,8 +193,36 @@ int main(int argc, char** argv) {
     };
 
     const auto sample_every = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(sample_interval / dt)));
-    CycleStatistics stats(net.vessel_count());
-    std::vector<VesselCycle> last, previous;
+    const Waveform& pulse = net.inlet->waveform;
+    const double frequency = analysis_frequency(pulse);
+    std::vector<std::size_t> outlet_vessels;
+    for (const Outlet& o : net.outlets) outlet_vessels.push_back(static_cast<std::size_t>(o.vessel));
+    CycleStatistics stats(net, frequency, static_cast<std::size_t>(net.index_of(net.inlet->vessel)), outlet_vessels);
+    // Statistics every 1e-4 of a period (or every step if that is longer): means and extrema
+    // of the smooth pulse are then exact to ~1e-7, at a few per cent of the run's time.
+    const auto stats_every = std::max<std::size_t>(1, static_cast<std::size_t>(1e-4 * period / dt));
+    CycleSummary last, previous;
+    nlohmann::json results;
+    auto report = [&](const nlohmann::json& info) {
+      results = vessel_results(net, run, last, frequency);
+      write_summary(dir / "summary.json", info, results, last);
+      if (vtk) write_results_vtk(dir / "results.vtp", net, results);
+    };
+    std::vector<double> frame_area, frame_flow, frame_pressure, frame_velocity;
+    auto write_frame = [&](VtkTimeSeries& series) {
+      run.sample_all(0.5, frame_area, frame_flow);
+      frame_pressure.resize(frame_area.size());
+      frame_velocity.resize(frame_area.size());
+      for (std::size_t v = 0; v < frame_area.size(); ++v) {
+        frame_pressure[v] = run.law(v).pressure(frame_area[v]);
+        frame_velocity[v] = frame_flow[v] / frame_area[v];
+      }
+      series.add_frame(run.time(), {{"p", frame_pressure}, {"Q", frame_flow}, {"A", frame_area}, {"u", frame_velocity}});
+    };
+    if (frames > 0) {
+      std::filesystem::create_directories(dir / "frames", ec);
+      if (ec) throw IoError("cannot create " + (dir / "frames").string() + ": " + ec.message());
+    }
     PeriodicityChange change;
     int done = 0;
     const bool until_periodic = periodic_tol > 0;
@@ -225,14 +237,28 @@ int main(int argc, char** argv) {
                                {"threads", options.threads},
                                {"rheology", to_string(run.blood().rheology)},
                                {"start", start}, {"period", period},
+                               {"pulse_frequency", pulse_frequency(pulse)}, {"analysis_frequency", frequency},
+                               {"time_step", dt},
                                {"time_step_limit", dt_reason}};
     for (const auto& [p, count] : degrees) run_info["elements_of_degree"][std::to_string(p)] = count;
     try {
       sample_probes();
       for (; done < planned; ++done) {
+        // Every cycle could be the last (--until-periodic): its frames replace the previous ones.
+        std::optional<VtkTimeSeries> series;
+        if (frames > 0) series.emplace(net, dir / "frames", "frames");
+        std::size_t frames_written = 0;
+        double sampled_until = run.time();
         for (std::size_t k = 0; k < steps_per_cycle; ++k) {
           run.step();
-          stats.sample(run, dt);
+          if ((k + 1) % stats_every == 0 || k + 1 == steps_per_cycle) {
+            stats.sample(run, run.time(), run.time() - sampled_until);
+            sampled_until = run.time();
+          }
+          if (series && (k + 1) * static_cast<std::size_t>(frames) >= (frames_written + 1) * steps_per_cycle) {
+            write_frame(*series);
+            ++frames_written;
+          }
           if (run.steps() % sample_every == 0) sample_probes();
           if (show && k % 256 == 0) {
             const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -245,8 +271,9 @@ int main(int argc, char** argv) {
         run.check_solution();
         previous = std::move(last);
         last = stats.close();
-        if (!previous.empty()) change = cycle_change(previous, last);
-        if (until_periodic && !previous.empty() && change.change < periodic_tol) {
+        if (series) series->finish();
+        if (!previous.vessels.empty()) change = cycle_change(previous.vessels, last.vessels);
+        if (until_periodic && !previous.vessels.empty() && change.change < periodic_tol) {
           ++done;
           break;
         }
@@ -257,7 +284,7 @@ int main(int argc, char** argv) {
       run_info["error"] = e.what();
       run_info["cycles"] = done;
       write_probes();
-      if (!last.empty()) write_summary(dir, net, run, run_info, last);
+      if (!last.vessels.empty()) report(run_info);
       throw InputError(e.what());
     }
     if (show) std::fprintf(stderr, "\r\033[K");
@@ -266,16 +293,16 @@ int main(int argc, char** argv) {
     run_info["cycles"] = done;
     run_info["steps"] = run.steps();
     run_info["wall_time"] = wall;
-    if (!previous.empty()) {
+    if (!previous.vessels.empty()) {
       run_info["periodic_change"] = change.change;
       run_info["slowest_vessel"] = net.id[change.vessel];
     }
     write_probes();
-    write_summary(dir, net, run, run_info, last);
+    report(run_info);
     if (!quiet) {
       std::ostringstream m;
       m << done << " cycles in " << wall << " s";
-      if (!previous.empty())
+      if (!previous.vessels.empty())
         m << "; last cycle-to-cycle change " << change.change << " (vessel " << net.id[change.vessel] << ")";
       m << "; results in " << out_dir;
       note(m.str());

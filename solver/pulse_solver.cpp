@@ -568,6 +568,29 @@ double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
   return viscosity_(area_at(vessel, x));
 }
 
+void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<double>& flow) const {
+  const std::size_t n = net_.vessel_count();
+  area.resize(n);
+  flow.resize(n);
+  if (n == 0) return;
+  std::size_t element;
+  double xi;
+  locate(0, x, element, xi);
+  const auto k = static_cast<std::int32_t>(element) - first_element_[0];  // the same in every vessel
+  std::vector<double> phi(static_cast<std::size_t>(max_degree()) + 1);
+  for (std::size_t j = 0; j < phi.size(); ++j) phi[j] = legendre(static_cast<int>(j), xi);
+  for (std::size_t v = 0; v < n; ++v) {
+    const Eigen::Index el = first_element_[v] + k;
+    double a = 0, q = 0;
+    for (int j = 0; j <= vessel_degree_[v]; ++j) {
+      a += state_.area(el, j) * phi[static_cast<std::size_t>(j)];
+      q += state_.flow(el, j) * phi[static_cast<std::size_t>(j)];
+    }
+    area[v] = a;
+    flow[v] = q;
+  }
+}
+
 double PulseSolver::mean_flow(std::size_t vessel) const {
   double sum = 0;
   for (auto el = first_element_[vessel]; el < end_element(vessel); ++el) sum += state_.flow(el, 0);

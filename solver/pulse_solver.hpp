@@ -70,6 +70,10 @@ class PulseSolver {
   // Mean flow over the vessel (its mode-0 coefficients, averaged over its elements).
   double mean_flow(std::size_t vessel) const;
   double viscosity_at(std::size_t vessel, double x) const;  // [Pa s]
+  double viscosity(double area) const { return viscosity_(area); }  // [Pa s] at a lumen area
+  // Area and flow of every vessel at the same fraction x along each, in one pass (the cycle
+  // statistics sample all vessels every few steps).
+  void sample_all(double x, std::vector<double>& area, std::vector<double>& flow) const;
 
   const VesselLaw& law(std::size_t vessel) const { return laws_[vessel]; }
   const Blood& blood() const { return blood_; }

@@ -33,77 +33,18 @@
 #include "solver/solution_breakdown.hpp"
 #include "solver/stability_limit.hpp"
 #include "solver/vessel_equations.hpp"
+#include "tests/network_builders.hpp"
 
 using namespace hemotree;
+using namespace hemotree::test_networks;
 
 namespace {
 
 
 constexpr double pi = std::numbers::pi;
-constexpr double rho = 1050.0;
-
-Blood newtonian(double viscosity) {
-  Blood b;
-  b.density = rho;
-  b.rheology = Rheology::newtonian;
-  b.newtonian_viscosity = viscosity;
-  b.alpha = 4.0 / 3.0;
-  return b;
-}
-
-// beta that gives wave speed c at the reference area: c^2 = beta sqrt(A) / (2 rho).
-double beta_for_wave_speed(double c, double area) { return 2 * rho * c * c / std::sqrt(area); }
-
 // The Boileau et al. (2015) wall: beta = (4/3) sqrt(pi) E h / A0 (Poisson ratio 1/2).
 double boileau_beta(double youngs_modulus, double thickness, double area) {
   return 4.0 / 3.0 * std::sqrt(pi) * youngs_modulus * thickness / area;
-}
-
-// A chain of `count` equal vessels (ids 0..count-1) from node 0 to node count, with the tube
-// law given directly. Wall data are present too but unused (beta wins).
-Network chain(int count, double total_length, double diameter, double beta, double reference_pressure,
-              const Blood& blood) {
-  Network net;
-  for (int k = 0; k <= count; ++k) net.add_node(k);
-  for (int k = 0; k < count; ++k)
-    net.add_vessel(k, k, k + 1, total_length / count, diameter, 0.1 * diameter, 1e6, k);
-  net.beta.assign(static_cast<std::size_t>(count), beta);
-  net.reference_pressure.assign(static_cast<std::size_t>(count), reference_pressure);
-  net.blood = blood;
-  return net;
-}
-
-// A waveform tabulated from f on [0, duration] with `samples` points, and zero (the table
-// wraps linearly from the last sample to the first) until the period ends. Dense samples
-// make the linear interpolation error negligible: (dt_sample / sigma)^2 / 8 relative for a
-// Gaussian of width sigma.
-Waveform tabulate(const std::function<double(double)>& f, double duration, int samples, double period) {
-  Waveform w;
-  w.shape = Waveform::Shape::table;
-  w.period = period;
-  for (int k = 0; k < samples; ++k) {
-    const double t = duration * k / (samples - 1);
-    w.time.push_back(t);
-    w.flow.push_back(f(t));
-  }
-  return w;
-}
-
-Outlet reflection_outlet(std::int32_t vessel, double coefficient) {
-  Outlet o;
-  o.vessel = vessel;
-  o.type = OutletType::reflection;
-  o.reflection = coefficient;
-  return o;
-}
-
-Outlet resistance_outlet(std::int32_t vessel, double r, double p_out) {
-  Outlet o;
-  o.vessel = vessel;
-  o.type = OutletType::resistance;
-  o.r = r;
-  o.p_out = p_out;
-  return o;
 }
 
 // Time of the largest sample, refined by the parabola through it and its neighbours.

@@ -8,19 +8,12 @@
 #include "formats/network_io.hpp"
 #include "physics/rheology.hpp"
 #include "solver/steady_flow.hpp"
+#include "tests/network_builders.hpp"
 
 using namespace hemotree;
+using test_networks::resistance_outlet;
 
 namespace {
-
-Outlet resistance_outlet(std::int32_t vessel, double r, double p_out) {
-  Outlet o;
-  o.vessel = vessel;
-  o.type = OutletType::resistance;
-  o.r = r;
-  o.p_out = p_out;
-  return o;
-}
 
 // root 0 -> 1, daughters 1 -> 2 and 1 -> 3
 Network bifurcation(double d0, double d1, double d2) {

@@ -11,7 +11,7 @@ PY=/usr/bin/python3
 "$VGEN" --root-diameter 150um --min-diameter 8.5um \
   | "$VPRUNE" --budget 31 --mean-flow 0.01ml/min 2>"$WORK/prune.log" \
   | tee "$WORK/net.json" \
-  | "$HEMOSOLVE" - --out "$WORK/run" --cycles 1 --degree 2 --quiet --probe 0:0 --probe 1:1 \
+  | "$HEMOSOLVE" - --out "$WORK/run" --cycles 1 --degree 2 --quiet --probe 0:0 --probe 1:1 --vtk --frames 4 \
     >"$WORK/solve.out" 2>"$WORK/solve.err"
 status=("${PIPESTATUS[@]}")
 if [ "${status[0]}" -eq 0 ] && [ "${status[1]}" -eq 0 ] && [ "${status[2]}" -eq 0 ] && [ "${status[3]}" -eq 0 ]; then
@@ -34,10 +34,19 @@ assert s["time_step"] > 0
 assert abs(s["steps"] * s["time_step"] - s["period"]) <= 1e-9 * s["period"], (s["steps"], s["time_step"])
 # The real limit, not the rebuild's "given by --dt".
 assert "wave speed" in s["time_step_limit"] or "friction" in s["time_step_limit"], s["time_step_limit"]
-assert s["units"] == {"flow": "m^3/s", "pressure": "Pa", "length": "m"}, s["units"]
+assert s["units"]["flow"] == "m^3/s" and s["units"]["pressure"] == "Pa" and s["units"]["wss"] == "Pa", s["units"]
+# The half sine of 0.3 s in a 1 s cycle: 3.33 Hz, analysed at the nearest harmonic, 3 Hz.
+assert abs(s["pulse_frequency"] - 1 / 0.3) < 1e-9 and s["analysis_frequency"] == 3.0, s["analysis_frequency"]
+q_in = net["inlet"]["waveform"]["mean"]
+assert abs(s["inlet_mean_flow"] - q_in) <= 1e-3 * q_in, (s["inlet_mean_flow"], q_in)
+# The first cycle from the steady start changes the stored volume (here -10 %: the pulse's
+# mean pressures differ from the steady ones); periodic, it is 8e-5 (6 cycles, measured).
+assert abs(s["mass_balance"] - (s["inlet_mean_flow"] - s["outlets_mean_flow"]) / s["inlet_mean_flow"]) < 1e-12
+assert abs(s["mass_balance"]) < 0.2, s["mass_balance"]
 
 keys = {"id", "diameter", "length", "class", "degree", "mean_flow", "mean_pressure", "systolic_pressure",
-        "diastolic_pressure", "pulsatility_index"}
+        "diastolic_pressure", "pulsatility_index", "mean_wss", "reynolds", "womersley", "pwv_pressure",
+        "pwv_velocity", "pwv_elastic", "pwv_theory"}
 by_id = {v["id"]: v for v in net["vessels"]}
 rows = s["vessels"]
 assert len(rows) == len(net["vessels"]) == len(by_id), (len(rows), len(net["vessels"]))
@@ -51,8 +60,13 @@ for r in rows:
                 else "arteriole" if d >= 10e-6 else "capillary")
     assert r["class"] == expected, (r["id"], r["class"], d)
     assert r["degree"] == 2, r
-    for k in keys - {"id", "class", "degree"}:
+    for k in keys - {"id", "class", "degree", "pwv_pressure", "pwv_velocity"}:
         assert isinstance(r[k], (int, float)) and math.isfinite(r[k]), (r["id"], k, r[k])
+    for k in ("pwv_pressure", "pwv_velocity"):  # null where no forward wave is measurable
+        assert r[k] is None or (math.isfinite(r[k]) and r[k] > 0), (r["id"], k, r[k])
+    # Poiseuille: WSS = 4 mu u / R > 0 with forward flow; the theory lies below c0 (W < 1).
+    assert r["mean_wss"] > 0 and r["reynolds"] > 0 and 0 < r["womersley"] < 1, r
+    assert 0 < r["pwv_theory"] < r["pwv_elastic"], r
     assert 0 < r["diastolic_pressure"] <= r["mean_pressure"] <= r["systolic_pressure"] < 40000, r
     pi = (r["systolic_pressure"] - r["diastolic_pressure"]) / r["mean_pressure"]
     assert abs(r["pulsatility_index"] - pi) <= 1e-12 * max(1, pi), r
@@ -89,6 +103,32 @@ for r in data:
 # The inlet probe (vessel 0, x = 0) sees the prescribed half sine: zero in diastole.
 q_inlet = [r[2] for r in data]
 assert max(q_inlet) > 0 and abs(q_inlet[-2]) < 1e-3 * max(q_inlet)
+PY
+
+"$PY" - "$WORK/run" "$WORK/run/summary.json" <<'PY' && pass "--vtk and --frames: well-formed VTK with every result" || fail "--vtk/--frames"
+import json, math, os, sys
+import xml.etree.ElementTree as ET
+run, s = sys.argv[1], json.load(open(sys.argv[2]))
+n = len(s["vessels"])
+def cell_arrays(path):
+    root = ET.parse(path).getroot()  # raises on malformed XML
+    piece = root.find("./PolyData/Piece")
+    assert int(piece.get("NumberOfLines")) == n, piece.attrib
+    return {a.get("Name"): [float(x) for x in a.text.split()] for a in piece.find("CellData")}
+results = cell_arrays(os.path.join(run, "results.vtp"))
+for key in ("mean_flow", "mean_pressure", "pulsatility_index", "mean_wss", "pwv_pressure", "pwv_theory",
+            "womersley", "reynolds", "degree"):
+    assert key in results and len(results[key]) == n, key
+for row, value in zip(s["vessels"], results["mean_pressure"]):
+    assert abs(value - row["mean_pressure"]) <= 1e-8 * row["mean_pressure"], (row["id"], value)
+pvd = ET.parse(os.path.join(run, "frames", "frames.pvd")).getroot()
+sets = pvd.findall("./Collection/DataSet")
+times = [float(d.get("timestep")) for d in sets]
+assert len(sets) == 4 and times == sorted(times) and abs(times[-1] - s["period"]) < 1e-9, times
+for d in sets:
+    frame = cell_arrays(os.path.join(run, "frames", d.get("file")))
+    assert {"p", "Q", "A", "u"} <= set(frame), frame.keys()
+    assert all(math.isfinite(x) and x > 0 for x in frame["p"] + frame["A"])
 PY
 
 # ---- refusals ------------------------------------------------------------------------------
@@ -152,6 +192,8 @@ status=("${PIPESTATUS[@]}")
 # A degree outside 0..30 is bad input, not an internal error (it was exit 70 before b442c97).
 refuse "--degree -1" 2 "degree" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --degree -1
 refuse "--degree 31" 2 "degree" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --degree 31
+refuse "--degree two" 2 "degree" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --degree two
+refuse "--frames -1" 2 "frames" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --frames -1
 # High degree on coupled elements runs with the defaults (it broke down at t = 3 ms before the
 # step followed (p + 1)^2 above p = 7).
 "$HEMOSOLVE" "$CCA" --out "$WORK/high-degree" --degree 12 --elements 8 --cycles 1 --quiet 2>"$WORK/err" \

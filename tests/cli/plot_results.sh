@@ -122,6 +122,26 @@ notes=$(grep -c "^plot-results: note: .*skipping" "$WORK/err")
 [ "$notes" -eq 3 ] && grep -q "^plot-results: wrote 3 figures to" "$WORK/err" \
   && pass "older summary: one note per skipped figure" || fail "older summary: stderr: $(cat "$WORK/err")"
 
+# ---- a real run: vgen | vprune | hemosolve, Pries against Newtonian -------------------------
+
+"$BUILD/generator/vgen" --root-diameter 150um --min-diameter 8.5um \
+  | "$BUILD/pruner/vprune" --budget 31 --mean-flow 0.01ml/min -o "$WORK/real-net.json" 2>/dev/null
+for rheology in pries newtonian; do
+  "$BUILD/solver/hemosolve" "$WORK/real-net.json" --out "$WORK/real-$rheology" --cycles 1 --degree 1 \
+    --rheology "$rheology" --quiet
+done
+"$BUILD/stats/vstats" --json "$WORK/real-net.json" >"$WORK/real-pries/network-stats.json"
+if "$PY" "$PLOT" "$WORK/real-pries" --compare "$WORK/real-newtonian" 2>"$WORK/real.err"; then
+  missing=""
+  for f in "${FIGURES[@]}"; do
+    for ext in png svg; do [ -s "$WORK/real-pries/figures/$f.$ext" ] || missing+=" $f.$ext"; done
+  done
+  [ -z "$missing" ] && pass "a real hemosolve run (31 vessels, Pries vs Newtonian): every figure" \
+    || fail "real run: missing$missing"
+else
+  fail "real run: $(cat "$WORK/real.err")"
+fi
+
 # ---- refusals ------------------------------------------------------------------------------
 
 mkdir -p "$WORK/empty" "$WORK/bad" "$WORK/novessels"

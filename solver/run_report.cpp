@@ -1,0 +1,96 @@
+#include "solver/run_report.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "formats/output_stream.hpp"
+#include "physics/womersley.hpp"
+
+namespace hemotree {
+
+double pulse_frequency(const Waveform& w) {
+  return w.shape == Waveform::Shape::half_sine ? 1 / w.systole : 1 / w.period;
+}
+
+double analysis_frequency(const Waveform& w) {
+  const double harmonic = std::max(1.0, std::round(pulse_frequency(w) * w.period));
+  return harmonic / w.period;
+}
+
+WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_t v, double omega) {
+  const VesselLaw& law = solver.law(v);
+  const double d = net.diameter[v];
+  WaveTheory t;
+  t.pwv_elastic = law.wave_speed(law.reference_area);
+  t.womersley = womersley_number(d, solver.blood().density, solver.viscosity(std::numbers::pi / 4 * d * d), omega);
+  t.pwv_theory = womersley_wave(t.pwv_elastic, t.womersley, omega).phase_velocity;
+  return t;
+}
+
+namespace {
+nlohmann::json finite_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+}  // namespace
+
+nlohmann::json vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
+                              double frequency) {
+  const double omega = 2 * std::numbers::pi * frequency;
+  nlohmann::json vessels = nlohmann::json::array();
+  for (std::size_t v = 0; v < cycle.vessels.size(); ++v) {
+    const VesselCycle& c = cycle.vessels[v];
+    const WaveTheory theory = wave_theory(solver, net, v, omega);
+    vessels.push_back({{"id", net.id[v]},
+                       {"diameter", net.diameter[v]},
+                       {"length", net.length[v]},
+                       {"class", to_string(net.vessel_class[v])},
+                       {"degree", solver.degree(v)},
+                       {"mean_flow", c.mean_flow},
+                       {"mean_pressure", c.mean_pressure},
+                       {"systolic_pressure", c.systolic_pressure},
+                       {"diastolic_pressure", c.diastolic_pressure},
+                       {"pulsatility_index", c.pulsatility_index()},
+                       {"mean_wss", c.mean_wss},
+                       {"reynolds", c.reynolds},
+                       {"womersley", theory.womersley},
+                       {"pwv_pressure", finite_or_null(c.pwv_pressure)},
+                       {"pwv_velocity", finite_or_null(c.pwv_velocity)},
+                       {"pwv_elastic", theory.pwv_elastic},
+                       {"pwv_theory", theory.pwv_theory}});
+  }
+  return vessels;
+}
+
+void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const nlohmann::json& vessels,
+                   const CycleSummary& cycle) {
+  nlohmann::json summary = run;
+  summary["inlet_mean_flow"] = cycle.inlet_mean_flow;
+  summary["outlets_mean_flow"] = cycle.outlets_mean_flow;
+  summary["mass_balance"] = (cycle.inlet_mean_flow - cycle.outlets_mean_flow) / cycle.inlet_mean_flow;
+  summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}, {"wss", "Pa"},
+                      {"speed", "m/s"}, {"frequency", "Hz"}};
+  summary["vessels"] = vessels;
+  OutputStream out(file.string());
+  out << summary.dump(1) << '\n';
+  out.commit();
+}
+
+void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels) {
+  std::vector<std::string> names;
+  for (const auto& [key, value] : vessels.front().items())
+    if ((value.is_number() || value.is_null()) && key != "id" && key != "diameter" && key != "length")
+      names.push_back(key);
+  std::vector<std::vector<double>> columns(names.size(), std::vector<double>(vessels.size()));
+  for (std::size_t v = 0; v < vessels.size(); ++v)
+    for (std::size_t f = 0; f < names.size(); ++f) {
+      const auto& x = vessels[v][names[f]];
+      columns[f][v] = x.is_number() ? x.get<double>() : std::numeric_limits<double>::quiet_NaN();
+    }
+  std::vector<CellField> fields;
+  for (std::size_t f = 0; f < names.size(); ++f) fields.push_back({names[f], columns[f]});
+  OutputStream out(file.string());
+  write_vtk(net, out, fields);
+  out.commit();
+}
+
+}  // namespace hemotree

@@ -1,0 +1,43 @@
+// What hemosolve reports of a run: every vessel's results over the last cycle (measured, and
+// the linear wave theory beside them) in summary.json and as VTK cell data for ParaView.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "formats/exports.hpp"
+#include "formats/network.hpp"
+#include "solver/cycle_statistics.hpp"
+#include "solver/pulse_solver.hpp"
+
+namespace hemotree {
+
+// The pulse's frequency [Hz]: 1 / systole for the half-sine (the paper's 3.33 Hz), 1 / period
+// for a tabulated waveform. The wave speeds are measured and predicted at the harmonic of the
+// period nearest to it (3 Hz for the paper's pulse in a 1 s cycle): only harmonics are free
+// of leakage in a one-cycle Fourier sum.
+double pulse_frequency(const Waveform& w);
+double analysis_frequency(const Waveform& w);
+
+// Linear theory for a vessel at angular frequency omega: the Womersley number of its
+// reference lumen (viscosity at that diameter), the elastic wave speed c0 of its reference
+// state, and the Womersley phase velocity at that c0 and W (the paper's eq. wavespeedWomersley).
+struct WaveTheory {
+  double womersley = 0, pwv_elastic = 0, pwv_theory = 0;
+};
+WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_t vessel, double omega);
+
+// The per-vessel results, one row per vessel in the network's order.
+nlohmann::json vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
+                              double analysis_frequency);
+
+// summary.json: the run's facts (`run`), the mass balance and the vessels' results.
+void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const nlohmann::json& vessels,
+                   const CycleSummary& cycle);
+
+// The network as VTK PolyData with every numeric per-vessel result as cell data (null -> NaN).
+void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels);
+
+}  // namespace hemotree
