@@ -71,21 +71,23 @@ bool junction_state(std::span<const VesselLaw* const> laws, std::span<const doub
   const std::size_t n = laws.size();
   constexpr std::size_t max_ends = 16;
   if (n > max_ends || n < 2) return false;
-  std::array<double, max_ends> mu, x, f, dpt;  // the first n entries are used
+  std::array<double, max_ends> mu, x, f, dpt, root_reference;  // the first n entries are used
   for (std::size_t i = 0; i < n; ++i) {
     mu[i] = incoming_speed(*laws[i], a[i], q[i], sign[i] > 0);
     x[i] = out[i].area > 0 ? out[i].area : a[i];
+    root_reference[i] = std::sqrt(laws[i]->reference_area);
   }
   for (int it = 0; it < 50; ++it) {
     // f_0 = sum sign Q* (mass); f_i = P_t,i - P_t,0 (total pressure), i >= 1. The Jacobian
     // is an arrowhead (row 0 full, then a diagonal and column 0): eliminated in O(n).
     double pt0 = 0, mass = 0;
     for (std::size_t i = 0; i < n; ++i) {
+      // The tube law written out: one square root per end and iteration.
       const VesselLaw& law = *laws[i];
       const double qs = q[i] + mu[i] * (x[i] - a[i]);
-      const double u = qs / x[i];
-      const double pt = law.pressure(x[i]) + 0.5 * law.density * u * u;
-      dpt[i] = law.beta / (2 * std::sqrt(x[i])) + law.density * u * (mu[i] * x[i] - qs) / (x[i] * x[i]);
+      const double u = qs / x[i], root = std::sqrt(x[i]);
+      const double pt = law.reference_pressure + law.beta * (root - root_reference[i]) + 0.5 * law.density * u * u;
+      dpt[i] = law.beta / (2 * root) + law.density * u * (mu[i] - u) / x[i];
       mass += sign[i] * qs;
       if (i == 0) pt0 = pt;
       f[i] = pt;
