@@ -23,7 +23,9 @@ CycleStatistics::CycleStatistics(const Network& net, double analysis_frequency, 
     : net_(net), omega_(2 * std::numbers::pi * analysis_frequency), inlet_(inlet), outlets_(std::move(outlets)),
       flow_(net.vessel_count(), 0.0), pressure_(net.vessel_count(), 0.0),
       p_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
-      p_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()), wss_(net.vessel_count(), 0.0),
+      p_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()),
+      q_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
+      q_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()), wss_(net.vessel_count(), 0.0),
       reynolds_(net.vessel_count(), 0.0), p_in_(net.vessel_count()), p_out_(net.vessel_count()),
       u_in_(net.vessel_count()), u_out_(net.vessel_count()), first_(4 * net.vessel_count()),
       last_(4 * net.vessel_count()) {}
@@ -40,6 +42,8 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     pressure_[v] += weight * p;
     p_min_[v] = std::min(p_min_[v], p);
     p_max_[v] = std::max(p_max_[v], p);
+    q_min_[v] = std::min(q_min_[v], q);
+    q_max_[v] = std::max(q_max_[v], q);
     wss_[v] += weight * wall_shear_stress(mu, u, radius, alpha);
     reynolds_[v] += weight * rho * u * 2 * radius / mu;
   }
@@ -90,6 +94,8 @@ CycleSummary CycleStatistics::close() {
     c.mean_pressure = pressure_[v] / duration_;
     c.systolic_pressure = p_max_[v];
     c.diastolic_pressure = p_min_[v];
+    c.peak_flow = q_max_[v];
+    c.least_flow = q_min_[v];
     c.mean_wss = wss_[v] / duration_;
     c.reynolds = reynolds_[v] / duration_;
     c.pwv_pressure = phase_velocity(detrended(p_in_[v], 4 * v), detrended(p_out_[v], 4 * v + 1), omega_, net_.length[v]);
@@ -98,6 +104,8 @@ CycleSummary CycleStatistics::close() {
     p_in_[v] = p_out_[v] = u_in_[v] = u_out_[v] = 0;
     p_min_[v] = std::numeric_limits<double>::infinity();
     p_max_[v] = -std::numeric_limits<double>::infinity();
+    q_min_[v] = std::numeric_limits<double>::infinity();
+    q_max_[v] = -std::numeric_limits<double>::infinity();
   }
   duration_ = 0;
   return summary;

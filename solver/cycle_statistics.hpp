@@ -18,6 +18,7 @@ namespace hemotree {
 struct VesselCycle {
   double mean_flow = 0, mean_pressure = 0;
   double systolic_pressure = 0, diastolic_pressure = 0;
+  double peak_flow = 0, least_flow = 0;  // largest and smallest flow at the centre
   double mean_wss = 0;   // [Pa]
   double reynolds = 0;   // rho u D / mu, cycle mean
   // Phase velocity omega L / (phase lag from inlet end to outlet end) at the analysis
@@ -61,7 +62,7 @@ class CycleStatistics {
   std::size_t inlet_;
   std::vector<std::size_t> outlets_;
   double inlet_flow_ = 0, outlets_flow_ = 0;
-  std::vector<double> flow_, pressure_, p_min_, p_max_, wss_, reynolds_;
+  std::vector<double> flow_, pressure_, p_min_, p_max_, q_min_, q_max_, wss_, reynolds_;
   // Fourier sums at the ends, and each signal's first and last sample of the cycle: a
   // cycle that is not yet periodic drifts, and the drift's own Fourier component is removed.
   std::vector<std::complex<double>> p_in_, p_out_, u_in_, u_out_;

@@ -50,6 +50,8 @@ nlohmann::json vessel_results(const Network& net, const PulseSolver& solver, con
                        {"systolic_pressure", c.systolic_pressure},
                        {"diastolic_pressure", c.diastolic_pressure},
                        {"pulsatility_index", c.pulsatility_index()},
+                       {"peak_flow", c.peak_flow},
+                       {"least_flow", c.least_flow},
                        {"mean_wss", c.mean_wss},
                        {"reynolds", c.reynolds},
                        {"womersley", theory.womersley},

@@ -45,7 +45,7 @@ assert abs(s["mass_balance"] - (s["inlet_mean_flow"] - s["outlets_mean_flow"]) /
 assert abs(s["mass_balance"]) < 0.2, s["mass_balance"]
 
 keys = {"id", "diameter", "length", "class", "degree", "mean_flow", "mean_pressure", "systolic_pressure",
-        "diastolic_pressure", "pulsatility_index", "mean_wss", "reynolds", "womersley", "pwv_pressure",
+        "diastolic_pressure", "pulsatility_index", "peak_flow", "least_flow", "mean_wss", "reynolds", "womersley", "pwv_pressure",
         "pwv_velocity", "pwv_elastic", "pwv_theory"}
 by_id = {v["id"]: v for v in net["vessels"]}
 rows = s["vessels"]
@@ -66,6 +66,7 @@ for r in rows:
         assert r[k] is None or (math.isfinite(r[k]) and r[k] > 0), (r["id"], k, r[k])
     # Poiseuille: WSS = 4 mu u / R > 0 with forward flow; the theory lies below c0 (W < 1).
     assert r["mean_wss"] > 0 and r["reynolds"] > 0 and 0 < r["womersley"] < 1, r
+    assert r["least_flow"] <= r["mean_flow"] <= r["peak_flow"], r
     assert 0 < r["pwv_theory"] < r["pwv_elastic"], r
     assert 0 < r["diastolic_pressure"] <= r["mean_pressure"] <= r["systolic_pressure"] < 40000, r
     pi = (r["systolic_pressure"] - r["diastolic_pressure"]) / r["mean_pressure"]
