@@ -17,6 +17,7 @@
 #include "formats/network_io.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "formats/vtk_series.hpp"
+#include "solver/probes.hpp"
 #include "solver/pulse_solver.hpp"
 #include "solver/run_report.hpp"
 #include "solver/solution_breakdown.hpp"
@@ -24,34 +25,6 @@
 using namespace hemotree;
 
 namespace {
-
-struct Probe {
-  std::size_t vessel;
-  std::int64_t id;
-  double x;
-};
-
-Probe parse_probe(const std::string& text, const Network& net) {
-  const auto colon = text.find(':');
-  Probe p{0, 0, 0.5};
-  try {
-    std::size_t used = 0;
-    p.id = std::stoll(text.substr(0, colon), &used);
-    if (used != (colon == std::string::npos ? text.size() : colon)) throw std::invalid_argument("");
-    if (colon != std::string::npos) {
-      const std::string x = text.substr(colon + 1);
-      p.x = std::stod(x, &used);
-      if (used != x.size()) throw std::invalid_argument("");
-    }
-  } catch (const std::exception&) {
-    throw InputError("--probe: '" + text + "' is not ID or ID:x");
-  }
-  if (!(p.x >= 0 && p.x <= 1)) throw InputError("--probe: x must lie in [0, 1] in '" + text + "'");
-  const std::int64_t index = net.index_of(p.id);
-  if (index < 0) throw InputError("--probe: no vessel " + std::to_string(p.id));
-  p.vessel = static_cast<std::size_t>(index);
-  return p;
-}
 
 std::string number(double v) {
   char text[32];
@@ -147,8 +120,8 @@ int main(int argc, char** argv) {
     const Network net = read_network(input);
     if ((vtk || frames > 0) && net.x.empty())
       throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
-    std::vector<Probe> probes;
-    for (const auto& t : probe_texts) probes.push_back(parse_probe(t, net));
+    std::vector<Probe> probe_list;
+    for (const auto& t : probe_texts) probe_list.push_back(parse_probe(t, net));
     PulseSolver run(net, options);
     const double period = net.inlet->waveform.period;
     const auto steps_per_cycle = static_cast<std::size_t>(std::ceil(period / run.dt() - 1e-9));
@@ -169,29 +142,7 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(dir, ec);
     if (ec) throw IoError("cannot create " + out_dir + ": " + ec.message());
 
-    // Probe samples are kept in memory and written at the end (or at a breakdown).
-    std::ostringstream probe_rows;
-    auto sample_probes = [&] {
-      probe_rows << number(run.time());
-      for (const Probe& p : probes) {
-        const double a = run.area_at(p.vessel, p.x), q = run.flow_at(p.vessel, p.x);
-        probe_rows << ',' << number(run.law(p.vessel).pressure(a)) << ',' << number(q) << ','
-                   << number(a) << ',' << number(q / a);
-      }
-      probe_rows << '\n';
-    };
-    auto write_probes = [&] {
-      if (probes.empty()) return;
-      OutputStream out((dir / "probes.csv").string());
-      out << "t [s]";
-      for (const Probe& p : probes) {
-        const std::string at = " vessel " + std::to_string(p.id) + " x " + number(p.x);
-        out << ",p" << at << " [Pa],Q" << at << " [m^3/s],A" << at << " [m^2],u" << at << " [m/s]";
-      }
-      out << '\n' << probe_rows.str();
-      out.commit();
-    };
-
+    ProbeRecorder probes(std::move(probe_list));
     const auto sample_every = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(sample_interval / dt)));
     const Waveform& pulse = net.inlet->waveform;
     const double frequency = analysis_frequency(pulse);
@@ -242,7 +193,7 @@ int main(int argc, char** argv) {
                                {"time_step_limit", dt_reason}};
     for (const auto& [p, count] : degrees) run_info["elements_of_degree"][std::to_string(p)] = count;
     try {
-      sample_probes();
+      probes.sample(run);
       for (; done < planned; ++done) {
         // Every cycle could be the last (--until-periodic): its frames replace the previous ones.
         std::optional<VtkTimeSeries> series;
@@ -259,7 +210,7 @@ int main(int argc, char** argv) {
             write_frame(*series);
             ++frames_written;
           }
-          if (run.steps() % sample_every == 0) sample_probes();
+          if (run.steps() % sample_every == 0) probes.sample(run);
           if (show && k % 256 == 0) {
             const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
             const double rate = static_cast<double>(run.steps()) / std::max(elapsed, 1e-9);
@@ -283,7 +234,7 @@ int main(int argc, char** argv) {
       run_info["status"] = "broken down";
       run_info["error"] = e.what();
       run_info["cycles"] = done;
-      write_probes();
+      probes.write(dir / "probes.csv");
       if (!last.vessels.empty()) report(run_info);
       throw InputError(e.what());
     }
@@ -297,7 +248,7 @@ int main(int argc, char** argv) {
       run_info["periodic_change"] = change.change;
       run_info["slowest_vessel"] = net.id[change.vessel];
     }
-    write_probes();
+    probes.write(dir / "probes.csv");
     report(run_info);
     if (!quiet) {
       std::ostringstream m;

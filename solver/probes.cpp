@@ -1,0 +1,59 @@
+#include "solver/probes.hpp"
+
+#include "cli/errors.hpp"
+#include "formats/output_stream.hpp"
+
+namespace hemotree {
+
+Probe parse_probe(const std::string& text, const Network& net) {
+  const auto colon = text.find(':');
+  Probe p{0, 0, 0.5};
+  try {
+    std::size_t used = 0;
+    p.id = std::stoll(text.substr(0, colon), &used);
+    if (used != (colon == std::string::npos ? text.size() : colon)) throw std::invalid_argument("");
+    if (colon != std::string::npos) {
+      const std::string x = text.substr(colon + 1);
+      p.x = std::stod(x, &used);
+      if (used != x.size()) throw std::invalid_argument("");
+    }
+  } catch (const std::exception&) {
+    throw InputError("--probe: '" + text + "' is not ID or ID:x");
+  }
+  if (!(p.x >= 0 && p.x <= 1)) throw InputError("--probe: x must lie in [0, 1] in '" + text + "'");
+  const std::int64_t index = net.index_of(p.id);
+  if (index < 0) throw InputError("--probe: no vessel " + std::to_string(p.id));
+  p.vessel = static_cast<std::size_t>(index);
+  return p;
+}
+
+namespace {
+std::string number(double v) {
+  char text[32];
+  return std::string(text, format_real(text, v));
+}
+}  // namespace
+
+void ProbeRecorder::sample(const PulseSolver& solver) {
+  rows_ << number(solver.time());
+  for (const Probe& p : probes_) {
+    const double a = solver.area_at(p.vessel, p.x), q = solver.flow_at(p.vessel, p.x);
+    rows_ << ',' << number(solver.law(p.vessel).pressure(a)) << ',' << number(q) << ',' << number(a) << ','
+          << number(q / a);
+  }
+  rows_ << '\n';
+}
+
+void ProbeRecorder::write(const std::filesystem::path& file) const {
+  if (probes_.empty()) return;
+  OutputStream out(file.string());
+  out << "t [s]";
+  for (const Probe& p : probes_) {
+    const std::string at = " vessel " + std::to_string(p.id) + " x " + number(p.x);
+    out << ",p" << at << " [Pa],Q" << at << " [m^3/s],A" << at << " [m^2],u" << at << " [m/s]";
+  }
+  out << '\n' << rows_.str();
+  out.commit();
+}
+
+}  // namespace hemotree
