@@ -344,8 +344,10 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
   const auto area = s.area.block(first, 0, count, modes), flow = s.flow.block(first, 0, count, modes);
   area_q.noalias() = area.lazyProduct(basis.at_points.transpose());
   flow_q.noalias() = flow.lazyProduct(basis.at_points.transpose());
-  for (Eigen::Index el = 0; el < count; ++el)
-    if (!(area_q.row(el).array() > 0).all() || !area_q.row(el).allFinite()) return first + el;
+  if (!(area_q.array() > 0).all() || !area_q.allFinite()) {
+    for (Eigen::Index el = 0; el < count; ++el)
+      if (!(area_q.row(el).array() > 0).all() || !area_q.row(el).allFinite()) return first + el;
+  }
 
   // Volume term: (F(U), dphi/dx) for both equations.
   flux_q.array() = alpha * flow_q.array().square() / area_q.array() +
@@ -354,18 +356,17 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
   rate.area.block(first, 0, count, modes).noalias() = flow_q.lazyProduct(basis.weak_derivative.transpose());
   rate.flow.block(first, 0, count, modes).noalias() = flux_q.lazyProduct(basis.weak_derivative.transpose());
 
-  // Each element's friction rate at its mean area: the exponential scheme integrates
-  // -r Q exactly and leaves only the variation of r within the element explicit.
-  for (Eigen::Index el = first; el < first + count; ++el) {
-    const double a = s.area(el, 0);
-    friction_rate_(el) = a > 0 ? friction_k_ * viscosity_(a) / (rho * a) : 0.0;
-  }
-  // Friction source -k mu Q / (rho A), mu at the local diameter (Pries) or constant.
-  for (Eigen::Index el = 0; el < count; ++el)
-    for (Eigen::Index q = 0; q < area_q.cols(); ++q) {
+  // Friction -r Q with r = k mu / (rho A) at each point, mu at the local diameter (Pries) or
+  // constant. Column by column: the storage order.
+  for (Eigen::Index q = 0; q < points; ++q)
+    for (Eigen::Index el = 0; el < count; ++el) {
       const double a = area_q(el, q);
-      source_q(el, q) = -friction_k_ * viscosity_(a) / rho * flow_q(el, q) / a;
+      source_q(el, q) = friction_k_ * viscosity_(a) / (rho * a);
     }
+  // Each element's friction rate, r averaged over the element: the exponential scheme
+  // integrates -r Q exactly and leaves only the variation of r within the element explicit.
+  friction_rate_.segment(first, count).noalias() = source_q.lazyProduct(basis.rule.weights) / 2;
+  source_q.array() *= -flow_q.array();
 
   // Traces at both ends of every element.
   area_left_.segment(first, count).noalias() = area.lazyProduct(basis.left.transpose());
