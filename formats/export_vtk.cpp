@@ -2,6 +2,7 @@
 // line cell carrying its properties as cell data. ASCII arrays, written number by number
 // straight into the output stream, so a tree of millions of vessels never sits in memory
 // as text.
+#include <cmath>
 #include <string>
 
 #include "cli/errors.hpp"
@@ -92,7 +93,13 @@ void write_vtk(const Network& net, OutputStream& out, const std::vector<CellFiel
   write_cell_array<std::int32_t>(out, "Int32", "generation", net.generation);
   write_data_array(out, "UInt8", "class", 1, vessels,
                    [&](std::size_t v) { out << static_cast<int>(net.vessel_class[v]); });
-  for (const CellField& field : extra) write_cell_array(out, "Float64", field.name, field.values);
+  // Results may be undefined in some vessels (a wave speed with no forward wave): VTK's
+  // ASCII reader takes "nan" (ParaView shows it in the NaN colour), unlike JSON.
+  for (const CellField& field : extra)
+    write_data_array(out, "Float64", field.name, 1, field.values.size(), [&](std::size_t v) {
+      if (std::isfinite(field.values[v])) out << field.values[v];
+      else out << "nan";
+    });
   out << "      </CellData>\n"
          "    </Piece>\n"
          "  </PolyData>\n"

@@ -268,21 +268,25 @@ void PulseSolver::step_exponential() {
     previous_flow_ = state_.flow;
     have_previous_rate_ = true;
   }
-  for (const DegreeBlock& b : blocks_) {
-    const Eigen::Index modes = b.degree + 1;
-    for (Eigen::Index el = b.first; el < b.first + b.count; ++el) {
-      const double r = friction_rate_(el), z = -r * h;
-      double e, phi1, phi2;
-      phi_functions(z, e, phi1, phi2);
-      for (Eigen::Index j = 0; j < modes; ++j) {
-        const double q = state_.flow(el, j);
-        const double n_now = rate_.flow(el, j) + r * q;
-        const double n_before = previous_rate_.flow(el, j) + r * previous_flow_(el, j);
-        previous_flow_(el, j) = q;
-        state_.flow(el, j) = e * q + h * (phi1 * n_now + phi2 * (n_now - n_before));
-      }
+  const Eigen::Index elements = state_.flow.rows();
+  decay_.resize(elements);
+  phi1_.resize(elements);
+  phi2_.resize(elements);
+  for (Eigen::Index el = 0; el < elements; ++el) phi_functions(-friction_rate_(el) * h, decay_(el), phi1_(el), phi2_(el));
+  // Column by column (the storage order), over each degree's block of rows.
+  for (const DegreeBlock& b : blocks_)
+    for (Eigen::Index j = 0; j <= b.degree; ++j) {
+      const auto r = friction_rate_.segment(b.first, b.count).array();
+      auto q = state_.flow.col(j).segment(b.first, b.count).array();
+      auto q_before = previous_flow_.col(j).segment(b.first, b.count).array();
+      const auto n_now = rate_.flow.col(j).segment(b.first, b.count).array() + r * q;
+      const auto n_before = previous_rate_.flow.col(j).segment(b.first, b.count).array() + r * q_before;
+      const Eigen::ArrayXd next = decay_.segment(b.first, b.count).array() * q +
+                                  h * (phi1_.segment(b.first, b.count).array() * n_now +
+                                       phi2_.segment(b.first, b.count).array() * (n_now - n_before));
+      q_before = q;
+      q = next;
     }
-  }
   state_.area += h * (1.5 * rate_.area - 0.5 * previous_rate_.area);
   state_.capacitor += h * (1.5 * rate_.capacitor - 0.5 * previous_rate_.capacitor);
   std::swap(previous_rate_, rate_);

@@ -1,5 +1,6 @@
 // Exports read back: VTK through a small XML parser, GraphML through Boost's reader,
 // dot and CSV as text.
+#include <iterator>
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -282,6 +283,21 @@ TEST(ExportVtk, FieldNamesAreEscaped) {
   EXPECT_EQ(
       file.child("PolyData").child("Piece").child("CellData").children.back().attributes.at("Name"),
       "a&lt;b &amp; &quot;c&quot;");
+}
+
+// A result undefined in some vessels (a pulse wave speed where no forward wave is
+// measurable) is written as "nan", which ParaView's ASCII reader takes (5.11, checked), and
+// the other values are unaffected. It was a "non-finite number" internal error before.
+TEST(ExportVtk, UndefinedResultsAreWrittenAsNan) {
+  const std::vector<double> values = {1.5, std::nan(""), 2.5, INFINITY};
+  const std::string text = export_text("nan.vtp", [&](OutputStream& out) {
+    write_vtk(sample_network(), out, {CellField{"pwv", values}});
+  });
+  const XmlElement file = XmlParser(text).document();
+  const XmlElement& array = file.child("PolyData").child("Piece").child("CellData").children.back();
+  std::istringstream numbers(array.text);
+  std::vector<std::string> words{std::istream_iterator<std::string>(numbers), {}};
+  EXPECT_EQ(words, (std::vector<std::string>{"1.5", "nan", "2.5", "nan"}));
 }
 
 // --- GraphML -------------------------------------------------------------------------------
