@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <map>
 
 #include "solver/stability_limit.hpp"
 
@@ -10,12 +9,7 @@ namespace hemotree {
 
 std::vector<int> choose_degrees(std::span<const double> element_transit, double period,
                                 const DegreeRule& rule, TimeScheme scheme) {
-  std::map<int, double> courant;  // the Courant limit of each degree, computed once
-  auto limit = [&](int p) {
-    auto [it, fresh] = courant.try_emplace(p, 0.0);
-    if (fresh) it->second = courant_limit(p, scheme);
-    return it->second;
-  };
+  auto limit = [&](int p) { return courant_limit(p, scheme); };
   const std::size_t n = element_transit.size();
   std::vector<int> degree(n);
   // The shortest wavelength is c T / harmonics, so h / wavelength = transit harmonics / T.

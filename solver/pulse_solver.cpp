@@ -1,6 +1,7 @@
 #include "solver/pulse_solver.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -270,6 +271,7 @@ void PulseSolver::step_exponential() {
   }
   const Eigen::Index elements = state_.flow.rows();
   decay_.resize(elements);
+  next_flow_.resize(elements);
   phi1_.resize(elements);
   phi2_.resize(elements);
   for (Eigen::Index el = 0; el < elements; ++el) phi_functions(-friction_rate_(el) * h, decay_(el), phi1_(el), phi2_(el));
@@ -281,9 +283,10 @@ void PulseSolver::step_exponential() {
       auto q_before = previous_flow_.col(j).segment(b.first, b.count).array();
       const auto n_now = rate_.flow.col(j).segment(b.first, b.count).array() + r * q;
       const auto n_before = previous_rate_.flow.col(j).segment(b.first, b.count).array() + r * q_before;
-      const Eigen::ArrayXd next = decay_.segment(b.first, b.count).array() * q +
-                                  h * (phi1_.segment(b.first, b.count).array() * n_now +
-                                       phi2_.segment(b.first, b.count).array() * (n_now - n_before));
+      auto next = next_flow_.segment(b.first, b.count).array();  // scratch: no allocation per step
+      next = decay_.segment(b.first, b.count).array() * q +
+             h * (phi1_.segment(b.first, b.count).array() * n_now +
+                  phi2_.segment(b.first, b.count).array() * (n_now - n_before));
       q_before = q;
       q = next;
     }
@@ -396,7 +399,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   Eigen::Index bad = -1;
   for (const DegreeBlock& b : blocks_) {
     const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_) if (threads_ > 1)
     {
       const int threads = omp_get_num_threads(), me = omp_get_thread_num();
       const Eigen::Index first = b.first + b.count * me / threads, last = b.first + b.count * (me + 1) / threads;
@@ -411,7 +414,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
 
   // Interfaces inside vessels.
   const auto vessels = static_cast<std::int64_t>(net_.vessel_count());
-#pragma omp parallel for schedule(static) num_threads(threads_)
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t vi = 0; vi < vessels; ++vi) {
     const auto v = static_cast<std::size_t>(vi);
     const VesselLaw& law = laws_[v];
@@ -448,7 +451,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     set_end_flux(end, inflow_state(laws_[static_cast<std::size_t>(end.vessel)], a, q, boundaries_.inflow(t)));
   }
   const auto outlets = static_cast<std::int64_t>(boundaries_.outlets.size());
-#pragma omp parallel for schedule(static) num_threads(threads_)
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t k = 0; k < outlets; ++k) {
     const auto& o = boundaries_.outlets[static_cast<std::size_t>(k)];
     double a, q;
@@ -478,7 +481,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Junctions are independent: each writes only its own ends' fluxes.
   const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
   std::int64_t failed_junction = -1;
-#pragma omp parallel for schedule(static) num_threads(threads_)
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t jj = 0; jj < junctions; ++jj) {
     const auto j = static_cast<std::size_t>(jj);
     // Left uninitialised: only the first `count` entries are used (zeroing all 16 was 5 % of a step).
@@ -512,10 +515,10 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Surface term and scaling: dC/dt = (volume - M^-1 (phi(1) F*_R - phi(-1) F*_L)) / J + source.
   for (const DegreeBlock& b : blocks_) {
     const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
-    const Eigen::RowVectorXd right = basis.inverse_mass.cwiseProduct(basis.right);
-    const Eigen::RowVectorXd left = basis.inverse_mass.cwiseProduct(basis.left);
+    const auto right = basis.inverse_mass.cwiseProduct(basis.right);  // lifts of the end fluxes
+    const auto left = basis.inverse_mass.cwiseProduct(basis.left);
     const Eigen::Index modes = b.degree + 1;
-#pragma omp parallel num_threads(threads_)
+#pragma omp parallel num_threads(threads_) if (threads_ > 1)
     {
       const int threads = omp_get_num_threads(), me = omp_get_thread_num();
       const Eigen::Index first = b.first + b.count * me / threads,
@@ -582,8 +585,8 @@ void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<do
   double xi;
   locate(0, x, element, xi);
   const auto k = static_cast<std::int32_t>(element) - first_element_[0];  // the same in every vessel
-  std::vector<double> phi(static_cast<std::size_t>(max_degree()) + 1);
-  for (std::size_t j = 0; j < phi.size(); ++j) phi[j] = legendre(static_cast<int>(j), xi);
+  std::array<double, 32> phi;  // degrees are at most 30
+  for (std::size_t j = 0; j <= static_cast<std::size_t>(max_degree()); ++j) phi[j] = legendre(static_cast<int>(j), xi);
   for (std::size_t v = 0; v < n; ++v) {
     const Eigen::Index el = first_element_[v] + k;
     double a = 0, q = 0;

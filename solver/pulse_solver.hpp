@@ -124,7 +124,7 @@ class PulseSolver {
   // Per element: the friction rate r = k mu(A_mean) / (rho A_mean) the last evaluate() used;
   // for the exponential scheme, the previous step's flow coefficients.
   Eigen::VectorXd friction_rate_;
-  Eigen::VectorXd decay_, phi1_, phi2_;  // ETD2: e^(-r h), phi1, phi2 per element
+  Eigen::VectorXd decay_, phi1_, phi2_, next_flow_;  // ETD2: e^(-r h), phi1, phi2 per element; scratch
   Eigen::MatrixXd previous_flow_;
   bool have_previous_rate_ = false;
   TimeScheme scheme_;

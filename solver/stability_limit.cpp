@@ -1,6 +1,9 @@
 #include "solver/stability_limit.hpp"
 
 #include <algorithm>
+#include <map>
+#include <mutex>
+#include <utility>
 #include <numbers>
 
 #include <Eigen/Eigenvalues>
@@ -47,7 +50,8 @@ double amplification(TimeScheme scheme, std::complex<double> z) {
 
 double growth_tolerance(TimeScheme scheme) { return scheme == TimeScheme::runge_kutta4 ? 1e-12 : 3e-5; }
 
-double courant_limit(int degree, TimeScheme scheme) {
+namespace {
+double compute_courant_limit(int degree, TimeScheme scheme) {
   const auto spectrum = dg_advection_spectrum(degree);
   const double tolerance = growth_tolerance(scheme);
   auto stable = [&](double nu) {
@@ -68,6 +72,18 @@ double courant_limit(int degree, TimeScheme scheme) {
     (stable(mid) ? lo : hi) = mid;
   }
   return lo;
+}
+}  // namespace
+
+double courant_limit(int degree, TimeScheme scheme) {
+  // Computed once per degree and scheme (about 10 ms each: 128 eigenproblems and a search).
+  static std::mutex guard;
+  static std::map<std::pair<int, TimeScheme>, double> known;
+  const std::lock_guard<std::mutex> lock(guard);
+  const auto key = std::make_pair(degree, scheme);
+  auto it = known.find(key);
+  if (it == known.end()) it = known.emplace(key, compute_courant_limit(degree, scheme)).first;
+  return it->second;
 }
 
 }  // namespace hemotree
