@@ -605,6 +605,25 @@ double PulseSolver::mean_flow(std::size_t vessel) const {
   return sum / elements_per_vessel_;
 }
 
+std::size_t PulseSolver::extrapolate_capacitors() {
+  capacitor_history_.push_back(state_.capacitor);
+  if (capacitor_history_.size() < 3) return 0;
+  const Eigen::VectorXd &c0 = capacitor_history_[0], &c1 = capacitor_history_[1], &c2 = capacitor_history_[2];
+  std::size_t moved = 0;
+  for (Eigen::Index k = 0; k < c2.size(); ++k) {
+    const double d1 = c1(k) - c0(k), d2 = c2(k) - c1(k);
+    if (d1 == 0) continue;
+    const double ratio = d2 / d1;
+    if (!(ratio > 0 && ratio < 0.95)) continue;
+    state_.capacitor(k) = c2(k) + d2 * ratio / (1 - ratio);
+    ++moved;
+  }
+  // A moved capacitor starts a new sequence; an unmoved one keeps its last two values.
+  capacitor_history_.erase(capacitor_history_.begin());
+  if (moved > 0) capacitor_history_.assign(1, state_.capacitor);
+  return moved;
+}
+
 void PulseSolver::check_solution() const {
   for (Eigen::Index el = 0; el < state_.area.rows(); ++el)
     if (!(state_.area(el, 0) > 0) || !state_.area.row(el).allFinite() || !state_.flow.row(el).allFinite())

@@ -84,6 +84,14 @@ class PulseSolver {
   // Throws SolutionBreakdown when A <= 0 or a value is not finite.
   void check_solution() const;
 
+  // To be called at the start of the run and at the end of each cycle. The slowest part of the approach to the periodic
+  // state is each RCR capacitor charging towards its mean pressure, with time constants
+  // R2 C of seconds; seen at the same phase of every cycle it is a geometric sequence.
+  // Where the last three cycle ends show one (ratio in (0, 0.95)), the capacitor is moved to
+  // the sequence's limit (Aitken's delta-squared). The periodic state is a fixed point: its
+  // drift is zero, so nothing moves there. Returns how many capacitors moved.
+  std::size_t extrapolate_capacitors();
+
  private:
   void evaluate(double t, const PulseState& s, PulseState& rate);
   // Returns the first element whose area is not positive and finite, or -1.
@@ -124,6 +132,7 @@ class PulseSolver {
   // Per element: the friction rate r = k mu(A_mean) / (rho A_mean) the last evaluate() used;
   // for the exponential scheme, the previous step's flow coefficients.
   Eigen::VectorXd friction_rate_;
+  std::vector<Eigen::VectorXd> capacitor_history_;  // at the last cycle ends, oldest first
   Eigen::VectorXd decay_, phi1_, phi2_, next_flow_;  // ETD2: e^(-r h), phi1, phi2 per element; scratch
   Eigen::MatrixXd previous_flow_;
   bool have_previous_rate_ = false;
