@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   int cycles = 0, max_cycles = 50;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
-  bool quiet = false, vtk = false, plain_cycles = false;
+  bool quiet = false, vtk = false, extrapolate = false;
   int frames = 0;
   SolverOptions options;
   app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
@@ -79,8 +79,9 @@ int main(int argc, char** argv) {
   app.add_option("--frames", frames,
                  "write N frames of the last cycle (p, Q, A, u per vessel) as a ParaView time series "
                  "(frames/frames.pvd)");
-  app.add_flag("--no-extrapolation", plain_cycles,
-               "do not move RCR capacitors to the limit of their cycle-to-cycle drift (docs/solver.md)");
+  app.add_flag("--extrapolate-capacitors", extrapolate,
+               "experimental: at each cycle end, move RCR capacitors to the limit of their cycle-to-cycle "
+               "drift (docs/solver.md)");
   app.add_flag("--quiet", quiet, "no progress line");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
@@ -197,7 +198,7 @@ int main(int argc, char** argv) {
     for (const auto& [p, count] : degrees) run_info["elements_of_degree"][std::to_string(p)] = count;
     try {
       probes.sample(run);
-      if (!plain_cycles) run.extrapolate_capacitors();
+      if (extrapolate) run.extrapolate_capacitors();
       for (; done < planned; ++done) {
         // Every cycle could be the last (--until-periodic): its frames replace the previous ones.
         std::optional<VtkTimeSeries> series;
@@ -227,7 +228,7 @@ int main(int argc, char** argv) {
         previous = std::move(last);
         last = stats.close();
         if (series) series->finish();
-        if (!plain_cycles) extrapolated += run.extrapolate_capacitors();
+        if (extrapolate) extrapolated += run.extrapolate_capacitors();
         if (!previous.vessels.empty()) change = cycle_change(previous.vessels, last.vessels);
         if (until_periodic && !previous.vessels.empty() && change.change < periodic_tol) {
           ++done;
