@@ -10,9 +10,7 @@
 
 namespace hemotree {
 
-namespace {
-
-// Field names come from callers (simulation results); keep them from breaking the XML.
+// Field names and file names come from callers; keep them from breaking the XML.
 std::string xml_attribute(std::string_view text) {
   std::string escaped;
   for (char c : text) {
@@ -26,6 +24,8 @@ std::string xml_attribute(std::string_view text) {
   }
   return escaped;
 }
+
+namespace {
 
 // Writes one ASCII DataArray of `count` tuples; write_tuple(i) streams the numbers of tuple
 // i separated by spaces. Scalars go several to a line, vectors one to a line, which keeps

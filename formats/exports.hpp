@@ -27,6 +27,9 @@ struct CellField {
 // vessel; cell data: id, diameter, length, wall_thickness, youngs_modulus, generation,
 // class (0 artery, 1 small_artery, 2 arteriole, 3 capillary), then the extra fields.
 void write_vtk(const Network& net, OutputStream& out, const std::vector<CellField>& extra = {});
+
+// Text escaped for an XML attribute value (& < > ").
+std::string xml_attribute(std::string_view text);
 void write_graphml(const Network& net, OutputStream& out);
 void write_dot(const Network& net, OutputStream& out);
 void write_csv(const Network& net, OutputStream& out);

@@ -15,21 +15,6 @@ namespace hemotree {
 
 namespace {
 
-// The stem is the caller's; keep a quote or ampersand in it from breaking the .pvd.
-std::string xml_attribute(std::string_view text) {
-  std::string escaped;
-  for (char c : text) {
-    switch (c) {
-      case '&': escaped += "&amp;"; break;
-      case '<': escaped += "&lt;"; break;
-      case '>': escaped += "&gt;"; break;
-      case '"': escaped += "&quot;"; break;
-      default: escaped += c;
-    }
-  }
-  return escaped;
-}
-
 // A time as the .pvd carries it: 9 significant digits, like every number we write.
 std::string time_text(double time) {
   char text[32];

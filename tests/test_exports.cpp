@@ -19,9 +19,12 @@
 
 #include "cli/errors.hpp"
 #include "formats/exports.hpp"
+#include "tests/xml_reader.hpp"
 
 namespace hemotree {
 namespace {
+using test_xml::XmlElement;
+using test_xml::XmlParser;
 
 // A root and its subtree, with the nodes numbered so that the vessels' source nodes are
 // not in vessel order: the CSR graph behind GraphML/dot must still pair each edge with its
@@ -80,102 +83,6 @@ std::vector<double> numbers(const std::string& text) {
   EXPECT_TRUE(in.eof()) << "not a number in: " << text.substr(0, 80);
   return values;
 }
-
-// --- A minimal XML reader: enough to check that the VTK file is well formed. -------------
-
-struct XmlElement {
-  std::string name;
-  std::map<std::string, std::string> attributes;
-  std::string text;
-  std::vector<XmlElement> children;
-
-  const XmlElement& child(const std::string& child_name) const {
-    for (const auto& c : children)
-      if (c.name == child_name) return c;
-    throw std::runtime_error("no <" + child_name + "> in <" + name + ">");
-  }
-};
-
-class XmlParser {
- public:
-  explicit XmlParser(const std::string& text) : s_(text) {}
-
-  XmlElement document() {
-    skip_space();
-    if (s_.compare(pos_, 5, "<?xml") == 0) pos_ = s_.find("?>", pos_) + 2;
-    skip_space();
-    XmlElement root = element();
-    skip_space();
-    if (pos_ != s_.size()) fail("content after the root element");
-    return root;
-  }
-
- private:
-  XmlElement element() {
-    expect('<');
-    XmlElement e;
-    e.name = name();
-    for (;;) {
-      skip_space();
-      if (peek() == '/') {
-        ++pos_;
-        expect('>');
-        return e;
-      }
-      if (peek() == '>') {
-        ++pos_;
-        break;
-      }
-      std::string key = name();
-      expect('=');
-      expect('"');
-      const auto end = s_.find('"', pos_);
-      if (end == std::string::npos) fail("unterminated attribute");
-      if (!e.attributes.emplace(key, s_.substr(pos_, end - pos_)).second)
-        fail("duplicate attribute " + key);
-      pos_ = end + 1;
-    }
-    for (;;) {
-      const auto lt = s_.find('<', pos_);
-      if (lt == std::string::npos) fail("unclosed <" + e.name + ">");
-      e.text += s_.substr(pos_, lt - pos_);
-      pos_ = lt;
-      if (s_.compare(pos_, 2, "</") == 0) {
-        pos_ += 2;
-        if (name() != e.name) fail("mismatched closing tag for <" + e.name + ">");
-        skip_space();
-        expect('>');
-        return e;
-      }
-      if (s_.compare(pos_, 2, "<!") == 0 || s_.compare(pos_, 2, "<?") == 0)
-        fail("unexpected markup");
-      e.children.push_back(element());
-    }
-  }
-
-  std::string name() {
-    const auto start = pos_;
-    while (pos_ < s_.size() && (std::isalnum(static_cast<unsigned char>(s_[pos_])) ||
-                                s_[pos_] == '_' || s_[pos_] == ':' || s_[pos_] == '-'))
-      ++pos_;
-    if (pos_ == start) fail("expected a name");
-    return s_.substr(start, pos_ - start);
-  }
-  char peek() const { return pos_ < s_.size() ? s_[pos_] : '\0'; }
-  void expect(char c) {
-    if (peek() != c) fail(std::string("expected '") + c + "'");
-    ++pos_;
-  }
-  void skip_space() {
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
-  }
-  [[noreturn]] void fail(const std::string& why) const {
-    throw std::runtime_error("XML error at byte " + std::to_string(pos_) + ": " + why);
-  }
-
-  const std::string& s_;
-  std::size_t pos_ = 0;
-};
 
 // --- VTK -------------------------------------------------------------------------------------
 

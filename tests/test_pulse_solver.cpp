@@ -868,50 +868,6 @@ TEST(PulseSolverVerification, DegreeOutOfRangeIsAnInputError) {
 
 // ---- stability of the default step at every degree -------------------------------------------
 
-namespace {
-
-// Eigenvalues (times h/c) of the upwind DG operator of u_t + c u_x = 0 on equal elements, by
-// Bloch waves exp(i theta k) over the element index k: per theta, the (p+1)x(p+1) matrix
-// 2 M^-1 (K - e_R 1^T + e^(-i theta) e_L 1^T) with K_ij = int P_j P_i', e_R = P_i(1) = 1,
-// e_L = P_i(-1) = (-1)^i, M = diag(2/(2i + 1)). Coupled elements (several per vessel, or
-// vessels in series through junctions) have this spectrum; its radius grows like (p + 1)^2
-// (61.5 at p = 7, 164 at p = 12).
-std::vector<std::complex<double>> bloch_spectrum_of_dg(int p) {
-  using C = std::complex<double>;
-  const int m = p + 1;
-  const GaussLegendre rule = gauss_legendre(p + 2);
-  Eigen::MatrixXd k(m, m);
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      double sum = 0;
-      for (Eigen::Index q = 0; q < rule.nodes.size(); ++q)
-        sum += rule.weights(q) * legendre(j, rule.nodes(q)) * legendre_derivative(i, rule.nodes(q));
-      k(i, j) = sum;
-    }
-  std::vector<C> spectrum;
-  for (int t = 0; t < 128; ++t) {
-    const double theta = 2 * pi * t / 128;
-    Eigen::MatrixXcd a(m, m);
-    for (int i = 0; i < m; ++i)
-      for (int j = 0; j < m; ++j)
-        a(i, j) = static_cast<double>(2 * i + 1) * (k(i, j) - 1.0 + (i % 2 == 0 ? 1.0 : -1.0) * std::exp(C(0, -theta)));
-    const Eigen::ComplexEigenSolver<Eigen::MatrixXcd> eigen(a, false);
-    for (int i = 0; i < m; ++i) spectrum.push_back(eigen.eigenvalues()(i));
-  }
-  return spectrum;
-}
-
-// Largest root modulus of AB2's characteristic polynomial s^2 - (1 + 3z/2) s + z/2.
-double ab2_amplification(std::complex<double> z) {
-  const std::complex<double> b = -(1.0 + 1.5 * z), c = 0.5 * z, d = std::sqrt(b * b - 4.0 * c);
-  return std::max(std::abs((-b + d) / 2.0), std::abs((-b - d) / 2.0));
-}
-
-double rk4_amplification(std::complex<double> z) {
-  return std::abs(1.0 + z * (1.0 + z * (0.5 + z * (1.0 / 6 + z / 24.0))));
-}
-
-}  // namespace
 
 // The step the solver chooses (at rest, inviscid: the wave limit alone), times the DG
 // spectrum, must lie in the scheme's stability region for every degree 1..20: AB2 (and ETD2,
@@ -937,9 +893,11 @@ TEST(PulseSolverVerification, DefaultStepIsStableForEveryDegree) {
       o.elements = elements;
       const double courant = PulseSolver(net, o).dt() * c0 / (length / elements);  // dt c / h
       double growth = 0;
-      for (const auto lambda : bloch_spectrum_of_dg(p))
-        growth = std::max(growth, scheme == TimeScheme::runge_kutta4 ? rk4_amplification(lambda * courant)
-                                                                      : ab2_amplification(lambda * courant));
+      // The spectrum and amplification of solver/stability_limit, themselves checked
+      // against closed forms and published limits in test_stability_limit.cpp.
+      const TimeScheme waves = scheme == TimeScheme::runge_kutta4 ? scheme : TimeScheme::adams_bashforth2;
+      for (const auto lambda : dg_advection_spectrum(p))
+        growth = std::max(growth, amplification(waves, lambda * courant));
       if (growth > worst) {
         worst = growth;
         worst_degree = p;
