@@ -403,6 +403,28 @@ TEST(PulseSolverVerification, BoileauSinglePulseWithTheDefaultScheme) {
 
 // ---- 4. mass through junctions ---------------------------------------------------------------
 
+namespace {
+// A parent of 20 cm and two daughters with unequal wave speeds (6, 7, 8 m/s), a 10 ms
+// Gaussian pulse at the inlet, and reflection outlets of the given coefficient.
+Network pulsed_bifurcation(double d0, double d1, double d2, std::vector<double> reference_pressure,
+                           double reflection) {
+  Network net;
+  for (int n = 0; n < 4; ++n) net.add_node(n);
+  net.add_vessel(0, 0, 1, 0.2, d0, 4e-4, 4e5, 0);
+  net.add_vessel(1, 1, 2, 0.15, d1, 3e-4, 4e5, 1);
+  net.add_vessel(2, 1, 3, 0.12, d2, 3e-4, 4e5, 1);
+  net.beta = {beta_for_wave_speed(6.0, pi / 4 * d0 * d0), beta_for_wave_speed(7.0, pi / 4 * d1 * d1),
+              beta_for_wave_speed(8.0, pi / 4 * d2 * d2)};
+  net.reference_pressure = std::move(reference_pressure);
+  net.blood = newtonian(4e-3);
+  auto inflow = [](double t) { return 2e-6 * std::exp(-std::pow((t - 0.03) / 0.01, 2)); };
+  net.inlet = Inlet{0, tabulate(inflow, 0.06, 601, 10.0)};
+  net.outlets.push_back(reflection_outlet(1, reflection));
+  net.outlets.push_back(reflection_outlet(2, reflection));
+  return net;
+}
+}  // namespace
+
 // A bifurcation (parent 0, daughters 1 and 2) closed at both outlets (reflection coefficient 1
 // from rest: Q* = 0 exactly), fed by a pulse. The DG scheme is conservative inside vessels and
 // the ends pass mass only through their end states, so the volume in the network,
@@ -411,19 +433,8 @@ TEST(PulseSolverVerification, BoileauSinglePulseWithTheDefaultScheme) {
 // created or lost would show. Checked over 400 steps to round-off of the volume.
 TEST(PulseSolverVerification, JunctionConservesMass) {
   const double d0 = 4e-3, d1 = 3.2e-3, d2 = 2.8e-3;
-  Network net;
-  for (int n = 0; n < 4; ++n) net.add_node(n);
-  net.add_vessel(0, 0, 1, 0.2, d0, 4e-4, 4e5, 0);
-  net.add_vessel(1, 1, 2, 0.15, d1, 3e-4, 4e5, 1);
-  net.add_vessel(2, 1, 3, 0.12, d2, 3e-4, 4e5, 1);
-  net.beta = {beta_for_wave_speed(6.0, pi / 4 * d0 * d0), beta_for_wave_speed(7.0, pi / 4 * d1 * d1),
-              beta_for_wave_speed(8.0, pi / 4 * d2 * d2)};
-  net.reference_pressure = {1e4, 1.1e4, 0.9e4};  // unequal: the junction must balance them
-  net.blood = newtonian(4e-3);
-  auto inflow = [](double t) { return 2e-6 * std::exp(-std::pow((t - 0.03) / 0.01, 2)); };
-  net.inlet = Inlet{0, tabulate(inflow, 0.06, 601, 10.0)};
-  net.outlets.push_back(reflection_outlet(1, 1.0));
-  net.outlets.push_back(reflection_outlet(2, 1.0));
+  // Unequal reference pressures: the junction must balance them; closed ends.
+  const Network net = pulsed_bifurcation(d0, d1, d2, {1e4, 1.1e4, 0.9e4}, 1.0);
   SolverOptions o;
   o.degree = 5;
   o.elements = 2;
@@ -460,19 +471,7 @@ TEST(PulseSolverVerification, JunctionConservesMass) {
 // proximal traces, and the total pressure too, to the discretization error.
 TEST(PulseSolverVerification, JunctionTracesBalance) {
   const double d0 = 4e-3, d1 = 3.2e-3, d2 = 2.8e-3;
-  Network net;
-  for (int n = 0; n < 4; ++n) net.add_node(n);
-  net.add_vessel(0, 0, 1, 0.2, d0, 4e-4, 4e5, 0);
-  net.add_vessel(1, 1, 2, 0.15, d1, 3e-4, 4e5, 1);
-  net.add_vessel(2, 1, 3, 0.12, d2, 3e-4, 4e5, 1);
-  net.beta = {beta_for_wave_speed(6.0, pi / 4 * d0 * d0), beta_for_wave_speed(7.0, pi / 4 * d1 * d1),
-              beta_for_wave_speed(8.0, pi / 4 * d2 * d2)};
-  net.reference_pressure = {1e4, 1e4, 1e4};
-  net.blood = newtonian(4e-3);
-  auto inflow = [](double t) { return 2e-6 * std::exp(-std::pow((t - 0.03) / 0.01, 2)); };
-  net.inlet = Inlet{0, tabulate(inflow, 0.06, 601, 10.0)};
-  net.outlets.push_back(reflection_outlet(1, 0.0));
-  net.outlets.push_back(reflection_outlet(2, 0.0));
+  const Network net = pulsed_bifurcation(d0, d1, d2, {1e4, 1e4, 1e4}, 0.0);
   SolverOptions o;
   o.degree = 7;
   o.elements = 2;
