@@ -1,22 +1,35 @@
 #include "solver/degree_choice.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "solver/stability_limit.hpp"
 
 namespace hemotree {
 
-std::vector<int> choose_degrees(std::span<const double> element_transit, double period,
-                                const DegreeRule& rule, TimeScheme scheme) {
+double linear_profile_error(const VesselLaw& law, const ViscosityTable& viscosity, double p_in, double p_out) {
+  const double mean = 0.5 * (p_in + p_out);
+  if (p_in == p_out || mean <= 0) return 0;
+  auto gradient = [&](double p) {
+    const double a = law.area(p);
+    return viscosity(a) / (a * a);
+  };
+  return std::abs(p_in - p_out) * std::abs(std::log(gradient(p_out) / gradient(p_in))) / mean;
+}
+
+std::vector<int> choose_degrees(std::span<const double> element_transit, std::span<const double> linear_error,
+                                double period, const DegreeRule& rule, TimeScheme scheme) {
   auto limit = [&](int p) { return courant_limit(p, scheme); };
   const std::size_t n = element_transit.size();
   std::vector<int> degree(n);
   // The shortest wavelength is c T / harmonics, so h / wavelength = transit harmonics / T.
   const double shortest_period = period / rule.harmonics;
+  const int curved = std::min(2, rule.high);  // the degree of a short vessel too curved for a line
   double step = std::numeric_limits<double>::infinity();
   for (std::size_t v = 0; v < n; ++v) {
     degree[v] = element_transit[v] < rule.short_vessel * shortest_period ? rule.low : rule.high;
+    if (degree[v] < curved && !linear_error.empty() && linear_error[v] > rule.linear_error) degree[v] = curved;
     step = std::min(step, limit(degree[v]) * element_transit[v]);
   }
   // Raise short vessels while their own bound stays 10 % above the network's step, so that

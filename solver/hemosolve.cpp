@@ -65,6 +65,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--high-degree", options.degree_rule.high, "auto: degree of the other vessels")
       ->capture_default_str();
+  app.add_option("--linear-error", options.degree_rule.linear_error,
+                 "auto: a short vessel whose steady pressure profile departs further than this from a "
+                 "line (relative; docs/solver.md) takes degree 2")
+      ->capture_default_str();
   app.add_option("--elements", options.elements, "elements per vessel")->capture_default_str();
   app.add_option("--dt", dt_text, "time step (default: from the CFL and friction limits)");
   app.add_option("--cfl", options.cfl, "fraction of the wave-speed (Courant) stability limit of the degree and scheme")->capture_default_str();
@@ -116,6 +120,7 @@ int main(int argc, char** argv) {
     }
     for (const int p : {options.degree_rule.low, options.degree_rule.raise_to, options.degree_rule.high})
       if (p < 0 || p > 30) throw InputError("--low-degree, --raise-degree and --high-degree must lie in 0..30");
+    if (!(options.degree_rule.linear_error >= 0)) throw InputError("--linear-error must be zero or positive");
     options.external_pressure = parse_quantity(external_text, Dimension::pressure, "--external-pressure");
     const double sample_interval = parse_quantity(sample_text, Dimension::time, "--sample-interval");
 

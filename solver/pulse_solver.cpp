@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include <omp.h>
@@ -70,7 +71,16 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     }
   }
 
-  choose_degrees_and_elements(options);
+  // The steady Poiseuille solution, where the network has one (not with reflection outlets
+  // or loops): the degrees follow its pressure profiles, and the run starts from it.
+  std::optional<SteadyFlow> steady;
+  try {
+    Network steady_net = net;  // the steady solver reads blood from the network
+    steady_net.blood = blood_;
+    steady = solve_steady_flow(steady_net);
+  } catch (const InputError&) {
+  }
+  choose_degrees_and_elements(options, steady ? &*steady : nullptr);
   boundaries_ = build_boundaries(net, first_element_, elements_per_vessel_);
 
   const auto rows = static_cast<Eigen::Index>(element_vessel_.size());
@@ -85,16 +95,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   flux_q_.resize(rows, points);
   source_q_.resize(rows, points);
 
-  bool started = false;
-  if (options.steady_start) {
-    try {
-      start_from_steady_flow(net);
-      started = true;
-    } catch (const InputError&) {
-      // Networks with reflection outlets or loops have no steady solution here: rest.
-    }
-  }
-  if (!started) start_at_rest();
+  if (options.steady_start && steady) start_from_steady_flow(*steady);
+  else start_at_rest();
   choose_time_step(options);
   if (options.dt > 0) {
     dt_ = options.dt;
@@ -102,16 +104,24 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   }
 }
 
-void PulseSolver::choose_degrees_and_elements(const SolverOptions& options) {
+void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, const SteadyFlow* steady) {
   const std::size_t n = net_.vessel_count();
   const int e = options.elements;
   elements_per_vessel_ = e;
   if (options.degree == SolverOptions::automatic) {
-    std::vector<double> transit(n);
+    std::vector<double> transit(n), linear_error;
     for (std::size_t v = 0; v < n; ++v)
       transit[v] = net_.length[v] / e / laws_[v].wave_speed(laws_[v].reference_area);
+    if (steady) {
+      // Over one element of the vessel: its share of the drop.
+      linear_error.resize(n);
+      for (std::size_t v = 0; v < n; ++v) {
+        const double p_in = steady->node_pressure[net_.from[v]], p_out = steady->node_pressure[net_.to[v]];
+        linear_error[v] = linear_profile_error(laws_[v], viscosity_, p_in, p_in + (p_out - p_in) / e);
+      }
+    }
     const double period = net_.inlet ? net_.inlet->waveform.period : 1.0;
-    vessel_degree_ = choose_degrees(transit, period, options.degree_rule,
+    vessel_degree_ = choose_degrees(transit, linear_error, period, options.degree_rule,
                                     scheme_ == TimeScheme::runge_kutta4 ? TimeScheme::runge_kutta4
                                                                         : TimeScheme::adams_bashforth2);
   } else {
@@ -156,10 +166,8 @@ void PulseSolver::start_at_rest() {
   }
 }
 
-void PulseSolver::start_from_steady_flow(const Network& net) {
-  Network steady_net = net;  // the steady solver reads blood from the network
-  steady_net.blood = blood_;
-  const SteadyFlow s = solve_steady_flow(steady_net);
+void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
+  const Network& net = net_;
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
     const ModalBasis& basis = bases_[static_cast<std::size_t>(vessel_degree_[v])];
     const Eigen::Index points = basis.points;

@@ -16,6 +16,7 @@
 #include "solver/degree_choice.hpp"
 #include "solver/legendre_basis.hpp"
 #include "solver/network_boundaries.hpp"
+#include "solver/steady_flow.hpp"
 #include "solver/time_scheme.hpp"
 #include "solver/vessel_equations.hpp"
 
@@ -99,9 +100,10 @@ class PulseSolver {
                              Eigen::Index count);
   void step_exponential();
   void choose_time_step(const SolverOptions& options);
-  void start_from_steady_flow(const Network& net);
+  void start_from_steady_flow(const SteadyFlow& steady);
   void start_at_rest();
-  void choose_degrees_and_elements(const SolverOptions& options);
+  // steady: the network's steady flow, or null where it has none.
+  void choose_degrees_and_elements(const SolverOptions& options, const SteadyFlow* steady);
   std::int32_t end_element(std::size_t vessel) const { return first_element_[vessel] + elements_per_vessel_; }
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
   double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;

@@ -1,6 +1,7 @@
 // The Courant limits of the DG operator under each time scheme (solver/stability_limit) and
 // the automatic degree per vessel built on them (solver/degree_choice).
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -55,7 +56,7 @@ TEST(StabilityLimit, TheLimitIsSharp) {
 TEST(DegreeChoice, ShortVesselsLowLongOnesHighRaisedWhereTheStepAllows) {
   const DegreeRule rule;  // low 1, raise to 2, high 7
   const std::vector<double> transit = {10e-3, 0.1e-3, 0.3e-3, 0.2e-3};
-  const std::vector<int> p = choose_degrees(transit, 1.0, rule, TimeScheme::adams_bashforth2);
+  const std::vector<int> p = choose_degrees(transit, {}, 1.0, rule, TimeScheme::adams_bashforth2);
   const double ratio = courant_limit(1, TimeScheme::adams_bashforth2) / courant_limit(2, TimeScheme::adams_bashforth2);
   ASSERT_GT(ratio, 2.0 / 1.1);
   ASSERT_LT(ratio, 3.0 / 1.1);
@@ -67,5 +68,49 @@ TEST(DegreeChoice, ShortVesselsLowLongOnesHighRaisedWhereTheStepAllows) {
 
 TEST(DegreeChoice, AUniformNetworkStaysAtTheLowDegree) {
   const std::vector<double> transit(5, 1e-4);
-  EXPECT_EQ(choose_degrees(transit, 1.0, DegreeRule{}, TimeScheme::adams_bashforth2), std::vector<int>(5, 1));
+  EXPECT_EQ(choose_degrees(transit, {}, 1.0, DegreeRule{}, TimeScheme::adams_bashforth2), std::vector<int>(5, 1));
+}
+
+// Two short vessels; the longer one's steady profile is too curved for a line (estimate 5 %
+// against the tolerance 1 %): it takes degree 2 and its bound at degree 2 becomes the step
+// (nu(2) 0.15 ms < nu(1) 0.1 ms), which leaves the other at 1. Without the estimate (a
+// network with no steady flow) both stay linear; a rule whose high degree is 1 keeps 1.
+TEST(DegreeChoice, ACurvedSteadyProfileTakesDegreeTwo) {
+  const std::vector<double> transit = {0.1e-3, 0.15e-3}, linear_error = {0.0, 0.05};
+  const auto ab2 = TimeScheme::adams_bashforth2;
+  ASSERT_LT(courant_limit(2, ab2) * 0.15e-3, courant_limit(1, ab2) * 0.1e-3);
+  EXPECT_EQ(choose_degrees(transit, linear_error, 1.0, DegreeRule{}, ab2), (std::vector<int>{1, 2}));
+  EXPECT_EQ(choose_degrees(transit, {}, 1.0, DegreeRule{}, ab2), (std::vector<int>{1, 1}));
+  DegreeRule tolerant;
+  tolerant.linear_error = 0.06;
+  EXPECT_EQ(choose_degrees(transit, linear_error, 1.0, tolerant, ab2), (std::vector<int>{1, 1}));
+  DegreeRule linear_only;
+  linear_only.high = 1;
+  linear_only.raise_to = 1;
+  EXPECT_EQ(choose_degrees(transit, linear_error, 1.0, linear_only, ab2), (std::vector<int>{1, 1}));
+}
+
+// The estimate with a constant viscosity has a closed form: g = mu / A^2, so
+// |ln(g_out / g_in)| = 2 |ln(A_in / A_out)|, with A from the tube law at each end. It
+// vanishes without a drop, is the same whichever end is upstream, and grows with the
+// compliance (the drop narrows a softer vessel more).
+TEST(LinearProfileError, FollowsTheFrictionGradientAlongTheVessel) {
+  Blood blood;
+  blood.rheology = Rheology::newtonian;
+  blood.newtonian_viscosity = 3.5e-3;
+  const ViscosityTable mu(blood);
+  VesselLaw law;
+  law.reference_area = std::numbers::pi / 4 * 5.6e-6 * 5.6e-6;
+  law.reference_pressure = 1333.2;
+  law.density = 1050;
+  law.beta = 2 * law.density * 4.55 * 4.55 / std::sqrt(law.reference_area);  // c = 4.55 m/s
+  const double p_in = 3000, p_out = 2000;
+  const double expected = (p_in - p_out) * 2 * std::log(law.area(p_in) / law.area(p_out)) / (0.5 * (p_in + p_out));
+  EXPECT_NEAR(linear_profile_error(law, mu, p_in, p_out), expected, 1e-12 * expected);
+  EXPECT_NEAR(expected, 0.0358, 0.0005);  // dA/A = 4.5 % over the vessel
+  EXPECT_NEAR(linear_profile_error(law, mu, p_out, p_in), expected, 1e-12 * expected);
+  EXPECT_EQ(linear_profile_error(law, mu, p_in, p_in), 0.0);
+  VesselLaw stiffer = law;
+  stiffer.beta *= 10;
+  EXPECT_LT(linear_profile_error(stiffer, mu, p_in, p_out), 0.11 * expected);
 }
