@@ -167,17 +167,6 @@ int main(int argc, char** argv) {
       write_summary(dir / "summary.json", info, results, last);
       if (vtk) write_results_vtk(dir / "results.vtp", net, results);
     };
-    std::vector<double> frame_area, frame_flow, frame_pressure, frame_velocity;
-    auto write_frame = [&](VtkTimeSeries& series) {
-      run.sample_all(0.5, frame_area, frame_flow);
-      frame_pressure.resize(frame_area.size());
-      frame_velocity.resize(frame_area.size());
-      for (std::size_t v = 0; v < frame_area.size(); ++v) {
-        frame_pressure[v] = run.law(v).pressure(frame_area[v]);
-        frame_velocity[v] = frame_flow[v] / frame_area[v];
-      }
-      series.add_frame(run.time(), {{"p", frame_pressure}, {"Q", frame_flow}, {"A", frame_area}, {"u", frame_velocity}});
-    };
     if (frames > 0) {
       std::filesystem::create_directories(dir / "frames", ec);
       if (ec) throw IoError("cannot create " + (dir / "frames").string() + ": " + ec.message());
@@ -217,7 +206,7 @@ int main(int argc, char** argv) {
             sampled_until = run.time();
           }
           if (series && (k + 1) * static_cast<std::size_t>(frames) >= (frames_written + 1) * steps_per_cycle) {
-            write_frame(*series);
+            add_solution_frame(*series, run);
             ++frames_written;
           }
           if (run.steps() % sample_every == 0) probes.sample(run);

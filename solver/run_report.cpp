@@ -95,4 +95,15 @@ void write_results_vtk(const std::filesystem::path& file, const Network& net, co
   out.commit();
 }
 
+void add_solution_frame(VtkTimeSeries& series, const PulseSolver& solver) {
+  std::vector<double> area, flow;
+  solver.sample_all(0.5, area, flow);
+  std::vector<double> pressure(area.size()), velocity(area.size());
+  for (std::size_t v = 0; v < area.size(); ++v) {
+    pressure[v] = solver.law(v).pressure(area[v]);
+    velocity[v] = flow[v] / area[v];
+  }
+  series.add_frame(solver.time(), {{"p", pressure}, {"Q", flow}, {"A", area}, {"u", velocity}});
+}
+
 }  // namespace hemotree

@@ -1,5 +1,6 @@
 // What hemosolve reports of a run: every vessel's results over the last cycle (measured, and
-// the linear wave theory beside them) in summary.json and as VTK cell data for ParaView.
+// the linear wave theory beside them) in summary.json and as VTK cell data for ParaView, and
+// snapshots of the solution as frames of a ParaView time series.
 #pragma once
 
 #include <filesystem>
@@ -9,6 +10,7 @@
 
 #include "formats/exports.hpp"
 #include "formats/network.hpp"
+#include "formats/vtk_series.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/pulse_solver.hpp"
 
@@ -39,5 +41,8 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
 
 // The network as VTK PolyData with every numeric per-vessel result as cell data (null -> NaN).
 void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels);
+
+// Appends the solution now, at every vessel's centre (p, Q, A, u), as a frame at the solver's time.
+void add_solution_frame(VtkTimeSeries& series, const PulseSolver& solver);
 
 }  // namespace hemotree
