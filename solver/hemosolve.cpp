@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
                "hemosolve"};
   std::string input, out_dir, rheology, scheme = "etd2", start = "steady", dt_text, sample_text = "1ms",
               external_text = "10mmHg", degree_text = "auto";
-  int cycles = 0, max_cycles = 50;
+  int cycles = 1, max_cycles = 50;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
   bool quiet = false, vtk = false, extrapolate = false;
@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   SolverOptions options;
   app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
   app.add_option("--out", out_dir, "folder for summary.json and probes.csv")->required();
-  app.add_option("--cycles", cycles, "cardiac cycles to run");
+  app.add_option("--cycles", cycles, "cardiac cycles to run")->capture_default_str();
   app.add_option("--until-periodic", periodic_tol,
                  "run until every vessel's mean pressure changes less than this from one cycle to the next");
   app.add_option("--max-cycles", max_cycles, "upper bound for --until-periodic")->capture_default_str();
@@ -90,8 +90,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
   return run_tool(app, argc, argv, [&] {
-    if (cycles < 0) throw InputError("--cycles must be positive");
-    if (cycles == 0 && periodic_tol <= 0) cycles = 1;
+    if (cycles < 1) throw InputError("--cycles must be at least 1");
     if (scheme == "rk4") options.scheme = TimeScheme::runge_kutta4;
     else if (scheme == "ab2") options.scheme = TimeScheme::adams_bashforth2;
     else if (scheme == "etd2") options.scheme = TimeScheme::exponential_ab2;

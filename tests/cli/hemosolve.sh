@@ -175,6 +175,10 @@ refuse "--probe of an unknown vessel" 2 "--probe: no vessel 7" -- "$HEMOSOLVE" "
 refuse "--probe x beyond the vessel" 2 "x must lie in [0, 1]" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 1:1.5
 refuse "--probe not ID:x" 2 "is not ID or ID:x" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe abc
 refuse "--probe with a bad x" 2 "is not ID or ID:x" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 1:x
+# --cycles 0 once ran one cycle silently; it is bad input.
+refuse "--cycles 0" 2 "--cycles must be at least 1" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --cycles 0
+refuse "--linear-error negative" 2 "--linear-error must be zero or positive" -- \
+  "$HEMOSOLVE" "$CCA" --out "$(out)" --linear-error -1
 refuse "missing network file" 1 "cannot open" -- "$HEMOSOLVE" "$WORK/missing.json" --out "$(out)"
 refuse "empty standard input" 2 "standard input" -- \
   bash -c '"$0" - --out "$1" </dev/null' "$HEMOSOLVE" "$(out)"
