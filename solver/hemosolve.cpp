@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   int cycles = 1, max_cycles = 50;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
-  bool quiet = false, vtk = false, extrapolate = false;
+  bool quiet = false, vtk = false, balance = true;
   int frames = 0;
   SolverOptions options;
   app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
@@ -83,9 +83,9 @@ int main(int argc, char** argv) {
   app.add_option("--frames", frames,
                  "write N frames of the last cycle (p, Q, A, u per vessel) as a ParaView time series "
                  "(frames/frames.pvd)");
-  app.add_flag("--extrapolate-capacitors", extrapolate,
-               "experimental: at each cycle end, move RCR capacitors to the limit of their cycle-to-cycle "
-               "drift (docs/solver.md)");
+  app.add_flag("--balance-compliances,!--no-balance-compliances", balance,
+               "at each cycle end, move the network's compliances (vessels and RCR capacitors) to where "
+               "their mean filling over the cycle says the periodic state lies (docs/solver.md; on by default)");
   app.add_flag("--quiet", quiet, "no progress line");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
@@ -172,7 +172,7 @@ int main(int argc, char** argv) {
     }
     PeriodicityChange change;
     int done = 0;
-    std::size_t extrapolated = 0;  // capacitor moves
+    int balances = 0;  // cycle ends at which the compliances moved
     const bool until_periodic = periodic_tol > 0;
     const int planned = until_periodic ? max_cycles : cycles;
     const bool show = !quiet && stderr_is_terminal();
@@ -184,14 +184,14 @@ int main(int argc, char** argv) {
                                {"elements_per_vessel", options.elements}, {"scheme", scheme},
                                {"threads", options.threads},
                                {"rheology", to_string(run.blood().rheology)},
-                               {"start", start}, {"period", period},
+                               {"start", start}, {"balance_compliances", balance}, {"period", period},
                                {"pulse_frequency", pulse_frequency(pulse)}, {"analysis_frequency", frequency},
                                {"time_step", dt},
                                {"time_step_limit", dt_reason}};
     for (const auto& [p, count] : degrees) run_info["elements_of_degree"][std::to_string(p)] = count;
     try {
       probes.sample(run);
-      if (extrapolate) run.extrapolate_capacitors();
+      if (balance) run.balance_compliances(period);
       for (; done < planned; ++done) {
         // Every cycle could be the last (--until-periodic): its frames replace the previous ones.
         std::optional<VtkTimeSeries> series;
@@ -221,7 +221,7 @@ int main(int argc, char** argv) {
         previous = std::move(last);
         last = stats.close();
         if (series) series->finish();
-        if (extrapolate) extrapolated += run.extrapolate_capacitors();
+        if (balance && run.balance_compliances(period) > 0) ++balances;
         if (!previous.vessels.empty()) change = cycle_change(previous.vessels, last.vessels);
         if (until_periodic && !previous.vessels.empty() && change.change < periodic_tol) {
           ++done;
@@ -242,7 +242,7 @@ int main(int argc, char** argv) {
     run_info["status"] = until_periodic && !(change.change < periodic_tol) ? "not periodic" : "complete";
     run_info["cycles"] = done;
     run_info["steps"] = run.steps();
-    run_info["capacitor_extrapolations"] = extrapolated;
+    run_info["compliance_balances"] = balances;
     run_info["wall_time"] = wall;
     if (!previous.vessels.empty()) {
       run_info["periodic_change"] = change.change;

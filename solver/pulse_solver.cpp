@@ -14,6 +14,7 @@
 #include "physics/wall_law.hpp"
 #include "solver/solution_breakdown.hpp"
 #include "solver/stability_limit.hpp"
+#include "solver/loaded_tree.hpp"
 #include "solver/steady_flow.hpp"
 
 namespace hemotree {
@@ -77,7 +78,9 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   try {
     Network steady_net = net;  // the steady solver reads blood from the network
     steady_net.blood = blood_;
-    steady = solve_steady_flow(steady_net);
+    if (!net.inlet) throw InputError("the network has no inlet");
+    steady = solve_distended_steady_flow(steady_net, laws_, viscosity_, net.inlet->waveform.mean_flow(),
+                                         &steady_resistance_);
   } catch (const InputError&) {
   }
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
@@ -613,23 +616,77 @@ double PulseSolver::mean_flow(std::size_t vessel) const {
   return sum / elements_per_vessel_;
 }
 
-std::size_t PulseSolver::extrapolate_capacitors() {
-  capacitor_history_.push_back(state_.capacitor);
-  if (capacitor_history_.size() < 3) return 0;
-  const Eigen::VectorXd &c0 = capacitor_history_[0], &c1 = capacitor_history_[1], &c2 = capacitor_history_[2];
-  std::size_t moved = 0;
-  for (Eigen::Index k = 0; k < c2.size(); ++k) {
-    const double d1 = c1(k) - c0(k), d2 = c2(k) - c1(k);
-    if (d1 == 0) continue;
-    const double ratio = d2 / d1;
-    if (!(ratio > 0 && ratio < 0.95)) continue;
-    state_.capacitor(k) = c2(k) + d2 * ratio / (1 - ratio);
-    ++moved;
+std::size_t PulseSolver::balance_compliances(double period) {
+  if (steady_resistance_.empty()) return 0;
+  const std::size_t n = net_.vessel_count();
+  // Each vessel's volume and dA/dp (at its mean area), and the capacitors, now.
+  std::vector<double> volume(n, 0.0), area_per_pressure(n, 0.0);
+  for (std::size_t v = 0; v < n; ++v) {
+    for (auto el = first_element_[v]; el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
+    const double mean_area = volume[v] / net_.length[v];
+    area_per_pressure[v] = 2 * std::sqrt(mean_area) / laws_[v].beta;
   }
-  // A moved capacitor starts a new sequence; an unmoved one keeps its last two values.
-  capacitor_history_.erase(capacitor_history_.begin());
-  if (moved > 0) capacitor_history_.assign(1, state_.capacitor);
-  return moved;
+  if (cycle_volume_.empty()) {
+    cycle_volume_ = volume;
+    cycle_capacitor_ = state_.capacitor;
+    return 0;
+  }
+  // Volume rates over the last cycle: each vessel's half to each of its nodes.
+  TreeLoads loads;
+  loads.node_shunt.assign(net_.node_count(), 0.0);
+  loads.node_current.assign(net_.node_count(), 0.0);
+  loads.capacitor_shunt.assign(net_.outlets.size(), 0.0);
+  loads.capacitor_current.assign(net_.outlets.size(), 0.0);
+  std::vector<double> node_compliance(net_.node_count(), 0.0), capacitor_compliance(net_.outlets.size(), 0.0);
+  for (std::size_t v = 0; v < n; ++v) {
+    const double rate = (volume[v] - cycle_volume_[v]) / period, compliance = area_per_pressure[v] * net_.length[v];
+    for (const auto node : {net_.from[v], net_.to[v]}) {
+      loads.node_current[static_cast<std::size_t>(node)] += rate / 2;
+      node_compliance[static_cast<std::size_t>(node)] += compliance / 2;
+    }
+  }
+  std::vector<std::int32_t> capacitor_outlet(boundaries_.capacitors, -1);
+  for (std::size_t k = 0; k < net_.outlets.size(); ++k)
+    for (const auto& o : boundaries_.outlets)
+      if (o.capacitor >= 0 && o.outlet.vessel == net_.outlets[k].vessel) capacitor_outlet[static_cast<std::size_t>(o.capacitor)] = static_cast<std::int32_t>(k);
+  for (std::size_t c = 0; c < capacitor_outlet.size(); ++c) {
+    const auto k = static_cast<std::size_t>(capacitor_outlet[c]);
+    capacitor_compliance[k] = net_.outlets[k].c;
+    loads.capacitor_current[k] = net_.outlets[k].c * (state_.capacitor(static_cast<Eigen::Index>(c)) - cycle_capacitor_(static_cast<Eigen::Index>(c))) / period;
+  }
+  // delta = K^-1 I: the shifts that cancel the rates in the linear network (K its conductance).
+  const TreePotentials delta = solve_loaded_tree(net_, steady_resistance_, loads);
+  // y = (C + K T/2)^-1 C delta: e^(-z) / (1 - e^(-z)) of z = C^-1 K T, the distance still to
+  // go after a cycle that moved by the drift, as 1 / (z (1 + z/2)): right for the slow modes
+  // (1/z - 1/2), small for the fast ones that have settled.
+  for (std::size_t node = 0; node < node_compliance.size(); ++node) {
+    loads.node_shunt[node] = 2 * node_compliance[node] / period;
+    loads.node_current[node] = loads.node_shunt[node] * delta.node[node];
+  }
+  for (std::size_t k = 0; k < capacitor_compliance.size(); ++k) {
+    loads.capacitor_shunt[k] = 2 * capacitor_compliance[k] / period;
+    loads.capacitor_current[k] = loads.capacitor_shunt[k] * delta.capacitor[k];
+  }
+  const TreePotentials move = solve_loaded_tree(net_, steady_resistance_, loads);
+  // Every vessel's pressure shifts linearly between its nodes' moves.
+  const int e = elements_per_vessel_;
+  for (std::size_t v = 0; v < n; ++v) {
+    const double y0 = move.node[static_cast<std::size_t>(net_.from[v])], y1 = move.node[static_cast<std::size_t>(net_.to[v])];
+    for (int k = 0; k < e; ++k) {
+      const auto el = first_element_[v] + k;
+      state_.area(el, 0) += area_per_pressure[v] * (y0 + (y1 - y0) * (k + 0.5) / e);
+      if (state_.area.cols() > 1 && vessel_degree_[v] >= 1) state_.area(el, 1) += area_per_pressure[v] * (y1 - y0) / (2 * e);
+    }
+  }
+  for (std::size_t c = 0; c < capacitor_outlet.size(); ++c)
+    state_.capacitor(static_cast<Eigen::Index>(c)) += move.capacitor[static_cast<std::size_t>(capacitor_outlet[c])];
+  for (std::size_t v = 0; v < n; ++v) {
+    cycle_volume_[v] = 0;
+    for (auto el = first_element_[v]; el < end_element(v); ++el) cycle_volume_[v] += 2 * half_length_(el) * state_.area(el, 0);
+  }
+  cycle_capacitor_ = state_.capacitor;
+  have_previous_rate_ = false;  // the multistep history belongs to the state before the move
+  return n;
 }
 
 void PulseSolver::check_solution() const {

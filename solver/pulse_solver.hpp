@@ -85,13 +85,16 @@ class PulseSolver {
   // Throws SolutionBreakdown when A <= 0 or a value is not finite.
   void check_solution() const;
 
-  // To be called at the start of the run and at the end of each cycle. The slowest part of the approach to the periodic
-  // state is each RCR capacitor charging towards its mean pressure, with time constants
-  // R2 C of seconds; seen at the same phase of every cycle it is a geometric sequence.
-  // Where the last three cycle ends show one (ratio in (0, 0.95)), the capacitor is moved to
-  // the sequence's limit (Aitken's delta-squared). The periodic state is a fixed point: its
-  // drift is zero, so nothing moves there. Returns how many capacitors moved.
-  std::size_t extrapolate_capacitors();
+
+  // To be called at the start of the run and at the end of each cycle (of length period).
+  // The slowest part of the approach to the periodic state is the filling of the network's
+  // compliances (vessels and RCR capacitors) through its resistances. Over a cycle each
+  // changes its volume at a mean rate I; linearised about the steady network (an RC tree
+  // with the vessels' compliances at their nodes), the pressure shifts that put it at its
+  // limit follow from two O(vessels) solves of that tree (docs/solver.md §6).
+  // Every vessel's area and every capacitor moves by them. At the periodic state the rates
+  // vanish and nothing moves. Returns the vessels moved (0 without a steady solution).
+  std::size_t balance_compliances(double period);
 
  private:
   void evaluate(double t, const PulseState& s, PulseState& rate);
@@ -134,7 +137,9 @@ class PulseSolver {
   // Per element: the friction rate r = k mu(A_mean) / (rho A_mean) the last evaluate() used;
   // for the exponential scheme, the previous step's flow coefficients.
   Eigen::VectorXd friction_rate_;
-  std::vector<Eigen::VectorXd> capacitor_history_;  // at the last cycle ends, oldest first
+  std::vector<double> steady_resistance_;  // Poiseuille, per vessel; empty without a steady solution
+  std::vector<double> cycle_volume_;       // per vessel, at the last cycle end
+  Eigen::VectorXd cycle_capacitor_;        // the capacitors there
   Eigen::VectorXd decay_, phi1_, phi2_, next_flow_;  // ETD2: e^(-r h), phi1, phi2 per element; scratch
   Eigen::MatrixXd previous_flow_;
   bool have_previous_rate_ = false;

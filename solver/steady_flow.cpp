@@ -1,5 +1,8 @@
 #include "solver/steady_flow.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <string>
 
 #include "cli/errors.hpp"
@@ -27,7 +30,7 @@ struct Reduction {
   std::vector<Equivalent> through;  // the vessel itself and what lies beyond it
 };
 
-Reduction reduce(const Network& net, const std::vector<double>& resistance) {
+Reduction reduce(const Network& net, const std::vector<Outlet>& outlets, const std::vector<double>& resistance) {
   Reduction red;
   red.root = check_rooted_tree(net);
   red.children = children_of(net);
@@ -39,8 +42,8 @@ Reduction reduce(const Network& net, const std::vector<double>& resistance) {
 
   // The outlet, if any, at each vessel's distal node.
   std::vector<std::int32_t> outlet_of(n, -1);
-  for (std::size_t k = 0; k < net.outlets.size(); ++k) {
-    const Outlet& o = net.outlets[k];
+  for (std::size_t k = 0; k < outlets.size(); ++k) {
+    const Outlet& o = outlets[k];
     const auto v = static_cast<std::size_t>(o.vessel);
     if (children.offset[v + 1] != children.offset[v])
       throw InputError(name(v) + " has an outlet but is not terminal");
@@ -60,7 +63,7 @@ Reduction reduce(const Network& net, const std::vector<double>& resistance) {
     const auto first = children.offset[v], last = children.offset[v + 1];
     if (first == last) {
       if (outlet_of[v] < 0) throw InputError(name(v) + " is terminal but has no outlet");
-      const Outlet& o = net.outlets[static_cast<std::size_t>(outlet_of[v])];
+      const Outlet& o = outlets[static_cast<std::size_t>(outlet_of[v])];
       beyond[v] = {o.resistance(), o.p_out};
     } else {
       // Daughters in parallel: conductances add, source pressures average by conductance.
@@ -80,12 +83,18 @@ Reduction reduce(const Network& net, const std::vector<double>& resistance) {
 }  // namespace
 
 std::vector<Equivalent> reduce_beyond(const Network& net, const std::vector<double>& resistance) {
-  return reduce(net, resistance).beyond;
+  return reduce(net, net.outlets, resistance).beyond;
 }
 
 SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
                              double inlet_flow, std::vector<Equivalent>* beyond) {
-  Reduction red = reduce(net, resistance);
+  return solve_steady_flow(net, net.outlets, resistance, inlet_flow, beyond);
+}
+
+SteadyFlow solve_steady_flow(const Network& net, const std::vector<Outlet>& outlets,
+                             const std::vector<double>& resistance, double inlet_flow,
+                             std::vector<Equivalent>* beyond) {
+  Reduction red = reduce(net, outlets, resistance);
   const std::size_t root = red.root;
   const std::size_t n = net.vessel_count();
   const Children& children = red.children;
@@ -116,6 +125,34 @@ SteadyFlow solve_steady_flow(const Network& net) {
   if (!net.inlet) throw InputError("the network has no inlet");
   const Blood blood = net.blood.value_or(Blood{});
   return solve_steady_flow(net, vessel_resistances(net, blood), net.inlet->waveform.mean_flow());
+}
+
+SteadyFlow solve_distended_steady_flow(const Network& net, std::span<const VesselLaw> laws,
+                                       const ViscosityTable& viscosity, double inlet_flow,
+                                       std::vector<double>* resistance) {
+  const Blood blood = net.blood.value_or(Blood{});
+  std::vector<double> r = vessel_resistances(net, blood);
+  SteadyFlow s = solve_steady_flow(net, r, inlet_flow);
+  // Each sweep's resistances are averaged with the last ones: the iteration alternates (a
+  // higher pressure widens the lumens, which lowers it), and halving the step damps that.
+  for (int sweep = 0; sweep < 200; ++sweep) {
+    for (std::size_t v = 0; v < r.size(); ++v) {
+      const double p = 0.5 * (s.node_pressure[net.from[v]] + s.node_pressure[net.to[v]]);
+      const double area = laws[v].area(p);
+      if (!(area > 0))
+        throw InputError("vessel " + std::to_string(net.id[v]) + ": the lumen collapses in steady flow");
+      const double diameter = std::sqrt(4 / std::numbers::pi * area);
+      r[v] = 0.5 * (r[v] + poiseuille_resistance(viscosity(area), net.length[v], diameter, blood.alpha));
+    }
+    SteadyFlow next = solve_steady_flow(net, r, inlet_flow);
+    double change = 0;
+    for (std::size_t k = 0; k < next.node_pressure.size(); ++k)
+      change = std::max(change, std::abs(next.node_pressure[k] - s.node_pressure[k]));
+    s = std::move(next);
+    if (change <= 1e-9 * std::abs(s.inlet_pressure)) break;
+  }
+  if (resistance) *resistance = std::move(r);
+  return s;
 }
 
 }  // namespace hemotree

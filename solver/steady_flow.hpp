@@ -4,9 +4,12 @@
 // vprune checks its outlets with it; hemosolve starts from it instead of from rest.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "formats/network.hpp"
+#include "physics/viscosity_table.hpp"
+#include "solver/vessel_equations.hpp"
 
 namespace hemotree {
 
@@ -41,7 +44,25 @@ std::vector<Equivalent> reduce_beyond(const Network& net, const std::vector<doub
 SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
                              double inlet_flow, std::vector<Equivalent>* beyond = nullptr);
 
+// The same with other outlets in place of net.outlets (each on a terminal vessel), e.g. with
+// other outflow pressures.
+SteadyFlow solve_steady_flow(const Network& net, const std::vector<Outlet>& outlets,
+                             const std::vector<double>& resistance, double inlet_flow,
+                             std::vector<Equivalent>* beyond = nullptr);
+
 // The same with the network's own blood (defaults if absent) and inlet (mean flow).
 SteadyFlow solve_steady_flow(const Network& net);
+
+// The steady state of the pulse solver's own equations under the mean inflow: every vessel
+// compliant, at the lumen its tube law gives at its mean pressure, with the viscosity of that
+// lumen (the rigid solution above keeps the reference lumens: in the default network it puts
+// the inlet at 68.6 mmHg, the distended vessels at 62.6 mmHg). Fixed-point
+// iteration from the rigid solution: resistances at the distended lumens, then flows and
+// pressures again, until no pressure changes by more than 1e-9 of the inlet's (about 20
+// sweeps). resistance, when given, receives the final ones. Throws InputError where
+// solve_steady_flow does, or where a lumen collapses.
+SteadyFlow solve_distended_steady_flow(const Network& net, std::span<const VesselLaw> laws,
+                                       const ViscosityTable& viscosity, double inlet_flow,
+                                       std::vector<double>* resistance = nullptr);
 
 }  // namespace hemotree

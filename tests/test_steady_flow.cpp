@@ -55,6 +55,35 @@ TEST(SteadyFlow, SingleTubeWithAResistanceOutlet) {
   EXPECT_DOUBLE_EQ(s.flow[0], 1e-6);
 }
 
+// The distended solution of a compliant tube (Newtonian blood, tube law given): its
+// resistance is Poiseuille's at the lumen of its mean pressure, so the solution satisfies
+// p_in - p_node = Q 8 pi mu L / A(p_mean)^2; the tube widens above p_ref, so it resists less
+// than at its reference lumen and the inlet pressure falls.
+TEST(SteadyFlow, DistendedTubeResistsAtTheLumenOfItsMeanPressure) {
+  Network net = test_networks::chain(1, 0.05, 1e-3, 0, 1333.0, test_networks::newtonian(3.5e-3));
+  const double a_ref = std::numbers::pi / 4 * 1e-6;
+  net.beta[0] = test_networks::beta_for_wave_speed(3.0, a_ref);  // soft: c = 3 m/s
+  net.outlets.push_back(resistance_outlet(0, 1e9, 1333.0));
+  VesselLaw law;
+  law.beta = net.beta[0];
+  law.reference_area = a_ref;
+  law.reference_pressure = 1333.0;
+  law.density = test_networks::rho;
+  const std::vector<VesselLaw> laws{law};
+  const ViscosityTable mu(*net.blood);
+  const double q = 5e-6;
+  std::vector<double> r;
+  const SteadyFlow s = solve_distended_steady_flow(net, laws, mu, q, &r);
+  const double p_node = 1333.0 + q * 1e9;
+  EXPECT_NEAR(s.node_pressure[1], p_node, 1e-9 * p_node);
+  const double a = law.area(0.5 * (s.inlet_pressure + p_node));
+  const double drop = q * 8 * std::numbers::pi * 3.5e-3 * 0.05 / (a * a);
+  EXPECT_NEAR(s.inlet_pressure - p_node, drop, 1e-8 * drop);
+  EXPECT_NEAR(r[0], drop / q, 1e-8 * r[0]);
+  const SteadyFlow rigid = solve_steady_flow(net, vessel_resistances(net, *net.blood), q);
+  EXPECT_LT(s.inlet_pressure, rigid.inlet_pressure - 0.1 * (rigid.inlet_pressure - p_node));
+}
+
 TEST(SteadyFlow, BifurcationSplitsByConductanceAndConservesMass) {
   Network net = bifurcation(1e-3, 8e-4, 6e-4);
   net.outlets.push_back(resistance_outlet(1, 4e9, 500.0));

@@ -1,0 +1,30 @@
+// A linear resistive tree with loads: the network's vessels (Poiseuille resistances) and
+// outlets (R to ground; RCR as R1 to a capacitor node and R2 to ground), the inlet open, and
+// at every node and every capacitor node a conductance to ground and an injected current.
+// Its potentials are what the slow drift of the network's compliances towards the periodic
+// state needs (PulseSolver::balance_compliances): pressure shifts in Pa for volume rates in
+// m^3/s. Outflow pressures are zero: the tree is the network's response to disturbances.
+#pragma once
+
+#include <vector>
+
+#include "formats/network.hpp"
+
+namespace hemotree {
+
+struct TreeLoads {
+  std::vector<double> node_shunt, node_current;            // per node [m^3/(s Pa)], [m^3/s]
+  std::vector<double> capacitor_shunt, capacitor_current;  // per outlet (used for RCR only)
+};
+
+struct TreePotentials {
+  std::vector<double> node;       // per node [Pa]
+  std::vector<double> capacitor;  // per outlet: the capacitor node's (RCR), else 0 [Pa]
+};
+
+// Series and parallel reduction from the leaves up, potentials from the root down: O(vessels).
+// Throws InputError as solve_steady_flow does (not a rooted tree, a terminal vessel without
+// an outlet, a reflection outlet), and where a subtree has no path to ground.
+TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& resistance, const TreeLoads& loads);
+
+}  // namespace hemotree
