@@ -645,10 +645,12 @@ std::size_t PulseSolver::balance_compliances(double period) {
       node_compliance[static_cast<std::size_t>(node)] += compliance / 2;
     }
   }
-  std::vector<std::int32_t> capacitor_outlet(boundaries_.capacitors, -1);
+  // Each capacitor's outlet in the network's list (the boundaries keep their own order).
+  std::vector<std::int32_t> outlet_of(n, -1), capacitor_outlet(boundaries_.capacitors, -1);
   for (std::size_t k = 0; k < net_.outlets.size(); ++k)
-    for (const auto& o : boundaries_.outlets)
-      if (o.capacitor >= 0 && o.outlet.vessel == net_.outlets[k].vessel) capacitor_outlet[static_cast<std::size_t>(o.capacitor)] = static_cast<std::int32_t>(k);
+    outlet_of[static_cast<std::size_t>(net_.outlets[k].vessel)] = static_cast<std::int32_t>(k);
+  for (const auto& o : boundaries_.outlets)
+    if (o.capacitor >= 0) capacitor_outlet[static_cast<std::size_t>(o.capacitor)] = outlet_of[static_cast<std::size_t>(o.outlet.vessel)];
   for (std::size_t c = 0; c < capacitor_outlet.size(); ++c) {
     const auto k = static_cast<std::size_t>(capacitor_outlet[c]);
     capacitor_compliance[k] = net_.outlets[k].c;
