@@ -669,9 +669,19 @@ std::size_t PulseSolver::balance_compliances(double period) {
     loads.capacitor_shunt[k] = 2 * capacitor_compliance[k] / period;
     loads.capacitor_current[k] = loads.capacitor_shunt[k] * delta.capacitor[k];
   }
-  const TreePotentials move = solve_loaded_tree(net_, steady_resistance_, loads);
+  TreePotentials move = solve_loaded_tree(net_, steady_resistance_, loads);
+  // The linearisation holds for small moves: none may change a lumen by more than 20 %
+  // (far from the periodic state, e.g. after a start at rest, the moves shrink to that).
+  double largest = 0;
+  for (std::size_t v = 0; v < n; ++v)
+    for (const auto node : {net_.from[v], net_.to[v]})
+      largest = std::max(largest, std::abs(area_per_pressure[v] * move.node[static_cast<std::size_t>(node)]) /
+                                      (volume[v] / net_.length[v]));
+  const double scale = largest > 0.2 ? 0.2 / largest : 1.0;
   // Every vessel's pressure shifts linearly between its nodes' moves.
   const int e = elements_per_vessel_;
+  for (auto& y : move.node) y *= scale;
+  for (auto& y : move.capacitor) y *= scale;
   for (std::size_t v = 0; v < n; ++v) {
     const double y0 = move.node[static_cast<std::size_t>(net_.from[v])], y1 = move.node[static_cast<std::size_t>(net_.to[v])];
     for (int k = 0; k < e; ++k) {
