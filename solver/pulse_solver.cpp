@@ -616,16 +616,20 @@ double PulseSolver::mean_flow(std::size_t vessel) const {
   return sum / elements_per_vessel_;
 }
 
+std::vector<double> PulseSolver::vessel_volumes() const {
+  std::vector<double> volume(net_.vessel_count(), 0.0);
+  for (std::size_t v = 0; v < volume.size(); ++v)
+    for (auto el = first_element_[v]; el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
+  return volume;
+}
+
 std::size_t PulseSolver::balance_compliances(double period) {
   if (steady_resistance_.empty()) return 0;
   const std::size_t n = net_.vessel_count();
-  // Each vessel's volume and dA/dp (at its mean area), and the capacitors, now.
-  std::vector<double> volume(n, 0.0), area_per_pressure(n, 0.0);
-  for (std::size_t v = 0; v < n; ++v) {
-    for (auto el = first_element_[v]; el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
-    const double mean_area = volume[v] / net_.length[v];
-    area_per_pressure[v] = 2 * std::sqrt(mean_area) / laws_[v].beta;
-  }
+  // Each vessel's volume and dA/dp = 2 sqrt(A) / beta at its mean area, now.
+  const std::vector<double> volume = vessel_volumes();
+  std::vector<double> area_per_pressure(n);
+  for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = 2 * std::sqrt(volume[v] / net_.length[v]) / laws_[v].beta;
   if (cycle_volume_.empty()) {
     cycle_volume_ = volume;
     cycle_capacitor_ = state_.capacitor;
@@ -692,10 +696,7 @@ std::size_t PulseSolver::balance_compliances(double period) {
   }
   for (std::size_t c = 0; c < capacitor_outlet.size(); ++c)
     state_.capacitor(static_cast<Eigen::Index>(c)) += move.capacitor[static_cast<std::size_t>(capacitor_outlet[c])];
-  for (std::size_t v = 0; v < n; ++v) {
-    cycle_volume_[v] = 0;
-    for (auto el = first_element_[v]; el < end_element(v); ++el) cycle_volume_[v] += 2 * half_length_(el) * state_.area(el, 0);
-  }
+  cycle_volume_ = vessel_volumes();
   cycle_capacitor_ = state_.capacitor;
   have_previous_rate_ = false;  // the multistep history belongs to the state before the move
   return n;

@@ -104,6 +104,7 @@ class PulseSolver {
   void step_exponential();
   void choose_time_step(const SolverOptions& options);
   void start_from_steady_flow(const SteadyFlow& steady);
+  std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
   void start_at_rest();
   // steady: the network's steady flow, or null where it has none.
   void choose_degrees_and_elements(const SolverOptions& options, const SteadyFlow* steady);
