@@ -85,7 +85,6 @@ class PulseSolver {
   // Throws SolutionBreakdown when A <= 0 or a value is not finite.
   void check_solution() const;
 
-
   // To be called at the start of the run and at the end of each cycle (of length period).
   // The slowest part of the approach to the periodic state is the filling of the network's
   // compliances (vessels and RCR capacitors) through its resistances. Over a cycle each

@@ -30,7 +30,7 @@ struct Reduction {
   std::vector<Equivalent> through;  // the vessel itself and what lies beyond it
 };
 
-Reduction reduce(const Network& net, const std::vector<Outlet>& outlets, const std::vector<double>& resistance) {
+Reduction reduce(const Network& net, const std::vector<double>& resistance) {
   Reduction red;
   red.root = check_rooted_tree(net);
   red.children = children_of(net);
@@ -42,8 +42,8 @@ Reduction reduce(const Network& net, const std::vector<Outlet>& outlets, const s
 
   // The outlet, if any, at each vessel's distal node.
   std::vector<std::int32_t> outlet_of(n, -1);
-  for (std::size_t k = 0; k < outlets.size(); ++k) {
-    const Outlet& o = outlets[k];
+  for (std::size_t k = 0; k < net.outlets.size(); ++k) {
+    const Outlet& o = net.outlets[k];
     const auto v = static_cast<std::size_t>(o.vessel);
     if (children.offset[v + 1] != children.offset[v])
       throw InputError(name(v) + " has an outlet but is not terminal");
@@ -63,7 +63,7 @@ Reduction reduce(const Network& net, const std::vector<Outlet>& outlets, const s
     const auto first = children.offset[v], last = children.offset[v + 1];
     if (first == last) {
       if (outlet_of[v] < 0) throw InputError(name(v) + " is terminal but has no outlet");
-      const Outlet& o = outlets[static_cast<std::size_t>(outlet_of[v])];
+      const Outlet& o = net.outlets[static_cast<std::size_t>(outlet_of[v])];
       beyond[v] = {o.resistance(), o.p_out};
     } else {
       // Daughters in parallel: conductances add, source pressures average by conductance.
@@ -83,18 +83,12 @@ Reduction reduce(const Network& net, const std::vector<Outlet>& outlets, const s
 }  // namespace
 
 std::vector<Equivalent> reduce_beyond(const Network& net, const std::vector<double>& resistance) {
-  return reduce(net, net.outlets, resistance).beyond;
+  return reduce(net, resistance).beyond;
 }
 
 SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
                              double inlet_flow, std::vector<Equivalent>* beyond) {
-  return solve_steady_flow(net, net.outlets, resistance, inlet_flow, beyond);
-}
-
-SteadyFlow solve_steady_flow(const Network& net, const std::vector<Outlet>& outlets,
-                             const std::vector<double>& resistance, double inlet_flow,
-                             std::vector<Equivalent>* beyond) {
-  Reduction red = reduce(net, outlets, resistance);
+  Reduction red = reduce(net, resistance);
   const std::size_t root = red.root;
   const std::size_t n = net.vessel_count();
   const Children& children = red.children;
@@ -127,10 +121,9 @@ SteadyFlow solve_steady_flow(const Network& net) {
   return solve_steady_flow(net, vessel_resistances(net, blood), net.inlet->waveform.mean_flow());
 }
 
-SteadyFlow solve_distended_steady_flow(const Network& net, std::span<const VesselLaw> laws,
+SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const VesselLaw> laws,
                                        const ViscosityTable& viscosity, double inlet_flow,
                                        std::vector<double>* resistance) {
-  const Blood blood = net.blood.value_or(Blood{});
   std::vector<double> r = vessel_resistances(net, blood);
   SteadyFlow s = solve_steady_flow(net, r, inlet_flow);
   // Each sweep's resistances are averaged with the last ones: the iteration alternates (a

@@ -44,12 +44,6 @@ std::vector<Equivalent> reduce_beyond(const Network& net, const std::vector<doub
 SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
                              double inlet_flow, std::vector<Equivalent>* beyond = nullptr);
 
-// The same with other outlets in place of net.outlets (each on a terminal vessel), e.g. with
-// other outflow pressures.
-SteadyFlow solve_steady_flow(const Network& net, const std::vector<Outlet>& outlets,
-                             const std::vector<double>& resistance, double inlet_flow,
-                             std::vector<Equivalent>* beyond = nullptr);
-
 // The same with the network's own blood (defaults if absent) and inlet (mean flow).
 SteadyFlow solve_steady_flow(const Network& net);
 
@@ -61,7 +55,8 @@ SteadyFlow solve_steady_flow(const Network& net);
 // pressures again, until no pressure changes by more than 1e-9 of the inlet's (about 20
 // sweeps). resistance, when given, receives the final ones. Throws InputError where
 // solve_steady_flow does, or where a lumen collapses.
-SteadyFlow solve_distended_steady_flow(const Network& net, std::span<const VesselLaw> laws,
+// blood: the run's (its rheology may differ from the file's).
+SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const VesselLaw> laws,
                                        const ViscosityTable& viscosity, double inlet_flow,
                                        std::vector<double>* resistance = nullptr);
 

@@ -73,7 +73,7 @@ TEST(SteadyFlow, DistendedTubeResistsAtTheLumenOfItsMeanPressure) {
   const ViscosityTable mu(*net.blood);
   const double q = 5e-6;
   std::vector<double> r;
-  const SteadyFlow s = solve_distended_steady_flow(net, laws, mu, q, &r);
+  const SteadyFlow s = solve_distended_steady_flow(net, *net.blood, laws, mu, q, &r);
   const double p_node = 1333.0 + q * 1e9;
   EXPECT_NEAR(s.node_pressure[1], p_node, 1e-9 * p_node);
   const double a = law.area(0.5 * (s.inlet_pressure + p_node));
