@@ -43,7 +43,8 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
           throw InputError(name(v0) + " is terminal but has no outlet");
         NetworkBoundaries::OutletEnd o;
         o.end = e;
-        o.outlet = net.outlets[static_cast<std::size_t>(outlet_of[v0])];
+        o.index = outlet_of[v0];
+        o.outlet = net.outlets[static_cast<std::size_t>(o.index)];
         if (o.outlet.type == OutletType::rcr && o.outlet.c > 0)
           o.capacitor = static_cast<std::int32_t>(b.capacitors++);
         b.outlets.push_back(o);

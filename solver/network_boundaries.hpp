@@ -33,6 +33,7 @@ struct NetworkBoundaries {
   struct OutletEnd {
     VesselEnd end;
     Outlet outlet;
+    std::int32_t index = -1;      // its position in the network's outlets
     std::int32_t capacitor = -1;  // index of its RCR state, or -1
     double rest_area = 0, rest_flow = 0;  // for the reflection coefficient
   };

@@ -648,16 +648,11 @@ std::size_t PulseSolver::balance_compliances(double period) {
       node_compliance[static_cast<std::size_t>(node)] += compliance / 2;
     }
   }
-  // Each capacitor's outlet in the network's list (the boundaries keep their own order).
-  std::vector<std::int32_t> outlet_of(n, -1), capacitor_outlet(boundaries_.capacitors, -1);
-  for (std::size_t k = 0; k < net_.outlets.size(); ++k)
-    outlet_of[static_cast<std::size_t>(net_.outlets[k].vessel)] = static_cast<std::int32_t>(k);
-  for (const auto& o : boundaries_.outlets)
-    if (o.capacitor >= 0) capacitor_outlet[static_cast<std::size_t>(o.capacitor)] = outlet_of[static_cast<std::size_t>(o.outlet.vessel)];
-  for (std::size_t c = 0; c < capacitor_outlet.size(); ++c) {
-    const auto k = static_cast<std::size_t>(capacitor_outlet[c]);
-    capacitor_compliance[k] = net_.outlets[k].c;
-    loads.capacitor_current[k] = net_.outlets[k].c * (state_.capacitor(static_cast<Eigen::Index>(c)) - cycle_capacitor_(static_cast<Eigen::Index>(c))) / period;
+  for (const auto& o : boundaries_.outlets) {
+    if (o.capacitor < 0) continue;
+    const auto k = static_cast<std::size_t>(o.index);
+    capacitor_compliance[k] = o.outlet.c;
+    loads.capacitor_current[k] = o.outlet.c * (state_.capacitor(o.capacitor) - cycle_capacitor_(o.capacitor)) / period;
   }
   // delta = K^-1 I: the shifts that cancel the rates in the linear network (K its conductance).
   const TreePotentials delta = solve_loaded_tree(net_, steady_resistance_, loads);
@@ -693,8 +688,8 @@ std::size_t PulseSolver::balance_compliances(double period) {
       if (state_.area.cols() > 1 && vessel_degree_[v] >= 1) state_.area(el, 1) += area_per_pressure[v] * (y1 - y0) / (2 * e);
     }
   }
-  for (std::size_t c = 0; c < capacitor_outlet.size(); ++c)
-    state_.capacitor(static_cast<Eigen::Index>(c)) += move.capacitor[static_cast<std::size_t>(capacitor_outlet[c])];
+  for (const auto& o : boundaries_.outlets)
+    if (o.capacitor >= 0) state_.capacitor(o.capacitor) += move.capacitor[static_cast<std::size_t>(o.index)];
   cycle_volume_ = vessel_volumes();
   cycle_capacitor_ = state_.capacitor;
   have_previous_rate_ = false;  // the multistep history belongs to the state before the move
