@@ -1,5 +1,6 @@
 #include "formats/json_pull.hpp"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -195,8 +196,8 @@ struct JsonPull::Impl {
     finished       // end_of_input was returned
   };
 
-  Impl(std::FILE* stream, std::string name)
-      : in(stream), storage(buffer_size), source(std::move(name)) {
+  Impl(std::FILE* stream, std::string name, std::size_t buffer_bytes)
+      : in(stream), storage(std::max<std::size_t>(buffer_bytes, 1)), source(std::move(name)) {
     begin = p = end = storage.data();
   }
   Impl(std::string_view text, std::string name) : source(std::move(name)) {
@@ -727,8 +728,8 @@ struct JsonPull::Impl {
   }
 };
 
-JsonPull::JsonPull(std::FILE* in, std::string source)
-    : impl_(std::make_unique<Impl>(in, std::move(source))) {}
+JsonPull::JsonPull(std::FILE* in, std::string source, std::size_t buffer_bytes)
+    : impl_(std::make_unique<Impl>(in, std::move(source), buffer_bytes)) {}
 JsonPull::JsonPull(std::string_view text, std::string source)
     : impl_(std::make_unique<Impl>(text, std::move(source))) {}
 JsonPull::~JsonPull() = default;

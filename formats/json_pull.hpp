@@ -44,8 +44,9 @@ class JsonPull {
     end_of_input
   };
 
-  // Reads from a stream (not owned) through an internal buffer; source names it in errors.
-  JsonPull(std::FILE* in, std::string source);
+  // Reads from a stream (not owned) through an internal buffer of buffer_bytes (at least 1;
+  // small values exercise every refill path, for tests and fuzzing); source names it in errors.
+  JsonPull(std::FILE* in, std::string source, std::size_t buffer_bytes = buffer_size);
   // Parses text held in memory (tests, small documents).
   JsonPull(std::string_view text, std::string source);
   ~JsonPull();

@@ -295,7 +295,11 @@ Network read_with(JsonPull& in, const std::string& source) { return Reader(in, s
 }  // namespace
 
 Network read_network(std::FILE* in, const std::string& source) {
-  JsonPull pull(in, source);
+  return read_network(in, source, JsonPull::buffer_size);
+}
+
+Network read_network(std::FILE* in, const std::string& source, std::size_t buffer_bytes) {
+  JsonPull pull(in, source, buffer_bytes);
   return read_with(pull, source);
 }
 
