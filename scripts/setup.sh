@@ -1,12 +1,23 @@
 # Shared by scripts/demo and scripts/test: install what is missing (Debian/Ubuntu), then
 # configure and build Release in build/. Quick when everything is already there.
+#
+# Each long stage says so on stderr, one plain line before and one after (no progress bars
+# or carriage returns: the output is often a log or a pipe). Set before sourcing:
+#   HEMOTREE_BUILD_DIR         the build folder (default build/)
+#   HEMOTREE_JOBS              parallel compile jobs (default: the number of cores)
+#   hemotree_cmake_args=(...)  configure options replacing -DCMAKE_BUILD_TYPE=Release; when
+#                              set, the folder is configured every time (a few seconds), so
+#                              that a folder made with other options gets these.
 set -euo pipefail
 
 HEMOTREE_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BUILD_DIR=${HEMOTREE_BUILD_DIR:-$HEMOTREE_ROOT/build}
+JOBS=${HEMOTREE_JOBS:-$(nproc)}
 
 packages=(build-essential cmake ninja-build libboost-graph-dev libeigen3-dev
           nlohmann-json3-dev libgtest-dev libcli11-dev python3-matplotlib)
+
+say() { echo "hemotree: $*" >&2; }
 
 install_missing_packages() {
   local missing=()
@@ -14,19 +25,40 @@ install_missing_packages() {
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   ((${#missing[@]} == 0)) && return 0
-  echo "hemotree: installing ${missing[*]}" >&2
-  local sudo=()
+  local sudo=() start=$SECONDS
   [ "$(id -u)" -ne 0 ] && sudo=(sudo)
+  # apt-get -qq prints nothing for minutes: announce each step and its end instead.
+  say "installing ${#missing[@]} packages with apt-get (about 3 minutes on a fresh machine): ${missing[*]}"
+  say "apt-get update: reading the package lists..."
   "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  say "apt-get install: downloading and unpacking ${#missing[@]} packages and their dependencies..."
   "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
     "${missing[@]}" >/dev/null
+  say "installed ${#missing[@]} packages in $((SECONDS - start)) s"
 }
 
 build_release() {
-  if [ ! -f "$BUILD_DIR/build.ninja" ]; then
-    cmake -S "$HEMOTREE_ROOT" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+  local args=(-DCMAKE_BUILD_TYPE=Release) start=$SECONDS
+  local configure=0
+  [ -f "$BUILD_DIR/build.ninja" ] || configure=1
+  if [ -n "${hemotree_cmake_args+set}" ]; then
+    args=("${hemotree_cmake_args[@]}")
+    configure=1
   fi
-  cmake --build "$BUILD_DIR" -- -j"$(nproc)"
+  # ccache, where installed, makes a rebuild after switching branches or flags quick.
+  if command -v ccache >/dev/null; then args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+  if ((configure)); then
+    say "configuring $BUILD_DIR (cmake ${args[*]})"
+    cmake -S "$HEMOTREE_ROOT" -B "$BUILD_DIR" -G Ninja "${args[@]}" >/dev/null
+  fi
+  # Ninja prints one "[n/N] Building ..." line per file when its output is not a terminal
+  # (redrawn in place on a terminal); nothing at all when everything is up to date.
+  say "building in $BUILD_DIR with $JOBS jobs (the first build takes several minutes; a line per file)"
+  if ! cmake --build "$BUILD_DIR" -- -j"$JOBS"; then
+    say "the build in $BUILD_DIR failed after $((SECONDS - start)) s (the compiler's message is above)"
+    exit 1
+  fi
+  say "build up to date ($((SECONDS - start)) s)"
 }
 
 install_missing_packages
