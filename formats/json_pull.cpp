@@ -26,6 +26,7 @@ constexpr std::size_t max_depth = JsonPull::max_depth;
 constexpr std::array<bool, 256> make_string_stop() {
   std::array<bool, 256> table{};
   for (int c = 0; c < 0x20; ++c) table[c] = true;  // raw control characters are errors
+  for (int c = 0x80; c < 0x100; ++c) table[c] = true;  // UTF-8 sequences are checked
   table['"'] = true;
   table['\\'] = true;
   return table;
@@ -59,11 +60,13 @@ inline std::uint64_t load8(const char* at) {
 inline std::uint64_t non_digit_lanes(std::uint64_t w) {
   return ((w + lanes(0x46)) | (w - lanes('0')) | w) & high_bits;
 }
-// Lanes holding '"', '\\' or a control byte: where a plain run inside a string ends.
+// Lanes holding '"', '\\', a control byte or a non-ASCII byte (the start of a UTF-8
+// sequence, which is checked): where a plain run inside a string ends.
 inline std::uint64_t string_stop_lanes(std::uint64_t w) {
   auto zero_lanes = [](std::uint64_t x) { return (x - lanes(1)) & ~x & high_bits; };
   const std::uint64_t below_space = (w - lanes(0x20)) & ~w & high_bits;
-  return zero_lanes(w ^ lanes('"')) | zero_lanes(w ^ lanes('\\')) | below_space;
+  return zero_lanes(w ^ lanes('"')) | zero_lanes(w ^ lanes('\\')) | below_space |
+         (w & high_bits);
 }
 inline const char* first_lane(const char* at, std::uint64_t mask) {
   return at + std::countr_zero(mask) / 8;
@@ -182,6 +185,54 @@ bool fast_double(std::string_view number, double& out) {
   return true;
 }
 
+// RFC 8259 s. 8.1: text is UTF-8, so a string holds only well-formed sequences (RFC 3629
+// s. 4: no overlong forms, no encoded surrogates, nothing above U+10FFFF). Checked here
+// so that every later consumer (nlohmann::json among them, which throws on bad UTF-8 when
+// it writes) can trust the strings. Given the bytes [q, last) of a sequence whose lead
+// byte *q is >= 0x80, returns the sequence length and leaves `problem` empty; 0 when the
+// bytes end before the sequence does (the caller fetches more); otherwise sets `problem`.
+std::size_t utf8_sequence(const char* q, const char* last, std::string& problem) {
+  const unsigned char lead = byte(*q);
+  std::size_t length = 0;
+  unsigned char low = 0x80, high = 0xBF;  // the allowed range of the second byte
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    length = 2;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    length = 3;
+    if (lead == 0xE0) low = 0xA0;   // below: an overlong form of U+0000..U+07FF
+    if (lead == 0xED) high = 0x9F;  // above: the surrogates U+D800..U+DFFF
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    length = 4;
+    if (lead == 0xF0) low = 0x90;   // below: an overlong form of U+0000..U+FFFF
+    if (lead == 0xF4) high = 0x8F;  // above: beyond U+10FFFF
+  } else if (lead < 0xC0) {
+    problem = "continuation byte " + hex_byte(*q) + " without a lead byte";
+    return 0;
+  } else if (lead < 0xC2) {
+    problem = "overlong encoding (lead byte " + hex_byte(*q) + ")";
+    return 0;
+  } else {
+    problem = "byte " + hex_byte(*q) + " never occurs in UTF-8";
+    return 0;
+  }
+  for (std::size_t i = 1; i < length; ++i) {
+    if (q + i >= last) return 0;
+    const unsigned char c = byte(q[i]);
+    if (c >= 0x80 && c <= 0xBF && (i > 1 || (c >= low && c <= high))) continue;
+    if (i == 1 && c >= 0x80 && c <= 0xBF) {
+      problem = lead == 0xED   ? "an encoded UTF-16 surrogate (U+D800..U+DFFF)"
+                : lead == 0xF4 ? "a code point above U+10FFFF"
+                               : "overlong encoding";
+      problem += " (bytes " + hex_byte(q[0]) + " " + hex_byte(q[1]) + ")";
+    } else {
+      problem = "sequence cut short: lead byte " + hex_byte(q[0]) + " followed by " +
+                describe_byte(q[i]);
+    }
+    return 0;
+  }
+  return length;
+}
+
 }  // namespace
 
 struct JsonPull::Impl {
@@ -231,6 +282,7 @@ struct JsonPull::Impl {
   bool bool_value = false;
   std::uint64_t token_offset = 0;
   std::string scratch;          // reused for tokens with escapes or across refills
+  std::string problem;          // what utf8_sequence found wrong; empty when all is well
 
   std::uint64_t offset_of(const char* at) const {
     return base + static_cast<std::uint64_t>(at - begin);
@@ -368,6 +420,13 @@ struct JsonPull::Impl {
   void scan_string() {
     const char* start = ++p;
     const char* q = skip_plain(start);
+    // Non-ASCII text in the buffer is checked in place; a sequence cut by the buffer's end
+    // (or a bad one, which the slow path then reports) leaves the loop.
+    while (q < end && byte(*q) >= 0x80) {
+      const std::size_t length = utf8_sequence(q, end, problem);
+      if (length == 0) break;
+      q = skip_plain(q + length);
+    }
     if (q < end && *q == '"') {
       text = std::string_view(start, static_cast<std::size_t>(q - start));
       p = q + 1;
@@ -394,9 +453,33 @@ struct JsonPull::Impl {
       }
       if (byte(c) < 0x20)
         error_at(offset_of(p), "unescaped control character " + hex_byte(c) + " in string");
+      if (byte(c) >= 0x80) {
+        take_utf8();
+        continue;
+      }
       const char* q = skip_plain(p);
       scratch.append(p, q);
       p = q;
+    }
+  }
+
+  // p at a byte >= 0x80 inside a string: checks one UTF-8 sequence, which may be cut by
+  // buffer refills, and appends it to scratch. Errors point at the sequence's first byte.
+  void take_utf8() {
+    const std::uint64_t at = offset_of(p);
+    char sequence[4];
+    std::size_t have = 0;
+    for (;;) {
+      if (p == end && !refill())
+        error_at(at, "invalid UTF-8 in string: sequence cut short by the end of input");
+      sequence[have++] = *p++;
+      problem.clear();
+      const std::size_t length = utf8_sequence(sequence, sequence + have, problem);
+      if (!problem.empty()) error_at(at, "invalid UTF-8 in string: " + problem);
+      if (length != 0) {
+        scratch.append(sequence, length);
+        return;
+      }
     }
   }
 

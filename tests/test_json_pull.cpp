@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -53,14 +54,15 @@ std::vector<Seen> tokens_in_memory(std::string_view text) {
   return all_tokens(json);
 }
 
-// Parses text through a FILE*, as read_network does with files and pipes.
-std::vector<Seen> tokens_from_stream(const std::string& text) {
-  std::FILE* in = fmemopen(const_cast<char*>(text.data()), text.size(), "r");
+// Parses text through a FILE* and a buffer of buffer_bytes, as read_network does with files
+// and pipes (1 MiB buffers there; tiny ones here put a refill inside every token).
+std::vector<Seen> tokens_from_stream(const std::string& text, std::size_t buffer_bytes = chunk) {
+  std::FILE* in = text.empty() ? std::tmpfile()
+                               : fmemopen(const_cast<char*>(text.data()), text.size(), "r");
   if (!in) throw std::runtime_error("fmemopen failed");
-  JsonPull json(in, "doc.json");
-  auto seen = all_tokens(json);
-  std::fclose(in);
-  return seen;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> closer(in, &std::fclose);
+  JsonPull json(in, "doc.json", buffer_bytes);
+  return all_tokens(json);
 }
 
 // A compact picture of the token sequence, e.g. "{ key:a num:1 }".
@@ -97,9 +99,9 @@ std::string error_of(std::string_view text) {
   return "no error";
 }
 
-std::string stream_error_of(const std::string& text) {
+std::string stream_error_of(const std::string& text, std::size_t buffer_bytes = chunk) {
   try {
-    tokens_from_stream(text);
+    tokens_from_stream(text, buffer_bytes);
   } catch (const JsonError& e) {
     return e.what();
   }
@@ -215,6 +217,60 @@ TEST(JsonPullStrings, SurrogatePairs) {
 TEST(JsonPullStrings, RawUtf8PassesThrough) {
   EXPECT_EQ(string_value("\"h\xC3\xA9mo \xE2\x82\xAC \xF0\x9F\xA9\xB8\""),
             "h\xC3\xA9mo \xE2\x82\xAC \xF0\x9F\xA9\xB8");
+}
+
+// RFC 8259 s. 8.1 with RFC 3629 s. 4: the shortest form only, no surrogates, nothing
+// above U+10FFFF. Each edge of each range, in memory and through buffers of 1 to 5 bytes
+// (which cut every sequence at every byte).
+TEST(JsonPullStrings, WellFormedUtf8AtEveryEdgeIsAccepted) {
+  const std::string edges[] = {"\xC2\x80", "\xDF\xBF", "\xE0\xA0\x80", "\xEC\xBF\xBF",
+                               "\xED\x80\x80", "\xED\x9F\xBF", "\xEE\x80\x80",
+                               "\xEF\xBF\xBF", "\xF0\x90\x80\x80", "\xF3\xBF\xBF\xBF",
+                               "\xF4\x80\x80\x80", "\xF4\x8F\xBF\xBF"};
+  for (const std::string& e : edges) {
+    const std::string text = "{\"k" + e + "\":\"a" + e + "b" + e + e + "\\n" + e + "\"}";
+    const auto expected = tokens_in_memory(text);
+    ASSERT_EQ(expected[1].text, "k" + e);
+    ASSERT_EQ(expected[2].text, "a" + e + "b" + e + e + "\n" + e);
+    for (std::size_t buffer = 1; buffer <= 5; ++buffer)
+      ASSERT_EQ(tokens_from_stream(text, buffer), expected) << "buffer " << buffer;
+  }
+}
+
+TEST(JsonPullStrings, IllFormedUtf8IsRefusedWithItsPosition) {
+  struct Case { std::string bytes, error; };
+  const Case cases[] = {
+      {"\x80", "continuation byte 0x80 without a lead byte"},
+      {"\xBF", "continuation byte 0xBF without a lead byte"},
+      {"\xC0\xAF", "overlong encoding (lead byte 0xC0)"},
+      {"\xC1\xBF", "overlong encoding (lead byte 0xC1)"},
+      {"\xE0\x9F\xBF", "overlong encoding (bytes 0xE0 0x9F)"},
+      {"\xF0\x8F\xBF\xBF", "overlong encoding (bytes 0xF0 0x8F)"},
+      {"\xED\xA0\x80", "an encoded UTF-16 surrogate (U+D800..U+DFFF) (bytes 0xED 0xA0)"},
+      {"\xED\xBF\xBF", "an encoded UTF-16 surrogate (U+D800..U+DFFF) (bytes 0xED 0xBF)"},
+      {"\xF4\x90\x80\x80", "a code point above U+10FFFF (bytes 0xF4 0x90)"},
+      {"\xF5\x80\x80\x80", "byte 0xF5 never occurs in UTF-8"},
+      {"\xFF", "byte 0xFF never occurs in UTF-8"},
+      {"\xE2\x82x", "sequence cut short: lead byte 0xE2 followed by 'x'"},
+      {"\xC3\"", "sequence cut short: lead byte 0xC3 followed by '\"'"},
+      {"\xF0\x9F\x98\xC3\xA9", "sequence cut short: lead byte 0xF0 followed by byte 0xC3"},
+  };
+  for (const Case& c : cases) {
+    // In a value and in a key, after a well-formed sequence; the column is the bad one's.
+    for (const std::string& text : {"[\"\xC3\xA9" + c.bytes + "z\"]",
+                                    "{\"\xC3\xA9" + c.bytes + "z\":1}"}) {
+      const std::string expected = "doc.json:1:5: invalid UTF-8 in string: " + c.error;
+      EXPECT_EQ(error_of(text), expected);
+      for (std::size_t buffer : {1, 2, 3, 4, 7})
+        EXPECT_EQ(stream_error_of(text, buffer), expected) << "buffer " << buffer;
+    }
+  }
+  EXPECT_EQ(error_of("[\"ab\xE2\x82"),
+            "doc.json:1:5: invalid UTF-8 in string: sequence cut short by the end of input");
+  EXPECT_EQ(stream_error_of("[\"ab\xE2\x82", 3),
+            "doc.json:1:5: invalid UTF-8 in string: sequence cut short by the end of input");
+  // Outside strings a non-ASCII byte was already a grammar error, and stays one.
+  EXPECT_EQ(error_of("[\xC3\xA9]"), "doc.json:1:2: expected a value or ']', found byte 0xC3");
 }
 
 TEST(JsonPullStrings, KeysAreUnescapedToo) {
@@ -527,6 +583,13 @@ TEST(JsonPullStream, ErrorsAtChunkBoundariesMatchMemory) {
   const std::string cut = "[\"" + std::string(chunk + 10, 'x');
   EXPECT_EQ(stream_error_of(cut),
             "doc.json:1:" + std::to_string(cut.size() + 1) + ": unexpected end of input inside string");
+}
+
+TEST(JsonPullStream, AnyBufferSizeGivesTheSameTokens) {
+  const std::string text = std::string("{\"a\":") + sample + ",\"b\":[1,2,{\"c\":\"\\u00e9\"}]}";
+  const auto expected = tokens_in_memory(text);
+  for (std::size_t buffer = 0; buffer <= 70; ++buffer)  // 0 stands for 1
+    ASSERT_EQ(tokens_from_stream(text, buffer), expected) << "buffer " << buffer;
 }
 
 TEST(JsonPullStream, EmptyStream) {
