@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 #include <string>
 
 #include "cli/errors.hpp"
+#include "formats/field_ranges.hpp"
 
 namespace hemotree {
 
@@ -57,7 +60,9 @@ double Waveform::mean_flow() const {
   return integral / period;
 }
 
-// ---- JSON -----------------------------------------------------------------------------
+// ---- JSON ----------------------------------------------------------------------------
+// Every access checks the type first: a value of the wrong type is the user's mistake and
+// gets one line naming the field, never a nlohmann::json exception.
 
 namespace {
 
@@ -68,14 +73,44 @@ double number(const nlohmann::json& j, const char* key, const std::string& where
   return v.get<double>();
 }
 
-double positive(const nlohmann::json& j, const char* key, const std::string& where) {
+double in_range(const nlohmann::json& j, const char* key, const FieldRange& range,
+                const std::string& where) {
   const double v = number(j, key, where);
-  if (!(v > 0)) throw InputError(where + ": \"" + key + "\" must be positive");
+  if (!range.contains(v)) throw InputError(where + ": " + out_of_range(key, range, v));
   return v;
 }
 
-double number_or(const nlohmann::json& j, const char* key, double fallback, const std::string& where) {
-  return j.contains(key) ? number(j, key, where) : fallback;
+double in_range_or(const nlohmann::json& j, const char* key, const FieldRange& range,
+                   double fallback, const std::string& where) {
+  return j.contains(key) ? in_range(j, key, range, where) : fallback;
+}
+
+// The member as a string, or fallback when it is absent; `choices` names the allowed values.
+std::string text(const nlohmann::json& j, const char* key, const std::string& fallback,
+                 const std::string& where, const char* choices) {
+  if (!j.contains(key)) return fallback;
+  const auto& v = j.at(key);
+  if (!v.is_string())
+    throw InputError(where + ": \"" + key + "\" must be a string: " + choices + " (got " +
+                     std::string(v.type_name()) + ")");
+  return v.get<std::string>();
+}
+
+std::vector<double> samples(const nlohmann::json& w, const char* key, const std::string& where) {
+  const std::string message =
+      where + ": a table needs number lists \"time\" and \"flow\"";
+  if (!w.contains(key) || !w.at(key).is_array()) throw InputError(message);
+  std::vector<double> values;
+  values.reserve(w.at(key).size());
+  for (const auto& v : w.at(key)) {
+    if (!v.is_number()) throw InputError(message);
+    values.push_back(v.get<double>());
+  }
+  return values;
+}
+
+std::string element(const char* key, std::size_t k) {
+  return std::string(key) + "[" + std::to_string(k) + "]";
 }
 
 }  // namespace
@@ -94,23 +129,20 @@ Blood blood_from_json(const nlohmann::json& j) {
   const std::string where = "blood";
   if (!j.is_object()) throw InputError("\"blood\" must be an object");
   Blood b;
-  b.density = j.contains("density") ? positive(j, "density", where) : b.density;
+  b.density = in_range_or(j, "density", ranges::density, b.density, where);
   b.plasma_viscosity =
-      j.contains("plasma_viscosity") ? positive(j, "plasma_viscosity", where) : b.plasma_viscosity;
-  b.hematocrit = number_or(j, "hematocrit", b.hematocrit, where);
-  if (!(b.hematocrit >= 0 && b.hematocrit < 1)) throw InputError("blood: hematocrit must lie in [0, 1)");
-  b.alpha = number_or(j, "alpha", b.alpha, where);
-  if (!(b.alpha > 1)) throw InputError("blood: alpha must exceed 1 (4/3 is a parabolic profile)");
-  if (j.contains("rheology")) {
-    const auto& r = j.at("rheology");
-    if (r == "pries") b.rheology = Rheology::pries;
-    else if (r == "newtonian") b.rheology = Rheology::newtonian;
-    else throw InputError("blood: rheology must be \"pries\" or \"newtonian\"");
-  }
-  b.newtonian_viscosity = j.contains("newtonian_viscosity")
-                              ? positive(j, "newtonian_viscosity", where) : b.newtonian_viscosity;
-  b.pries_max_diameter = j.contains("pries_max_diameter")
-                             ? positive(j, "pries_max_diameter", where) : b.pries_max_diameter;
+      in_range_or(j, "plasma_viscosity", ranges::viscosity, b.plasma_viscosity, where);
+  b.hematocrit = in_range_or(j, "hematocrit", ranges::hematocrit, b.hematocrit, where);
+  b.alpha = in_range_or(j, "alpha", ranges::alpha, b.alpha, where);
+  const std::string rheology =
+      text(j, "rheology", "pries", where, "\"pries\" or \"newtonian\"");
+  if (rheology == "pries") b.rheology = Rheology::pries;
+  else if (rheology == "newtonian") b.rheology = Rheology::newtonian;
+  else throw InputError("blood: \"rheology\" must be \"pries\" or \"newtonian\"");
+  b.newtonian_viscosity =
+      in_range_or(j, "newtonian_viscosity", ranges::viscosity, b.newtonian_viscosity, where);
+  b.pries_max_diameter = in_range_or(j, "pries_max_diameter", ranges::pries_max_diameter,
+                                     b.pries_max_diameter, where);
   return b;
 }
 
@@ -124,44 +156,72 @@ nlohmann::json to_json(const Inlet& inlet) {
   return {{"vessel", inlet.vessel}, {"type", "flow"}, {"waveform", wave}};
 }
 
+void check_waveform(const Waveform& wave, const std::string& where) {
+  if (!ranges::period.contains(wave.period))
+    throw InputError(where + ": " + out_of_range("period", ranges::period, wave.period));
+  if (wave.shape == Waveform::Shape::half_sine) {
+    if (!ranges::systole.contains(wave.systole))
+      throw InputError(where + ": " + out_of_range("systole", ranges::systole, wave.systole));
+    if (wave.systole > wave.period)
+      throw InputError(where + ": \"systole\" (" + format_number(wave.systole) +
+                       " s) exceeds the period (" + format_number(wave.period) + " s)");
+    if (!ranges::mean_flow.contains(wave.mean))
+      throw InputError(where + ": " + out_of_range("mean", ranges::mean_flow, wave.mean));
+    return;
+  }
+  if (wave.time.size() < 2 || wave.time.size() != wave.flow.size())
+    throw InputError(where + ": \"time\" and \"flow\" need the same length, at least 2");
+  for (std::size_t k = 0; k < wave.flow.size(); ++k)
+    if (!ranges::flow_sample.contains(wave.flow[k]))
+      throw InputError(where + ": " +
+                       out_of_range(element("flow", k), ranges::flow_sample, wave.flow[k]));
+  for (std::size_t k = 1; k < wave.time.size(); ++k)
+    if (!(wave.time[k] > wave.time[k - 1]))
+      throw InputError(where + ": times must increase (" + element("time", k) + " = " +
+                       format_number(wave.time[k]) + " s)");
+  if (wave.time.front() < 0 || !(wave.time.back() < wave.period + wave.time.front()))
+    throw InputError(where + ": times must lie within one period, from \"time\"[0] >= 0");
+  const double mean = wave.mean_flow();
+  if (!ranges::mean_flow.contains(mean))
+    throw InputError(where + ": the table's mean flow must lie in " +
+                     describe(ranges::mean_flow) + " (got " + format_number(mean) + ")");
+}
+
 Inlet inlet_from_json(const nlohmann::json& j) {
   const std::string where = "inlet";
   if (!j.is_object()) throw InputError("\"inlet\" must be an object");
   if (!j.contains("vessel") || !j.at("vessel").is_number_integer())
     throw InputError("inlet: \"vessel\" must be a vessel id");
-  if (j.value("type", std::string("flow")) != "flow")
+  // An id beyond the signed 64 bits of vessel ids names no vessel; say so with the number
+  // as written rather than its wrapped value.
+  if (j.at("vessel").is_number_unsigned() &&
+      j.at("vessel").get<std::uint64_t>() >
+          static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+    throw InputError("inlet: unknown vessel " + j.at("vessel").dump());
+  if (text(j, "type", "flow", where, "\"flow\"") != "flow")
     throw InputError("inlet: only \"type\": \"flow\" (a prescribed volume flow) is supported");
   if (!j.contains("waveform") || !j.at("waveform").is_object())
     throw InputError("inlet: missing \"waveform\"");
   Inlet inlet;
   inlet.vessel = j.at("vessel").get<std::int64_t>();
   const auto& w = j.at("waveform");
+  const std::string wave_where = "inlet.waveform";
   Waveform& wave = inlet.waveform;
-  wave.period = positive(w, "period", "inlet.waveform");
-  const std::string shape = w.value("shape", std::string());
+  wave.period = number(w, "period", wave_where);
+  const std::string shape =
+      text(w, "shape", "", wave_where, "\"half_sine\" or \"table\"");
   if (shape == "half_sine") {
     wave.shape = Waveform::Shape::half_sine;
-    wave.systole = positive(w, "systole", "inlet.waveform");
-    wave.mean = number(w, "mean", "inlet.waveform");
-    if (wave.systole > wave.period) throw InputError("inlet.waveform: systole exceeds the period");
+    wave.systole = number(w, "systole", wave_where);
+    wave.mean = number(w, "mean", wave_where);
   } else if (shape == "table") {
     wave.shape = Waveform::Shape::table;
-    try {
-      wave.time = w.at("time").get<std::vector<double>>();
-      wave.flow = w.at("flow").get<std::vector<double>>();
-    } catch (const nlohmann::json::exception&) {
-      throw InputError("inlet.waveform: a table needs number lists \"time\" and \"flow\"");
-    }
-    if (wave.time.size() < 2 || wave.time.size() != wave.flow.size())
-      throw InputError("inlet.waveform: \"time\" and \"flow\" need the same length, at least 2");
-    for (std::size_t k = 1; k < wave.time.size(); ++k)
-      if (!(wave.time[k] > wave.time[k - 1]))
-        throw InputError("inlet.waveform: times must increase");
-    if (wave.time.front() < 0 || !(wave.time.back() < wave.period + wave.time.front()))
-      throw InputError("inlet.waveform: times must lie within one period");
+    wave.time = samples(w, "time", wave_where);
+    wave.flow = samples(w, "flow", wave_where);
   } else {
-    throw InputError("inlet.waveform: \"shape\" must be \"half_sine\" or \"table\"");
+    throw InputError(wave_where + ": \"shape\" must be \"half_sine\" or \"table\"");
   }
+  check_waveform(wave, wave_where);
   return inlet;
 }
 
@@ -184,20 +244,20 @@ Outlet outlet_from_json(const nlohmann::json& j, const std::string& where) {
   const std::string type = j.at("type").get<std::string>();
   if (type == "RCR") {
     o.type = OutletType::rcr;
-    o.r1 = number(j, "R1", where);
-    o.c = number(j, "C", where);
-    o.r2 = number(j, "R2", where);
-    o.p_out = number_or(j, "p_out", 0.0, where);
-    if (!(o.r1 >= 0 && o.r2 >= 0 && o.r1 + o.r2 > 0 && o.c >= 0))
-      throw InputError(where + ": RCR needs R1, R2 >= 0 with R1 + R2 > 0 and C >= 0");
+    o.r1 = in_range(j, "R1", ranges::rcr_part, where);
+    o.c = in_range(j, "C", ranges::compliance, where);
+    o.r2 = in_range(j, "R2", ranges::rcr_part, where);
+    o.p_out = in_range_or(j, "p_out", ranges::pressure, 0.0, where);
+    if (!(o.r1 + o.r2 >= ranges::resistance.min))
+      throw InputError(where + ": RCR needs R1 + R2 >= " + format_number(ranges::resistance.min) +
+                       " Pa s/m^3 (got " + format_number(o.r1 + o.r2) + ")");
   } else if (type == "R") {
     o.type = OutletType::resistance;
-    o.r = positive(j, "R", where);
-    o.p_out = number_or(j, "p_out", 0.0, where);
+    o.r = in_range(j, "R", ranges::resistance, where);
+    o.p_out = in_range_or(j, "p_out", ranges::pressure, 0.0, where);
   } else if (type == "reflection") {
     o.type = OutletType::reflection;
-    o.reflection = number_or(j, "coefficient", 0.0, where);
-    if (!(std::abs(o.reflection) <= 1)) throw InputError(where + ": the reflection coefficient must lie in [-1, 1]");
+    o.reflection = in_range_or(j, "coefficient", ranges::reflection, 0.0, where);
   } else {
     throw InputError(where + ": unknown outlet type \"" + type + "\" (RCR, R or reflection)");
   }

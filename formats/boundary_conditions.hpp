@@ -68,5 +68,8 @@ nlohmann::json to_json(const Outlet& outlet);  // without the vessel: it sits in
 Blood blood_from_json(const nlohmann::json& j);
 Inlet inlet_from_json(const nlohmann::json& j);
 Outlet outlet_from_json(const nlohmann::json& j, const std::string& where);
+// Throws InputError (prefixed with where) unless the waveform lies in the accepted ranges
+// (formats/field_ranges.hpp); inlet_from_json calls it, tools that build one may too.
+void check_waveform(const Waveform& wave, const std::string& where);
 
 }  // namespace hemotree

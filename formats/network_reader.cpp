@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli/errors.hpp"
+#include "formats/field_ranges.hpp"
 #include "formats/json_pull.hpp"
 #include "formats/network_io.hpp"
 #include "formats/topology.hpp"
@@ -32,17 +33,23 @@ void expect(JsonPull& in, Token wanted, const char* context) {
 
 // `where` names the object for messages; it is a callable so that the name is built only
 // when something is wrong (building it for every member cost 6 % of reading a full tree).
+// Member names are literals, never the key's text(): that view dies with the next() that
+// reads the value (it points into the parser's buffer, which a refill or a longer string
+// overwrites).
 template <class Where>
-double read_number(JsonPull& in, std::string_view member, const Where& where) {
+double read_number(JsonPull& in, const char* member, const FieldRange& range,
+                   const Where& where) {
   if (in.next() != Token::number)
-    in.fail(std::string(where()) + ": \"" + std::string(member) + "\" must be a number");
-  return in.number();
+    in.fail(std::string(where()) + ": \"" + member + "\" must be a number");
+  const double value = in.number();
+  if (!range.contains(value)) in.fail(std::string(where()) + ": " + out_of_range(member, range, value));
+  return value;
 }
 
 template <class Where>
-std::int64_t read_integer(JsonPull& in, std::string_view member, const Where& where) {
+std::int64_t read_integer(JsonPull& in, const char* member, const Where& where) {
   if (in.next() != Token::number)
-    in.fail(std::string(where()) + ": \"" + std::string(member) + "\" must be an integer");
+    in.fail(std::string(where()) + ": \"" + member + "\" must be an integer");
   return in.integer();
 }
 
@@ -70,13 +77,19 @@ struct NodeIndex {
   }
 };
 
+// Where a token was, to report it after the parser has moved on.
+struct Position {
+  std::size_t line = 0, column = 0;
+  static Position of(const JsonPull& in) { return {in.line(), in.column()}; }
+};
+
 class Reader {
  public:
   Reader(JsonPull& in, std::string source) : in_(in), source_(std::move(source)) {}
 
   Network read() {
     expect(in_, Token::begin_object, "at the start of a network file");
-    bool seen_format = false, seen_nodes = false, seen_vessels = false;
+    bool seen_format = false, seen_version = false, seen_nodes = false, seen_vessels = false;
     while (in_.next() == Token::key) {
       std::string key(in_.text());
       if (key == "format") {
@@ -89,15 +102,20 @@ class Reader {
           in_.fail("network format version " + std::to_string(version) +
                    " is not supported (this build reads up to " +
                    std::to_string(vnet_version) + ")");
+        seen_version = true;
       } else if (key == "provenance") {
         in_.next();
+        // Later stages add to it: anything but an object would fail there, not here.
+        if (in_.token() != Token::begin_object) in_.fail("\"provenance\" must be an object");
         net_.provenance = in_.read_value();
       } else if (key == "blood") {
         in_.next();
-        net_.blood = blood_from_json(in_.read_value());
+        const Position at = Position::of(in_);
+        net_.blood = from_json(blood_from_json, at);
       } else if (key == "inlet") {
         in_.next();
-        net_.inlet = inlet_from_json(in_.read_value());
+        const Position at = Position::of(in_);
+        net_.inlet = from_json(inlet_from_json, at);
       } else if (key == "nodes") {
         read_nodes();
         seen_nodes = true;
@@ -111,8 +129,14 @@ class Reader {
     }
     if (in_.token() != Token::end_object) in_.fail("expected a member name or '}'");
     if (in_.next() != Token::end_of_input) in_.fail("unexpected content after the network");
-    if (!seen_format) throw InputError(in_source() + ": missing \"format\": \"vnet\"");
-    if (!seen_vessels) throw InputError(in_source() + ": missing \"vessels\"");
+    if (!seen_format) throw InputError(source_ + ": missing \"format\": \"vnet\"");
+    // Required by the format: without it a future reader could not tell version 1 files
+    // from later ones.
+    if (!seen_version)
+      throw InputError(source_ + ": missing \"version\" (this build reads version " +
+                       std::to_string(vnet_version) + ")");
+    if (!seen_vessels) throw InputError(source_ + ": missing \"vessels\"");
+    check_unique_vessel_ids();
     resolve_nodes(seen_nodes);
     finish_generations();
     if (!net_.beta.empty()) {
@@ -125,7 +149,22 @@ class Reader {
   }
 
  private:
-  std::string in_source() const { return source_; }
+  [[noreturn]] void fail_at(const Position& at, const std::string& message) const {
+    throw JsonError(source_ + ":" + std::to_string(at.line) + ":" + std::to_string(at.column) +
+                    ": " + message);
+  }
+
+  // Reads the current value as JSON and converts it, the conversion's InputError placed at
+  // the value's start.
+  template <class Convert>
+  auto from_json(Convert convert, const Position& at) -> decltype(convert(nlohmann::json())) {
+    const nlohmann::json value = in_.read_value();
+    try {
+      return convert(value);
+    } catch (const InputError& e) {
+      fail_at(at, e.what());
+    }
+  }
 
   void read_nodes() {
     expect(in_, Token::begin_array, "for \"nodes\"");
@@ -133,18 +172,22 @@ class Reader {
     int with_coordinates = -1;  // unknown until the first node
     while (in_.next() != Token::end_array) {
       if (in_.token() != Token::begin_object) in_.fail("each node must be an object");
-      auto where = [&] { return "nodes[" + std::to_string(n) + "]"; };
+      if (n >= max_elements) in_.fail("more than " + std::to_string(max_elements) + " nodes");
       std::int64_t node = 0;
       bool has_id = false;
+      auto where = [&] {
+        return has_id ? "node " + std::to_string(node) : "nodes[" + std::to_string(n) + "]";
+      };
       double p[3] = {unset, unset, unset};
       while (in_.next() == Token::key) {
-        std::string_view key = in_.text();
+        const std::string_view key = in_.text();  // compared before the next next() only
         if (key == "id") {
           node = read_integer(in_, "id", where);
           has_id = true;
         } else if (key.size() == 1 && key[0] >= 'x' && key[0] <= 'z') {
           const int axis = key[0] - 'x';
-          p[axis] = read_number(in_, key == "x" ? "x" : key == "y" ? "y" : "z", where);
+          static constexpr const char* names[] = {"x", "y", "z"};
+          p[axis] = read_number(in_, names[axis], ranges::coordinate, where);
         } else {
           in_.next();
           in_.skip_value();
@@ -168,33 +211,46 @@ class Reader {
     std::size_t n = 0;
     while (in_.next() != Token::end_array) {
       if (in_.token() != Token::begin_object) in_.fail("each vessel must be an object");
+      if (n >= max_elements) in_.fail("more than " + std::to_string(max_elements) + " vessels");
       read_vessel(n++);
     }
   }
 
   void read_vessel(std::size_t n) {
-    std::int64_t vid = 0, from = 0, to = 0, generation = -1;
+    std::int64_t vid = 0, from = 0, to = 0, generation = 0;
     double length = unset, diameter = unset, wall = unset, modulus = unset;
     double beta = unset, reference_pressure = unset;
     bool has_id = false, has_from = false, has_to = false, has_class = false;
+    bool has_generation = false;
+    Position generation_at;
     std::optional<nlohmann::json> outlet;
     VesselClass given_class{};
     auto where = [&] {
       return has_id ? "vessel " + std::to_string(vid) : "vessels[" + std::to_string(n) + "]";
     };
     while (in_.next() == Token::key) {
-      std::string_view key = in_.text();
-      if (key == "id") { vid = read_integer(in_, key, where); has_id = true; }
+      // The key's view is only compared, before the value's next(): see read_number.
+      const std::string_view key = in_.text();
+      if (key == "id") { vid = read_integer(in_, "id", where); has_id = true; }
       else if (key == "from") { from = read_integer(in_, "from", where); has_from = true; }
       else if (key == "to") { to = read_integer(in_, "to", where); has_to = true; }
-      else if (key == "length") length = read_number(in_, "length", where);
-      else if (key == "diameter") diameter = read_number(in_, "diameter", where);
-      else if (key == "wall_thickness") wall = read_number(in_, "wall_thickness", where);
-      else if (key == "youngs_modulus") modulus = read_number(in_, "youngs_modulus", where);
-      else if (key == "generation") generation = read_integer(in_, "generation", where);
-      else if (key == "beta") beta = read_number(in_, "beta", where);
+      else if (key == "length") length = read_number(in_, "length", ranges::length, where);
+      else if (key == "diameter") diameter = read_number(in_, "diameter", ranges::diameter, where);
+      else if (key == "wall_thickness")
+        wall = read_number(in_, "wall_thickness", ranges::wall_thickness, where);
+      else if (key == "youngs_modulus")
+        modulus = read_number(in_, "youngs_modulus", ranges::youngs_modulus, where);
+      else if (key == "generation") {
+        generation = read_integer(in_, "generation", where);
+        generation_at = Position::of(in_);
+        has_generation = true;
+        // The vessel count bounds it from above once every vessel is read.
+        if (generation < 0 || generation > ranges::max_generation)
+          in_.fail(where() + ": \"generation\" must lie in [0, vessel count - 1] (got " +
+                   std::to_string(generation) + ")");
+      } else if (key == "beta") beta = read_number(in_, "beta", ranges::beta, where);
       else if (key == "reference_pressure")
-        reference_pressure = read_number(in_, "reference_pressure", where);
+        reference_pressure = read_number(in_, "reference_pressure", ranges::pressure, where);
       else if (key == "class") {
         if (in_.next() != Token::string) in_.fail(where() + ": \"class\" must be a string");
         auto c = parse_vessel_class(in_.text());
@@ -214,21 +270,21 @@ class Reader {
     if (!has_to) in_.fail(where() + ": missing \"to\"");
     if (std::isnan(length)) in_.fail(where() + ": missing \"length\"");
     if (std::isnan(diameter)) in_.fail(where() + ": missing \"diameter\"");
-    if (!(length > 0)) in_.fail(where() + ": length must be positive");
-    if (!(diameter > 0)) in_.fail(where() + ": diameter must be positive");
-    if (!std::isnan(wall) && !(wall > 0)) in_.fail(where() + ": wall_thickness must be positive");
-    if (!std::isnan(modulus) && !(modulus > 0))
-      in_.fail(where() + ": youngs_modulus must be positive");
     if (has_class && given_class != classify(diameter))
       in_.fail(where() + ": class \"" + std::string(to_string(given_class)) +
                "\" does not match its diameter (" + std::string(to_string(classify(diameter))) +
                ")");
-    if (!std::isnan(beta) && !(beta > 0)) in_.fail(where() + ": beta must be positive");
     if (std::isnan(beta) != std::isnan(reference_pressure))
       in_.fail(where() + ": give \"beta\" and \"reference_pressure\" together");
-    if ((generation >= 0) != generations_given_ && n > 0)
-      in_.fail(where() + ": either every vessel has a \"generation\" or none does");
-    generations_given_ = generation >= 0;
+    if (n > 0 && has_generation != generations_given_)
+      in_.fail(where() + (has_generation ? ": has a \"generation\" but vessels[0] has none"
+                                         : ": missing \"generation\" (vessels[0] has one)") +
+               "; either every vessel has a \"generation\" or none does");
+    generations_given_ = has_generation;
+    if (has_generation && generation > deepest_) {
+      deepest_ = generation;
+      deepest_at_ = generation_at;
+    }
     // Node ids for now; resolve_nodes() turns them into indices.
     const std::size_t index = net_.add_vessel(vid, 0, 0, length, diameter, wall, modulus,
                                               static_cast<std::int32_t>(generation));
@@ -250,6 +306,24 @@ class Reader {
     to_id_.push_back(to);
   }
 
+  // Ids name vessels in results and between stages: two vessels with one id would be
+  // merged or written twice downstream.
+  void check_unique_vessel_ids() const {
+    const std::vector<std::int64_t>& ids = net_.id;
+    bool identity = true;  // ids 0..n-1 in order, the usual case: unique without sorting
+    for (std::size_t i = 0; i < ids.size() && identity; ++i)
+      identity = ids[i] == static_cast<std::int64_t>(i);
+    if (identity) return;
+    std::vector<std::pair<std::int64_t, std::size_t>> sorted(ids.size());
+    for (std::size_t i = 0; i < ids.size(); ++i) sorted[i] = {ids[i], i};
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 1; i < sorted.size(); ++i)
+      if (sorted[i].first == sorted[i - 1].first)
+        throw InputError(source_ + ": vessel id " + std::to_string(sorted[i].first) +
+                         " appears twice: vessels[" + std::to_string(sorted[i - 1].second) +
+                         "] and vessels[" + std::to_string(sorted[i].second) + "]");
+  }
+
   void resolve_nodes(bool nodes_given) {
     if (!nodes_given) {
       // Nodes may be left out of hand-written files: they are the vessels' end points.
@@ -257,6 +331,8 @@ class Reader {
       ids.insert(ids.end(), to_id_.begin(), to_id_.end());
       std::sort(ids.begin(), ids.end());
       ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+      if (ids.size() > max_elements)
+        throw InputError(source_ + ": more than " + std::to_string(max_elements) + " nodes");
       for (std::int64_t id : ids) net_.add_node(id);
     }
     const NodeIndex index(net_.node_id);
@@ -264,7 +340,8 @@ class Reader {
       for (std::size_t i = 1; i < index.sorted.size(); ++i)
         if (index.sorted[i].first == index.sorted[i - 1].first)
           throw InputError(source_ + ": node id " + std::to_string(index.sorted[i].first) +
-                           " appears twice");
+                           " appears twice: nodes[" + std::to_string(index.sorted[i - 1].second) +
+                           "] and nodes[" + std::to_string(index.sorted[i].second) + "]");
     }
     const std::size_t count = net_.node_count();
     for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
@@ -279,15 +356,34 @@ class Reader {
   }
 
   void finish_generations() {
-    if (generations_given_ || net_.vessel_count() == 0) return;
-    net_.generation = generations_from_inlets(net_);
+    if (net_.vessel_count() == 0) return;
+    if (!generations_given_) {
+      net_.generation = generations_from_inlets(net_);
+      return;
+    }
+    // A generation counts vessels from a root, so none can reach the vessel count; a
+    // larger label is corrupt, and would make per-generation tables of that many rows.
+    const auto count = static_cast<std::int64_t>(net_.vessel_count());
+    if (deepest_ >= count) {
+      const auto v = std::find(net_.generation.begin(), net_.generation.end(), deepest_) -
+                     net_.generation.begin();
+      fail_at(deepest_at_, "vessel " + std::to_string(net_.id[static_cast<std::size_t>(v)]) +
+                               ": \"generation\" must lie in [0, " + std::to_string(count - 1) +
+                               "] (the vessel count - 1) (got " + std::to_string(deepest_) +
+                               ")");
+    }
   }
+
+  // Indices are 32-bit (from, to, outlets); beyond that a file is not a network we can hold.
+  static constexpr std::size_t max_elements = std::numeric_limits<std::int32_t>::max();
 
   JsonPull& in_;
   std::string source_;
   Network net_;
   std::vector<std::int64_t> from_id_, to_id_;
   bool generations_given_ = false;
+  std::int64_t deepest_ = -1;  // the largest generation read, and where
+  Position deepest_at_;
 };
 
 Network read_with(JsonPull& in, const std::string& source) { return Reader(in, source).read(); }

@@ -2,6 +2,7 @@
 // well. Lines are formatted in parallel blocks and written in order, so the output is
 // byte-identical whatever the number of threads.
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <exception>
 #include <string>
@@ -21,6 +22,21 @@ void append_real(std::string& s, double v) {
 }
 
 void append_integer(std::string& s, long long v) { s += std::to_string(v); }
+
+// The class follows from the diameter, and readers check that they agree. A diameter
+// within rounding of a class boundary (9.9999999996e-6 against 10 um) would be written as
+// the boundary itself and read back in the next class: there the shortest exact form is
+// written instead (at most 17 digits), so that what is written reads back the same.
+void append_diameter(std::string& s, double d) {
+  constexpr double boundaries[] = {artery_min_diameter, small_artery_min_diameter,
+                                   arteriole_min_diameter};
+  bool near = false;
+  for (double b : boundaries) near = near || std::abs(d - b) <= 1e-8 * b;
+  if (!near) return append_real(s, d);
+  char text[32];
+  const auto result = std::to_chars(text, text + sizeof text, d);
+  s.append(text, result.ptr);
+}
 
 void append_node(std::string& s, const Network& net, std::size_t n) {
   s += "{\"id\":";
@@ -47,7 +63,7 @@ void append_vessel(std::string& s, const Network& net, std::size_t v,
   s += ",\"length\":";
   append_real(s, net.length[v]);
   s += ",\"diameter\":";
-  append_real(s, net.diameter[v]);
+  append_diameter(s, net.diameter[v]);
   // Optional members a hand-written file may lack (NaN here) are left out again.
   if (!std::isnan(net.wall_thickness[v])) {
     s += ",\"wall_thickness\":";

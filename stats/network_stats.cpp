@@ -14,9 +14,11 @@ namespace hemotree {
 
 namespace {
 
-// Generations are array indices here; a label far beyond any real tree depth means a
-// corrupt file, and would otherwise make us allocate a table of that many rows.
-constexpr std::int64_t max_supported_generation = 1'000'000;
+// Generations are array indices here (one table row each). No vessel of a consistently
+// labelled network lies deeper than the vessel count - 1, and the reader refuses files that
+// say otherwise (a 17-vessel file with generation 999999 printed a 110 MB table). Networks
+// built in code may carry other labels: up to this many rows are allowed for them.
+constexpr std::size_t min_generation_rows = 10'000;
 
 std::string vessel_name(const Network& net, std::size_t v) {
   return "vessel " + std::to_string(net.id[v]);
@@ -30,13 +32,14 @@ void check_network(const Network& net) {
     throw std::invalid_argument("compute_stats: vessel arrays of unequal length");
 
   const auto nodes = static_cast<std::int64_t>(net.node_count());
+  const std::size_t rows = std::max(n, min_generation_rows);
   for (std::size_t v = 0; v < n; ++v) {
     if (net.from[v] < 0 || net.from[v] >= nodes || net.to[v] < 0 || net.to[v] >= nodes)
       throw InputError(vessel_name(net, v) + ": node index out of range");
-    if (net.generation[v] < 0 || net.generation[v] > max_supported_generation)
-      throw InputError(vessel_name(net, v) + ": generation " +
-                       std::to_string(net.generation[v]) + " out of range 0.." +
-                       std::to_string(max_supported_generation));
+    if (net.generation[v] < 0 || static_cast<std::size_t>(net.generation[v]) >= rows)
+      throw InputError(vessel_name(net, v) + ": \"generation\" must lie in [0, " +
+                       std::to_string(rows - 1) + "] (got " + std::to_string(net.generation[v]) +
+                       ")");
     if (static_cast<int>(net.vessel_class[v]) >= vessel_class_count)
       throw InputError(vessel_name(net, v) + ": unknown vessel class");
     if (std::isnan(net.diameter[v]))  // NaN has no place in an ordering: quartiles need one

@@ -160,7 +160,7 @@ TEST(NetworkFormat, ContentErrorsNameTheVessel) {
     return t;
   };
   expect_refusal(replaced("\"length\": 0.01, \"diameter\": 6e-4", "\"length\": -1, \"diameter\": 6e-4"),
-                 "vessel 2: length must be positive");
+                 "net.json:6:45: vessel 2: \"length\" must lie in [1e-7, 10] m (got -1)");
   expect_refusal(replaced("\"diameter\": 5e-5,", ""), "vessel 3: missing \"diameter\"");
   expect_refusal(replaced("\"to\": 13", "\"to\": 99"), "vessel 3: unknown node 99");
   expect_refusal(replaced("\"length\": 0.01, \"diameter\": 6e-4", "\"length\": \"long\", \"diameter\": 6e-4"),
@@ -171,6 +171,69 @@ TEST(NetworkFormat, ContentErrorsNameTheVessel) {
   expect_refusal(replaced("\"version\": 1", "\"version\": 7"), "version 7 is not supported");
   expect_refusal(replaced("{\"id\": 13}", "{\"id\": 12}"), "node id 12 appears twice");
   expect_refusal(R"({"format":"vnet","version":1})", "missing \"vessels\"");
+}
+
+// Issue 11, item 1: the message for a non-integer "id" was built from the key's view after
+// next() had moved the scratch buffer (a longer escaped string reallocates it): garbage as
+// the key's name, and a heap use after free under ASan. The issue's reproduction.
+TEST(NetworkFormat, AKeysNameSurvivesTheValueAfterIt) {
+  const std::string text = "{\"format\":\"vnet\",\"version\":1,\"provenance\":{\"a\":\"" +
+                           std::string(40, 'p') + "\\n\"},\"vessels\":[{\"\\u0069d\":\"" +
+                           std::string(200, 'v') + "\\n\"}]}";
+  const std::string wanted = "net.json:1:116: vessels[0]: \"id\" must be an integer";
+  try {
+    parse_network(text, "net.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const JsonError& e) {
+    EXPECT_EQ(std::string(e.what()), wanted);
+  }
+  std::FILE* in = fmemopen(const_cast<char*>(text.data()), text.size(), "r");
+  ASSERT_NE(in, nullptr);
+  try {
+    read_network(in, "net.json", 16);
+    ADD_FAILURE() << "accepted";
+  } catch (const JsonError& e) {
+    EXPECT_EQ(std::string(e.what()), wanted);
+  }
+  std::fclose(in);
+}
+
+// The same at the stream's 1 MiB refill: the key "id" lies at the end of the first buffer,
+// its string value runs into the next, whose bytes then took the key's place ("QQ").
+TEST(NetworkFormat, AKeysNameSurvivesABufferRefill) {
+  const std::string head = "{\"format\":\"vnet\",\"version\":1,\"provenance\":{\"a\":\"";
+  const std::string tail = "\"},\"vessels\":[{\"id\":\"";
+  const std::size_t pad = JsonPull::buffer_size - head.size() - tail.size() + 2;
+  const std::string text = head + std::string(pad, 'p') + tail +
+                           std::string(JsonPull::buffer_size, 'Q') + "\"}]}";
+  ASSERT_EQ(text.find("\"id\""), JsonPull::buffer_size - 4);  // "id" ends the first buffer
+  const fs::path path = temp_path("refill.json");
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+  }
+  try {
+    read_network(path.string());
+    ADD_FAILURE() << "accepted";
+  } catch (const JsonError& e) {
+    EXPECT_NE(std::string(e.what()).find(": vessels[0]: \"id\" must be an integer"),
+              std::string::npos) << e.what();
+  }
+  fs::remove(path);
+}
+
+// Streamed through buffers of any size, a network reads as it does from memory.
+TEST(NetworkFormat, TinyBuffersReadTheSameNetwork) {
+  const std::string text = write_to_string(grown_tree(), "tiny.json");
+  const Network expected = parse_network(text, "t.json");
+  for (std::size_t buffer : {1, 3, 64, 4096}) {
+    std::FILE* in = fmemopen(const_cast<char*>(text.data()), text.size(), "r");
+    ASSERT_NE(in, nullptr);
+    const Network got = read_network(in, "t.json", buffer);
+    std::fclose(in);
+    EXPECT_EQ(write_to_string(got, "tiny-again.json"), text) << "buffer " << buffer;
+    EXPECT_EQ(got.vessel_count(), expected.vessel_count());
+  }
 }
 
 TEST(Topology, RootedTreeChecksNameTheVesselAtFault) {
