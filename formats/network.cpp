@@ -1,6 +1,9 @@
 #include "formats/network.hpp"
 
+#include <cmath>
 #include <numbers>
+
+#include "cli/errors.hpp"
 
 namespace hemotree {
 
@@ -75,6 +78,19 @@ std::int64_t Network::index_of(std::int64_t vessel_id) const {
   for (std::size_t v = 0; v < id.size(); ++v)
     if (id[v] == vessel_id) return static_cast<std::int64_t>(v);
   return -1;
+}
+
+void require_tube_laws(const Network& net, const std::string& source) {
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    if (!net.beta.empty() && !std::isnan(net.beta[v])) continue;
+    const char* missing = std::isnan(net.wall_thickness[v])   ? "wall_thickness"
+                          : std::isnan(net.youngs_modulus[v]) ? "youngs_modulus"
+                                                              : nullptr;
+    if (missing)
+      throw InputError(source + ": vessel " + std::to_string(net.id[v]) + ": missing \"" +
+                       missing + "\" (a tube law needs \"wall_thickness\" and " +
+                       "\"youngs_modulus\", or \"beta\" and \"reference_pressure\")");
+  }
 }
 
 double Network::volume(std::size_t v) const {

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -73,5 +74,12 @@ struct Network {
   // Vessel index of an id (linear search unless ids equal indices); -1 when absent.
   std::int64_t index_of(std::int64_t vessel_id) const;
 };
+
+// Wave propagation (vprune's outlet calibration, hemosolve) needs a tube law for every
+// vessel: "wall_thickness" and "youngs_modulus", or "beta" and "reference_pressure". The
+// format leaves them optional (vstats needs neither), so the tools that need them call this
+// before any work. Throws InputError "SOURCE: vessel ID: missing \"wall_thickness\" ..."
+// naming the first vessel without one.
+void require_tube_laws(const Network& net, const std::string& source);
 
 }  // namespace hemotree

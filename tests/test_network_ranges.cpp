@@ -298,3 +298,25 @@ TEST(NetworkRanges, DiametersAtClassBoundariesRoundTrip) {
     EXPECT_EQ(back.vessel_class[1], net.vessel_class[1]);
   }
 }
+
+// A missing wall is allowed by the format (vstats needs none) but not by wave propagation:
+// vprune's calibration said "wall thickness must be positive and finite [m] (got nan)"
+// without naming a vessel. require_tube_laws names it.
+TEST(NetworkRanges, MissingWallsAreNamedForToolsThatNeedThem) {
+  const Network net = parse_network(base, "net.json");
+  EXPECT_NO_THROW(require_tube_laws(net, "net.json"));
+  const Network no_wall =
+      parse_network(replaced(base, "\"wall_thickness\":0.00008,", ""), "net.json");
+  try {
+    require_tube_laws(no_wall, "net.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "net.json: vessel 2: missing \"wall_thickness\" (a tube law needs "
+              "\"wall_thickness\" and \"youngs_modulus\", or \"beta\" and \"reference_pressure\")");
+  }
+  // Vessel 1 has beta: its wall is not needed.
+  const Network beta_only = parse_network(
+      replaced(base, "\"wall_thickness\":0.0001,\"youngs_modulus\":400000,", ""), "net.json");
+  EXPECT_NO_THROW(require_tube_laws(beta_only, "net.json"));
+}
