@@ -3,6 +3,8 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -59,6 +61,13 @@ std::string_view si_name(Dimension d) {
   return "";
 }
 
+// An SI value expressed in unit; unchanged for "" or a unit not in the table.
+double in_unit(double value_si, std::string_view unit) {
+  for (const Unit& u : units)
+    if (u.symbol == unit) return value_si * u.divide / u.multiply;
+  return value_si;
+}
+
 }  // namespace
 
 double parse_quantity(std::string_view text, Dimension dim, std::string_view what) {
@@ -70,14 +79,89 @@ double parse_quantity(std::string_view text, Dimension dim, std::string_view wha
   text.remove_prefix(start);
   double value = 0;
   auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || !std::isfinite(value)) throw bad("is not a number");
+  // inf, nan and 1e400 are no quantity: refused here, before they reach a computation.
+  if (ec != std::errc() || !std::isfinite(value)) throw bad("is not a finite number");
   std::string_view unit = text.substr(static_cast<std::size_t>(end - text.data()));
   while (!unit.empty() && unit.front() == ' ') unit.remove_prefix(1);
   if (unit.empty()) return value;  // plain SI
+  if (dim == Dimension::dimensionless) throw bad("is not a finite number");
   for (const Unit& u : units)
-    if (u.symbol == unit && u.dimension == dim) return value * u.multiply / u.divide;
+    if (u.symbol == unit && u.dimension == dim) {
+      const double si = value * u.multiply / u.divide;
+      if (!std::isfinite(si)) throw bad("is too large");  // 1e308 mmHg
+      return si;
+    }
   throw bad("has an unknown unit '" + std::string(unit) + "' (use " +
             std::string(si_name(dim)) + ", or a plain SI number)");
+}
+
+bool Interval::contains(double value) const {
+  return (min_open ? value > min : value >= min) && (max_open ? value < max : value <= max);
+}
+
+std::string describe(const Interval& range, std::string_view unit) {
+  std::string text = range.min_open ? "(" : "[";
+  text += format_rounded(in_unit(range.min, unit)) + ", " + format_rounded(in_unit(range.max, unit));
+  text += range.max_open ? ")" : "]";
+  if (!unit.empty()) text += " " + std::string(unit);  // "[0.01, 100] s"
+  return text;
+}
+
+double parse_quantity(std::string_view text, Dimension dim, std::string_view what,
+                      const Interval& range, std::string_view unit) {
+  const double value = parse_quantity(text, dim, what);
+  if (!range.contains(value))
+    throw InputError(std::string(what) + ": '" + std::string(text) +
+                     "' lies outside the accepted range " + describe(range, unit));
+  return value;
+}
+
+double parse_number(std::string_view text, std::string_view what, const Interval& range) {
+  return parse_quantity(text, Dimension::dimensionless, what, range, "");
+}
+
+std::uint64_t parse_count(std::string_view text, std::string_view what, std::uint64_t min,
+                          std::uint64_t max) {
+  auto bad = [&](const std::string& why) {
+    return InputError(std::string(what) + ": '" + std::string(text) + "' " + why +
+                      "; the accepted range is " + std::to_string(min) + ".." + std::to_string(max));
+  };
+  if (text.empty()) throw bad("is empty");
+  if (text.front() == '-') throw bad("is negative");
+  std::uint64_t value = 0;
+  const char* end = text.data() + text.size();
+  auto [stop, ec] = std::from_chars(text.data(), end, value);
+  if (ec == std::errc::result_out_of_range) throw bad("is too large");
+  if (ec != std::errc() || stop != end) throw bad("is not an integer");
+  if (value < min || value > max) throw bad("lies outside it");
+  return value;
+}
+
+std::int64_t parse_integer(std::string_view text, std::string_view what, std::int64_t min,
+                           std::int64_t max) {
+  auto bad = [&](const std::string& why) {
+    return InputError(std::string(what) + ": '" + std::string(text) + "' " + why +
+                      "; the accepted range is " + std::to_string(min) + ".." + std::to_string(max));
+  };
+  if (text.empty()) throw bad("is empty");
+  std::int64_t value = 0;
+  const char* end = text.data() + text.size();
+  auto [stop, ec] = std::from_chars(text.data(), end, value);
+  if (ec == std::errc::result_out_of_range) throw bad("is too large");
+  if (ec != std::errc() || stop != end) throw bad("is not an integer");
+  if (value < min || value > max) throw bad("lies outside it");
+  return value;
+}
+
+std::string format_rounded(double value) {
+  char text[32];  // "%.6g" needs at most 13 characters ("-1.23457e+308")
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+std::string format_quantity(double value_si, std::string_view unit) {
+  const std::string number = format_rounded(in_unit(value_si, unit));
+  return unit.empty() ? number : number + " " + std::string(unit);
 }
 
 }  // namespace hemotree

@@ -5,7 +5,11 @@
 #include <cmath>
 #include <csignal>
 #include <cstring>
+#include <fcntl.h>
 #include <filesystem>
+#include <iostream>
+#include <limits>
+#include <string_view>
 #include <unistd.h>
 
 #include "cli/errors.hpp"
@@ -36,6 +40,16 @@ void watch_temp(const std::string& path) {
 }
 
 void unwatch_temp() { pending_temp[0] = '\0'; }
+
+// This machine's name as it can stand in a file name ('/' would make it a folder).
+std::string host_name() {
+  char name[256] = "";
+  if (::gethostname(name, sizeof name - 1) != 0 || name[0] == '\0') return "localhost";
+  std::string text(name);
+  for (char& c : text)
+    if (c == '/' || c < ' ') c = '_';
+  return text;
+}
 }  // namespace
 
 std::size_t format_real(char* out, double value) {
@@ -49,7 +63,52 @@ std::size_t format_real(char* out, double value) {
   return static_cast<std::size_t>(res.ptr - out);
 }
 
-OutputStream::OutputStream(const std::string& path) : buffer_(buffer_size) {
+std::string partial_path(const std::string& path) {
+  return path + ".partial-" + host_name() + "-" + std::to_string(::getpid());
+}
+
+std::size_t remove_stale_partials(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string prefix = target.filename().string() + ".partial-";
+  const std::string host = host_name();
+  std::size_t removed = 0;
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, fs::directory_options::skip_permission_denied, ec), end;
+       !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    // PID alone (the older form) or HOST-PID; another host's file is never touched, since
+    // its process cannot be seen from here (a folder shared over NFS).
+    std::string_view rest = std::string_view(name).substr(prefix.size());
+    const std::size_t dash = rest.rfind('-');
+    if (dash != std::string_view::npos) {
+      if (rest.substr(0, dash) != host) continue;
+      rest.remove_prefix(dash + 1);
+    }
+    long long pid = 0;
+    const auto [stop, parse_error] = std::from_chars(rest.data(), rest.data() + rest.size(), pid);
+    if (parse_error != std::errc() || stop != rest.data() + rest.size() || pid <= 0) continue;
+    if (pid == ::getpid()) continue;
+    // Only a process that is certainly gone: EPERM means it runs under another user.
+    if (pid <= std::numeric_limits<pid_t>::max() && ::kill(static_cast<pid_t>(pid), 0) == 0) continue;
+    if (pid <= std::numeric_limits<pid_t>::max() && errno != ESRCH) continue;
+    std::error_code ignored;
+    if (fs::remove(it->path(), ignored)) ++removed;
+  }
+  return removed;
+}
+
+std::string standard_output_error() {
+  std::cout.flush();
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || std::cout.fail())
+    return errno != 0 ? errno_text() : "an earlier write failed";
+  return "";
+}
+
+OutputStream::OutputStream(const std::string& path, Temporary temporary) : buffer_(buffer_size) {
   if (path.empty() || path == "-") {
     // A closed pipe must become a write error we can report, not a silent death.
     std::signal(SIGPIPE, SIG_IGN);
@@ -68,7 +127,25 @@ OutputStream::OutputStream(const std::string& path) : buffer_(buffer_size) {
     direct_ = true;
     return;
   }
-  temp_path_ = path + ".partial-" + std::to_string(::getpid());
+  remove_stale_partials(path);
+  if (temporary == Temporary::anonymous_if_possible) {
+    const std::filesystem::path target(path);
+    const std::string folder = target.has_parent_path() ? target.parent_path().string() : ".";
+    // commit() links the file in through /proc/self/fd: without /proc, the named fallback.
+    const int fd = ::access("/proc/self/fd", X_OK) == 0
+                       ? ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666)
+                       : -1;
+    if (fd >= 0) {
+      file_ = ::fdopen(fd, "wb");
+      if (!file_) {
+        ::close(fd);
+        throw IoError("cannot create " + path + ": " + errno_text());
+      }
+      anonymous_ = true;
+      return;
+    }
+  }
+  temp_path_ = partial_path(path);
   file_ = std::fopen(temp_path_.c_str(), "wb");
   if (!file_) throw IoError("cannot create " + path + ": " + errno_text());
   watch_temp(temp_path_);
@@ -76,8 +153,8 @@ OutputStream::OutputStream(const std::string& path) : buffer_(buffer_size) {
 
 OutputStream::~OutputStream() {
   if (is_stdout_ || committed_) return;
-  if (file_) std::fclose(file_);
-  if (direct_) return;
+  if (file_) std::fclose(file_);  // an anonymous file vanishes with its last descriptor
+  if (direct_ || temp_path_.empty()) return;
   std::error_code ignored;
   std::filesystem::remove(temp_path_, ignored);
   unwatch_temp();
@@ -120,8 +197,25 @@ void OutputStream::commit() {
   flush_buffer();
   if (std::fflush(file_) != 0) throw IoError("cannot write " + display_name_ + ": " + errno_text());
   if (is_stdout_) {
+    // Closing a duplicate reports what a file system defers to close (NFS), without closing
+    // standard output itself.
+    const int copy = ::dup(STDOUT_FILENO);
+    if (std::ferror(stdout) || (copy >= 0 && ::close(copy) != 0))
+      throw IoError("cannot write " + display_name_ + ": " + errno_text());
     committed_ = true;
     return;
+  }
+  if (anonymous_) {
+    // The complete file gets a name only now; rename() then replaces the target atomically
+    // (linkat cannot replace an existing file).
+    temp_path_ = partial_path(final_path_);
+    const std::string fd_path = "/proc/self/fd/" + std::to_string(::fileno(file_));
+    if (::linkat(AT_FDCWD, fd_path.c_str(), AT_FDCWD, temp_path_.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+      const std::string why = errno_text();
+      temp_path_.clear();
+      throw IoError("cannot create " + final_path_ + ": " + why);
+    }
+    watch_temp(temp_path_);
   }
   if (std::fclose(file_) != 0) {
     file_ = nullptr;

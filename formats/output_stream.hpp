@@ -1,6 +1,12 @@
-// Buffered output that never leaves a file looking complete when it is not:
-// a named file is written under a temporary name and renamed by commit();
-// standard output is checked for write errors (full disk, closed pipe).
+// Buffered output that never leaves a file looking complete when it is not, nor a stray
+// temporary after the writer is killed:
+// - a named file is written into an anonymous file in the target's folder (O_TMPFILE),
+//   which commit() links in under a temporary name and renames over the target; killed at
+//   any moment, even by SIGKILL, the writer leaves the folder as it was;
+// - where the file system has no O_TMPFILE (NFS, old overlayfs), into NAME.partial-HOST-PID,
+//   removed on failure, on SIGINT, SIGTERM and SIGHUP, and, after a SIGKILL, by the next
+//   writer of NAME once no process PID runs on HOST;
+// - standard output is checked for write errors (full disk, closed pipe).
 #pragma once
 
 #include <cstdio>
@@ -12,8 +18,11 @@ namespace hemotree {
 
 class OutputStream {
  public:
-  // path "-" or "" means standard output.
-  explicit OutputStream(const std::string& path);
+  enum class Temporary { anonymous_if_possible, named };
+
+  // path "-" or "" means standard output. Temporary::named forces the fallback (for tests).
+  explicit OutputStream(const std::string& path,
+                        Temporary temporary = Temporary::anonymous_if_possible);
   ~OutputStream();  // without commit(): the temporary file is removed
   OutputStream(const OutputStream&) = delete;
   OutputStream& operator=(const OutputStream&) = delete;
@@ -30,17 +39,32 @@ class OutputStream {
   // Flushes, checks, closes and renames into place. Throws hemotree::IoError on failure.
   void commit();
   const std::string& name() const { return display_name_; }
+  // Where the bytes go until commit(): "" for an anonymous file, else NAME.partial-HOST-PID.
+  const std::string& temporary_path() const { return temp_path_; }
 
  private:
   void flush_buffer();
   std::FILE* file_ = nullptr;
   bool is_stdout_ = false;
-  bool direct_ = false;  // a device or pipe given by name: written in place
+  bool direct_ = false;     // a device or pipe given by name: written in place
+  bool anonymous_ = false;  // an O_TMPFILE file, linked in by commit()
   bool committed_ = false;
   std::string final_path_, temp_path_, display_name_;
   std::vector<char> buffer_;
   std::size_t used_ = 0;
 };
+
+// The fallback temporary's name for path on this host and process: path.partial-HOST-PID.
+std::string partial_path(const std::string& path);
+
+// Removes path.partial-HOST-PID (this host) and path.partial-PID (the older form) files whose
+// process no longer runs: what a writer killed by SIGKILL left. Returns how many it removed.
+std::size_t remove_stale_partials(const std::string& path);
+
+// Flushes standard output (and std::cout) and returns "" when everything written to it
+// reached its destination, else the reason. A tool that printed to standard output outside
+// an OutputStream (help, version) calls it before exiting 0.
+std::string standard_output_error();
 
 // Formats a real number with 9 significant digits (the precision of the network format).
 // Returns the number of characters written to out (at most 24).

@@ -29,11 +29,16 @@ class UniformSource {
   std::mt19937_64 engine_;
 };
 
+// The most vessels a grown tree may have: node and vessel indices are 32-bit, and a tree of
+// n vessels has n + 1 nodes.
+inline constexpr std::size_t max_grown_vessels = 2'147'483'646;
+
 // Grows the tree breadth first from a root vessel of root_diameter: every vessel draws
 // kappa from its diameter's range and splits by Murray's law, until the stop rule ends the
 // branch. Vessel ids are the breadth-first order (root 0); the node at the distal end of
 // vessel i has id i + 1, the inlet node id 0. No coordinates (see tree_layout.hpp).
-// progress(done) is called now and then with the number of vessels made.
+// progress(done) is called now and then with the number of vessels made. InputError when the
+// tree would exceed max_grown_vessels.
 Network grow_tree(const GrowthRules& rules, const GrowthParameters& parameters,
                   std::size_t expected_vessels = 0,
                   const std::function<void(std::size_t)>& progress = {});

@@ -1,7 +1,7 @@
 // vgen: grows a statistically calibrated full vascular tree and writes it as a network.
+#include <cstdint>
 #include <cstdio>
-#include <iostream>
-#include <sstream>
+#include <limits>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -11,6 +11,7 @@
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "formats/exports.hpp"
+#include "formats/field_ranges.hpp"
 #include "formats/network_io.hpp"
 #include "generator/growth_rules.hpp"
 #include "generator/size_estimate.hpp"
@@ -19,40 +20,82 @@
 
 using namespace hemotree;
 
+namespace {
+
+// Below 3 um no red cell passes (the narrowest capillaries measured are about 3 um), and the
+// last daughters, up to 23 % thinner than --min-diameter under the default stop rule, would
+// fall below the 2 um the network format accepts.
+constexpr double lowest_min_diameter = 3e-6;
+
+// Every vessel within the ranges the reader accepts, so that what vgen writes reads back;
+// only a rules file can grow one outside them.
+void check_fields(const Network& net) {
+  auto check = [&](const std::vector<double>& values, std::string_view field,
+                   const FieldRange& range) {
+    for (std::size_t v = 0; v < values.size(); ++v)
+      if (!range.contains(values[v]))
+        throw InputError("the growth rules give vessel " + std::to_string(net.id[v]) + " " +
+                         out_of_range(field, range, values[v]) +
+                         ": change the rules or --min-diameter");
+  };
+  check(net.diameter, "diameter", ranges::diameter);
+  check(net.length, "length", ranges::length);
+  check(net.wall_thickness, "wall_thickness", ranges::wall_thickness);
+  check(net.youngs_modulus, "youngs_modulus", ranges::youngs_modulus);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"Grow a full vascular tree by stochastic branching (Murray's law, fractal "
                "length law) and write it in the vnet network format.",
                "vgen"};
   std::string root_text = "1mm", min_text = "7um", rules_path, output = "-", format_name = "json";
-  std::uint64_t seed = 1;
+  std::string seed_text = "1";
   bool print_rules = false, force = false;
-  app.add_option("--root-diameter", root_text, "root vessel diameter (SI metres or with a unit: 1mm)")
+  app.add_option("--root-diameter", root_text,
+                 "diameter of the root vessel, SI metres or with a unit (1mm); above "
+                 "--min-diameter and below the rules' largest diameter (2.6cm by default)")
       ->capture_default_str();
-  app.add_option("--min-diameter", min_text, "smallest diameter grown (7um)")->capture_default_str();
-  app.add_option("--seed", seed, "random seed; the same seed gives byte-identical output")
+  app.add_option("--min-diameter", min_text,
+                 "where growth stops: a vessel branches only if its daughters' mean diameter "
+                 "would be at least this (the rules' stop rule, mean_daughter by default), so "
+                 "the thinner daughters of the last branchings lie below it (down to 5.4um for "
+                 "7um); at least 3um and below --root-diameter")
+      ->capture_default_str();
+  app.add_option("--seed", seed_text,
+                 "random seed, an integer in 0..18446744073709551615; the same seed gives "
+                 "byte-identical output")
       ->capture_default_str();
   app.add_option("--rules", rules_path, "growth rules (JSON, the form --print-rules prints)");
-  app.add_flag("--print-rules", print_rules, "print the growth rules in use and exit");
+  app.add_flag("--print-rules", print_rules, "print the growth rules in use (to -o) and exit");
   app.add_option("-o,--output", output, "output file, - for standard output")->capture_default_str();
   app.add_option("--format", format_name, "json (vnet), vtk, graphml, dot or csv")
       ->capture_default_str();
-  app.add_flag("--force", force, "grow even when the estimated size exceeds available memory");
+  app.add_flag("--force", force,
+               "grow even when the estimated size exceeds available memory (never beyond the "
+               "2147483646 vessels a network holds)");
   app.set_version_flag("--version", std::string("vgen ") + HEMOTREE_VERSION);
 
-  return run_tool(app, argc, argv, [&] {
+  const int status = run_tool(app, argc, argv, [&] {
     const GrowthRules rules = rules_path.empty() ? default_rules() : read_rules(rules_path);
     if (print_rules) {
-      std::cout << to_json(rules).dump(2) << '\n';
+      OutputStream out(output);
+      out << to_json(rules).dump(2) << '\n';
+      out.commit();
       return 0;
     }
     const auto format = parse_export_format(format_name);
     if (!format) throw InputError("--format: unknown format '" + format_name + "'");
     GrowthParameters p;
-    p.root_diameter = parse_quantity(root_text, Dimension::length, "--root-diameter");
-    p.min_diameter = parse_quantity(min_text, Dimension::length, "--min-diameter");
-    p.seed = seed;
-    if (!(p.root_diameter > 0)) throw InputError("--root-diameter must be positive");
-    if (!(p.min_diameter > 0)) throw InputError("--min-diameter must be positive");
+    p.seed = parse_count(seed_text, "--seed", 0, std::numeric_limits<std::uint64_t>::max());
+    // The rules' ranges are sorted and contiguous: together they cover [front.min, back.max).
+    const double rules_top = rules.ranges.back().diameter_max;
+    const double lowest = std::max(lowest_min_diameter, rules.ranges.front().diameter_min);
+    p.min_diameter = parse_quantity(min_text, Dimension::length, "--min-diameter",
+                                    Interval{lowest, rules_top, false, true}, "um");
+    p.root_diameter = parse_quantity(root_text, Dimension::length, "--root-diameter",
+                                     Interval{lowest, rules_top, false, true}, "mm");
     if (!(p.min_diameter < p.root_diameter))
       throw InputError("--min-diameter (" + min_text + ") must be below --root-diameter (" +
                        root_text + ")");
@@ -62,18 +105,22 @@ int main(int argc, char** argv) {
     const double expected = expected_vessel_count(rules, p);
     const double needed = expected * vgen_bytes_per_vessel;
     const double available = available_memory_bytes();
-    if (!force && (expected > 2e9 || (available > 0 && needed > available))) {
-      std::ostringstream m;
-      m << "the tree would have about " << static_cast<long long>(expected) << " vessels and need "
-        << needed / 1e9 << " GB of memory, more than the " << available / 1e9
-        << " GB available (use --force to try anyway)";
-      throw InputError(m.str());
-    }
+    if (!(expected <= static_cast<double>(max_grown_vessels)))
+      throw InputError("the tree would have about " + format_rounded(expected) +
+                       " vessels, more than the " + std::to_string(max_grown_vessels) +
+                       " a network holds (even with --force): raise --min-diameter or lower "
+                       "--root-diameter");
+    if (!force && available > 0 && needed > available)
+      throw InputError("the tree would have about " + format_rounded(expected) +
+                       " vessels and need " + format_rounded(needed / 1e9) +
+                       " GB of memory, more than the " + format_rounded(available / 1e9) +
+                       " GB available (use --force to try anyway)");
 
     Progress progress("vgen: growing", static_cast<std::size_t>(expected));
     Network net = grow_tree(rules, p, static_cast<std::size_t>(expected * 1.05),
                             [&](std::size_t done) { progress.update(done); });
     progress.finish();
+    check_fields(net);
     lay_out_tree(net);
     net.provenance = {{"tool", "vgen"},
                       {"version", HEMOTREE_VERSION},
@@ -88,4 +135,12 @@ int main(int argc, char** argv) {
     out.commit();
     return 0;
   });
+  // --help and --version print outside any OutputStream: a full disk must not pass for them.
+  if (status == 0) {
+    if (const std::string why = standard_output_error(); !why.empty()) {
+      std::fprintf(stderr, "vgen: error: cannot write standard output: %s\n", why.c_str());
+      return 1;
+    }
+  }
+  return status;
 }
