@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -42,5 +43,13 @@ nlohmann::json to_json(const OutletReport& report);
 // in order.
 OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pruned,
                                const OutletParameters& parameters);
+
+// Steady arterial pressures lie within 0 to 300 mmHg. When the full tree's steady inlet
+// pressure leaves that range, a warning naming the value in mmHg and the likely cause: an
+// inflow (vprune's --mean-flow) meant for a tree of another size, with the inflow that would
+// give 100 mmHg (the drop down the tree is proportional to it); "" when it is in range.
+std::string unphysiological_pressure_warning(const OutletReport& report,
+                                             const OutletParameters& parameters,
+                                             double mean_inflow, double root_diameter);
 
 }  // namespace hemotree

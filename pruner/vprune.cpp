@@ -1,8 +1,10 @@
 // vprune: cuts a full tree to a computational budget and replaces every removed subtree by
 // an outlet calibrated from it, so the pruned network runs as it is in hemosolve.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -12,6 +14,7 @@
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "formats/exports.hpp"
+#include "formats/field_ranges.hpp"
 #include "formats/network_io.hpp"
 #include "formats/topology.hpp"
 #include "pruner/outlet_calibration.hpp"
@@ -21,8 +24,17 @@ using namespace hemotree;
 
 namespace {
 
+// The flags that make a network's blood and inlet accept what the reader accepts in a file
+// (formats/field_ranges.hpp), so that vprune never writes what hemosolve then refuses.
+Interval accepted(const FieldRange& r) { return Interval{r.min, r.max}; }
+
+// What --help says of a range: "in [0.01, 100] s".
+std::string in(const FieldRange& r, std::string_view unit) {
+  return "in " + describe(accepted(r), unit);
+}
+
 // A measured inflow: two columns, time [s] and flow [m^3/s], comma or space separated,
-// '#' comments; the period is given separately.
+// '#' comments; the period is given separately. Every row is checked here, by line.
 Waveform read_inflow_table(const std::string& path, double period) {
   std::ifstream in(path);
   if (!in) throw IoError("cannot open inflow table " + path);
@@ -33,24 +45,53 @@ Waveform read_inflow_table(const std::string& path, double period) {
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
+    const std::string where = "--inflow-table " + path + ":" + std::to_string(number);
     if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
     for (char& c : line)
-      if (c == ',' || c == ';' || c == '\t') c = ' ';
+      if (c == ',' || c == ';' || c == '\t' || c == '\r') c = ' ';
     std::istringstream fields(line);
-    double t, q;
-    if (!(fields >> t)) continue;  // blank line
-    if (!(fields >> q))
-      throw InputError(path + ":" + std::to_string(number) + ": expected two numbers (time, flow)");
+    std::string t_text, q_text, extra;
+    if (!(fields >> t_text)) continue;  // blank line
+    if (!(fields >> q_text) || (fields >> extra))
+      throw InputError(where + ": expected two numbers (time [s], flow [m^3/s])");
+    const double t = parse_quantity(t_text, Dimension::dimensionless, where + ": time",
+                                    Interval{0, period, false, true}, "s");
+    const double q = parse_quantity(q_text, Dimension::dimensionless, where + ": flow",
+                                    accepted(ranges::flow_sample), "m^3/s");
+    if (!w.time.empty() && !(t > w.time.back()))
+      throw InputError(where + ": times must increase (" + t_text + " s follows " +
+                       format_rounded(w.time.back()) + " s)");
     w.time.push_back(t);
     w.flow.push_back(q);
   }
+  if (w.time.size() < 2) throw InputError("--inflow-table " + path + ": needs at least two rows");
+  const double mean = w.mean_flow();
+  if (!ranges::mean_flow.contains(mean))
+    throw InputError("--inflow-table " + path + ": the mean flow " +
+                     format_quantity(mean, "ml/min") + " lies outside the accepted range " +
+                     describe(accepted(ranges::mean_flow), "ml/min"));
   return w;
 }
 
-std::string mmhg(double pascal) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.2f mmHg", pascal / pascal_per_mmhg);
-  return text;
+// Every calibrated outlet within what the reader accepts: extreme but accepted flags (a tiny
+// inflow over a large tree) could otherwise give resistances beyond them.
+void check_outlets(const Network& pruned) {
+  for (const Outlet& o : pruned.outlets) {
+    const std::string where = "the calibrated outlet of vessel " +
+                              std::to_string(pruned.id[static_cast<std::size_t>(o.vessel)]) + ": ";
+    auto check = [&](std::string_view field, const FieldRange& range, double value) {
+      if (!range.contains(value))
+        throw InputError(where + out_of_range(field, range, value) +
+                         " (--mean-flow or --capillary-drop out of proportion for this tree)");
+    };
+    if (o.type == OutletType::rcr) {
+      check("R1", ranges::rcr_part, o.r1);
+      check("R2", ranges::rcr_part, o.r2);
+      check("C", ranges::compliance, o.c);
+    } else if (o.type == OutletType::resistance) {
+      check("R", ranges::resistance, o.r);
+    }
+  }
 }
 
 }  // namespace
@@ -61,86 +102,164 @@ int main(int argc, char** argv) {
                "vprune"};
   std::string input = "-", output = "-", format_name = "json", strategy = "profile";
   std::string profile_report;
-  long long budget = 0;
-  std::uint64_t seed = 1;
+  std::string budget_text, seed_text = "1", max_generation_text, keep_subtree_text;
   std::string cutoff_text, mean_flow_text = "1.74ml/min", period_text = "1s",
               systole_text = "0.3s", inflow_table, venous_text = "10mmHg",
               capillary_drop_text = "5mmHg", external_text = "10mmHg",
               plasma_text = "1mPa s", pries_max_text = "300um", newtonian_text = "3.4mPa s";
-  int max_generation = -1;
-  long long keep_subtree = -1;
-  double hematocrit = 0.45, alpha = 4.0 / 3.0;
+  std::string hematocrit_text = "0.45", alpha_text;  // alpha: 4/3 unless given
   std::string rheology = "pries";
+  const std::string int64_max = std::to_string(std::numeric_limits<std::int64_t>::max());
 
   app.add_option("input", input, "full tree (vnet JSON), - for standard input")->capture_default_str();
-  app.add_option("--budget", budget, "number of vessels to keep (the result has it within 1 %)");
+  app.add_option("--budget", budget_text,
+                 "profile strategy: number of vessels to keep, an integer in 1.." + int64_max +
+                     " (the result has it within 1 %; at least the tree's size keeps it whole)");
   app.add_option("-o,--output", output, "output file, - for standard output")->capture_default_str();
   app.add_option("--format", format_name, "json (vnet), vtk, graphml, dot or csv")->capture_default_str();
   app.add_option("--strategy", strategy, "profile (the paper's), diameter or generation")
       ->capture_default_str();
-  app.add_option("--cutoff", cutoff_text, "diameter strategy: keep the daughters of vessels at least this wide");
-  app.add_option("--max-generation", max_generation, "generation strategy: keep generations 0..G");
-  app.add_option("--keep-subtree", keep_subtree, "keep the subtree below this vessel id complete");
-  app.add_option("--seed", seed, "random seed of the selection")->capture_default_str();
+  app.add_option("--cutoff", cutoff_text,
+                 "diameter strategy: keep the daughters of vessels at least this wide, " +
+                     in(ranges::diameter, "um"));
+  app.add_option("--max-generation", max_generation_text,
+                 "generation strategy: keep generations 0..G, G an integer in 0.." +
+                     std::to_string(ranges::max_generation));
+  app.add_option("--keep-subtree", keep_subtree_text,
+                 "profile strategy: keep the subtree below this vessel id (an integer) complete");
+  app.add_option("--seed", seed_text,
+                 "random seed of the selection, an integer in 0..18446744073709551615")
+      ->capture_default_str();
   app.add_option("--profile-report", profile_report, "write the full, target and kept profiles (JSON)");
   auto* flow_group = app.add_option_group("inflow");
-  flow_group->add_option("--mean-flow", mean_flow_text, "mean inflow of the half-sine wave")->capture_default_str();
-  flow_group->add_option("--period", period_text, "cardiac period")->capture_default_str();
-  flow_group->add_option("--systole", systole_text, "duration of the half sine")->capture_default_str();
-  flow_group->add_option("--inflow-table", inflow_table, "measured inflow: lines of time [s], flow [m^3/s] over one --period");
+  auto* mean_flow_option = flow_group->add_option("--mean-flow", mean_flow_text,
+      "mean inflow of the half-sine wave, " + in(ranges::mean_flow, "ml/min") +
+          "; the steady pressures scale with it, so it must suit the tree's size")
+      ->capture_default_str();
+  flow_group->add_option("--period", period_text, "cardiac period, " + in(ranges::period, "s"))
+      ->capture_default_str();
+  auto* systole_option = flow_group->add_option("--systole", systole_text,
+      "duration of the half sine, " + in(ranges::systole, "s") + " and at most --period")
+      ->capture_default_str();
+  flow_group->add_option("--inflow-table", inflow_table,
+      "measured inflow instead of the half sine: lines of time [s] in [0, --period), "
+      "increasing, and flow [m^3/s] " + in(ranges::flow_sample, "m^3/s") + ", with a mean " +
+          in(ranges::mean_flow, "ml/min"));
   auto* blood_group = app.add_option_group("blood and outlets");
-  blood_group->add_option("--hematocrit", hematocrit, "discharge hematocrit")->capture_default_str();
+  blood_group->add_option("--hematocrit", hematocrit_text,
+                          "discharge hematocrit, " + in(ranges::hematocrit, ""))
+      ->capture_default_str();
   blood_group->add_option("--rheology", rheology, "pries or newtonian")->capture_default_str();
-  blood_group->add_option("--plasma-viscosity", plasma_text, "plasma (water) viscosity")->capture_default_str();
-  blood_group->add_option("--newtonian-viscosity", newtonian_text, "constant viscosity of --rheology newtonian")->capture_default_str();
-  blood_group->add_option("--pries-max-diameter", pries_max_text, "Pries law below this diameter, constant above")->capture_default_str();
-  blood_group->add_option("--alpha", alpha, "velocity-profile coefficient (4/3 parabolic)")->capture_default_str();
-  blood_group->add_option("--venous-pressure", venous_text, "outflow pressure of every outlet")->capture_default_str();
-  blood_group->add_option("--capillary-drop", capillary_drop_text, "mean pressure drop across the capillary outlets")->capture_default_str();
-  blood_group->add_option("--external-pressure", external_text, "interstitial pressure for the wall laws")->capture_default_str();
+  blood_group->add_option("--plasma-viscosity", plasma_text,
+                          "plasma (water) viscosity, " + in(ranges::viscosity, "mPa s"))
+      ->capture_default_str();
+  blood_group->add_option("--newtonian-viscosity", newtonian_text,
+                          "constant viscosity of --rheology newtonian, " +
+                              in(ranges::viscosity, "mPa s"))
+      ->capture_default_str();
+  blood_group->add_option("--pries-max-diameter", pries_max_text,
+                          "Pries law below this diameter, constant above, " +
+                              in(ranges::pries_max_diameter, "um"))
+      ->capture_default_str();
+  blood_group->add_option("--alpha", alpha_text,
+                          "velocity-profile coefficient, " + in(ranges::alpha, "") +
+                              " (default 4/3, a parabolic profile)");
+  blood_group->add_option("--venous-pressure", venous_text,
+                          "outflow pressure of every outlet, " + in(ranges::pressure, "mmHg"))
+      ->capture_default_str();
+  blood_group->add_option("--capillary-drop", capillary_drop_text,
+                          "mean pressure drop across the capillary outlets, in (0, " +
+                              format_quantity(ranges::pressure.max, "mmHg") + "]")
+      ->capture_default_str();
+  blood_group->add_option("--external-pressure", external_text,
+                          "interstitial pressure for the wall laws, " + in(ranges::pressure, "mmHg"))
+      ->capture_default_str();
   app.set_version_flag("--version", std::string("vprune ") + HEMOTREE_VERSION);
 
-  return run_tool(app, argc, argv, [&] {
+  const int status = run_tool(app, argc, argv, [&] {
+    // ---- every flag, before any work ---------------------------------------------------
     const auto format = parse_export_format(format_name);
     if (!format) throw InputError("--format: unknown format '" + format_name + "'");
-    if (strategy == "profile" && budget < 1)
-      throw InputError(budget == 0 ? "--budget is required for the profile strategy"
-                                   : "--budget must be at least 1");
-    if (strategy == "diameter" && cutoff_text.empty()) throw InputError("--strategy diameter needs --cutoff");
-    if (strategy == "generation" && max_generation < 0)
-      throw InputError("--strategy generation needs --max-generation >= 0");
     if (strategy != "profile" && strategy != "diameter" && strategy != "generation")
       throw InputError("--strategy must be profile, diameter or generation");
+    // A flag of another strategy would be ignored: say so rather than run without it.
+    auto only_for = [&](const std::string& text, const char* flag, const char* wanted) {
+      if (!text.empty() && strategy != wanted)
+        throw InputError(std::string(flag) + " applies to --strategy " + wanted + " only");
+    };
+    only_for(budget_text, "--budget", "profile");
+    only_for(keep_subtree_text, "--keep-subtree", "profile");
+    only_for(cutoff_text, "--cutoff", "diameter");
+    only_for(max_generation_text, "--max-generation", "generation");
+    if (strategy == "profile" && budget_text.empty())
+      throw InputError("--budget is required for the profile strategy");
+    if (strategy == "diameter" && cutoff_text.empty()) throw InputError("--strategy diameter needs --cutoff");
+    if (strategy == "generation" && max_generation_text.empty())
+      throw InputError("--strategy generation needs --max-generation");
+
+    const long long budget =
+        budget_text.empty() ? 0
+                            : static_cast<long long>(parse_count(
+                                  budget_text, "--budget", 1, std::numeric_limits<std::int64_t>::max()));
+    const int max_generation =
+        max_generation_text.empty()
+            ? -1
+            : static_cast<int>(parse_count(max_generation_text, "--max-generation", 0,
+                                           static_cast<std::uint64_t>(ranges::max_generation)));
+    const bool keep_subtree = !keep_subtree_text.empty();
+    const std::int64_t subtree_id =
+        keep_subtree ? parse_integer(keep_subtree_text, "--keep-subtree",
+                                     std::numeric_limits<std::int64_t>::min(),
+                                     std::numeric_limits<std::int64_t>::max())
+                     : 0;
+    const std::uint64_t seed =
+        parse_count(seed_text, "--seed", 0, std::numeric_limits<std::uint64_t>::max());
+    const double cutoff =
+        cutoff_text.empty() ? 0
+                            : parse_quantity(cutoff_text, Dimension::length, "--cutoff",
+                                             accepted(ranges::diameter), "um");
 
     Blood blood;
-    blood.hematocrit = hematocrit;
-    blood.alpha = alpha;
-    blood.plasma_viscosity = parse_quantity(plasma_text, Dimension::viscosity, "--plasma-viscosity");
-    blood.newtonian_viscosity = parse_quantity(newtonian_text, Dimension::viscosity, "--newtonian-viscosity");
-    blood.pries_max_diameter = parse_quantity(pries_max_text, Dimension::length, "--pries-max-diameter");
+    blood.hematocrit = parse_number(hematocrit_text, "--hematocrit", accepted(ranges::hematocrit));
+    if (!alpha_text.empty()) blood.alpha = parse_number(alpha_text, "--alpha", accepted(ranges::alpha));
+    blood.plasma_viscosity = parse_quantity(plasma_text, Dimension::viscosity, "--plasma-viscosity",
+                                            accepted(ranges::viscosity), "mPa s");
+    blood.newtonian_viscosity =
+        parse_quantity(newtonian_text, Dimension::viscosity, "--newtonian-viscosity",
+                       accepted(ranges::viscosity), "mPa s");
+    blood.pries_max_diameter =
+        parse_quantity(pries_max_text, Dimension::length, "--pries-max-diameter",
+                       accepted(ranges::pries_max_diameter), "um");
     if (rheology == "newtonian") blood.rheology = Rheology::newtonian;
     else if (rheology != "pries") throw InputError("--rheology must be pries or newtonian");
     blood = blood_from_json(to_json(blood));  // the same checks as a file's "blood"
 
-    const double period = parse_quantity(period_text, Dimension::time, "--period");
-    if (!(period > 0)) throw InputError("--period must be positive");
+    const double period = parse_quantity(period_text, Dimension::time, "--period",
+                                         accepted(ranges::period), "s");
     Waveform wave;
     if (!inflow_table.empty()) {
+      if (mean_flow_option->count() || systole_option->count())
+        throw InputError("--inflow-table replaces the half sine: give it without --mean-flow and --systole");
       wave = read_inflow_table(inflow_table, period);
     } else {
       wave.period = period;
-      wave.mean = parse_quantity(mean_flow_text, Dimension::flow, "--mean-flow");
-      wave.systole = parse_quantity(systole_text, Dimension::time, "--systole");
-      if (!(wave.mean > 0)) throw InputError("--mean-flow must be positive");
-      if (!(wave.systole > 0 && wave.systole <= period))
-        throw InputError("--systole must lie in (0, --period]");
+      wave.mean = parse_quantity(mean_flow_text, Dimension::flow, "--mean-flow",
+                                 accepted(ranges::mean_flow), "ml/min");
+      Interval systole = accepted(ranges::systole);
+      systole.max = std::min(systole.max, period);
+      wave.systole = parse_quantity(systole_text, Dimension::time, "--systole", systole, "s");
     }
 
     OutletParameters outlets;
-    outlets.venous_pressure = parse_quantity(venous_text, Dimension::pressure, "--venous-pressure");
-    outlets.capillary_pressure_drop = parse_quantity(capillary_drop_text, Dimension::pressure, "--capillary-drop");
-    outlets.external_pressure = parse_quantity(external_text, Dimension::pressure, "--external-pressure");
+    outlets.venous_pressure = parse_quantity(venous_text, Dimension::pressure, "--venous-pressure",
+                                             accepted(ranges::pressure), "mmHg");
+    outlets.capillary_pressure_drop =
+        parse_quantity(capillary_drop_text, Dimension::pressure, "--capillary-drop",
+                       Interval{0, ranges::pressure.max, true, false}, "mmHg");
+    outlets.external_pressure = parse_quantity(external_text, Dimension::pressure,
+                                               "--external-pressure", accepted(ranges::pressure), "mmHg");
 
+    // ---- the tree and its pruning --------------------------------------------------------
     Network full = read_network(input);
     const std::size_t root = check_rooted_tree(full);
     Inlet inlet;
@@ -153,16 +272,16 @@ int main(int argc, char** argv) {
     ProfileReport profile;
     KeepMask keep;
     const auto size = static_cast<long long>(full.vessel_count());
+    bool keeping_all = false;
     if (strategy == "profile" && budget >= size) {
-      note("the budget (" + std::to_string(budget) + ") is not below the tree's " +
-           std::to_string(size) + " vessels: keeping every vessel");
+      keeping_all = true;
       keep.assign(full.vessel_count(), 1);
-    } else if (keep_subtree >= 0) {
-      keep = prune_keeping_subtree(full, keep_subtree, static_cast<std::size_t>(budget), seed, &profile);
+    } else if (keep_subtree) {
+      keep = prune_keeping_subtree(full, subtree_id, static_cast<std::size_t>(budget), seed, &profile);
     } else if (strategy == "profile") {
       keep = prune_by_profile(full, static_cast<std::size_t>(budget), seed, &profile);
     } else if (strategy == "diameter") {
-      keep = prune_by_diameter(full, parse_quantity(cutoff_text, Dimension::length, "--cutoff"));
+      keep = prune_by_diameter(full, cutoff);
     } else {
       keep = prune_by_generation(full, max_generation);
     }
@@ -171,14 +290,16 @@ int main(int argc, char** argv) {
     const OutletReport report = calibrate_outlets(full, keep, pruned, outlets);
     const double full_p = report.steady_inlet_pressure_full;
     const double pruned_p = report.steady_inlet_pressure_pruned;
-    const double mismatch = std::abs(pruned_p - full_p) / full_p;
-    note("kept " + std::to_string(pruned.vessel_count()) + " of " + std::to_string(size) +
-         " vessels; outlets: " + std::to_string(report.rcr) + " RCR, " +
-         std::to_string(report.resistance) + " R, " + std::to_string(report.leaf) +
-         " capillary; steady inlet pressure " + mmhg(pruned_p) + " (full tree " + mmhg(full_p) + ")");
-    if (!(mismatch <= 1e-3))
+
+    // ---- every check of the result, before anything is said or written -------------------
+    if (!std::isfinite(full_p) || !std::isfinite(pruned_p))
+      throw InputError("the steady flow of this tree has no finite inlet pressure: check "
+                       "--mean-flow and the vessels' lengths and diameters");
+    check_outlets(pruned);
+    if (!(std::abs(pruned_p - full_p) <= 1e-3 * std::abs(full_p)))
       throw std::logic_error("the outlets do not reproduce the full tree's steady inlet pressure (" +
-                             mmhg(pruned_p) + " against " + mmhg(full_p) + ")");
+                             format_quantity(pruned_p, "mmHg") + " against " +
+                             format_quantity(full_p, "mmHg") + ")");
 
     nlohmann::json parameters = {{"strategy", strategy}, {"seed", seed}, {"outlets",
         {{"venous_pressure", outlets.venous_pressure},
@@ -187,13 +308,31 @@ int main(int argc, char** argv) {
          {"rcr_min_diameter", outlets.rcr_min_diameter},
          {"thick_wall_ratio", outlets.thick_wall_ratio}}}};
     if (budget > 0) parameters["budget"] = budget;
-    if (!cutoff_text.empty()) parameters["cutoff"] = parse_quantity(cutoff_text, Dimension::length, "--cutoff");
+    if (!cutoff_text.empty()) parameters["cutoff"] = cutoff;
     if (max_generation >= 0) parameters["max_generation"] = max_generation;
-    if (keep_subtree >= 0) parameters["keep_subtree"] = keep_subtree;
+    if (keep_subtree) parameters["keep_subtree"] = subtree_id;
     nlohmann::json provenance = {{"tool", "vprune"}, {"version", HEMOTREE_VERSION},
                                  {"parameters", parameters}, {"source", full.provenance}};
     provenance.update(to_json(report));
+    try {
+      (void)provenance.dump();  // the writer's own serialization, tried before anything is said
+    } catch (const nlohmann::json::exception&) {
+      throw InputError("the input's provenance holds a string that is not valid UTF-8");
+    }
     pruned.provenance = provenance;
+
+    if (keeping_all)
+      note("the budget (" + std::to_string(budget) + ") is not below the tree's " +
+           std::to_string(size) + " vessels: keeping every vessel");
+    note("kept " + std::to_string(pruned.vessel_count()) + " of " + std::to_string(size) +
+         " vessels; outlets: " + std::to_string(report.rcr) + " RCR, " +
+         std::to_string(report.resistance) + " R, " + std::to_string(report.leaf) +
+         " capillary; steady inlet pressure " + format_quantity(pruned_p, "mmHg") +
+         " (full tree " + format_quantity(full_p, "mmHg") + ")");
+    if (const std::string w = unphysiological_pressure_warning(
+            report, outlets, full.inlet->waveform.mean_flow(), full.diameter[root]);
+        !w.empty())
+      warn(w);
 
     if (!profile_report.empty()) {
       OutputStream report_out(profile_report);
@@ -205,4 +344,12 @@ int main(int argc, char** argv) {
     out.commit();
     return 0;
   });
+  // --help and --version print outside any OutputStream: a full disk must not pass for them.
+  if (status == 0) {
+    if (const std::string why = standard_output_error(); !why.empty()) {
+      std::fprintf(stderr, "vprune: error: cannot write standard output: %s\n", why.c_str());
+      return 1;
+    }
+  }
+  return status;
 }
