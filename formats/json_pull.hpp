@@ -59,7 +59,11 @@ class JsonPull {
   Token next();
 
   Token token() const;
-  std::string_view text() const;   // valid until the next call of next()
+  // Valid until the next call of next(): a key's text dies when its value is read (it may
+  // point into the stream buffer, which a refill overwrites, or into a scratch string that a
+  // longer escaped string reallocates). Compare it or copy it first. Strings and keys are
+  // well-formed UTF-8 (ill-formed bytes are a JsonError at their position).
+  std::string_view text() const;
   double number() const;           // the current number token as a double
   std::int64_t integer() const;    // the current number token; JsonError if not an integer
   bool boolean() const;
