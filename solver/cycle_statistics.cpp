@@ -18,9 +18,8 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
   return omega * dx / lag;
 }
 
-CycleStatistics::CycleStatistics(const Network& net, double analysis_frequency, std::size_t inlet,
-                                 std::vector<std::size_t> outlets)
-    : net_(net), omega_(2 * std::numbers::pi * analysis_frequency), inlet_(inlet), outlets_(std::move(outlets)),
+CycleStatistics::CycleStatistics(const Network& net, double analysis_frequency)
+    : net_(net), omega_(2 * std::numbers::pi * analysis_frequency),
       flow_(net.vessel_count(), 0.0), pressure_(net.vessel_count(), 0.0),
       p_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
       p_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()),
@@ -29,6 +28,11 @@ CycleStatistics::CycleStatistics(const Network& net, double analysis_frequency, 
       reynolds_(net.vessel_count(), 0.0), p_in_(net.vessel_count()), p_out_(net.vessel_count()),
       u_in_(net.vessel_count()), u_out_(net.vessel_count()), first_(4 * net.vessel_count()),
       last_(4 * net.vessel_count()) {}
+
+void CycleStatistics::begin(const PulseSolver& solver) {
+  exchanged_start_ = solver.state().exchanged;
+  volume_start_ = solver.network_volume();
+}
 
 void CycleStatistics::sample(const PulseSolver& solver, double t, double weight) {
   // Rectangle rule: spectrally accurate for the means of periodic signals.
@@ -63,7 +67,6 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     record(4 * v, p);
     record(4 * v + 2, u);
   }
-  inlet_flow_ += weight * q_end_[inlet_];
   solver.sample_all(1.0, area_end_, q_end_);
   for (std::size_t v = 0; v < flow_.size(); ++v) {
     const double p = solver.law(v).pressure(area_end_[v]), u = q_end_[v] / area_end_[v];
@@ -72,15 +75,17 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     record(4 * v + 1, p);
     record(4 * v + 3, u);
   }
-  for (const std::size_t v : outlets_) outlets_flow_ += weight * q_end_[v];
   duration_ += weight;
 }
 
-CycleSummary CycleStatistics::close() {
+CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   CycleSummary summary;
-  summary.inlet_mean_flow = inlet_flow_ / duration_;
-  summary.outlets_mean_flow = outlets_flow_ / duration_;
-  inlet_flow_ = outlets_flow_ = 0;
+  const Eigen::Vector2d exchanged = solver.state().exchanged - exchanged_start_;
+  summary.inlet_mean_flow = exchanged(0) / duration_;
+  summary.outlets_mean_flow = exchanged(1) / duration_;
+  summary.volume_change = solver.network_volume() - volume_start_;
+  summary.conservation_error = (exchanged(0) - exchanged(1) - summary.volume_change) / exchanged(0);
+  begin(solver);  // the next cycle starts here unless begin() is called again
   std::vector<VesselCycle>& out = summary.vessels;
   out.resize(flow_.size());
   // A linear drift s(t) = slope (t - t0) over the cycle [t0, t0 + T] has the Fourier sum

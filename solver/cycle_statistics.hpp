@@ -40,28 +40,30 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 
 struct CycleSummary {
   std::vector<VesselCycle> vessels;
-  // Mean flow in at the inlet and out through all outlets: over a periodic cycle the
-  // compliances store nothing, so they agree to the discretization's mass balance.
+  // Mean flow in at the inlet and out through all outlets, from the volume fluxes the solver
+  // exchanged there: over a periodic cycle the compliances store nothing, and they agree.
   double inlet_mean_flow = 0, outlets_mean_flow = 0;
+  // The change of the blood volume in the vessels over the cycle [m^3], and the scheme's
+  // mass balance: (in - out - change) / in, round-off and the junctions' tolerance.
+  double volume_change = 0, conservation_error = 0;
 };
 
 class CycleStatistics {
  public:
-  // analysis_frequency: the harmonic [Hz] at which the pulse wave speeds are measured;
-  // inlet: the inlet vessel's index; outlets: the outlet vessels' indices.
-  CycleStatistics(const Network& net, double analysis_frequency, std::size_t inlet,
-                  std::vector<std::size_t> outlets);
+  // analysis_frequency: the harmonic [Hz] at which the pulse wave speeds are measured.
+  CycleStatistics(const Network& net, double analysis_frequency);
+  // Marks the start of a cycle (after any compliance balance, which moves volume).
+  void begin(const PulseSolver& solver);
   // Samples the solver's state at time t, standing for the `weight` seconds before it.
   void sample(const PulseSolver& solver, double t, double weight);
-  // Closes the cycle: returns the statistics and starts the next cycle.
-  CycleSummary close();
+  // Closes the cycle at the solver's state now: returns the statistics.
+  CycleSummary close(const PulseSolver& solver);
 
  private:
   const Network& net_;
   double omega_;
-  std::size_t inlet_;
-  std::vector<std::size_t> outlets_;
-  double inlet_flow_ = 0, outlets_flow_ = 0;
+  Eigen::Vector2d exchanged_start_ = Eigen::Vector2d::Zero();  // at begin()
+  double volume_start_ = 0;
   std::vector<double> flow_, pressure_, p_min_, p_max_, q_min_, q_max_, wss_, reynolds_;
   // Fourier sums at the ends, and each signal's first and last sample of the cycle: a
   // cycle that is not yet periodic drifts, and the drift's own Fourier component is removed.

@@ -10,25 +10,71 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <omp.h>
 
 #include "cli/errors.hpp"
+#include "cli/interrupt.hpp"
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "formats/network_io.hpp"
-#include "solver/cycle_statistics.hpp"
-#include "formats/vtk_series.hpp"
+#include "solver/checkpoint.hpp"
+#include "solver/output_folder.hpp"
 #include "solver/probes.hpp"
+#include "solver/pulsatile_run.hpp"
 #include "solver/pulse_solver.hpp"
+#include "solver/run_estimate.hpp"
 #include "solver/run_report.hpp"
-#include "solver/solution_breakdown.hpp"
 
 using namespace hemotree;
 
 namespace {
 
-std::string number(double v) {
-  char text[32];
-  return std::string(text, format_real(text, v));
+constexpr double one_day = 86400;
+constexpr double most_steps_per_cycle = 1e12;  // beyond any machine's reach, and size_t's range is safe
+// The scheme's own mass balance: round-off plus the junctions' Newton tolerance (1e-12 of
+// the flow; docs/solver.md). Far above both and far below any error that changes a result.
+constexpr double conservation_tolerance = 1e-8;
+// Steady or mean pressures outside this band are not physiological [mmHg].
+constexpr double physiological_low = 0, physiological_high = 300;
+
+// The network's arrays that shape the solution: a checkpoint of another network is refused.
+std::uint64_t network_fingerprint(const Network& net) {
+  Fingerprint f;
+  f.add(net.id);
+  f.add(net.from);
+  f.add(net.to);
+  f.add(net.length);
+  f.add(net.diameter);
+  f.add(net.wall_thickness);
+  f.add(net.youngs_modulus);
+  f.add(net.beta);
+  f.add(net.reference_pressure);
+  if (net.blood) f.add(to_json(*net.blood).dump());
+  if (net.inlet) f.add(to_json(*net.inlet).dump());
+  for (const Outlet& o : net.outlets) f.add(to_json(o).dump() + std::to_string(o.vessel));
+  return f.value();
+}
+
+void check_range(double value, const Interval& range, const std::string& flag, std::string_view unit = "") {
+  if (!range.contains(value))
+    throw InputError(flag + " must lie in " + describe(range, unit) + " (got " +
+                     (unit.empty() ? format_rounded(value) : format_quantity(value, unit)) + ")");
+}
+
+void check_count(long long value, long long low, long long high, const std::string& flag) {
+  if (value < low || value > high)
+    throw InputError(flag + " must lie in [" + std::to_string(low) + ", " + std::to_string(high) + "] (got " +
+                     std::to_string(value) + ")");
+}
+
+// Warns when pressures leave the physiological band, with the likely cause.
+void warn_unphysiological(double low, double high, std::int64_t vessel, const Network& net, const char* what) {
+  if (!std::isfinite(low) || !std::isfinite(high)) return;
+  if (low >= physiological_low * pascal_per_mmhg && high <= physiological_high * pascal_per_mmhg) return;
+  warn(std::string(what) + " reach " + format_quantity(high, "mmHg") + " (lowest " + format_quantity(low, "mmHg") +
+       ", at vessel " + std::to_string(vessel) + "), outside a physiological 0 to 300 mmHg: the inlet's mean flow (" +
+       format_quantity(net.inlet->waveform.mean_flow(), "ml/min") +
+       ") is likely wrong for this network's size (vprune --mean-flow sets it)");
 }
 
 }  // namespace
@@ -37,76 +83,105 @@ int main(int argc, char** argv) {
   CLI::App app{"Solve 1D pulsatile blood flow in a compliant vascular network (spectral/hp "
                "discontinuous Galerkin) and report flows, pressures and pulsatility.",
                "hemosolve"};
-  std::string input, out_dir, rheology, scheme = "etd2", start = "steady", dt_text, sample_text = "1ms",
-              external_text = "10mmHg", degree_text = "auto";
-  int cycles = 1, max_cycles = 50;
+  std::string input, out_dir, resume_dir, rheology, scheme = "etd2", start = "steady", dt_text,
+      sample_text = "1ms", external_text = "10mmHg", degree_text = "auto";
+  int cycles = 1, max_cycles = 50, frames = 0, checkpoint_every = 0;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
-  bool quiet = false, vtk = false, balance = true;
-  int frames = 0;
+  bool quiet = false, vtk = false, balance = true, force = false;
   SolverOptions options;
+  const int cores = omp_get_num_procs();
   app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
-  app.add_option("--out", out_dir, "folder for summary.json and probes.csv")->required();
-  app.add_option("--cycles", cycles, "cardiac cycles to run")->capture_default_str();
-  app.add_option("--until-periodic", periodic_tol,
-                 "run until every vessel's mean pressure changes less than this from one cycle to the next");
-  app.add_option("--max-cycles", max_cycles, "upper bound for --until-periodic")->capture_default_str();
-  app.add_option("--probe", probe_texts, "record p, Q, A, u at vessel ID, fraction x along it (ID[:x], x 0.5 by default)");
-  app.add_option("--sample-interval", sample_text, "time between probe samples")->capture_default_str();
+  app.add_option("--out", out_dir,
+                                    "folder for summary.json, probes.csv, results.vtp and frames/; written as "
+                                    "OUT.partial and renamed to OUT when the run ends, so OUT never mixes two runs");
+  app.add_option("--resume", resume_dir,
+                 "continue the run whose results folder this is from its last checkpoint (same network and "
+                 "options; --cycles and --max-cycles may grow)");
+  app.add_option("--checkpoint-every", checkpoint_every,
+                 "write the solver's whole state to OUT.partial/checkpoint.bin every N cycles, in [0, 100000] "
+                 "(0: only when interrupted)")
+      ->capture_default_str();
+  app.add_option("--cycles", cycles, "cardiac cycles to run, in [1, 100000]")->capture_default_str();
+  auto* periodic_option = app.add_option(
+      "--until-periodic", periodic_tol,
+      "run until every vessel's mean pressure changes less than this (relative, in (0, 1)) from one cycle to the next");
+  app.add_option("--max-cycles", max_cycles, "upper bound for --until-periodic, in [1, 100000]")->capture_default_str();
+  app.add_option("--probe", probe_texts, "record p, Q, A, u at vessel ID, fraction x in [0, 1] along it (ID[:x], x 0.5 by default)");
+  app.add_option("--sample-interval", sample_text, "time between probe samples, in (0, the inlet's period]")
+      ->capture_default_str();
   app.add_option("--degree", degree_text,
-                 "polynomial degree p in every vessel, or auto: per vessel, --low-degree in vessels much "
-                 "shorter than the pulse's wavelength (raised up to --raise-degree where the time step "
+                 "polynomial degree p in [0, 30] in every vessel, or auto: per vessel, --low-degree in vessels "
+                 "much shorter than the pulse's wavelength (raised up to --raise-degree where the time step "
                  "allows), --high-degree elsewhere")
       ->capture_default_str();
-  app.add_option("--low-degree", options.degree_rule.low, "auto: degree of acoustically short vessels")
+  app.add_option("--low-degree", options.degree_rule.low, "auto: degree of acoustically short vessels, in [0, 30]")
       ->capture_default_str();
   app.add_option("--raise-degree", options.degree_rule.raise_to,
-                 "auto: the most a short vessel is raised to at no cost in time step")
+                 "auto: the most a short vessel is raised to at no cost in time step, in [0, 30]")
       ->capture_default_str();
-  app.add_option("--high-degree", options.degree_rule.high, "auto: degree of the other vessels")
+  app.add_option("--high-degree", options.degree_rule.high, "auto: degree of the other vessels, in [0, 30]")
       ->capture_default_str();
   app.add_option("--linear-error", options.degree_rule.linear_error,
                  "auto: a short vessel whose steady pressure profile departs further than this from a "
-                 "line (relative; docs/solver.md) takes degree 2")
+                 "line (relative, in [0, 1]; docs/solver.md) takes degree 2")
       ->capture_default_str();
-  app.add_option("--elements", options.elements, "elements per vessel")->capture_default_str();
-  app.add_option("--dt", dt_text, "time step (default: from the CFL and friction limits)");
-  app.add_option("--cfl", options.cfl, "fraction of the wave-speed (Courant) stability limit of the degree and scheme")->capture_default_str();
+  app.add_option("--elements", options.elements, "elements per vessel, in [1, 1000]")->capture_default_str();
+  app.add_option("--dt", dt_text,
+                 "time step, at most the stability limit unless --force (default: from the CFL and friction limits)");
+  app.add_option("--cfl", options.cfl,
+                 "fraction of the wave-speed (Courant) stability limit of the degree and scheme, in (0, 1] "
+                 "(above 1 only with --force)")
+      ->capture_default_str();
   app.add_option("--scheme", scheme, "time scheme: etd2 (Adams-Bashforth 2 with exact friction), ab2 (the paper's) or rk4")->capture_default_str();
   app.add_option("--rheology", rheology, "pries or newtonian (default: the network's blood)");
   app.add_option("--start", start, "initial state: steady (Poiseuille solution) or rest")->capture_default_str();
-  app.add_option("--external-pressure", external_text, "interstitial pressure for the wall laws")->capture_default_str();
-  app.add_option("--thick-wall-ratio", options.thick_wall_ratio, "h/D above which a wall is thick")->capture_default_str();
-  app.add_option("--threads", options.threads, "threads over elements (use the idle cores; results agree to round-off)")
+  app.add_option("--external-pressure", external_text, "interstitial pressure for the wall laws, in [-100, 100] mmHg")
+      ->capture_default_str();
+  app.add_option("--thick-wall-ratio", options.thick_wall_ratio, "h/D above which a wall is thick, in (0, 10]")
+      ->capture_default_str();
+  app.add_option("--threads", options.threads,
+                 "threads over elements, in [1, " + std::to_string(cores) +
+                     "] (this machine's cores; use the idle ones: results agree to round-off)")
       ->capture_default_str();
   app.add_flag("--vtk", vtk, "also write the network with every per-vessel result as VTK (results.vtp, for ParaView)");
   app.add_option("--frames", frames,
                  "write N frames of the last cycle (p, Q, A, u per vessel) as a ParaView time series "
-                 "(frames/frames.pvd)");
+                 "(frames/frames.pvd), N in [0, 10000] and at most the steps of a cycle");
   app.add_flag("--balance-compliances,!--no-balance-compliances", balance,
                "at each cycle end, move the network's compliances (vessels and RCR capacitors) to where "
                "their mean filling over the cycle says the periodic state lies (docs/solver.md; on by default)");
-  app.add_flag("--quiet", quiet, "no progress line");
+  app.add_flag("--force", force,
+               "run even with a --dt or --cfl above the stability limit, or an estimated wall time above a day");
+  app.add_flag("--quiet", quiet, "no progress lines or notes (warnings and errors still)");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
   return run_tool(app, argc, argv, [&] {
-    if (cycles < 1) throw InputError("--cycles must be at least 1");
+    // ---- every flag, before any work -------------------------------------------------
+    if (out_dir.empty() && resume_dir.empty()) throw InputError("--out DIR is required (or --resume DIR)");
+    if (!resume_dir.empty() && !out_dir.empty() &&
+        std::filesystem::absolute(out_dir).lexically_normal() != std::filesystem::absolute(resume_dir).lexically_normal())
+      throw InputError("--resume " + resume_dir + " continues the run in that folder; --out must name it too or be left out");
+    if (out_dir.empty()) out_dir = resume_dir;
+    check_count(cycles, 1, 100000, "--cycles");
+    check_count(max_cycles, 1, 100000, "--max-cycles");
+    check_count(checkpoint_every, 0, 100000, "--checkpoint-every");
+    check_count(frames, 0, 10000, "--frames");
+    const bool until_periodic = periodic_option->count() > 0;
+    if (until_periodic) check_range(periodic_tol, {0, 1, true, true}, "--until-periodic");
     if (scheme == "rk4") options.scheme = TimeScheme::runge_kutta4;
     else if (scheme == "ab2") options.scheme = TimeScheme::adams_bashforth2;
     else if (scheme == "etd2") options.scheme = TimeScheme::exponential_ab2;
-    else throw InputError("--scheme must be etd2, ab2 or rk4");
+    else throw InputError("--scheme must be etd2, ab2 or rk4 (got '" + scheme + "')");
     if (start == "rest") options.steady_start = false;
-    else if (start != "steady") throw InputError("--start must be steady or rest");
+    else if (start != "steady") throw InputError("--start must be steady or rest (got '" + start + "')");
     if (!rheology.empty()) {
       if (rheology == "pries") options.rheology_override = static_cast<int>(Rheology::pries);
       else if (rheology == "newtonian") options.rheology_override = static_cast<int>(Rheology::newtonian);
-      else throw InputError("--rheology must be pries or newtonian");
+      else throw InputError("--rheology must be pries or newtonian (got '" + rheology + "')");
     }
-    if (!dt_text.empty()) {
-      options.dt = parse_quantity(dt_text, Dimension::time, "--dt");
-      if (!(options.dt > 0)) throw InputError("--dt must be positive");
-    }
-    if (!(options.cfl > 0)) throw InputError("--cfl must be positive");
+    if (!dt_text.empty()) options.dt = parse_quantity(dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");
+    check_range(options.cfl, {0, force ? 100.0 : 1.0, true, false}, force ? "--cfl (with --force)" : "--cfl");
     if (degree_text != "auto") {
       std::size_t used = 0;
       try {
@@ -114,69 +189,154 @@ int main(int argc, char** argv) {
       } catch (const std::exception&) {
         used = 0;
       }
-      if (used == 0 || used != degree_text.size() || options.degree < 0)
-        throw InputError("--degree must be auto or a whole number from 0 to 30");
+      if (used == 0 || used != degree_text.size() || options.degree < 0 || options.degree > 30)
+        throw InputError("--degree must be auto or a whole number in [0, 30] (got '" + degree_text + "')");
     }
-    for (const int p : {options.degree_rule.low, options.degree_rule.raise_to, options.degree_rule.high})
-      if (p < 0 || p > 30) throw InputError("--low-degree, --raise-degree and --high-degree must lie in 0..30");
-    if (!(options.degree_rule.linear_error >= 0)) throw InputError("--linear-error must be zero or positive");
-    options.external_pressure = parse_quantity(external_text, Dimension::pressure, "--external-pressure");
-    const double sample_interval = parse_quantity(sample_text, Dimension::time, "--sample-interval");
+    check_count(options.degree_rule.low, 0, 30, "--low-degree");
+    check_count(options.degree_rule.raise_to, 0, 30, "--raise-degree");
+    check_count(options.degree_rule.high, 0, 30, "--high-degree");
+    check_range(options.degree_rule.linear_error, {0, 1}, "--linear-error");
+    check_count(options.elements, 1, 1000, "--elements");
+    check_count(options.threads, 1, cores, "--threads");
+    check_range(options.thick_wall_ratio, {0, 10, true, false}, "--thick-wall-ratio");
+    options.external_pressure = parse_quantity(external_text, Dimension::pressure, "--external-pressure",
+                                               {-100 * pascal_per_mmhg, 100 * pascal_per_mmhg}, "mmHg");
+    const double sample_interval =
+        parse_quantity(sample_text, Dimension::time, "--sample-interval", {0, 1e6, true, false}, "s");
 
-    if (frames < 0) throw InputError("--frames must be positive");
+    // Ctrl-C and kill are answered at a step's end from here on (cli/interrupt.hpp).
+    InterruptRequests interrupts;
     const Network net = read_network(input);
     if ((vtk || frames > 0) && net.x.empty())
       throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
+    if (!net.inlet) throw InputError("the network has no \"inlet\": hemosolve needs one (vprune adds it)");
+    const double period = net.inlet->waveform.period;
+    check_range(sample_interval, {0, period, true, false}, "--sample-interval", "s");
     std::vector<Probe> probe_list;
     for (const auto& t : probe_texts) probe_list.push_back(parse_probe(t, net));
+    OutputFolder folder(out_dir);
+    std::string checkpoint_bytes, checkpoint_source;
+    if (!resume_dir.empty()) {
+      const auto file = folder.latest_checkpoint();
+      if (!file)
+        throw InputError("--resume " + resume_dir + ": no checkpoint.bin in it or in " + folder.staging().string() +
+                         " (a run writes one when interrupted, or every N cycles with --checkpoint-every N)");
+      checkpoint_bytes = read_checkpoint_file(*file);
+      checkpoint_source = file->string();
+    }
+    if (const int s = interrupts.poll()) {
+      warn(std::string("interrupted by ") + InterruptRequests::name(s) + " before the first step: nothing written");
+      return InterruptRequests::exit_status(s);
+    }
+
+    // ---- the discretisation, its step and its cost ---------------------------------------
     PulseSolver run(net, options);
-    const double period = net.inlet->waveform.period;
-    const auto steps_per_cycle = static_cast<std::size_t>(std::ceil(period / run.dt() - 1e-9));
+    if (options.dt > 0 && options.dt > run.stable_dt() * (1 + 1e-9) && !force)
+      throw InputError("--dt " + format_quantity(options.dt, "s") + " is " + format_rounded(options.dt / run.stable_dt()) +
+                       " times the stability limit " + format_quantity(run.stable_dt(), "s") + " (" +
+                       run.stable_dt_reason() + "); the solution would blow up or be wrong: use a --dt of at "
+                       "most the limit, or --force to run it anyway");
+    const double steps_wanted = std::ceil(period / run.dt() - 1e-9);
+    if (!(steps_wanted <= most_steps_per_cycle))
+      throw InputError("a time step of " + format_quantity(run.dt(), "s") + " (" + run.dt_reason() + ") needs " +
+                       format_rounded(steps_wanted) + " steps per cycle: no run can finish; check that vessel's "
+                       "wall and length, and the inlet's flow");
+    const auto steps_per_cycle = static_cast<std::size_t>(steps_wanted);
     const double dt = period / static_cast<double>(steps_per_cycle);  // a whole number per cycle
     const std::string dt_reason = run.dt_reason();
     run.set_time_step(dt);  // slightly smaller, so that cycles end exactly on a step
+    if (static_cast<std::size_t>(frames) > steps_per_cycle)
+      throw InputError("--frames " + std::to_string(frames) + " exceeds the " + std::to_string(steps_per_cycle) +
+                       " steps of a cycle");
     std::map<int, std::size_t> degrees;  // elements per degree
     for (std::size_t v = 0; v < net.vessel_count(); ++v) degrees[run.degree(v)] += static_cast<std::size_t>(options.elements);
+    std::vector<double> elements_of_degree(static_cast<std::size_t>(run.max_degree()) + 1, 0.0);
     std::string degree_list;
-    for (const auto& [p, count] : degrees)
+    for (const auto& [p, count] : degrees) {
+      elements_of_degree[static_cast<std::size_t>(p)] = static_cast<double>(count);
       degree_list += (degree_list.empty() ? "" : ", ") + std::to_string(count) + " of degree " + std::to_string(p);
-    if (!quiet)
-      note("time step " + number(dt) + " s (" + dt_reason + "), " + std::to_string(steps_per_cycle) +
-           " steps per cycle, " + std::to_string(run.element_count()) + " elements: " + degree_list);
-
-    std::filesystem::path dir(out_dir);
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) throw IoError("cannot create " + out_dir + ": " + ec.message());
-
-    ProbeRecorder probes(std::move(probe_list));
-    const auto sample_every = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(sample_interval / dt)));
-    const Waveform& pulse = net.inlet->waveform;
-    const double frequency = analysis_frequency(pulse);
-    std::vector<std::size_t> outlet_vessels;
-    for (const Outlet& o : net.outlets) outlet_vessels.push_back(static_cast<std::size_t>(o.vessel));
-    CycleStatistics stats(net, frequency, static_cast<std::size_t>(net.index_of(net.inlet->vessel)), outlet_vessels);
-    // Statistics every 1e-4 of a period (or every step if that is longer): means and extrema
-    // of the smooth pulse are then exact to ~1e-7, at a few per cent of the run's time.
-    const auto stats_every = std::max<std::size_t>(1, static_cast<std::size_t>(1e-4 * period / dt));
-    CycleSummary last, previous;
-    nlohmann::json results;
-    auto report = [&](const nlohmann::json& info) {
-      results = vessel_results(net, run, last, frequency);
-      write_summary(dir / "summary.json", info, results, last);
-      if (vtk) write_results_vtk(dir / "results.vtp", net, results);
-    };
-    if (frames > 0) {
-      std::filesystem::create_directories(dir / "frames", ec);
-      if (ec) throw IoError("cannot create " + (dir / "frames").string() + ": " + ec.message());
     }
-    PeriodicityChange change;
-    int done = 0;
-    int balances = 0;  // cycle ends at which the compliances moved
-    const bool until_periodic = periodic_tol > 0;
     const int planned = until_periodic ? max_cycles : cycles;
-    const bool show = !quiet && stderr_is_terminal();
+    const RunEstimate per_cycle = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), options.threads);
+    const RunEstimate whole = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned, options.threads);
+    if (!quiet)
+      note("time step " + format_quantity(dt, "s") + " (" + dt_reason + "), " + std::to_string(steps_per_cycle) +
+           " steps per cycle, " + std::to_string(run.element_count()) + " elements: " + degree_list +
+           "; estimated " + describe_duration(per_cycle.seconds) + " per cycle, " + describe_duration(whole.seconds) +
+           (until_periodic ? " for at most " : " for ") + std::to_string(planned) + " cycles on " +
+           std::to_string(options.threads) + (options.threads == 1 ? " thread" : " threads"));
+    if (per_cycle.seconds > one_day && !force)
+      throw InputError("one cycle would take about " + describe_duration(per_cycle.seconds) + " (" +
+                       format_rounded(static_cast<double>(steps_per_cycle)) + " steps of " + format_quantity(dt, "s") +
+                       ", set by the " + dt_reason + "; " + std::to_string(run.element_count()) +
+                       " elements): refused, more than a day. Check that vessel's wall and length and the inlet's "
+                       "flow, use fewer --elements or a lower --degree, or --force to run it anyway");
+    if (whole.seconds > one_day && !quiet)
+      warn("the whole run may take " + describe_duration(whole.seconds) +
+           " (use --checkpoint-every N to be able to resume it)");
+
+    // ---- what the run starts from, said as it is --------------------------------------------
+    const bool steady_start = run.started_from_steady();
+    if (options.steady_start && !steady_start)
+      warn("no steady solution to start from (" + run.steady_refusal() + "): starting from rest" +
+           (balance ? std::string(", without the compliance balance (it needs the steady network)") : std::string()));
+    warn_unphysiological(run.steady_pressure_min(), run.steady_pressure_max(),
+                         net.id[run.steady_pressure_max_vessel()], net, "steady pressures");
+
+    // ---- the run ------------------------------------------------------------------------------
+    std::ostringstream shaping;  // the options a checkpoint must share with the run resuming it
+    shaping << "scheme " << scheme << ", degree " << degree_text << " (" << options.degree_rule.low << "/"
+            << options.degree_rule.raise_to << "/" << options.degree_rule.high << ", linear error "
+            << options.degree_rule.linear_error << "), elements " << options.elements << ", time step " << dt
+            << ", rheology " << to_string(run.blood().rheology) << ", start " << start << ", external pressure "
+            << options.external_pressure << " Pa, thick wall ratio " << options.thick_wall_ratio
+            << ", balance " << (balance ? "on" : "off") << ", sample interval " << sample_interval << " s, probes";
+    for (const auto& t : probe_texts) shaping << ' ' << t;
+    RunPlan plan;
+    plan.cycles = cycles;
+    plan.until_periodic = until_periodic;
+    plan.periodic_tolerance = periodic_tol;
+    plan.max_cycles = max_cycles;
+    plan.balance_compliances = balance;
+    plan.frames = frames;
+    plan.steps_per_cycle = steps_per_cycle;
+    plan.sample_every = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(sample_interval / dt)));
+    plan.checkpoint_every = checkpoint_every;
+    plan.options = shaping.str();
+    plan.fingerprint = network_fingerprint(net);
+    plan.live_progress = !quiet && stderr_is_terminal();
+    plan.log_progress = !quiet && !stderr_is_terminal();
+    PulsatileRun pulsatile(net, run, std::move(probe_list), plan, folder.staging());
+    if (!checkpoint_bytes.empty()) {
+      pulsatile.resume(checkpoint_bytes, checkpoint_source);
+      if (!quiet)
+        note("resuming from " + checkpoint_source + " after " + std::to_string(pulsatile.cycles_done()) +
+             " cycles (t = " + format_quantity(run.time(), "s") + ")");
+    }
+    folder.open();
+    if (frames > 0) {
+      std::error_code ec;
+      std::filesystem::create_directories(folder.staging() / "frames", ec);
+      if (ec) throw IoError("cannot create " + (folder.staging() / "frames").string() + ": " + ec.message());
+    }
     const auto started = std::chrono::steady_clock::now();
+    RunStatus status = pulsatile.run(interrupts);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const CycleSummary& last = pulsatile.last_cycle();
+
+    // A run is complete only when its numbers say so.
+    std::string failure;
+    if (status == RunStatus::complete || status == RunStatus::not_periodic) {
+      const double prescribed = net.inlet->waveform.mean_flow();
+      if (!(std::abs(last.conservation_error) < conservation_tolerance))
+        failure = "the scheme lost mass: (in - out - stored) / in = " + format_rounded(last.conservation_error) +
+                  " over the last cycle, above " + format_rounded(conservation_tolerance);
+      else if (!(std::abs(last.inlet_mean_flow - prescribed) <= 1e-2 * std::abs(prescribed)))
+        failure = "the inlet's mean flow over the last cycle is " + format_quantity(last.inlet_mean_flow, "ml/min") +
+                  " where the waveform prescribes " + format_quantity(prescribed, "ml/min") +
+                  ": the time step cannot follow the pulse";
+    }
+
     nlohmann::json run_info = {{"tool", "hemosolve"}, {"version", HEMOTREE_VERSION},
                                {"network", input},
                                {"degree", options.degree == SolverOptions::automatic ? nlohmann::json("auto")
@@ -184,81 +344,72 @@ int main(int argc, char** argv) {
                                {"elements_per_vessel", options.elements}, {"scheme", scheme},
                                {"threads", options.threads},
                                {"rheology", to_string(run.blood().rheology)},
-                               {"start", start}, {"balance_compliances", balance}, {"period", period},
-                               {"pulse_frequency", pulse_frequency(pulse)}, {"analysis_frequency", frequency},
-                               {"time_step", dt},
-                               {"time_step_limit", dt_reason}};
+                               {"start", steady_start ? "steady" : "rest"},
+                               {"start_requested", start},
+                               {"balance_compliances", balance && steady_start},
+                               {"period", period},
+                               {"pulse_frequency", pulse_frequency(net.inlet->waveform)},
+                               {"analysis_frequency", analysis_frequency(net.inlet->waveform)},
+                               {"time_step", dt}, {"time_step_limit", dt_reason},
+                               {"steps_per_cycle", steps_per_cycle},
+                               {"status", failure.empty() ? to_string(status) : "failed"},
+                               {"cycles", pulsatile.cycles_done()},
+                               {"steps", static_cast<std::uint64_t>(pulsatile.cycles_done()) * steps_per_cycle},
+                               {"compliance_balances", pulsatile.compliance_balances()},
+                               {"wall_time", wall}};
+    if (!steady_start && options.steady_start) run_info["steady_refusal"] = run.steady_refusal();
     for (const auto& [p, count] : degrees) run_info["elements_of_degree"][std::to_string(p)] = count;
-    try {
-      probes.sample(run);
-      if (balance) run.balance_compliances(period);
-      for (; done < planned; ++done) {
-        // Every cycle could be the last (--until-periodic): its frames replace the previous ones.
-        std::optional<VtkTimeSeries> series;
-        if (frames > 0) series.emplace(net, dir / "frames", "frames");
-        std::size_t frames_written = 0;
-        double sampled_until = run.time();
-        for (std::size_t k = 0; k < steps_per_cycle; ++k) {
-          run.step();
-          if ((k + 1) % stats_every == 0 || k + 1 == steps_per_cycle) {
-            stats.sample(run, run.time(), run.time() - sampled_until);
-            sampled_until = run.time();
-          }
-          if (series && (k + 1) * static_cast<std::size_t>(frames) >= (frames_written + 1) * steps_per_cycle) {
-            add_solution_frame(*series, run);
-            ++frames_written;
-          }
-          if (run.steps() % sample_every == 0) probes.sample(run);
-          if (show && k % 256 == 0) {
-            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-            const double rate = static_cast<double>(run.steps()) / std::max(elapsed, 1e-9);
-            const double left = static_cast<double>(planned * steps_per_cycle - run.steps()) / rate;
-            std::fprintf(stderr, "\rhemosolve: cycle %d/%d  t = %.4f s  %.0f steps/s  %.0f s left   ",
-                         done + 1, planned, run.time(), rate, left);
-          }
-        }
-        run.check_solution();
-        previous = std::move(last);
-        last = stats.close();
-        if (series) series->finish();
-        if (balance && run.balance_compliances(period) > 0) ++balances;
-        if (!previous.vessels.empty()) change = cycle_change(previous.vessels, last.vessels);
-        if (until_periodic && !previous.vessels.empty() && change.change < periodic_tol) {
-          ++done;
-          break;
-        }
-      }
-    } catch (const SolutionBreakdown& e) {
-      if (show) std::fprintf(stderr, "\r\033[K");
-      run_info["status"] = "broken down";
-      run_info["error"] = e.what();
-      run_info["cycles"] = done;
-      probes.write(dir / "probes.csv");
-      if (!last.vessels.empty()) report(run_info);
-      throw InputError(e.what());
+    if (pulsatile.has_change()) {
+      run_info["periodic_change"] = pulsatile.change().change;
+      run_info["slowest_vessel"] = net.id[pulsatile.change().vessel];
     }
-    if (show) std::fprintf(stderr, "\r\033[K");
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    run_info["status"] = until_periodic && !(change.change < periodic_tol) ? "not periodic" : "complete";
-    run_info["cycles"] = done;
-    run_info["steps"] = run.steps();
-    run_info["compliance_balances"] = balances;
-    run_info["wall_time"] = wall;
-    if (!previous.vessels.empty()) {
-      run_info["periodic_change"] = change.change;
-      run_info["slowest_vessel"] = net.id[change.vessel];
+    if (!failure.empty()) run_info["error"] = failure;
+    if (status == RunStatus::broken_down) run_info["error"] = pulsatile.breakdown();
+    if (status == RunStatus::interrupted)
+      run_info["error"] = std::string("interrupted by ") + InterruptRequests::name(pulsatile.signal()) +
+                          "; resume with --resume " + out_dir;
+
+    // Nothing computed, nothing kept: DIR stays as it was.
+    if (status == RunStatus::broken_down && last.vessels.empty()) {
+      folder.discard();
+      throw InputError(pulsatile.breakdown());
     }
-    probes.write(dir / "probes.csv");
-    report(run_info);
+    const std::filesystem::path dir = folder.staging();
+    if (status == RunStatus::interrupted || checkpoint_every > 0) pulsatile.write_checkpoint();
+    pulsatile.probes().write(dir / "probes.csv");
+    const nlohmann::json results =
+        last.vessels.empty() ? nlohmann::json::array() : vessel_results(net, run, last, analysis_frequency(net.inlet->waveform));
+    write_summary(dir / "summary.json", run_info, results, last);
+    if (vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results);
+    folder.publish();
+
+    if (status == RunStatus::interrupted) {
+      warn(std::string("interrupted by ") + InterruptRequests::name(pulsatile.signal()) + " after " +
+           std::to_string(pulsatile.cycles_done()) + " cycles: " + out_dir +
+           (pulsatile.cycles_done() > 0 ? " holds the results of the last whole cycle and its checkpoint"
+                                        : " holds the checkpoint of the start (no cycle was completed)") +
+           "; --resume " + out_dir + " continues");
+      return InterruptRequests::exit_status(pulsatile.signal());
+    }
+    if (status == RunStatus::broken_down) throw InputError(pulsatile.breakdown());
+    if (!failure.empty()) throw InputError("the results are wrong and marked failed in summary.json: " + failure);
     if (!quiet) {
       std::ostringstream m;
-      m << done << " cycles in " << wall << " s";
-      if (!previous.vessels.empty())
-        m << "; last cycle-to-cycle change " << change.change << " (vessel " << net.id[change.vessel] << ")";
+      m << pulsatile.cycles_done() << " cycles in " << describe_duration(wall);
+      if (pulsatile.has_change())
+        m << "; last cycle-to-cycle change " << format_rounded(pulsatile.change().change) << " (vessel "
+          << net.id[pulsatile.change().vessel] << ")";
       m << "; results in " << out_dir;
       note(m.str());
     }
-    if (until_periodic && !(change.change < periodic_tol))
+    double low = INFINITY, high = -INFINITY;
+    std::size_t highest = 0;
+    for (std::size_t v = 0; v < last.vessels.size(); ++v) {
+      low = std::min(low, last.vessels[v].mean_pressure);
+      if (last.vessels[v].mean_pressure > high) high = last.vessels[(highest = v)].mean_pressure;
+    }
+    warn_unphysiological(low, high, net.id[highest], net, "mean pressures");
+    if (status == RunStatus::not_periodic)
       warn("not periodic within " + std::to_string(max_cycles) + " cycles (--max-cycles)");
     return 0;
   });

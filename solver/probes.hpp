@@ -28,6 +28,9 @@ class ProbeRecorder {
   void sample(const PulseSolver& solver);  // one row at the solver's time
   // probes.csv: a header with units, then one row per sample; nothing without probes.
   void write(const std::filesystem::path& file) const;
+  // The rows recorded so far, as text (a checkpoint keeps them).
+  std::string rows() const { return rows_.str(); }
+  void restore_rows(const std::string& rows) { rows_.str(rows); rows_.seekp(0, std::ios::end); }
 
  private:
   std::vector<Probe> probes_;

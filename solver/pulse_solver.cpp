@@ -23,12 +23,14 @@ void PulseState::set_zero_like(const PulseState& other) {
   area.setZero(other.area.rows(), other.area.cols());
   flow.setZero(other.flow.rows(), other.flow.cols());
   capacitor.setZero(other.capacitor.size());
+  exchanged.setZero();
 }
 
 void PulseState::add_scaled(double factor, const PulseState& other) {
   area += factor * other.area;
   flow += factor * other.flow;
   capacitor += factor * other.capacitor;
+  exchanged += factor * other.exchanged;
 }
 
 namespace {
@@ -79,8 +81,18 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     try {
       steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet->waveform.mean_flow(),
                                            &steady_resistance_);
-    } catch (const InputError&) {
+    } catch (const InputError& e) {
+      steady_refusal_ = e.what();
     }
+  }
+  if (steady) {
+    const auto [low, high] = std::minmax_element(steady->node_pressure.begin(), steady->node_pressure.end());
+    steady_pressure_min_ = *low;
+    steady_pressure_max_ = *high;
+    const auto node = high - steady->node_pressure.begin();  // the inlet's node, as a rule
+    const auto entering = std::find(net.to.begin(), net.to.end(), node), leaving = std::find(net.from.begin(), net.from.end(), node);
+    steady_pressure_max_vessel_ = static_cast<std::size_t>(
+        entering != net.to.end() ? entering - net.to.begin() : leaving - net.from.begin());
   }
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
   boundaries_ = build_boundaries(net, first_element_, elements_per_vessel_);
@@ -97,9 +109,12 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   flux_q_.resize(rows, points);
   source_q_.resize(rows, points);
 
-  if (options.steady_start && steady) start_from_steady_flow(*steady);
+  started_from_steady_ = options.steady_start && steady;
+  if (started_from_steady_) start_from_steady_flow(*steady);
   else start_at_rest();
   choose_time_step(options);
+  stable_dt_ = dt_;
+  stable_dt_reason_ = dt_reason_;
   if (options.dt > 0) {
     dt_ = options.dt;
     dt_reason_ = "given by --dt";
@@ -302,6 +317,7 @@ void PulseSolver::step_exponential() {
     }
   state_.area += h * (1.5 * rate_.area - 0.5 * previous_rate_.area);
   state_.capacitor += h * (1.5 * rate_.capacitor - 0.5 * previous_rate_.capacitor);
+  state_.exchanged += h * (1.5 * rate_.exchanged - 0.5 * previous_rate_.exchanged);
   std::swap(previous_rate_, rate_);
 }
 
@@ -488,6 +504,15 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     }
     set_end_flux(o.end, u);
   }
+  // The volume fluxes the boundaries exchange, summed in a fixed order (the same bits
+  // whatever the threads); an end's flow is positive along the vessel.
+  auto leaving = [&](const VesselEnd& end) {
+    const double q = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)].flow;
+    return end.distal ? q : -q;
+  };
+  rate.exchanged(0) = -leaving(boundaries_.inlet);
+  rate.exchanged(1) = 0;
+  for (const auto& o : boundaries_.outlets) rate.exchanged(1) += leaving(o.end);
   // Junctions are independent: each writes only its own ends' fluxes.
   const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
   std::int64_t failed_junction = -1;
@@ -615,6 +640,12 @@ double PulseSolver::mean_flow(std::size_t vessel) const {
   return sum / elements_per_vessel_;
 }
 
+double PulseSolver::network_volume() const {
+  double volume = 0;
+  for (const double v : vessel_volumes()) volume += v;
+  return volume;
+}
+
 std::vector<double> PulseSolver::vessel_volumes() const {
   std::vector<double> volume(net_.vessel_count(), 0.0);
   for (std::size_t v = 0; v < volume.size(); ++v)
@@ -700,6 +731,81 @@ void PulseSolver::check_solution() const {
   for (Eigen::Index el = 0; el < state_.area.rows(); ++el)
     if (!(state_.area(el, 0) > 0) || !state_.area.row(el).allFinite() || !state_.flow.row(el).allFinite())
       throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], time_);
+}
+
+}  // namespace hemotree
+
+namespace hemotree {
+
+void PulseSolver::save(CheckpointWriter& out) const {
+  out.section("pulse solver");
+  out.put(time_);
+  out.put(dt_);
+  out.put(static_cast<std::uint64_t>(steps_));
+  out.put(have_previous_rate_);
+  for (const PulseState* s : {&state_, &previous_rate_}) {
+    out.put(s->area);
+    out.put(s->flow);
+    out.put(s->capacitor);
+    out.put(s->exchanged(0));
+    out.put(s->exchanged(1));
+  }
+  out.put(previous_flow_);
+  out.put(cycle_volume_);
+  out.put(cycle_capacitor_);
+  // The junctions' Newton iterations start from the last end states.
+  std::vector<double> ends;
+  ends.reserve(2 * boundaries_.end_state.size());
+  for (const EndState& e : boundaries_.end_state) {
+    ends.push_back(e.area);
+    ends.push_back(e.flow);
+  }
+  out.put(ends);
+  std::vector<double> rest;
+  for (const auto& o : boundaries_.outlets) {
+    rest.push_back(o.rest_area);
+    rest.push_back(o.rest_flow);
+  }
+  out.put(rest);
+}
+
+void PulseSolver::restore(CheckpointReader& in) {
+  in.section("pulse solver");
+  time_ = in.get_double();
+  const double dt = in.get_double();
+  if (dt != dt_)
+    in.fail("time step " + std::to_string(dt) + " s in the checkpoint, " + std::to_string(dt_) +
+            " s in this run: the checkpoint belongs to other options or another network");
+  steps_ = static_cast<std::size_t>(in.get_u64());
+  have_previous_rate_ = in.get_bool();
+  in.get_into(state_.area, "areas");
+  in.get_into(state_.flow, "flows");
+  in.get_into(state_.capacitor, "capacitors");
+  state_.exchanged(0) = in.get_double();
+  state_.exchanged(1) = in.get_double();
+  // The multistep history: empty until a multistep scheme has taken a step.
+  previous_rate_.area = in.get_matrix();
+  previous_rate_.flow = in.get_matrix();
+  previous_rate_.capacitor = in.get_eigen_vector();
+  previous_rate_.exchanged(0) = in.get_double();
+  previous_rate_.exchanged(1) = in.get_double();
+  if (previous_rate_.area.size() != 0 &&
+      (previous_rate_.area.rows() != state_.area.rows() || previous_rate_.area.cols() != state_.area.cols() ||
+       previous_rate_.flow.rows() != state_.flow.rows() || previous_rate_.capacitor.size() != state_.capacitor.size()))
+    in.fail("multistep history of another discretisation");
+  previous_flow_ = in.get_matrix();
+  cycle_volume_ = in.get_vector();
+  cycle_capacitor_ = in.get_eigen_vector();
+  const std::vector<double> ends = in.get_vector();
+  if (ends.size() != 2 * boundaries_.end_state.size()) in.fail("vessel ends of another network");
+  for (std::size_t k = 0; k < boundaries_.end_state.size(); ++k)
+    boundaries_.end_state[k] = {ends[2 * k], ends[2 * k + 1]};
+  const std::vector<double> rest = in.get_vector();
+  if (rest.size() != 2 * boundaries_.outlets.size()) in.fail("outlets of another network");
+  for (std::size_t k = 0; k < boundaries_.outlets.size(); ++k) {
+    boundaries_.outlets[k].rest_area = rest[2 * k];
+    boundaries_.outlets[k].rest_flow = rest[2 * k + 1];
+  }
 }
 
 }  // namespace hemotree

@@ -6,6 +6,7 @@
 // of the right-hand side acts on all of them at once.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "solver/degree_choice.hpp"
 #include "solver/legendre_basis.hpp"
 #include "solver/network_boundaries.hpp"
+#include "solver/checkpoint.hpp"
 #include "solver/steady_flow.hpp"
 #include "solver/time_scheme.hpp"
 #include "solver/vessel_equations.hpp"
@@ -42,11 +44,14 @@ struct SolverOptions {
   int threads = 1;
 };
 
-// The discrete state: modal coefficients of A and Q per element, and the pressures of the
-// RCR outlets' capacitors.
+// The discrete state: modal coefficients of A and Q per element, the pressures of the RCR
+// outlets' capacitors, and the volumes the network has exchanged through its boundaries,
+// integrated by the same scheme as the areas, so that in - out - (change in the vessels'
+// volume) is the scheme's own mass balance (round-off and the junctions' Newton tolerance).
 struct PulseState {
   Eigen::MatrixXd area, flow;  // elements x modes
   Eigen::VectorXd capacitor;   // one per RCR outlet [Pa]
+  Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();  // in at the inlet, out at the outlets [m^3]
 
   void set_zero_like(const PulseState& other);
   void add_scaled(double factor, const PulseState& other);  // this += factor * other
@@ -62,6 +67,10 @@ class PulseSolver {
   // Replaces the chosen step (e.g. by one that divides the period); the reason stays.
   void set_time_step(double dt) { dt_ = dt; }
   const std::string& dt_reason() const { return dt_reason_; }
+  // The largest stable step of the scheme (at --cfl 1 would be the limit itself; this is
+  // cfl times it), whatever --dt asked for, and what sets it.
+  double stable_dt() const { return stable_dt_; }
+  const std::string& stable_dt_reason() const { return stable_dt_reason_; }
   std::size_t steps() const { return steps_; }
 
   // The solution at fraction x in [0, 1] along a vessel (index).
@@ -84,6 +93,24 @@ class PulseSolver {
   const PulseState& state() const { return state_; }
   // Throws SolutionBreakdown when A <= 0 or a value is not finite.
   void check_solution() const;
+
+  // Whether the run started from the steady solution; if it was asked to and could not,
+  // why (the steady solver's message).
+  bool started_from_steady() const { return started_from_steady_; }
+  const std::string& steady_refusal() const { return steady_refusal_; }
+  // Lowest and highest steady node pressure [Pa] (NaN without a steady solution), and the
+  // index of the vessel entering the node of the highest.
+  double steady_pressure_min() const { return steady_pressure_min_; }
+  double steady_pressure_max() const { return steady_pressure_max_; }
+  std::size_t steady_pressure_max_vessel() const { return steady_pressure_max_vessel_; }
+  // Blood volume in all vessels now [m^3] (mode 0 of the areas).
+  double network_volume() const;
+
+  // The whole evolving state (solution, multistep history, junction guesses, compliance
+  // balance marks, time), written and read back bit for bit: a run resumed from it goes on
+  // exactly as the uninterrupted run would. The rest is rebuilt from the network and options.
+  void save(CheckpointWriter& out) const;
+  void restore(CheckpointReader& in);
 
   // To be called at the start of the run and at the end of each cycle (of length period).
   // The slowest part of the approach to the periodic state is the filling of the network's
@@ -147,7 +174,14 @@ class PulseSolver {
   int threads_ = 1;
   double time_ = 0, dt_ = 0;
   std::string dt_reason_;
+  double stable_dt_ = 0;
+  std::string stable_dt_reason_;
   std::size_t steps_ = 0;
+  bool started_from_steady_ = false;
+  std::string steady_refusal_;
+  double steady_pressure_min_ = std::numeric_limits<double>::quiet_NaN();
+  double steady_pressure_max_ = std::numeric_limits<double>::quiet_NaN();
+  std::size_t steady_pressure_max_vessel_ = 0;
 
   // Scratch, sized once: values at quadrature points and traces.
   Eigen::MatrixXd area_q_, flow_q_, flux_q_, source_q_;

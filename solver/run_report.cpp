@@ -69,11 +69,15 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
   summary["inlet_mean_flow"] = cycle.inlet_mean_flow;
   summary["outlets_mean_flow"] = cycle.outlets_mean_flow;
   summary["mass_balance"] = (cycle.inlet_mean_flow - cycle.outlets_mean_flow) / cycle.inlet_mean_flow;
+  summary["volume_change"] = cycle.volume_change;
+  summary["conservation_error"] = cycle.conservation_error;
   summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}, {"wss", "Pa"},
                       {"speed", "m/s"}, {"frequency", "Hz"}};
   summary["vessels"] = vessels;
   OutputStream out(file.string());
-  out << summary.dump(1) << '\n';
+  // Strings from outside (a file name that is not UTF-8) must not stop the report: such bytes
+  // are written as U+FFFD.
+  out << summary.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   out.commit();
 }
 

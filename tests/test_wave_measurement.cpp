@@ -26,16 +26,14 @@ CycleSummary run_cycles(const Network& net, const SolverOptions& options, int cy
   const double period = net.inlet->waveform.period;
   const auto steps = static_cast<std::size_t>(std::ceil(period / solver.dt()));
   solver.set_time_step(period / static_cast<double>(steps));
-  std::vector<std::size_t> outlets;
-  for (const Outlet& o : net.outlets) outlets.push_back(static_cast<std::size_t>(o.vessel));
-  CycleStatistics stats(net, frequency, 0, outlets);
+  CycleStatistics stats(net, frequency);
   CycleSummary last;
   for (int c = 0; c < cycles; ++c) {
     for (std::size_t k = 0; k < steps; ++k) {
       solver.step();
       stats.sample(solver, solver.time(), solver.dt());
     }
-    last = stats.close();
+    last = stats.close(solver);
   }
   return last;
 }

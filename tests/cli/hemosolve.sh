@@ -163,12 +163,12 @@ refuse() {
 }
 out() { echo "$WORK/refused-$refusal"; }
 
-refuse "no inlet" 2 "no inlet" -- "$HEMOSOLVE" "$WORK/no-inlet.json" --out "$(out)" --probe 1
+refuse "no inlet" 2 "has no \"inlet\"" -- "$HEMOSOLVE" "$WORK/no-inlet.json" --out "$(out)" --probe 1
 refuse "terminal vessel without outlet" 2 "vessel 3 is terminal but has no outlet" -- \
   "$HEMOSOLVE" "$WORK/no-outlet.json" --out "$(out)"
-refuse "zero length (reader)" 2 "vessel 1: length must be positive" -- \
+refuse "zero length (reader)" 2 'vessel 1: "length" must lie in' -- \
   "$HEMOSOLVE" "$WORK/zero-length.json" --out "$(out)"
-refuse "negative length (reader)" 2 "vessel 1: length must be positive" -- \
+refuse "negative length (reader)" 2 'vessel 1: "length" must lie in' -- \
   "$HEMOSOLVE" "$WORK/negative-length.json" --out "$(out)"
 refuse "no wall and no beta" 2 "vessel 1" -- "$HEMOSOLVE" "$WORK/no-wall.json" --out "$(out)"
 refuse "--probe of an unknown vessel" 2 "--probe: no vessel 7" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 7
@@ -176,17 +176,20 @@ refuse "--probe x beyond the vessel" 2 "x must lie in [0, 1]" -- "$HEMOSOLVE" "$
 refuse "--probe not ID:x" 2 "is not ID or ID:x" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe abc
 refuse "--probe with a bad x" 2 "is not ID or ID:x" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 1:x
 # --cycles 0 once ran one cycle silently; it is bad input.
-refuse "--cycles 0" 2 "--cycles must be at least 1" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --cycles 0
-refuse "--linear-error negative" 2 "--linear-error must be zero or positive" -- \
+refuse "--cycles 0" 2 "--cycles must lie in [1, 100000] (got 0)" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --cycles 0
+refuse "--linear-error negative" 2 "--linear-error must lie in [0, 1] (got -1)" -- \
   "$HEMOSOLVE" "$CCA" --out "$(out)" --linear-error -1
 refuse "missing network file" 1 "cannot open" -- "$HEMOSOLVE" "$WORK/missing.json" --out "$(out)"
 refuse "empty standard input" 2 "standard input" -- \
   bash -c '"$0" - --out "$1" </dev/null' "$HEMOSOLVE" "$(out)"
-refuse "no inlet through standard input" 2 "no inlet" -- \
+refuse "no inlet through standard input" 2 "has no \"inlet\"" -- \
   bash -c '"$0" - --out "$1" <"$2"' "$HEMOSOLVE" "$(out)" "$WORK/no-inlet.json"
-# A run that breaks down in its first cycle: one line naming the vessel, no summary.
-refuse "breakdown (time step far too long)" 2 "broke down in vessel 1" -- \
+# A step far above the stability limit is refused, naming the limit and what sets it.
+refuse "--dt above the stability limit" 2 "times the stability limit" -- \
   "$HEMOSOLVE" "$CCA" --out "$(out)" --dt 20ms --quiet
+# Forced, it breaks down in its first cycle: one line naming the vessel, no summary.
+refuse "breakdown (time step far too long, forced)" 2 "broke down in vessel 1" -- \
+  "$HEMOSOLVE" "$CCA" --out "$(out)" --dt 20ms --force --quiet
 # A failed upstream stage: hemosolve refuses the empty pipe on its own line.
 "$VPRUNE" --budget 0 "$WORK/net.json" 2>/dev/null | "$HEMOSOLVE" - --out "$WORK/after-vprune" 2>"$WORK/err"
 status=("${PIPESTATUS[@]}")

@@ -1,0 +1,182 @@
+#include "solver/pulsatile_run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "cli/tool.hpp"
+#include "formats/vtk_series.hpp"
+#include "solver/run_report.hpp"
+#include "solver/solution_breakdown.hpp"
+
+namespace hemotree {
+
+const char* to_string(RunStatus status) {
+  switch (status) {
+    case RunStatus::complete: return "complete";
+    case RunStatus::not_periodic: return "not periodic";
+    case RunStatus::interrupted: return "interrupted";
+    case RunStatus::broken_down: return "broken down";
+  }
+  return "unknown";
+}
+
+namespace {
+double seconds_since_epoch_start() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// A cycle's summary as numbers, for the checkpoint.
+constexpr std::size_t vessel_fields = 10;
+void put_summary(CheckpointWriter& out, const CycleSummary& c) {
+  std::vector<double> values{c.inlet_mean_flow, c.outlets_mean_flow, c.volume_change, c.conservation_error};
+  for (const VesselCycle& v : c.vessels)
+    values.insert(values.end(), {v.mean_flow, v.mean_pressure, v.systolic_pressure, v.diastolic_pressure,
+                                 v.peak_flow, v.least_flow, v.mean_wss, v.reynolds, v.pwv_pressure, v.pwv_velocity});
+  out.put(values);
+}
+
+CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
+  const std::vector<double> values = in.get_vector();
+  CycleSummary c;
+  if (values.size() != 4 && values.size() != 4 + vessel_fields * vessels) in.fail("cycle results of another network");
+  c.inlet_mean_flow = values[0];
+  c.outlets_mean_flow = values[1];
+  c.volume_change = values[2];
+  c.conservation_error = values[3];
+  for (std::size_t k = 4; k < values.size(); k += vessel_fields) {
+    const double* f = &values[k];
+    c.vessels.push_back({f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], f[9]});
+  }
+  return c;
+}
+}  // namespace
+
+PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<Probe> probes, RunPlan plan,
+                           std::filesystem::path folder)
+    : net_(net), solver_(solver), plan_(std::move(plan)), folder_(std::move(folder)),
+      stats_(net, analysis_frequency(net.inlet->waveform)), probes_(std::move(probes)) {}
+
+void PulsatileRun::snapshot() {
+  CheckpointWriter out;
+  out.section("run");
+  out.put(plan_.fingerprint);
+  out.put(plan_.options);
+  out.put(static_cast<std::uint64_t>(done_));
+  out.put(static_cast<std::uint64_t>(balances_));
+  put_summary(out, last_);
+  put_summary(out, previous_);
+  out.put(change_.change);
+  out.put(static_cast<std::uint64_t>(change_.vessel));
+  out.put(probes_.rows());
+  solver_.save(out);
+  out.section("end");
+  snapshot_ = std::move(out);
+}
+
+void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
+  CheckpointReader in(bytes, source);
+  in.section("run");
+  if (in.get_u64() != plan_.fingerprint) in.fail("written for another network (its fingerprint differs)");
+  const std::string options = in.get_string();
+  if (options != plan_.options)
+    in.fail("written by a run with other options (there: " + options + "; here: " + plan_.options + ")");
+  done_ = static_cast<int>(in.get_u64());
+  balances_ = static_cast<int>(in.get_u64());
+  last_ = get_summary(in, net_.vessel_count());
+  previous_ = get_summary(in, net_.vessel_count());
+  change_.change = in.get_double();
+  change_.vessel = static_cast<std::size_t>(in.get_u64());
+  probes_.restore_rows(in.get_string());
+  solver_.restore(in);
+  in.section("end");
+  if (!in.at_end()) in.fail("unexpected bytes after the checkpoint");
+  resumed_ = true;
+}
+
+void PulsatileRun::write_checkpoint() const { write_checkpoint_file(folder_ / "checkpoint.bin", snapshot_); }
+
+void PulsatileRun::progress(std::size_t k, double started) {
+  const double elapsed = seconds_since_epoch_start() - started;
+  const int planned = plan_.until_periodic ? plan_.max_cycles : plan_.cycles;
+  const double rate = static_cast<double>(k + 1) / std::max(elapsed, 1e-9);
+  const double left = static_cast<double>(plan_.steps_per_cycle - k - 1) / rate;
+  std::fprintf(stderr, "\rhemosolve: cycle %d/%d  t = %.4f s  %.0f steps/s  %.0f s left in this cycle   ", done_ + 1,
+               planned, solver_.time(), rate, left);
+}
+
+RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
+  const double period = net_.inlet->waveform.period;
+  const int planned = plan_.until_periodic ? plan_.max_cycles : plan_.cycles;
+  // Statistics every 1e-4 of a period (or every step if that is longer): means and extrema
+  // of the smooth pulse are then exact to ~1e-7, at a few per cent of the run's time.
+  const auto stats_every = std::max<std::size_t>(
+      1, static_cast<std::size_t>(1e-4 * static_cast<double>(plan_.steps_per_cycle)));
+  if (!resumed_) {
+    probes_.sample(solver_);
+    if (plan_.balance_compliances) solver_.balance_compliances(period);
+    snapshot();
+  }
+  auto periodic = [&] { return plan_.until_periodic && has_change() && change_.change < plan_.periodic_tolerance; };
+  try {
+    while (done_ < planned && !periodic()) {
+      std::optional<VtkTimeSeries> series;  // each cycle could be the last: its frames replace the previous
+      if (plan_.frames > 0) series.emplace(net_, folder_ / "frames", "frames");
+      std::size_t frames_written = 0;
+      stats_.begin(solver_);
+      double sampled_until = solver_.time();
+      const double started = seconds_since_epoch_start();
+      for (std::size_t k = 0; k < plan_.steps_per_cycle; ++k) {
+        solver_.step();
+        if ((k + 1) % stats_every == 0 || k + 1 == plan_.steps_per_cycle) {
+          stats_.sample(solver_, solver_.time(), solver_.time() - sampled_until);
+          sampled_until = solver_.time();
+        }
+        if (series && (k + 1) * static_cast<std::size_t>(plan_.frames) >= (frames_written + 1) * plan_.steps_per_cycle) {
+          add_solution_frame(*series, solver_);
+          ++frames_written;
+        }
+        if (solver_.steps() % plan_.sample_every == 0) probes_.sample(solver_);
+        if (k % 256 == 0) {
+          if ((signal_ = interrupts.poll()) != 0) {
+            // Back to the last cycle end: what the summary and the checkpoint describe.
+            if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
+            return RunStatus::interrupted;
+          }
+          if (plan_.live_progress) progress(k, started);
+        }
+      }
+      solver_.check_solution();
+      previous_ = std::move(last_);
+      last_ = stats_.close(solver_);
+      if (series) series->finish();
+      if (plan_.balance_compliances && solver_.balance_compliances(period) > 0) ++balances_;
+      if (has_change()) change_ = cycle_change(previous_.vessels, last_.vessels);
+      ++done_;
+      snapshot();
+      if (plan_.checkpoint_every > 0 && done_ % plan_.checkpoint_every == 0) write_checkpoint();
+      if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
+      if (plan_.log_progress) {
+        const double wall = seconds_since_epoch_start() - started;
+        std::string line = "cycle " + std::to_string(done_) + "/" + std::to_string(planned) + " done in " +
+                           std::to_string(static_cast<long long>(std::lround(wall))) + " s";
+        if (has_change()) {
+          char text[64];
+          std::snprintf(text, sizeof text, "; change %.3g (vessel %lld)", change_.change,
+                        static_cast<long long>(net_.id[change_.vessel]));
+          line += text;
+        }
+        note(line);
+      }
+    }
+  } catch (const SolutionBreakdown& e) {
+    if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
+    breakdown_ = e.what();
+    return RunStatus::broken_down;
+  }
+  if (plan_.until_periodic && !periodic()) return RunStatus::not_periodic;
+  return RunStatus::complete;
+}
+
+}  // namespace hemotree

@@ -1,0 +1,79 @@
+// The time loop of a pulsatile run: cardiac cycles of the solver, their statistics, probes,
+// frames and compliance balances, until the planned cycles are done, the solution is
+// periodic, it breaks down or the user interrupts it. At every cycle end the loop keeps a
+// checkpoint of itself (solver and progress) in memory and, every --checkpoint-every
+// cycles, on disk: a run resumed from it continues bit for bit as if never stopped.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli/interrupt.hpp"
+#include "solver/checkpoint.hpp"
+#include "solver/cycle_statistics.hpp"
+#include "solver/probes.hpp"
+#include "solver/pulse_solver.hpp"
+
+namespace hemotree {
+
+struct RunPlan {
+  int cycles = 1;               // without until_periodic
+  bool until_periodic = false;  // stop when the cycle-to-cycle change < periodic_tolerance
+  double periodic_tolerance = 0;
+  int max_cycles = 50;          // with until_periodic
+  bool balance_compliances = true;
+  int frames = 0;               // of the last cycle, in folder/frames
+  std::size_t steps_per_cycle = 1;
+  std::size_t sample_every = 1;  // steps between probe samples
+  int checkpoint_every = 0;     // cycles; 0: only in memory (written on an interrupt)
+  std::uint64_t fingerprint = 0;  // of the network
+  std::string options;          // those options, for a clear refusal of another run's checkpoint
+  bool live_progress = false;   // a line that redraws itself (stderr is a terminal)
+  bool log_progress = false;    // a plain line per cycle (stderr is a log)
+};
+
+enum class RunStatus { complete, not_periodic, interrupted, broken_down };
+const char* to_string(RunStatus status);
+
+class PulsatileRun {
+ public:
+  PulsatileRun(const Network& net, PulseSolver& solver, std::vector<Probe> probes, RunPlan plan,
+               std::filesystem::path folder);
+
+  // Continues from a checkpoint instead of starting (InputError for one of another run).
+  void resume(const std::string& checkpoint_bytes, const std::string& source);
+  RunStatus run(InterruptRequests& interrupts);
+
+  int cycles_done() const { return done_; }
+  int compliance_balances() const { return balances_; }
+  const CycleSummary& last_cycle() const { return last_; }
+  bool has_change() const { return !previous_.vessels.empty(); }
+  const PeriodicityChange& change() const { return change_; }
+  int signal() const { return signal_; }                    // after an interrupt
+  const std::string& breakdown() const { return breakdown_; }  // after a breakdown
+  const ProbeRecorder& probes() const { return probes_; }
+  // Writes the checkpoint of the last cycle end to folder/checkpoint.bin.
+  void write_checkpoint() const;
+
+ private:
+  void snapshot();  // the checkpoint of this cycle end, in memory
+  void progress(std::size_t step_in_cycle, double started);
+
+  const Network& net_;
+  PulseSolver& solver_;
+  RunPlan plan_;
+  std::filesystem::path folder_;
+  CycleStatistics stats_;
+  ProbeRecorder probes_;
+  CycleSummary last_, previous_;
+  PeriodicityChange change_;
+  int done_ = 0, balances_ = 0, signal_ = 0;
+  bool resumed_ = false;
+  std::string breakdown_;
+  CheckpointWriter snapshot_;
+};
+
+}  // namespace hemotree

@@ -1,0 +1,45 @@
+#include "solver/run_estimate.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace hemotree {
+
+namespace {
+// Measured on the reference machine (bench/README.md): the 5301-vessel network (2516, 2639
+// and 146 elements of degree 1, 2 and 7) at 0.765 ms per step on one core; a one-vessel
+// network of degree 7 at 10 us per step, nearly all of it per-step overhead.
+constexpr double step_cost = 5e-6;     // [s per step]
+constexpr double fixed_cost = 100e-9;  // [s per element and step]
+constexpr double modal_cost = 6e-9;    // [s per element, step and (p + 1)^2]
+}  // namespace
+
+double element_step_seconds(int degree) {
+  // Fitted to steps of one degree everywhere (bench/README.md, "Cost model"): a fixed part
+  // per element (traces, Riemann problems, friction) and a part that grows with the modes
+  // times the quadrature points of the degree's products.
+  const double modes = degree + 1;
+  return fixed_cost + modal_cost * modes * modes;
+}
+
+RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads) {
+  double step = step_cost;
+  for (std::size_t p = 0; p < elements_of_degree.size(); ++p)
+    step += elements_of_degree[p] * element_step_seconds(static_cast<int>(p));
+  // Two threads gave 1.8 times one thread's speed from 5000 vessels up (bench/README.md).
+  const double speedup = threads > 1 ? 0.9 * threads : 1.0;
+  return {steps, steps * step / speedup};
+}
+
+std::string describe_duration(double seconds) {
+  char text[64];
+  if (!std::isfinite(seconds)) return "forever";
+  if (seconds < 120) std::snprintf(text, sizeof text, "%.3g s", seconds);
+  else if (seconds < 7200) std::snprintf(text, sizeof text, "%.3g min", seconds / 60);
+  else if (seconds < 2 * 86400) std::snprintf(text, sizeof text, "%.3g h", seconds / 3600);
+  else if (seconds < 2 * 365.25 * 86400) std::snprintf(text, sizeof text, "%.3g days", seconds / 86400);
+  else std::snprintf(text, sizeof text, "%.3g years", seconds / (365.25 * 86400));
+  return text;
+}
+
+}  // namespace hemotree

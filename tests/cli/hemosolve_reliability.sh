@@ -1,0 +1,154 @@
+# hemosolve as a hostile user or a killed job would find it (issue 11): values that give
+# nothing computed are refused before any work; a run is "complete" only when its numbers
+# say so; the output folder never mixes two runs; a run killed and resumed gives the same
+# bits as one never stopped. About 40 s.
+source "$(dirname "$0")/lib.sh"
+VPRUNE=$BUILD/pruner/vprune
+HEMOSOLVE=$BUILD/solver/hemosolve
+CCA=$(cd "$(dirname "$0")/../../examples/boileau2015" && pwd)/cca.json
+PY=/usr/bin/python3
+
+# Refused before any work: one line, status 2, and neither OUT nor OUT.partial created.
+n=0
+refused() {
+  local what=$1 fragment=$2
+  shift 2
+  local out=$WORK/refused-$n
+  expect_error "$what" 2 "$fragment" -- "$HEMOSOLVE" "$CCA" --out "$out" --quiet "$@"
+  if [ -e "$out" ] || [ -e "$out.partial" ]; then fail "$what: left $out or $out.partial"; fi
+  n=$((n + 1))
+}
+refused "--dt 1e-300" "no run can finish" --dt 1e-300
+refused "--cfl 1e-300" "no run can finish" --cfl 1e-300
+refused "--cfl inf" "--cfl must lie in (0, 1]" --cfl inf
+refused "--cfl nan" "--cfl must lie in (0, 1]" --cfl nan
+refused "--cfl above 1" "--cfl must lie in (0, 1]" --cfl 1.5
+refused "--dt above the stability limit" "times the stability limit" --dt 1s
+refused "--until-periodic -1" "--until-periodic must lie in (0, 1)" --until-periodic -1
+refused "--until-periodic nan" "--until-periodic must lie in (0, 1)" --until-periodic nan
+refused "--max-cycles 0" "--max-cycles must lie in [1, 100000]" --until-periodic 1e-3 --max-cycles 0
+refused "--max-cycles -3" "--max-cycles must lie in [1, 100000]" --until-periodic 1e-3 --max-cycles -3
+refused "--sample-interval -1ms" "--sample-interval" --sample-interval -1ms
+refused "--sample-interval 1e300" "--sample-interval: '1e300' lies outside" --sample-interval 1e300
+refused "--sample-interval beyond the period" "--sample-interval must lie in (0, 1.1] s" --sample-interval 2s
+refused "--threads 1000" "--threads must lie in [1, $(nproc)]" --threads 1000
+refused "--elements 100000" "--elements must lie in [1, 1000]" --elements 100000
+refused "--external-pressure 1e300Pa" "--external-pressure" --external-pressure 1e300Pa
+refused "--thick-wall-ratio 0" "--thick-wall-ratio must lie in (0, 10]" --thick-wall-ratio 0
+refused "--frames beyond the steps of a cycle" "exceeds the 5500 steps of a cycle" --frames 10000 --dt 0.2ms
+# 5e10 steps: the estimate (more than a day) is printed and the run refused unless forced.
+refused "a run of more than a day" "refused, more than a day" --cfl 1e-7
+expect_error "--resume without a checkpoint" 2 "no checkpoint.bin" -- "$HEMOSOLVE" "$CCA" --resume "$WORK/nothing"
+
+# Forced past the limit, the run is never reported complete.
+"$HEMOSOLVE" "$CCA" --out "$WORK/forced" --dt 0.5s --force --quiet 2>"$WORK/err"
+status=$?
+if [ "$status" -ne 0 ] && [ "$(wc -l <"$WORK/err")" -eq 1 ] \
+   && { [ ! -e "$WORK/forced/summary.json" ] || ! grep -q '"status": "complete"' "$WORK/forced/summary.json"; }; then
+  pass "--dt 0.5s --force: exit $status, not complete ($(cat "$WORK/err"))"
+else
+  fail "--dt 0.5s --force: exit $status: $(cat "$WORK/err")"
+fi
+
+# A file name that is not UTF-8 is reported, not an internal error after the run.
+odd=$WORK/$'\xff\xfe'.json
+cp "$CCA" "$odd"
+"$HEMOSOLVE" "$odd" --out "$WORK/odd-name" --quiet 2>"$WORK/err" \
+  && "$PY" -c 'import json,sys; s=json.load(open(sys.argv[1])); assert s["status"]=="complete"' "$WORK/odd-name/summary.json" \
+  && pass "non-UTF-8 file name: complete, summary readable" || fail "non-UTF-8 file name: $(cat "$WORK/err")"
+
+# No steady solution (a reflection outlet): said on stderr and recorded as it was.
+"$PY" - "$CCA" "$WORK/reflection.json" <<'PY'
+import json, sys
+net = json.load(open(sys.argv[1]))
+net["vessels"][0]["outlet"] = {"type": "reflection", "coefficient": 0.3}
+json.dump(net, open(sys.argv[2], "w"))
+PY
+"$HEMOSOLVE" "$WORK/reflection.json" --out "$WORK/reflection" --quiet 2>"$WORK/err"
+grep -q "no steady solution to start from" "$WORK/err" \
+  && "$PY" -c 'import json,sys; s=json.load(open(sys.argv[1])); assert s["start"]=="rest" and s["start_requested"]=="steady" and not s["balance_compliances"] and s["steady_refusal"], s["start"]' "$WORK/reflection/summary.json" \
+  && pass "no steady solution: warned, start recorded as rest" || fail "no steady solution: $(cat "$WORK/err")"
+
+# Pressures far outside the physiological range are warned about, with the likely cause.
+"$VGEN" --root-diameter 60um 2>/dev/null | "$VPRUNE" --budget 31 2>/dev/null >"$WORK/tiny.json"
+"$HEMOSOLVE" "$WORK/tiny.json" --out "$WORK/tiny" --quiet --degree 1 2>"$WORK/err"
+grep -q "outside a physiological 0 to 300 mmHg" "$WORK/err" && grep -q -- "--mean-flow" "$WORK/err" \
+  && pass "unphysiological pressures warned" || fail "unphysiological pressures: $(cat "$WORK/err")"
+
+# ---- interrupted runs: the benchmark's carotid, 30 cycles of 0.05 s or so each -------------
+ARGS=(--probe 1:0.5 --frames 3 --vtk --cycles 30)
+
+# The scheme's own mass balance, from the fluxes it exchanged, to round-off.
+"$HEMOSOLVE" "$CCA" "${ARGS[@]}" --out "$WORK/whole" --checkpoint-every 1 2>"$WORK/whole.err" \
+  || fail "uninterrupted run: $(cat "$WORK/whole.err")"
+grep -q "cycle 1/30 done" "$WORK/whole.err" && pass "a plain progress line per cycle in a log" \
+  || fail "no progress lines: $(cat "$WORK/whole.err")"
+"$PY" - "$WORK/whole/summary.json" <<'PY' && pass "mass balance from the exchanged fluxes" || fail "mass balance"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["status"] == "complete" and s["cycles"] == 30, s["status"]
+assert abs(s["conservation_error"]) < 1e-10, s["conservation_error"]
+# Over the cycle, in - out is what the vessel stored.
+stored = (s["inlet_mean_flow"] - s["outlets_mean_flow"]) * s["period"]
+assert abs(stored - s["volume_change"]) <= 1e-9 * s["inlet_mean_flow"] * s["period"], (stored, s["volume_change"])
+assert abs(s["mass_balance"] - (s["inlet_mean_flow"] - s["outlets_mean_flow"]) / s["inlet_mean_flow"]) < 1e-15
+# The inlet passes the prescribed waveform's mean.
+assert abs(s["inlet_mean_flow"] - 6.5e-6) < 1e-3 * 6.5e-6, s["inlet_mean_flow"]
+PY
+
+same_results() {  # summary.json without the wall time, probes.csv, results.vtp and frames, bit for bit
+  "$PY" - "$1" "$2" <<'PY'
+import json, sys, filecmp, os
+a, b = (json.load(open(os.path.join(d, "summary.json"))) for d in sys.argv[1:3])
+for s in (a, b):
+    s.pop("wall_time")
+assert a == b, [k for k in a if a.get(k) != b.get(k)]
+for f in ["probes.csv", "results.vtp"] + ["frames/" + f for f in sorted(os.listdir(os.path.join(sys.argv[1], "frames")))]:
+    assert filecmp.cmp(os.path.join(sys.argv[1], f), os.path.join(sys.argv[2], f), shallow=False), f
+PY
+}
+
+# Killed with SIGKILL after its first checkpoint: the folder keeps the previous complete
+# results, the partial one says it is partial, and --resume gives the uninterrupted bits.
+cp -r "$WORK/whole" "$WORK/killed"
+rm "$WORK/killed/checkpoint.bin"
+cp "$WORK/whole/summary.json" "$WORK/previous-summary.json"
+"$HEMOSOLVE" "$CCA" "${ARGS[@]}" --out "$WORK/killed" --checkpoint-every 1 --quiet 2>/dev/null & pid=$!
+for _ in $(seq 600); do [ -e "$WORK/killed.partial/checkpoint.bin" ] && break; sleep 0.02; done
+kill -9 $pid; wait $pid 2>/dev/null
+cmp -s "$WORK/killed/summary.json" "$WORK/previous-summary.json" && [ -e "$WORK/killed.partial/checkpoint.bin" ] \
+  && pass "kill -9: the previous results intact, the new run's checkpoint in killed.partial" \
+  || fail "kill -9 mixed the folder"
+"$HEMOSOLVE" "$CCA" "${ARGS[@]}" --resume "$WORK/killed" --checkpoint-every 1 2>"$WORK/err" \
+  && grep -q "resuming from .*killed.partial/checkpoint.bin after [1-9]" "$WORK/err" && [ ! -e "$WORK/killed.partial" ] \
+  && same_results "$WORK/whole" "$WORK/killed" \
+  && pass "kill -9 and --resume: bit-identical to the uninterrupted run" || fail "resume after kill -9: $(cat "$WORK/err")"
+
+# SIGTERM: a checkpoint and a summary marked interrupted, exit 143; resumed, the same bits.
+"$HEMOSOLVE" "$CCA" "${ARGS[@]}" --out "$WORK/term" 2>"$WORK/err" & pid=$!
+for _ in $(seq 600); do grep -q "cycle 2/30 done" "$WORK/err" && break; sleep 0.02; done
+kill -TERM $pid; wait $pid; status=$?
+"$PY" -c 'import json,sys; s=json.load(open(sys.argv[1])); assert s["status"]=="interrupted" and 2 <= s["cycles"] < 30, s["status"]' "$WORK/term/summary.json" \
+  && [ "$status" -eq 143 ] && [ -e "$WORK/term/checkpoint.bin" ] && grep -q "interrupted by SIGTERM" "$WORK/err" \
+  && pass "SIGTERM: checkpoint, summary interrupted, exit 143" || fail "SIGTERM: exit $status: $(cat "$WORK/err")"
+"$HEMOSOLVE" "$CCA" "${ARGS[@]}" --resume "$WORK/term" --quiet 2>"$WORK/err" && same_results "$WORK/whole" "$WORK/term" \
+  && pass "SIGTERM and --resume: bit-identical" || fail "resume after SIGTERM: $(cat "$WORK/err")"
+
+# A checkpoint of other options or another network is refused, naming what differs.
+expect_error "resume with another scheme" 2 "other options" -- \
+  "$HEMOSOLVE" "$CCA" "${ARGS[@]}" --scheme ab2 --resume "$WORK/whole" --quiet
+"$PY" - "$CCA" "$WORK/other.json" <<'PY'
+import json, sys
+net = json.load(open(sys.argv[1]))
+net["vessels"][0]["length"] *= 1.01
+json.dump(net, open(sys.argv[2], "w"))
+PY
+expect_error "resume with another network" 2 "another network" -- \
+  "$HEMOSOLVE" "$WORK/other.json" "${ARGS[@]}" --resume "$WORK/whole" --quiet
+
+# A folder that is not hemosolve's is never replaced.
+mkdir "$WORK/mine" && echo precious >"$WORK/mine/notes.txt"
+expect_error "--out a folder of other files" 2 "not a hemosolve results folder" -- \
+  "$HEMOSOLVE" "$CCA" --out "$WORK/mine" --quiet
+[ "$(cat "$WORK/mine/notes.txt")" = precious ] && pass "the user's folder untouched" || fail "the user's folder changed"
+finish

@@ -1,0 +1,178 @@
+// A checkpoint holds the solver's evolving state bit for bit: a solver restored from it goes
+// on exactly as the one that wrote it (every scheme, with RCR capacitors, after a compliance
+// balance), and a file that is not such a checkpoint is refused with a clear message.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "cli/errors.hpp"
+#include "network_builders.hpp"
+#include "solver/checkpoint.hpp"
+#include "solver/pulse_solver.hpp"
+
+namespace hemotree {
+namespace {
+
+using namespace test_networks;
+
+TEST(Checkpoint, ValuesComeBackBitForBit) {
+  CheckpointWriter out;
+  out.section("a");
+  out.put(0.1);
+  out.put(std::nextafter(1.0, 2.0));
+  out.put(std::uint64_t{18446744073709551615ull});
+  out.put(std::string("x\0y", 3));
+  out.put(std::vector<double>{1e-300, -0.0, 3});
+  Eigen::MatrixXd m(2, 3);
+  m << 1, 2, 3, 4, 5, std::nan("");
+  out.put(m);
+  CheckpointReader in(out.bytes(), "test");
+  in.section("a");
+  EXPECT_EQ(in.get_double(), 0.1);
+  EXPECT_EQ(in.get_double(), std::nextafter(1.0, 2.0));
+  EXPECT_EQ(in.get_u64(), 18446744073709551615ull);
+  EXPECT_EQ(in.get_string(), std::string("x\0y", 3));
+  const std::vector<double> v = in.get_vector();
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_TRUE(std::signbit(v[1]));
+  const Eigen::MatrixXd back = in.get_matrix();
+  EXPECT_EQ(back.rows(), 2);
+  EXPECT_EQ(back(1, 1), 5);
+  EXPECT_TRUE(std::isnan(back(1, 2)));
+  EXPECT_TRUE(in.at_end());
+}
+
+TEST(Checkpoint, RefusesWhatIsNotOne) {
+  EXPECT_THROW(CheckpointReader("{\"format\": \"vnet\"}", "net.json"), InputError);
+  CheckpointWriter out;
+  out.section("run");
+  out.put(std::vector<double>(100, 1.0));
+  // Truncated anywhere: a clear refusal, never a read past the end.
+  for (std::size_t cut : {std::size_t{25}, out.bytes().size() / 2, out.bytes().size() - 1}) {
+    try {
+      CheckpointReader in(out.bytes().substr(0, cut), "cut");
+      in.section("run");
+      in.get_vector();
+      FAIL() << "read a truncated checkpoint cut at " << cut;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("cut: "), std::string::npos) << e.what();
+    }
+  }
+  CheckpointReader other(out.bytes(), "other");
+  EXPECT_THROW(other.section("pulse solver"), InputError);
+}
+
+TEST(Checkpoint, FileIsReplacedWhole) {
+  const auto file = std::filesystem::temp_directory_path() / ("checkpoint-test-" + std::to_string(::getpid()));
+  CheckpointWriter a, b;
+  a.put(1.0);
+  b.put(2.0);
+  write_checkpoint_file(file, a);
+  write_checkpoint_file(file, b);
+  EXPECT_EQ(read_checkpoint_file(file), b.bytes());
+  EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp"));
+  std::filesystem::remove(file);
+}
+
+// A chain of three vessels fed by a pulse, ending in an RCR outlet.
+Network pulsed_chain() {
+  const double d = 3e-3, a = std::numbers::pi / 4 * d * d;
+  Network net = chain(3, 0.3, d, beta_for_wave_speed(5.0, a), 1e4, newtonian(4e-3));
+  auto inflow = [](double t) { return 5e-6 + 3e-6 * std::sin(2 * std::numbers::pi * t / 0.8); };
+  net.inlet = Inlet{0, tabulate(inflow, 0.8, 801, 0.8)};
+  Outlet o;
+  o.vessel = 2;
+  o.type = OutletType::rcr;
+  o.r1 = 2e8;
+  o.c = 2e-10;
+  o.r2 = 1.6e9;
+  o.p_out = 0;
+  net.outlets.push_back(o);
+  return net;
+}
+
+class ResumedSolver : public ::testing::TestWithParam<TimeScheme> {};
+
+TEST_P(ResumedSolver, GoesOnBitForBit) {
+  const Network net = pulsed_chain();
+  SolverOptions options;
+  options.degree = 3;
+  options.elements = 2;
+  options.scheme = GetParam();
+  PulseSolver first(net, options);
+  first.balance_compliances(0.8);
+  for (int k = 0; k < 300; ++k) first.step();
+  first.balance_compliances(0.8);  // a move: the multistep history restarts
+  for (int k = 0; k < 7; ++k) first.step();
+  CheckpointWriter out;
+  first.save(out);
+  for (int k = 0; k < 200; ++k) first.step();
+
+  PulseSolver second(net, options);
+  CheckpointReader in(out.bytes(), "memory");
+  second.restore(in);
+  EXPECT_TRUE(in.at_end());
+  for (int k = 0; k < 200; ++k) second.step();
+  EXPECT_EQ(second.time(), first.time());
+  EXPECT_EQ(second.steps(), first.steps());
+  EXPECT_TRUE((second.state().area.array() == first.state().area.array()).all());
+  EXPECT_TRUE((second.state().flow.array() == first.state().flow.array()).all());
+  EXPECT_TRUE((second.state().capacitor.array() == first.state().capacitor.array()).all());
+  EXPECT_EQ(second.state().exchanged, first.state().exchanged);
+}
+
+INSTANTIATE_TEST_SUITE_P(Schemes, ResumedSolver,
+                         ::testing::Values(TimeScheme::exponential_ab2, TimeScheme::adams_bashforth2,
+                                           TimeScheme::runge_kutta4));
+
+TEST(ResumedSolver, RefusesAnotherDiscretisation) {
+  const Network net = pulsed_chain();
+  SolverOptions options;
+  options.degree = 3;
+  PulseSolver writer(net, options);
+  CheckpointWriter out;
+  writer.save(out);
+  options.degree = 4;
+  options.dt = writer.dt();
+  PulseSolver reader(net, options);
+  CheckpointReader in(out.bytes(), "memory");
+  EXPECT_THROW(reader.restore(in), InputError);
+}
+
+// The volumes exchanged at the inlet and the outlets, integrated by the scheme itself,
+// balance the change of the volume in the vessels to round-off: the mass balance that
+// summary.json reports is the scheme's, not an interpolation of end values.
+class ExchangedVolumes : public ::testing::TestWithParam<TimeScheme> {};
+
+TEST_P(ExchangedVolumes, BalanceTheStoredVolume) {
+  const Network net = pulsed_chain();
+  SolverOptions options;
+  options.degree = 4;
+  options.elements = 3;
+  options.scheme = GetParam();
+  PulseSolver s(net, options);
+  const double start = s.network_volume();
+  double inflow = 0;
+  const Waveform& w = net.inlet->waveform;
+  const int steps = 2000;
+  for (int k = 0; k < steps; ++k) {
+    inflow += s.dt() * w(s.time() + 0.5 * s.dt());  // midpoint: the prescribed inflow, to O(dt^2)
+    s.step();
+  }
+  const Eigen::Vector2d exchanged = s.state().exchanged;
+  const double stored = s.network_volume() - start;
+  EXPECT_GT(exchanged(1), 0);
+  EXPECT_NEAR(exchanged(0) - exchanged(1), stored, 1e-12 * exchanged(0));
+  // The inlet passes the prescribed flow.
+  EXPECT_NEAR(exchanged(0), inflow, 1e-5 * inflow);
+}
+
+INSTANTIATE_TEST_SUITE_P(Schemes, ExchangedVolumes,
+                         ::testing::Values(TimeScheme::exponential_ab2, TimeScheme::adams_bashforth2,
+                                           TimeScheme::runge_kutta4));
+
+}  // namespace
+}  // namespace hemotree
