@@ -133,7 +133,10 @@ std::uint64_t parse_count(std::string_view text, std::string_view what, std::uin
   auto [stop, ec] = std::from_chars(text.data(), end, value);
   if (ec == std::errc::result_out_of_range) throw bad("is too large");
   if (ec != std::errc() || stop != end) throw bad("is not an integer");
-  if (value < min || value > max) throw bad("lies outside it");
+  if (value < min || value > max)
+    throw InputError(std::string(what) + ": '" + std::string(text) +
+                     "' lies outside the accepted range " + std::to_string(min) + ".." +
+                     std::to_string(max));
   return value;
 }
 
@@ -149,7 +152,10 @@ std::int64_t parse_integer(std::string_view text, std::string_view what, std::in
   auto [stop, ec] = std::from_chars(text.data(), end, value);
   if (ec == std::errc::result_out_of_range) throw bad("is too large");
   if (ec != std::errc() || stop != end) throw bad("is not an integer");
-  if (value < min || value > max) throw bad("lies outside it");
+  if (value < min || value > max)
+    throw InputError(std::string(what) + ": '" + std::string(text) +
+                     "' lies outside the accepted range " + std::to_string(min) + ".." +
+                     std::to_string(max));
   return value;
 }
 

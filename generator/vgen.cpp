@@ -54,8 +54,8 @@ int main(int argc, char** argv) {
   std::string seed_text = "1";
   bool print_rules = false, force = false;
   app.add_option("--root-diameter", root_text,
-                 "diameter of the root vessel, SI metres or with a unit (1mm); above "
-                 "--min-diameter and below the rules' largest diameter (2.6cm by default)")
+                 "diameter of the root vessel, SI metres or with a unit (1mm); in [3um, 2.6cm) "
+                 "with the default rules (their largest diameter), above --min-diameter")
       ->capture_default_str();
   app.add_option("--min-diameter", min_text,
                  "where growth stops: a vessel branches only if its daughters' mean diameter "

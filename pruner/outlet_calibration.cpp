@@ -134,7 +134,8 @@ std::string unphysiological_pressure_warning(const OutletReport& report,
   if (inlet < lowest)
     return text + "--venous-pressure (" + format_quantity(p.venous_pressure, "mmHg") +
            ") is likely too low";
-  // The capillary outlets always take `drop`; the rest is Poiseuille, linear in the flow.
+  // The capillary outlets always take `drop` on average; the rest is Poiseuille, nearly
+  // linear in the flow.
   const double fixed = p.venous_pressure + p.capillary_pressure_drop;
   if (fixed > highest)
     return text + "--venous-pressure (" + format_quantity(p.venous_pressure, "mmHg") +

@@ -46,8 +46,9 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
 
 // Steady arterial pressures lie within 0 to 300 mmHg. When the full tree's steady inlet
 // pressure leaves that range, a warning naming the value in mmHg and the likely cause: an
-// inflow (vprune's --mean-flow) meant for a tree of another size, with the inflow that would
-// give 100 mmHg (the drop down the tree is proportional to it); "" when it is in range.
+// inflow (vprune's --mean-flow) meant for a tree of another size, with the inflow that gives
+// about 100 mmHg (the drop down the tree is nearly proportional to it: within 2 %, since the
+// capillary outlets' resistance follows the flow); "" when it is in range.
 std::string unphysiological_pressure_warning(const OutletReport& report,
                                              const OutletParameters& parameters,
                                              double mean_inflow, double root_diameter);

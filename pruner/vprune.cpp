@@ -168,8 +168,8 @@ int main(int argc, char** argv) {
                           "outflow pressure of every outlet, " + in(ranges::pressure, "mmHg"))
       ->capture_default_str();
   blood_group->add_option("--capillary-drop", capillary_drop_text,
-                          "mean pressure drop across the capillary outlets, in (0, " +
-                              format_quantity(ranges::pressure.max, "mmHg") + "]")
+                          "mean pressure drop across the capillary outlets, in " +
+                              describe(Interval{0, ranges::pressure.max, true, false}, "mmHg"))
       ->capture_default_str();
   blood_group->add_option("--external-pressure", external_text,
                           "interstitial pressure for the wall laws, " + in(ranges::pressure, "mmHg"))

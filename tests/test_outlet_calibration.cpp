@@ -136,3 +136,48 @@ TEST(OutletCalibration, OutletsInletAndBloodSurviveTheFile) {
   EXPECT_NEAR(solve_steady_flow(back).inlet_pressure, solve_steady_flow(pruned).inlet_pressure,
               1e-9 * solve_steady_flow(pruned).inlet_pressure);
 }
+
+// vprune's default inflow (1.74 ml/min, meant for the 1 mm tree) on a 60 um tree gave a
+// steady inlet pressure of 81,142 mmHg without a word.
+TEST(OutletCalibration, AnUnphysiologicalPressureIsNamedWithItsLikelyCauseAndRemedy) {
+  auto calibrated = [](double mean_flow) {
+    GrowthParameters g;
+    g.root_diameter = 60e-6;
+    g.seed = 1;
+    Network full = grow_tree(default_rules(), g);
+    full.blood = Blood{};
+    Inlet inlet;
+    inlet.vessel = 0;
+    inlet.waveform.mean = mean_flow;
+    full.inlet = inlet;
+    const KeepMask keep = prune_by_generation(full, 3);
+    Network pruned = extract(full, keep);
+    return calibrate_outlets(full, keep, pruned, OutletParameters{});
+  };
+  const double default_flow = 1.74e-6 / 60;
+  const OutletReport report = calibrated(default_flow);
+  EXPECT_NEAR(report.steady_inlet_pressure_full / 133.322, 81142.2, 0.5);
+  const std::string warning =
+      unphysiological_pressure_warning(report, OutletParameters{}, default_flow, 60e-6);
+  EXPECT_NE(warning.find("81142.2 mmHg"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("--mean-flow (1.74 ml/min) is likely too large"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("60 um"), std::string::npos) << warning;
+  // The flow it suggests gives about 100 mmHg: the drop down the tree is Poiseuille, linear in
+  // the flow, but the capillary outlets' R_cap = drop x leaves / Q follows the flow, which
+  // shifts its split among the leaves a little (101.4 mmHg here).
+  const auto at = warning.find("(about ");
+  ASSERT_NE(at, std::string::npos) << warning;
+  const double suggested_ml_min = std::stod(warning.substr(at + 7));
+  const OutletReport remedied = calibrated(suggested_ml_min * 1e-6 / 60);
+  EXPECT_NEAR(remedied.steady_inlet_pressure_full / 133.322, 100.0, 2.0);
+  EXPECT_EQ(unphysiological_pressure_warning(remedied, OutletParameters{}, suggested_ml_min * 1e-6 / 60,
+                                             60e-6),
+            "");
+  // A negative pressure comes from the venous pressure, not the flow.
+  OutletParameters negative;
+  negative.venous_pressure = -50 * 133.322;
+  OutletReport low = remedied;
+  low.steady_inlet_pressure_full = -20 * 133.322;
+  EXPECT_NE(unphysiological_pressure_warning(low, negative, 1e-9, 60e-6).find("--venous-pressure (-50 mmHg)"),
+            std::string::npos);
+}

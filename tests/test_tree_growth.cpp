@@ -245,6 +245,19 @@ TEST(SizeEstimate, ExpectedCountMatchesTheMeanOfGrownTrees) {
   EXPECT_NEAR(expected_vessel_count(rules, small_tree()) / mean, 1.0, 0.05);
 }
 
+// At the ends of the diameters vgen accepts (2.6 cm down to 3 um) the estimate is a finite
+// count, beyond what a network holds, so vgen refuses it whatever --force says. (At 1e-300 m it
+// was inf, printed as -9223372036854775808 vessels.)
+TEST(SizeEstimate, StaysFiniteAtTheEndsOfTheAcceptedDiameters) {
+  GrowthParameters p;
+  p.root_diameter = 2.59e-2;
+  p.min_diameter = 3e-6;
+  const double expected = expected_vessel_count(default_rules(), p);
+  EXPECT_TRUE(std::isfinite(expected));
+  EXPECT_GT(expected, static_cast<double>(max_grown_vessels));
+  EXPECT_LT(expected, 1e13);
+}
+
 TEST(TreeLayout, VesselsHaveTheirLengthAndDaughtersTheirMurrayAngle) {
   const GrowthRules rules = default_rules();
   Network net = grow_tree(rules, small_tree());
