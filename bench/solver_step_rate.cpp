@@ -10,6 +10,7 @@
 
 #include "formats/network_io.hpp"
 #include "solver/pulse_solver.hpp"
+#include "solver/run_estimate.hpp"
 
 using namespace hemotree;
 
@@ -57,5 +58,12 @@ int main(int argc, char** argv) {
               batches, steps, rates.front(), rates.back());
   std::printf("wall time per %.3g s cycle: %.3g s (%.3g h)\n", period, period / solver.dt() / rate,
               period / solver.dt() / rate / 3600);
+  // hemosolve's cost model (solver/run_estimate), against the measured step.
+  std::vector<double> elements_of_degree(static_cast<std::size_t>(solver.max_degree()) + 1, 0.0);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    elements_of_degree[static_cast<std::size_t>(solver.degree(v))] += options.elements;
+  const double model = estimate_run(elements_of_degree, 1, options.threads).seconds;
+  std::printf("cost model: %.3g us per step, measured %.3g us (model / measured %.2f)\n", model * 1e6,
+              1e6 / rate, model * rate);
   return 0;
 }
