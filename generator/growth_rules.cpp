@@ -115,7 +115,17 @@ void validate(const GrowthRules& rules) {
     if (!(r.kappa_min > 0 && r.kappa_min < 1) || !(r.kappa_max > 0 && r.kappa_max < 1))
       fail(name + ": kappa_min and kappa_max must lie in (0, 1)");
     if (r.kappa_min > r.kappa_max) fail(name + ": kappa_min exceeds kappa_max");
-    if (!(r.murray_exponent > 0)) fail(name + ": murray_exponent must be positive");
+    if (!(r.murray_exponent >= 1 && r.murray_exponent <= 10))
+      fail(name + ": murray_exponent must lie in [1, 10] (2.7-3.5 in the paper)");
+    // Both daughters must be thinner than their parent by at least 0.1 %: the size estimate's
+    // grid step, and what keeps growth finite (kappa -> 1 or m -> infinity gives a second
+    // daughter as wide as its parent, a branch that never ends).
+    const double widest_second =
+        std::pow(1.0 - std::pow(r.kappa_min, r.murray_exponent), 1.0 / r.murray_exponent);
+    if (r.kappa_max > 0.999 || !(widest_second <= 0.999))
+      fail(name + ": kappa_max and the second daughter (1 - kappa_min^m)^(1/m) must be at most "
+                  "0.999 of the parent's diameter (got " + std::to_string(r.kappa_max) + " and " +
+                  std::to_string(widest_second) + ")");
     const LengthLaw& l = r.length;
     if (l.kind == LengthLaw::Kind::power && !(l.zeta > 0 && std::isfinite(l.gamma)))
       fail(name + ": the length law needs zeta > 0 and a finite gamma");

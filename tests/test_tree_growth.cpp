@@ -133,6 +133,18 @@ TEST(GrowthRules, InvalidRulesAreRefusedWithTheReason) {
   bad = j;
   bad["ranges"][3]["length"]["zeta"] = 104;  // both zeta and its calibration
   refused(bad, "exactly one");
+  // A second daughter as wide as its parent never stops branching (issue 11: vgen would grow
+  // until memory ran out; the size estimate assumes daughters at least 0.1 % thinner).
+  bad = j;
+  bad["ranges"][1]["murray_exponent"] = 1e300;
+  refused(bad, "murray_exponent must lie in [1, 10]");
+  bad = j;
+  bad["ranges"][1]["murray_exponent"] = 10;
+  bad["ranges"][1]["kappa_min"] = 0.3;  // (1 - 0.3^10)^(1/10) = 0.999999
+  refused(bad, "at most 0.999 of the parent's diameter");
+  bad = j;
+  bad["ranges"][1]["kappa_max"] = 0.9999;
+  refused(bad, "at most 0.999 of the parent's diameter");
   refused({{"stop", "whenever"}}, "stop");
   refused({{"youngs_modulus", {{"diameter", {1e-5, 1e-6}}, {"modulus", {1e5, 2e5}}}}}, "increase");
   refused({{"wall_thickness", {{"venule", {{"law", "ratio"}, {"h_over_d", 0.1}}}}}}, "venule");
