@@ -327,6 +327,9 @@ GrowthRules read_rules(const std::string& path) {
     j = nlohmann::json::parse(in);
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError(path + ": " + e.what());
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number beyond a double ("1e3081") is the file's fault, not an internal error.
+    throw InputError(path + ": " + e.what());
   }
   try {
     return rules_from_json(j);

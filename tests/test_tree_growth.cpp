@@ -104,6 +104,19 @@ TEST(GrowthRules, JsonRoundTrip) {
   EXPECT_EQ(to_json(s)["ranges"], j["ranges"]);
 }
 
+// The fuzzer's first finding (tests/fuzz/regressions/growth_rules/number_overflow.json):
+// a number beyond a double was nlohmann's out_of_range.406, exit 70.
+TEST(GrowthRules, ANumberBeyondADoubleIsBadInputNotAnInternalError) {
+  const std::string path = HEMOTREE_SOURCE_DIR "/tests/fuzz/regressions/growth_rules/number_overflow.json";
+  try {
+    read_rules(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("number_overflow.json: "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e3081"), std::string::npos) << e.what();
+  }
+}
+
 TEST(GrowthRules, InvalidRulesAreRefusedWithTheReason) {
   auto refused = [](nlohmann::json j, const std::string& fragment) {
     try {
