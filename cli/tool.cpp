@@ -7,6 +7,7 @@
 
 #include "cli/errors.hpp"
 #include "formats/json_pull.hpp"
+#include "formats/output_stream.hpp"
 
 namespace hemotree {
 
@@ -23,23 +24,36 @@ void note(const std::string& message) { say("", message); }
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
 
+namespace {
+// What a tool printed outside an OutputStream (help, a table) must have reached its
+// destination before the tool says it succeeded: a full disk is exit 1, not 0.
+int checked_success(int status) {
+  if (status != 0) return status;
+  if (const std::string why = standard_output_error(); !why.empty()) {
+    say("error: ", "cannot write standard output: " + why);
+    return 1;
+  }
+  return 0;
+}
+}  // namespace
+
 int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
   tool_name = app.get_name();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return checked_success(app.exit(e));
   } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
+    return checked_success(app.exit(e));
   } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
+    return checked_success(app.exit(e));
   } catch (const CLI::ParseError& e) {
     // One line, not CLI11's usage dump: the user sees what is wrong at once.
     say("error: ", std::string(e.what()) + " (see --help)");
     return 2;
   }
   try {
-    return body();
+    return checked_success(body());
   } catch (const InputError& e) {
     say("error: ", e.what());
     return 2;

@@ -67,6 +67,10 @@ void check_count(long long value, long long low, long long high, const std::stri
                      std::to_string(value) + ")");
 }
 
+std::string plural(std::size_t count, const std::string& noun) {
+  return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
+}
+
 // Warns when pressures leave the physiological band, with the likely cause.
 void warn_unphysiological(double low, double high, std::int64_t vessel, const Network& net, const char* what) {
   if (!std::isfinite(low) || !std::isfinite(high)) return;
@@ -259,18 +263,18 @@ int main(int argc, char** argv) {
     const int planned = until_periodic ? max_cycles : cycles;
     const RunEstimate per_cycle = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), options.threads);
     const RunEstimate whole = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned, options.threads);
-    if (!quiet)
-      note("time step " + format_quantity(dt, "s") + " (" + dt_reason + "), " + std::to_string(steps_per_cycle) +
-           " steps per cycle, " + std::to_string(run.element_count()) + " elements: " + degree_list +
-           "; estimated " + describe_duration(per_cycle.seconds) + " per cycle, " + describe_duration(whole.seconds) +
-           (until_periodic ? " for at most " : " for ") + std::to_string(planned) + " cycles on " +
-           std::to_string(options.threads) + (options.threads == 1 ? " thread" : " threads"));
     if (per_cycle.seconds > one_day && !force)
       throw InputError("one cycle would take about " + describe_duration(per_cycle.seconds) + " (" +
                        format_rounded(static_cast<double>(steps_per_cycle)) + " steps of " + format_quantity(dt, "s") +
-                       ", set by the " + dt_reason + "; " + std::to_string(run.element_count()) +
-                       " elements): refused, more than a day. Check that vessel's wall and length and the inlet's "
+                       ", set by the " + dt_reason + "; " + plural(run.element_count(), "element") +
+                       "): refused, more than a day. Check that vessel's wall and length and the inlet's "
                        "flow, use fewer --elements or a lower --degree, or --force to run it anyway");
+    if (!quiet)
+      note("time step " + format_quantity(dt, "s") + " (" + dt_reason + "), " + std::to_string(steps_per_cycle) +
+           " steps per cycle, " + plural(run.element_count(), "element") + ": " + degree_list +
+           "; estimated " + describe_duration(per_cycle.seconds) + " per cycle, " + describe_duration(whole.seconds) +
+           (until_periodic ? " for at most " : " for ") + plural(planned, "cycle") + " on " +
+           plural(options.threads, "thread"));
     if (whole.seconds > one_day && !quiet)
       warn("the whole run may take " + describe_duration(whole.seconds) +
            " (use --checkpoint-every N to be able to resume it)");
@@ -385,7 +389,7 @@ int main(int argc, char** argv) {
 
     if (status == RunStatus::interrupted) {
       warn(std::string("interrupted by ") + InterruptRequests::name(pulsatile.signal()) + " after " +
-           std::to_string(pulsatile.cycles_done()) + " cycles: " + out_dir +
+           plural(pulsatile.cycles_done(), "cycle") + ": " + out_dir +
            (pulsatile.cycles_done() > 0 ? " holds the results of the last whole cycle and its checkpoint"
                                         : " holds the checkpoint of the start (no cycle was completed)") +
            "; --resume " + out_dir + " continues");
@@ -395,7 +399,7 @@ int main(int argc, char** argv) {
     if (!failure.empty()) throw InputError("the results are wrong and marked failed in summary.json: " + failure);
     if (!quiet) {
       std::ostringstream m;
-      m << pulsatile.cycles_done() << " cycles in " << describe_duration(wall);
+      m << plural(pulsatile.cycles_done(), "cycle") << " in " << describe_duration(wall);
       if (pulsatile.has_change())
         m << "; last cycle-to-cycle change " << format_rounded(pulsatile.change().change) << " (vessel "
           << net.id[pulsatile.change().vessel] << ")";

@@ -146,6 +146,13 @@ PY
 expect_error "resume with another network" 2 "another network" -- \
   "$HEMOSOLVE" "$WORK/other.json" "${ARGS[@]}" --resume "$WORK/whole" --quiet
 
+# What a tool prints to a full disk is an error, not a success.
+if [ -c /dev/full ]; then
+  expect_error "hemosolve --help to a full disk" 1 "cannot write standard output" -- bash -c '"$0" --help >/dev/full' "$HEMOSOLVE"
+  expect_error "vstats to a full disk" 1 "cannot write" -- bash -c '"$0" "$1" >/dev/full' "$VSTATS" "$CCA"
+  expect_error "vstats --version to a full disk" 1 "cannot write standard output" -- bash -c '"$0" --version >/dev/full' "$VSTATS"
+fi
+
 # A folder that is not hemosolve's is never replaced.
 mkdir "$WORK/mine" && echo precious >"$WORK/mine/notes.txt"
 expect_error "--out a folder of other files" 2 "not a hemosolve results folder" -- \
