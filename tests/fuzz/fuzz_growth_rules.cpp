@@ -1,7 +1,7 @@
 // The growth rules file (vgen --rules) on hostile bytes, through read_rules as vgen calls it.
 // Rules it accepts must print and read back the same (vgen --print-rules), give finite,
 // positive wall thicknesses and moduli inside their ranges, and grow a small tree that the
-// network writer and reader take.
+// network writer writes (and the reader reads or refuses with one of the project's errors).
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -28,7 +28,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::write_file(path, std::string_view(reinterpret_cast<const char*>(data), size));
   auto rules_result = fuzz::outcome("read_rules", [&] { return read_rules(path.string()); });
   auto& rules = rules_result.first;
-  auto& refusal = rules_result.second;
   if (!rules) return 0;
 
   const nlohmann::json printed = to_json(*rules);
@@ -54,7 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
 
   // A small tree from the top of the widest range down to half its diameter, when the
-  // estimate says it is small: it must write and read back as a network.
+  // estimate says it is small: it must write, and read back or be refused.
   const BranchingRange& top = rules->ranges.back();
   GrowthParameters p;
   p.root_diameter = std::nextafter(top.diameter_max, 0.0);
@@ -65,7 +64,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!expected || !(*expected >= 1 && *expected < 2000)) return 0;
   auto tree_result = fuzz::outcome("grow_tree", [&] { return grow_tree(*rules, p); });
   auto& tree = tree_result.first;
-  auto& growth_error = tree_result.second;
   if (!tree) return 0;
   if (static_cast<double>(tree->vessel_count()) > 100 * *expected + 100)
     finding("the estimate said " + std::to_string(*expected) + " vessels, the tree has " +
@@ -80,9 +78,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   auto& written = written_result.first;
   auto& write_error = written_result.second;
   if (!written) finding("write_network refuses a tree grown by accepted rules: " + write_error.message);
-  auto read_result = fuzz::outcome("read_network", [&] { return read_network(net_path.string()); });
-  auto& read = read_result.first;
-  auto& read_error = read_result.second;
-  if (!read) finding("the reader refuses a tree grown by accepted rules: " + read_error.message);
+  // The reader may refuse it with one of the project's errors (a length below its range, from a
+  // calibration that is valid but absurd): vgen checks the tree it grew the same way, exit 2.
+  fuzz::outcome("read_network", [&] { return read_network(net_path.string()); });
   return 0;
 }
