@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--linear-error", options.degree_rule.linear_error,
                  "auto: a short vessel whose steady pressure profile departs further than this from a "
-                 "line (relative, in [0, 1]; docs/solver.md) takes degree 2")
+                 "line (relative, in [0, inf]; inf: never; docs/solver.md) takes degree 2")
       ->capture_default_str();
   app.add_option("--elements", options.elements, "elements per vessel, in [1, 1000]")->capture_default_str();
   app.add_option("--dt", dt_text,
@@ -156,7 +156,8 @@ int main(int argc, char** argv) {
                "at each cycle end, move the network's compliances (vessels and RCR capacitors) to where "
                "their mean filling over the cycle says the periodic state lies (docs/solver.md; on by default)");
   app.add_flag("--force", force,
-               "run even with a --dt or --cfl above the stability limit, or an estimated wall time above a day");
+               "run even with a --dt or --cfl above the stability limit, an estimated wall time above a day, or "
+               "over the checkpoint a killed run left in OUT.partial");
   app.add_flag("--quiet", quiet, "no progress lines or notes (warnings and errors still)");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
@@ -199,7 +200,7 @@ int main(int argc, char** argv) {
     check_count(options.degree_rule.low, 0, 30, "--low-degree");
     check_count(options.degree_rule.raise_to, 0, 30, "--raise-degree");
     check_count(options.degree_rule.high, 0, 30, "--high-degree");
-    check_range(options.degree_rule.linear_error, {0, 1}, "--linear-error");
+    check_range(options.degree_rule.linear_error, {0, INFINITY}, "--linear-error");  // inf: never degree 2
     check_count(options.elements, 1, 1000, "--elements");
     check_count(options.threads, 1, cores, "--threads");
     check_range(options.thick_wall_ratio, {0, 10, true, false}, "--thick-wall-ratio");
@@ -228,6 +229,10 @@ int main(int argc, char** argv) {
       checkpoint_bytes = read_checkpoint_file(*file);
       checkpoint_source = file->string();
     }
+    if (resume_dir.empty() && !force && folder.latest_checkpoint() &&
+        folder.latest_checkpoint()->parent_path() == folder.staging())
+      throw InputError(folder.staging().string() + " holds the checkpoint of a run that was killed: --resume " +
+                       out_dir + " continues it; --force (or removing that folder) starts afresh");
     if (const int s = interrupts.poll()) {
       warn(std::string("interrupted by ") + InterruptRequests::name(s) + " before the first step: nothing written");
       return InterruptRequests::exit_status(s);

@@ -73,15 +73,17 @@ std::optional<fs::path> OutputFolder::latest_checkpoint() const {
   return std::nullopt;
 }
 
-void OutputFolder::open() {
+bool OutputFolder::open() {
   std::error_code ec;
-  if (fs::exists(staging_, ec)) remove_folder(staging_);  // a dead run's (the constructor checked)
+  const bool stale = fs::exists(staging_, ec);
+  if (stale) remove_folder(staging_);  // a dead run's (the constructor checked)
   fs::create_directories(final_.parent_path(), ec);
   if (!fs::create_directory(staging_, ec) || ec)
     throw IoError("cannot create " + staging_.string() + (ec ? ": " + ec.message() : std::string()));
   std::ofstream owner(owner_);
   owner << ::getpid() << '\n';
   if (!owner.flush()) throw IoError("cannot write " + owner_.string());
+  return stale;
 }
 
 void OutputFolder::publish() {

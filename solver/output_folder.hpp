@@ -23,8 +23,9 @@ class OutputFolder {
   // The newest checkpoint a run into DIR left: DIR.partial's (a killed run's), else DIR's.
   std::optional<std::filesystem::path> latest_checkpoint() const;
 
-  // Creates DIR.partial afresh (a stale one of a dead run is removed) and records its owner.
-  void open();
+  // Creates DIR.partial afresh (removing a stale one that a dead run left) and records
+  // its owner; returns true where it removed one.
+  bool open();
   // DIR.partial becomes DIR; the previous results go.
   void publish();
   // A run that produced nothing to keep: DIR.partial goes, DIR stays as it was.

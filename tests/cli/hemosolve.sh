@@ -177,7 +177,7 @@ refuse "--probe not ID:x" 2 "is not ID or ID:x" -- "$HEMOSOLVE" "$CCA" --out "$(
 refuse "--probe with a bad x" 2 "is not ID or ID:x" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --probe 1:x
 # --cycles 0 once ran one cycle silently; it is bad input.
 refuse "--cycles 0" 2 "--cycles must lie in [1, 100000] (got 0)" -- "$HEMOSOLVE" "$CCA" --out "$(out)" --cycles 0
-refuse "--linear-error negative" 2 "--linear-error must lie in [0, 1] (got -1)" -- \
+refuse "--linear-error negative" 2 "--linear-error must lie in [0, inf] (got -1)" -- \
   "$HEMOSOLVE" "$CCA" --out "$(out)" --linear-error -1
 refuse "missing network file" 1 "cannot open" -- "$HEMOSOLVE" "$WORK/missing.json" --out "$(out)"
 refuse "empty standard input" 2 "standard input" -- \

@@ -119,6 +119,9 @@ kill -9 $pid; wait $pid 2>/dev/null
 cmp -s "$WORK/killed/summary.json" "$WORK/previous-summary.json" && [ -e "$WORK/killed.partial/checkpoint.bin" ] \
   && pass "kill -9: the previous results intact, the new run's checkpoint in killed.partial" \
   || fail "kill -9 mixed the folder"
+# Its checkpoint is not thrown away by running the same command again.
+expect_error "a new run over a killed run's checkpoint" 2 "holds the checkpoint of a run that was killed" -- \
+  "$HEMOSOLVE" "$CCA" "${ARGS[@]}" --out "$WORK/killed" --checkpoint-every 1 --quiet
 "$HEMOSOLVE" "$CCA" "${ARGS[@]}" --resume "$WORK/killed" --checkpoint-every 1 2>"$WORK/err" \
   && grep -q "resuming from .*killed.partial/checkpoint.bin after [1-9]" "$WORK/err" && [ ! -e "$WORK/killed.partial" ] \
   && same_results "$WORK/whole" "$WORK/killed" \
