@@ -19,6 +19,29 @@ packages=(build-essential cmake ninja-build libboost-graph-dev libeigen3-dev
 
 say() { echo "hemotree: $*" >&2; }
 
+# heartbeat LABEL COMMAND...: runs COMMAND and, when stderr is not a terminal (where a tool's
+# own progress line would be broken by it), says "LABEL: still running (N min)" each minute.
+# The command stays in the foreground, so that Ctrl-C and signals reach it as usual; the
+# beating loop ends with it, or within a minute of this shell.
+heartbeat() {
+  local label=$1 status=0
+  shift
+  if [ -t 2 ]; then "$@"; return; fi
+  local parent=$$
+  (
+    minutes=0
+    while sleep 60 </dev/null >/dev/null 2>&1 && kill -0 "$parent" 2>/dev/null; do
+      minutes=$((minutes + 1))
+      say "$label: still running ($minutes min)"
+    done
+  ) &
+  local beat=$!
+  "$@" || status=$?
+  kill "$beat" 2>/dev/null || true
+  wait "$beat" 2>/dev/null || true
+  return "$status"
+}
+
 install_missing_packages() {
   local missing=()
   for p in "${packages[@]}"; do
@@ -30,10 +53,10 @@ install_missing_packages() {
   # apt-get -qq prints nothing for minutes: announce each step and its end instead.
   say "installing ${#missing[@]} packages with apt-get (about 3 minutes on a fresh machine): ${missing[*]}"
   say "apt-get update: reading the package lists..."
-  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  heartbeat "apt-get update" "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq
   say "apt-get install: downloading and unpacking ${#missing[@]} packages and their dependencies..."
-  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-    "${missing[@]}" >/dev/null
+  heartbeat "apt-get install" "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive \
+    apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
   say "installed ${#missing[@]} packages in $((SECONDS - start)) s"
 }
 
