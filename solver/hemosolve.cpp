@@ -315,6 +315,7 @@ int main(int argc, char** argv) {
     plan.fingerprint = network_fingerprint(net);
     plan.live_progress = !quiet && stderr_is_terminal();
     plan.log_progress = !quiet && !stderr_is_terminal();
+    plan.longest_cycle = force ? 0 : one_day;
     PulsatileRun pulsatile(net, run, std::move(probe_list), plan, folder.staging());
     if (!checkpoint_bytes.empty()) {
       pulsatile.resume(checkpoint_bytes, checkpoint_source);
@@ -378,6 +379,15 @@ int main(int argc, char** argv) {
       run_info["error"] = std::string("interrupted by ") + InterruptRequests::name(pulsatile.signal()) +
                           "; resume with --resume " + out_dir;
 
+    if (status == RunStatus::too_long) {
+      folder.discard();
+      const double cycle = pulsatile.measured_step() * static_cast<double>(steps_per_cycle);
+      throw InputError("one cycle would take about " + describe_duration(cycle) + " (measured over its first steps: " +
+                       format_quantity(pulsatile.measured_step(), "s") + " a step, " +
+                       format_rounded(static_cast<double>(steps_per_cycle)) +
+                       " steps): stopped, more than a day. Use fewer --elements or a lower --degree, --threads, "
+                       "or --force to run it anyway");
+    }
     // Nothing computed, nothing kept: DIR stays as it was.
     if (status == RunStatus::broken_down && last.vessels.empty()) {
       folder.discard();

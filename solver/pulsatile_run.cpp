@@ -18,6 +18,7 @@ const char* to_string(RunStatus status) {
     case RunStatus::not_periodic: return "not periodic";
     case RunStatus::interrupted: return "interrupted";
     case RunStatus::broken_down: return "broken down";
+    case RunStatus::too_long: return "too long";
   }
   return "unknown";
 }
@@ -145,6 +146,18 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
             return RunStatus::interrupted;
           }
           if (plan_.live_progress) progress(k, started);
+        }
+        // The cost model's estimate, checked against this machine once the first second or
+        // thousand steps have gone by (a clock reading a step until then).
+        if (measured_step_ == 0) {
+          const double elapsed = seconds_since_epoch_start() - started;
+          if (elapsed > 1 || k + 1 >= 1024 || k + 1 == plan_.steps_per_cycle) {
+            measured_step_ = elapsed / static_cast<double>(k + 1);
+            if (plan_.longest_cycle > 0 && measured_step_ * static_cast<double>(plan_.steps_per_cycle) > plan_.longest_cycle) {
+              if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
+              return RunStatus::too_long;
+            }
+          }
         }
       }
       solver_.check_solution();

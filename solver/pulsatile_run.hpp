@@ -33,9 +33,12 @@ struct RunPlan {
   std::string options;          // those options, for a clear refusal of another run's checkpoint
   bool live_progress = false;   // a line that redraws itself (stderr is a terminal)
   bool log_progress = false;    // a plain line per cycle (stderr is a log)
+  // The run measures its own step over its first seconds and stops (too_long) when a cycle
+  // would take longer than this [s]; 0: never (--force).
+  double longest_cycle = 0;
 };
 
-enum class RunStatus { complete, not_periodic, interrupted, broken_down };
+enum class RunStatus { complete, not_periodic, interrupted, broken_down, too_long };
 const char* to_string(RunStatus status);
 
 class PulsatileRun {
@@ -54,6 +57,8 @@ class PulsatileRun {
   const PeriodicityChange& change() const { return change_; }
   int signal() const { return signal_; }                    // after an interrupt
   const std::string& breakdown() const { return breakdown_; }  // after a breakdown
+  // Wall time per step measured over the first steps this process ran [s]; 0 before.
+  double measured_step() const { return measured_step_; }
   const ProbeRecorder& probes() const { return probes_; }
   // Writes the checkpoint of the last cycle end to folder/checkpoint.bin.
   void write_checkpoint() const;
@@ -72,6 +77,7 @@ class PulsatileRun {
   PeriodicityChange change_;
   int done_ = 0, balances_ = 0, signal_ = 0;
   bool resumed_ = false;
+  double measured_step_ = 0;
   std::string breakdown_;
   CheckpointWriter snapshot_;
 };

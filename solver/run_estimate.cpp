@@ -6,12 +6,14 @@
 namespace hemotree {
 
 namespace {
-// Measured on the reference machine (bench/README.md): the 5301-vessel network (2516, 2639
-// and 146 elements of degree 1, 2 and 7) at 0.765 ms per step on one core; a one-vessel
-// network of degree 7 at 10 us per step, nearly all of it per-step overhead.
-constexpr double step_cost = 5e-6;     // [s per step]
-constexpr double fixed_cost = 100e-9;  // [s per element and step]
-constexpr double modal_cost = 6e-9;    // [s per element, step and (p + 1)^2]
+// Measured on this project's machines (bench/README.md): the 5301-vessel network (2516, 2639
+// and 146 elements of degree 1, 2 and 7) takes 2.5 ms a step on one core of the Intel Xeon
+// VM (0.77 ms on the AMD EPYC one); the carotid (one element of degree 7) 10 us, nearly all
+// of it per-step overhead. The slower machine sets the constants: an estimate that errs
+// should err long. The run measures itself over its first steps too (pulsatile_run).
+constexpr double step_cost = 10e-6;    // [s per step]
+constexpr double fixed_cost = 300e-9;  // [s per element and step]
+constexpr double modal_cost = 18e-9;   // [s per element, step and (p + 1)^2]
 }  // namespace
 
 double element_step_seconds(int degree) {

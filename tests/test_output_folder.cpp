@@ -91,9 +91,9 @@ TEST(RunEstimate, DurationsReadAsPeopleSayThem) {
 }
 
 TEST(RunEstimate, ScalesWithStepsElementsAndThreads) {
-  // The model of solver/run_estimate.cpp: 5 us a step plus 100 ns + 6 ns (p + 1)^2 an element.
+  // The model of solver/run_estimate.cpp: 10 us a step plus 300 ns + 18 ns (p + 1)^2 an element.
   const RunEstimate one = estimate_run({0, 1000}, 1000, 1);
-  EXPECT_NEAR(one.seconds, 1000 * (5e-6 + 1000 * (100e-9 + 24e-9)), 1e-12);
+  EXPECT_NEAR(one.seconds, 1000 * (10e-6 + 1000 * (300e-9 + 72e-9)), 1e-12);
   EXPECT_NEAR(estimate_run({0, 1000}, 2000, 1).seconds, 2 * one.seconds, 1e-12);
   EXPECT_NEAR(estimate_run({0, 1000}, 1000, 2).seconds, one.seconds / 1.8, 1e-12);
   // Counts far beyond any run stay finite numbers, so that the refusal can say them.
