@@ -78,7 +78,7 @@ bool leaves_scratch(const std::string& a) {
 
 bool cheap_enough(std::string_view tool, const std::vector<std::string>& args) {
   if (tool == "vgen") {
-    if (has(args, "--print-rules") || has(args, "--help") || has(args, "-h") || has(args, "--version")) return true;
+    // No shortcut for --help or --print-rules: "-o --help" takes it as the output's name.
     const double root = quantity(args, "--root-diameter", Dimension::length).value_or(
         value_of(args, "--root-diameter") ? -1 : 1e-3);
     const double min = quantity(args, "--min-diameter", Dimension::length).value_or(
