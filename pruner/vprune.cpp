@@ -131,49 +131,62 @@ int main(int argc, char** argv) {
                  "random seed of the selection, an integer in 0..18446744073709551615")
       ->capture_default_str();
   app.add_option("--profile-report", profile_report, "write the full, target and kept profiles (JSON)");
-  auto* flow_group = app.add_option_group("inflow");
-  auto* mean_flow_option = flow_group->add_option("--mean-flow", mean_flow_text,
+  // Help sections by Option::group, not add_option_group: CLI11 2.1 takes an empty argument
+  // for the name of an option group (they have none) and loops forever ('vprune x "" --budget 5').
+  auto* mean_flow_option = app.add_option("--mean-flow", mean_flow_text,
       "mean inflow of the half-sine wave, " + in(ranges::mean_flow, "ml/min") +
           "; the steady pressures scale with it, so it must suit the tree's size")
-      ->capture_default_str();
-  flow_group->add_option("--period", period_text, "cardiac period, " + in(ranges::period, "s"))
-      ->capture_default_str();
-  auto* systole_option = flow_group->add_option("--systole", systole_text,
+      ->capture_default_str()
+      ->group("Inflow");
+  app.add_option("--period", period_text, "cardiac period, " + in(ranges::period, "s"))
+      ->capture_default_str()
+      ->group("Inflow");
+  auto* systole_option = app.add_option("--systole", systole_text,
       "duration of the half sine, " + in(ranges::systole, "s") + " and at most --period")
-      ->capture_default_str();
-  flow_group->add_option("--inflow-table", inflow_table,
+      ->capture_default_str()
+      ->group("Inflow");
+  app.add_option("--inflow-table", inflow_table,
       "measured inflow instead of the half sine: lines of time [s] in [0, --period), "
       "increasing, and flow [m^3/s] " + in(ranges::flow_sample, "m^3/s") + ", with a mean " +
-          in(ranges::mean_flow, "ml/min"));
-  auto* blood_group = app.add_option_group("blood and outlets");
-  blood_group->add_option("--hematocrit", hematocrit_text,
+          in(ranges::mean_flow, "ml/min"))
+      ->group("Inflow");
+  app.add_option("--hematocrit", hematocrit_text,
                           "discharge hematocrit, " + in(ranges::hematocrit, ""))
-      ->capture_default_str();
-  blood_group->add_option("--rheology", rheology, "pries or newtonian")->capture_default_str();
-  blood_group->add_option("--plasma-viscosity", plasma_text,
+      ->capture_default_str()
+      ->group("Blood and outlets");
+  app.add_option("--rheology", rheology, "pries or newtonian")->capture_default_str()
+      ->group("Blood and outlets");
+  app.add_option("--plasma-viscosity", plasma_text,
                           "plasma (water) viscosity, " + in(ranges::viscosity, "mPa s"))
-      ->capture_default_str();
-  blood_group->add_option("--newtonian-viscosity", newtonian_text,
+      ->capture_default_str()
+      ->group("Blood and outlets");
+  app.add_option("--newtonian-viscosity", newtonian_text,
                           "constant viscosity of --rheology newtonian, " +
                               in(ranges::viscosity, "mPa s"))
-      ->capture_default_str();
-  blood_group->add_option("--pries-max-diameter", pries_max_text,
+      ->capture_default_str()
+      ->group("Blood and outlets");
+  app.add_option("--pries-max-diameter", pries_max_text,
                           "Pries law below this diameter, constant above, " +
                               in(ranges::pries_max_diameter, "um"))
-      ->capture_default_str();
-  blood_group->add_option("--alpha", alpha_text,
+      ->capture_default_str()
+      ->group("Blood and outlets");
+  app.add_option("--alpha", alpha_text,
                           "velocity-profile coefficient, " + in(ranges::alpha, "") +
-                              " (default 4/3, a parabolic profile)");
-  blood_group->add_option("--venous-pressure", venous_text,
+                              " (default 4/3, a parabolic profile)")
+      ->group("Blood and outlets");
+  app.add_option("--venous-pressure", venous_text,
                           "outflow pressure of every outlet, " + in(ranges::pressure, "mmHg"))
-      ->capture_default_str();
-  blood_group->add_option("--capillary-drop", capillary_drop_text,
+      ->capture_default_str()
+      ->group("Blood and outlets");
+  app.add_option("--capillary-drop", capillary_drop_text,
                           "mean pressure drop across the capillary outlets, in " +
                               describe(Interval{0, ranges::pressure.max, true, false}, "mmHg"))
-      ->capture_default_str();
-  blood_group->add_option("--external-pressure", external_text,
+      ->capture_default_str()
+      ->group("Blood and outlets");
+  app.add_option("--external-pressure", external_text,
                           "interstitial pressure for the wall laws, " + in(ranges::pressure, "mmHg"))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group("Blood and outlets");
   app.set_version_flag("--version", std::string("vprune ") + HEMOTREE_VERSION);
 
   const int status = run_tool(app, argc, argv, [&] {

@@ -182,6 +182,12 @@ if /usr/bin/python3 -c 'import os,sys; os.close(os.open(sys.argv[1], os.O_TMPFIL
 else
   echo "note: no O_TMPFILE here; the named partial is checked below"
 fi
+# An empty stray argument (the fuzzer's second finding): CLI11 took it for the name of an
+# option group and looped forever; it is refused at once, by every tool.
+for tool in "$VGEN" "$VPRUNE" "$VSTATS" "$BUILD/solver/hemosolve"; do
+  expect_error "$(basename "$tool") x \"\" --budget 5 ends" 2 "not expected" -- timeout 10 "$tool" x "" --budget 5
+done
+
 # Whatever a killed writer left (the named fallback), the next writer of the name removes.
 sleep 1000 & alive=$!
 touch "$WORK/kill/tree.json.partial-99999999" "$WORK/kill/tree.json.partial-$(uname -n)-99999999" \
