@@ -23,6 +23,7 @@ CheckpointWriter::CheckpointWriter() {
 }
 
 void CheckpointWriter::raw(const void* data, std::size_t size) {
+  if (size == 0) return;  // an empty matrix's data() is null, which memcpy must not see
   bytes_.append(static_cast<const char*>(data), size);
 }
 
@@ -67,6 +68,7 @@ void CheckpointReader::fail(const std::string& message) const {
 
 void CheckpointReader::raw(void* data, std::size_t size) {
   if (size > bytes_.size() - at_) fail("truncated checkpoint");
+  if (size == 0) return;  // an empty matrix's data() is null, which memcpy must not see
   std::memcpy(data, bytes_.data() + at_, size);
   at_ += size;
 }
