@@ -9,6 +9,12 @@
 
 namespace hemotree {
 
+// Thrown to leave a tool at once on a request (run_tool returns the status): for a stage
+// that has nothing to save.
+struct InterruptedExit {
+  int status;
+};
+
 class InterruptRequests {
  public:
   // Blocks the signals; threads started afterwards (OpenMP's) inherit the mask.

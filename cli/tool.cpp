@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "cli/errors.hpp"
+#include "cli/interrupt.hpp"
 #include "formats/json_pull.hpp"
 #include "formats/output_stream.hpp"
 
@@ -54,6 +55,8 @@ int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& b
   }
   try {
     return checked_success(body());
+  } catch (const InterruptedExit& e) {
+    return e.status;
   } catch (const InputError& e) {
     say("error: ", e.what());
     return 2;

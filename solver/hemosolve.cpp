@@ -233,13 +233,17 @@ int main(int argc, char** argv) {
         folder.latest_checkpoint()->parent_path() == folder.staging())
       throw InputError(folder.staging().string() + " holds the checkpoint of a run that was killed: --resume " +
                        out_dir + " continues it; --force (or removing that folder) starts afresh");
-    if (const int s = interrupts.poll()) {
-      warn(std::string("interrupted by ") + InterruptRequests::name(s) + " before the first step: nothing written");
-      return InterruptRequests::exit_status(s);
-    }
+    auto stop_if_interrupted = [&] {  // before the time loop nothing is written: just stop
+      if (const int s = interrupts.poll()) {
+        warn(std::string("interrupted by ") + InterruptRequests::name(s) + " before the first step: nothing written");
+        throw InterruptedExit{InterruptRequests::exit_status(s)};
+      }
+    };
+    stop_if_interrupted();
 
     // ---- the discretisation, its step and its cost ---------------------------------------
-    PulseSolver run(net, options);
+    PulseSolver run(net, options);  // the steady solve: minutes on the full tree
+    stop_if_interrupted();
     if (options.dt > 0 && options.dt > run.stable_dt() * (1 + 1e-9) && !force)
       throw InputError("--dt " + format_quantity(options.dt, "s") + " is " + format_rounded(options.dt / run.stable_dt()) +
                        " times the stability limit " + format_quantity(run.stable_dt(), "s") + " (" +
