@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "cli/errors.hpp"
@@ -120,15 +121,18 @@ double parse_number(std::string_view text, std::string_view what, const Interval
   return parse_quantity(text, Dimension::dimensionless, what, range, "");
 }
 
-std::uint64_t parse_count(std::string_view text, std::string_view what, std::uint64_t min,
-                          std::uint64_t max) {
+namespace {
+// A decimal integer of type Int in [min, max]: no exponent, no silent wrap or saturation;
+// for an unsigned Int a minus sign is named as such.
+template <class Int>
+Int parse_whole(std::string_view text, std::string_view what, Int min, Int max) {
   auto bad = [&](const std::string& why) {
     return InputError(std::string(what) + ": '" + std::string(text) + "' " + why +
                       "; the accepted range is " + std::to_string(min) + ".." + std::to_string(max));
   };
   if (text.empty()) throw bad("is empty");
-  if (text.front() == '-') throw bad("is negative");
-  std::uint64_t value = 0;
+  if (std::is_unsigned_v<Int> && text.front() == '-') throw bad("is negative");
+  Int value = 0;
   const char* end = text.data() + text.size();
   auto [stop, ec] = std::from_chars(text.data(), end, value);
   if (ec == std::errc::result_out_of_range) throw bad("is too large");
@@ -139,24 +143,16 @@ std::uint64_t parse_count(std::string_view text, std::string_view what, std::uin
                      std::to_string(max));
   return value;
 }
+}  // namespace
+
+std::uint64_t parse_count(std::string_view text, std::string_view what, std::uint64_t min,
+                          std::uint64_t max) {
+  return parse_whole(text, what, min, max);
+}
 
 std::int64_t parse_integer(std::string_view text, std::string_view what, std::int64_t min,
                            std::int64_t max) {
-  auto bad = [&](const std::string& why) {
-    return InputError(std::string(what) + ": '" + std::string(text) + "' " + why +
-                      "; the accepted range is " + std::to_string(min) + ".." + std::to_string(max));
-  };
-  if (text.empty()) throw bad("is empty");
-  std::int64_t value = 0;
-  const char* end = text.data() + text.size();
-  auto [stop, ec] = std::from_chars(text.data(), end, value);
-  if (ec == std::errc::result_out_of_range) throw bad("is too large");
-  if (ec != std::errc() || stop != end) throw bad("is not an integer");
-  if (value < min || value > max)
-    throw InputError(std::string(what) + ": '" + std::string(text) +
-                     "' lies outside the accepted range " + std::to_string(min) + ".." +
-                     std::to_string(max));
-  return value;
+  return parse_whole(text, what, min, max);
 }
 
 std::string format_rounded(double value) {
