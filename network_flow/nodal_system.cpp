@@ -1,0 +1,311 @@
+#include "network_flow/nodal_system.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/SparseCholesky>
+
+namespace hemotree {
+
+// A Cholesky pivot this small against its row's unreduced diagonal is a nearly singular
+// component (a shunt lost in rounding against the conductances): the subtractions of the
+// factorisation leave the solution no correct digit. (The tree elimination does not subtract,
+// and solves such a system exactly to rounding.)
+static constexpr double singular_pivot = 1e-13;
+
+// The lower triangle of the weighted Laplacian in compressed columns, its analysed
+// factorisation, and where each edge's and node's value sits in it (so that a refactorisation
+// overwrites the values in place: O(nonzeros), no triplets).
+struct NodalSystem::Cholesky {
+  Eigen::SparseMatrix<double> lower;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> ldlt;
+  std::vector<Eigen::Index> edge_slot, diagonal_slot;
+};
+
+namespace {
+
+std::int32_t find_root(std::vector<std::int32_t>& up, std::int32_t i) {
+  while (up[static_cast<std::size_t>(i)] != i) {
+    auto& next = up[static_cast<std::size_t>(i)];
+    next = up[static_cast<std::size_t>(next)];  // path halving
+    i = next;
+  }
+  return i;
+}
+
+}  // namespace
+
+NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::vector<std::int32_t> b,
+                         Method method)
+    : nodes_(nodes), a_(std::move(a)), b_(std::move(b)) {
+  if (nodes_ > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    throw std::invalid_argument("NodalSystem: " + std::to_string(nodes_) + " nodes exceed 32-bit indices");
+  if (a_.size() != b_.size())
+    throw std::invalid_argument("NodalSystem: " + std::to_string(a_.size()) + " edge starts but " +
+                                std::to_string(b_.size()) + " edge ends");
+  const auto n = static_cast<std::int32_t>(nodes_);
+  const std::size_t m = a_.size();
+  for (std::size_t e = 0; e < m; ++e) {
+    if (a_[e] < 0 || a_[e] >= n || b_[e] < 0 || b_[e] >= n)
+      throw std::invalid_argument("NodalSystem: edge " + std::to_string(e) + " joins nodes " +
+                                  std::to_string(a_[e]) + " and " + std::to_string(b_[e]) + ", not both below " +
+                                  std::to_string(nodes_));
+    if (a_[e] == b_[e])
+      throw std::invalid_argument("NodalSystem: edge " + std::to_string(e) + " joins node " +
+                                  std::to_string(a_[e]) + " to itself");
+  }
+
+  if (m > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    throw std::invalid_argument("NodalSystem: " + std::to_string(m) + " edges exceed 32-bit indices");
+
+  // Is the graph a forest, and in what order can it be eliminated (every parent before its
+  // children)? First the common case at the cost of one pass: a network numbered from its
+  // root (vgen's, and what is extracted from it) joins every node to at most one lower node.
+  // Then each node hangs from that one, the lowest node of each component is its root, and
+  // the nodes' own order serves, which makes the sweeps stream through memory.
+  bool forest = false;
+  if (method != Method::sparse_cholesky) {
+    parent_.assign(nodes_, -1);
+    parent_edge_.assign(nodes_, -1);
+    forest = true;
+    for (std::size_t e = 0; e < m && forest; ++e) {
+      const auto high = static_cast<std::size_t>(std::max(a_[e], b_[e]));
+      forest = parent_[high] < 0;
+      parent_[high] = std::min(a_[e], b_[e]);
+      parent_edge_[high] = static_cast<std::int32_t>(e);
+    }
+    order_.resize(nodes_);
+    if (forest) {
+      std::iota(order_.begin(), order_.end(), 0);
+    } else {
+      // Else peeling leaves: a node with one edge left hangs from that edge's other node, and
+      // removing it may make that one a leaf in turn; the last node of each component is its
+      // root, and the reverse of the peeling an order for the elimination. parent_ and
+      // parent_edge_ first hold the XOR of each node's remaining neighbours and edges, so that
+      // a leaf's one neighbour and edge are there to read without an adjacency list (O(nodes),
+      // three flat arrays). Nodes on a loop or a doubled edge are never peeled.
+      std::vector<std::int32_t> degree(nodes_, 0);
+      std::fill(parent_.begin(), parent_.end(), 0);
+      std::fill(parent_edge_.begin(), parent_edge_.end(), 0);
+      for (std::size_t e = 0; e < m; ++e) {
+        const auto ea = static_cast<std::size_t>(a_[e]), eb = static_cast<std::size_t>(b_[e]);
+        ++degree[ea];
+        ++degree[eb];
+        parent_[ea] ^= b_[e];
+        parent_[eb] ^= a_[e];
+        parent_edge_[ea] ^= static_cast<std::int32_t>(e);
+        parent_edge_[eb] ^= static_cast<std::int32_t>(e);
+      }
+      order_.clear();
+      for (std::int32_t i = 0; i < n; ++i)
+        if (degree[static_cast<std::size_t>(i)] <= 1) order_.push_back(i);
+      for (std::size_t head = 0; head < order_.size(); ++head) {
+        const auto c = static_cast<std::size_t>(order_[head]);
+        if (degree[c] == 0) {  // the last of its component
+          parent_[c] = parent_edge_[c] = -1;
+          continue;
+        }
+        degree[c] = 0;
+        const auto p = static_cast<std::size_t>(parent_[c]);
+        parent_[p] ^= static_cast<std::int32_t>(c);
+        parent_edge_[p] ^= parent_edge_[c];
+        if (--degree[p] == 1) order_.push_back(static_cast<std::int32_t>(p));
+      }
+      forest = order_.size() == nodes_;
+      std::reverse(order_.begin(), order_.end());  // roots first
+    }
+  }
+  if (method == Method::tree_elimination && !forest)
+    throw std::invalid_argument("NodalSystem: tree_elimination needs a forest, and this graph has a loop or "
+                                "a doubled edge");
+  method_ = method == Method::automatic ? (forest ? Method::tree_elimination : Method::sparse_cholesky) : method;
+
+  if (method_ == Method::tree_elimination) {
+    pivot_.assign(nodes_, 0.0);
+    coupling_.assign(nodes_, 0.0);
+  } else {
+    order_ = {};
+    parent_ = {};
+    parent_edge_ = {};
+    // Each component is named by its lowest node: union-find that keeps the lower root at
+    // every union ends with it as the root.
+    std::vector<std::int32_t> up(nodes_);
+    std::iota(up.begin(), up.end(), 0);
+    for (std::size_t e = 0; e < m; ++e) {
+      const std::int32_t ra = find_root(up, a_[e]), rb = find_root(up, b_[e]);
+      up[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    }
+    component_.resize(nodes_);
+    for (std::int32_t i = 0; i < n; ++i) component_[static_cast<std::size_t>(i)] = find_root(up, i);
+    grounded_.resize(nodes_);
+
+    // The pattern: every edge's off-diagonal entry (doubled edges share one) and the whole
+    // diagonal, analysed once (AMD ordering, elimination tree, column counts).
+    cholesky_ = std::make_unique<Cholesky>();
+    Cholesky& c = *cholesky_;
+    std::vector<Eigen::Triplet<double, int>> pattern;
+    pattern.reserve(nodes_ + m);
+    for (std::int32_t i = 0; i < n; ++i) pattern.emplace_back(i, i, 1.0);
+    for (std::size_t e = 0; e < m; ++e) pattern.emplace_back(std::max(a_[e], b_[e]), std::min(a_[e], b_[e]), 1.0);
+    c.lower.resize(n, n);
+    c.lower.setFromTriplets(pattern.begin(), pattern.end());
+    c.lower.makeCompressed();
+    const int* outer = c.lower.outerIndexPtr();
+    const int* inner = c.lower.innerIndexPtr();
+    auto slot = [&](std::int32_t row, std::int32_t col) {
+      const int* first = inner + outer[col];
+      const int* last = inner + outer[col + 1];
+      return static_cast<Eigen::Index>(std::lower_bound(first, last, row) - inner);
+    };
+    c.diagonal_slot.resize(nodes_);
+    for (std::int32_t i = 0; i < n; ++i) c.diagonal_slot[static_cast<std::size_t>(i)] = slot(i, i);
+    c.edge_slot.resize(m);
+    for (std::size_t e = 0; e < m; ++e) c.edge_slot[e] = slot(std::max(a_[e], b_[e]), std::min(a_[e], b_[e]));
+    if (nodes_ > 0) c.ldlt.analyzePattern(c.lower);
+  }
+}
+
+// No nodes: an empty forest, solved by the elimination (nothing to eliminate).
+NodalSystem::NodalSystem() : method_(Method::tree_elimination) {}
+NodalSystem::~NodalSystem() = default;
+NodalSystem::NodalSystem(NodalSystem&&) noexcept = default;
+NodalSystem& NodalSystem::operator=(NodalSystem&&) noexcept = default;
+
+std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::span<const double> shunt) {
+  if (conductance.size() != a_.size() || shunt.size() != nodes_)
+    throw std::invalid_argument("NodalSystem::factorize: " + std::to_string(conductance.size()) +
+                                " conductances and " + std::to_string(shunt.size()) + " shunts for " +
+                                std::to_string(a_.size()) + " edges and " + std::to_string(nodes_) + " nodes");
+  factorized_ = false;
+  auto bad_value = [](const char* what, std::size_t k, double v) {
+    return std::invalid_argument("NodalSystem::factorize: " + std::string(what) + " " + std::to_string(k) +
+                                 " is " + std::to_string(v));
+  };
+
+  if (method_ == Method::tree_elimination) {
+    // Leaves up. pivot_ first gathers S_i, the conductance to ground of node i's subtree seen
+    // from i (its shunt and its children's subtrees through their edges); eliminating child c
+    // adds g S_c / (g + S_c) to its parent's, the series conductance of its edge and its
+    // subtree: the Schur complement d_p - g^2 / d_c with d_c = g + S_c, but as a sum of
+    // positive terms, without the cancellation of the subtraction (exact to a few ulps
+    // however the conductances spread, as the series/parallel reduction is).
+    for (std::size_t i = 0; i < nodes_; ++i) {
+      if (!(shunt[i] >= 0 && shunt[i] < std::numeric_limits<double>::infinity())) throw bad_value("shunt of node", i, shunt[i]);
+      pivot_[i] = shunt[i];
+    }
+    bool singular = false;
+    for (std::size_t k = nodes_; k-- > 0;) {
+      const auto c = static_cast<std::size_t>(order_[k]);
+      const std::int32_t p = parent_[c];
+      if (p < 0) {
+        // A root's S is its whole component's conductance to ground: a sum of non-negative
+        // terms, zero exactly when no node of the component has a shunt.
+        singular |= !(pivot_[c] > 0);
+        continue;
+      }
+      const auto e = static_cast<std::size_t>(parent_edge_[c]);
+      const double g = conductance[e];
+      if (!(g > 0 && g < std::numeric_limits<double>::infinity())) throw bad_value("conductance of edge", e, g);
+      const double s = pivot_[c];
+      pivot_[c] = g + s;
+      coupling_[c] = g;
+      pivot_[static_cast<std::size_t>(p)] += g * s / (g + s);
+    }
+    if (!singular) {
+      factorized_ = true;
+      return -1;
+    }
+    // Name a singular component by its lowest node (as the Cholesky path does): the lowest
+    // node whose root is singular. Roots come before their descendants in order_.
+    std::vector<std::int32_t> root(nodes_);
+    for (const std::int32_t i : order_) {
+      const std::int32_t p = parent_[static_cast<std::size_t>(i)];
+      root[static_cast<std::size_t>(i)] = p < 0 ? i : root[static_cast<std::size_t>(p)];
+    }
+    for (std::size_t i = 0; i < nodes_; ++i)
+      if (!(pivot_[static_cast<std::size_t>(root[i])] > 0)) return static_cast<std::int64_t>(i);
+  }
+
+  // Sparse Cholesky: refill the analysed pattern's values, shunts on the diagonal.
+  Cholesky& c = *cholesky_;
+  double* value = c.lower.valuePtr();
+  std::fill(value, value + c.lower.nonZeros(), 0.0);
+  std::fill(grounded_.begin(), grounded_.end(), 0);
+  for (std::size_t i = 0; i < nodes_; ++i) {
+    if (!(shunt[i] >= 0 && shunt[i] < std::numeric_limits<double>::infinity())) throw bad_value("shunt of node", i, shunt[i]);
+    value[c.diagonal_slot[i]] = shunt[i];
+    if (shunt[i] > 0) grounded_[static_cast<std::size_t>(component_[i])] = 1;
+  }
+  for (std::size_t e = 0; e < a_.size(); ++e) {
+    const double g = conductance[e];
+    if (!(g > 0 && g < std::numeric_limits<double>::infinity())) throw bad_value("conductance of edge", e, g);
+    value[c.edge_slot[e]] -= g;
+    value[c.diagonal_slot[static_cast<std::size_t>(a_[e])]] += g;
+    value[c.diagonal_slot[static_cast<std::size_t>(b_[e])]] += g;
+  }
+  // A component without a positive shunt is singular exactly; rounding would hide that
+  // behind a pivot of either sign, so it is found from the shunts. Its lowest node names it.
+  for (std::size_t i = 0; i < nodes_; ++i)
+    if (component_[i] == static_cast<std::int32_t>(i) && !grounded_[i]) return static_cast<std::int64_t>(i);
+  if (nodes_ == 0) {
+    factorized_ = true;
+    return -1;
+  }
+  c.ldlt.factorize(c.lower);
+  // Nearly singular (a shunt lost in rounding against the conductances): the component of the
+  // lowest node whose pivot vanishes against its diagonal. Past an exact zero pivot Eigen
+  // stops, and the later pivots are not set.
+  const auto& d = c.ldlt.vectorD();
+  const auto& position = c.ldlt.permutationP().indices();
+  Eigen::Index set = d.size();
+  if (c.ldlt.info() != Eigen::Success) {
+    set = 0;
+    while (set < d.size() && d[set] != 0) ++set;
+    ++set;
+  }
+  std::int64_t singular = -1;
+  for (std::size_t i = 0; i < nodes_; ++i) {
+    const Eigen::Index k = position[static_cast<Eigen::Index>(i)];
+    if (k < set && !(d[k] > singular_pivot * value[c.diagonal_slot[i]])) {
+      const std::int64_t named = component_[i];
+      if (singular < 0 || named < singular) singular = named;
+    }
+  }
+  if (singular >= 0) return singular;
+  factorized_ = true;
+  return -1;
+}
+
+void NodalSystem::solve(std::span<const double> b, std::span<double> x) const {
+  if (b.size() != nodes_ || x.size() != nodes_)
+    throw std::invalid_argument("NodalSystem::solve: right-hand side of " + std::to_string(b.size()) +
+                                " and solution of " + std::to_string(x.size()) + " for " + std::to_string(nodes_) +
+                                " nodes");
+  if (!factorized_) throw std::logic_error("NodalSystem::solve: no successful factorisation to solve with");
+  if (method_ == Method::tree_elimination) {
+    // x holds y, the right-hand side as the elimination transforms it: leaves up, each child's
+    // current reaches its parent through the divider g / d_c; then roots down, each node from
+    // its own row once its parent is known.
+    if (x.data() != b.data()) std::copy(b.begin(), b.end(), x.begin());
+    for (std::size_t k = nodes_; k-- > 0;) {
+      const auto c = static_cast<std::size_t>(order_[k]);
+      const std::int32_t p = parent_[c];
+      if (p >= 0) x[static_cast<std::size_t>(p)] += coupling_[c] * x[c] / pivot_[c];
+    }
+    for (std::size_t k = 0; k < nodes_; ++k) {
+      const auto i = static_cast<std::size_t>(order_[k]);
+      const std::int32_t p = parent_[i];
+      x[i] = (p >= 0 ? x[i] + coupling_[i] * x[static_cast<std::size_t>(p)] : x[i]) / pivot_[i];
+    }
+    return;
+  }
+  // Eigen permutes b into x first (in place if they are one array) and works in x from there.
+  const Eigen::Map<const Eigen::VectorXd> rhs(b.data(), static_cast<Eigen::Index>(nodes_));
+  Eigen::Map<Eigen::VectorXd> solution(x.data(), static_cast<Eigen::Index>(nodes_));
+  solution = cholesky_->ldlt.solve(rhs);
+}
+
+}  // namespace hemotree

@@ -1,0 +1,73 @@
+// The one linear system behind every network-flow problem of hemotree, in the node
+// potentials x (pressures):
+//
+//   (sum_e g_e (u_a - u_b)(u_a - u_b)^T + diag(s)) x = b
+//
+// a graph Laplacian weighted by the edges' conductances g_e (vessels: 1/R, or
+// 1/(R + 3L/(2 dt)) for a step of the 0D vessels) plus a diagonal of shunts s_i (conductances
+// to ground: outlets, C/dt of compliances). It is symmetric positive definite when every
+// connected component has a positive shunt. The steady flow (no time derivative), the
+// compliance balance and each implicit step of the 0D vessels are this system with other
+// conductances and shunts.
+//
+// The graph is fixed at construction; conductances and shunts change with every
+// factorisation. On a forest the factorisation is the elimination from the leaves up, which
+// makes no fill: O(nodes) to factorise and to solve. On any other graph (loops, parallel
+// edges) it is Eigen's sparse Cholesky (SimplicialLDLT, AMD ordering, the pattern analysed
+// once). Both give the same solution to rounding (tests/test_nodal_system).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace hemotree {
+
+class NodalSystem {
+ public:
+  enum class Method { automatic, tree_elimination, sparse_cholesky };
+
+  // Edges join nodes a[e] and b[e] (indices below nodes, a[e] != b[e]; std::invalid_argument
+  // otherwise). automatic: tree_elimination on a forest, else sparse_cholesky;
+  // tree_elimination on a graph that is not a forest is std::invalid_argument.
+  NodalSystem();  // of no nodes (defined with the Cholesky type complete)
+  NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::vector<std::int32_t> b,
+              Method method = Method::automatic);
+  ~NodalSystem();
+  NodalSystem(NodalSystem&&) noexcept;
+  NodalSystem& operator=(NodalSystem&&) noexcept;
+
+  std::size_t node_count() const { return nodes_; }
+  std::size_t edge_count() const { return a_.size(); }
+  std::span<const std::int32_t> edge_a() const { return a_; }
+  std::span<const std::int32_t> edge_b() const { return b_; }
+  Method method() const { return method_; }  // the one in use: never automatic
+
+  // conductance: per edge, > 0; shunt: per node, >= 0. Returns -1, or a node of a connected
+  // component that has no path to ground (no positive shunt: the system is singular), its
+  // lowest; the sparse Cholesky also names a component whose shunts are lost in rounding
+  // against its conductances (a pivot below 1e-13 of its diagonal).
+  std::int64_t factorize(std::span<const double> conductance, std::span<const double> shunt);
+  // x = system^-1 b with the last factorisation (x may alias b).
+  void solve(std::span<const double> b, std::span<double> x) const;
+
+ private:
+  std::size_t nodes_ = 0;
+  std::vector<std::int32_t> a_, b_;
+  Method method_ = Method::automatic;
+  // Tree elimination: the nodes with every parent before its children (their own order where
+  // every node hangs from a lower one, else the reverse of the order in which peeling leaves
+  // removes them), each node's parent and the edge to it (-1 at roots), and the pivots.
+  std::vector<std::int32_t> order_, parent_, parent_edge_;
+  std::vector<double> pivot_, coupling_;  // per node: d_i after eliminating its subtree; g to parent
+  struct Cholesky;  // Eigen's factorisation, out of this header
+  std::unique_ptr<Cholesky> cholesky_;
+  // Sparse Cholesky: each node's component, named by its lowest node, and per component
+  // whether it has a shunt (scratch). Whether the last factorisation succeeded.
+  std::vector<std::int32_t> component_;
+  std::vector<unsigned char> grounded_;
+  bool factorized_ = false;
+};
+
+}  // namespace hemotree

@@ -1,0 +1,310 @@
+// The nodal system (network_flow/nodal_system) against dense solves of the same matrix built
+// here independently, and its two methods against each other.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include "network_flow/nodal_system.hpp"
+
+using namespace hemotree;
+using Method = NodalSystem::Method;
+
+namespace {
+
+struct Graph {
+  std::size_t nodes = 0;
+  std::vector<std::int32_t> a, b;
+};
+
+// (sum_e g_e (u_a - u_b)(u_a - u_b)^T + diag(s)), entry by entry.
+Eigen::MatrixXd dense_matrix(const Graph& graph, const std::vector<double>& g, const std::vector<double>& s) {
+  const auto n = static_cast<Eigen::Index>(graph.nodes);
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(n, n);
+  for (std::size_t e = 0; e < graph.a.size(); ++e) {
+    const Eigen::Index i = graph.a[e], j = graph.b[e];
+    m(i, i) += g[e];
+    m(j, j) += g[e];
+    m(i, j) -= g[e];
+    m(j, i) -= g[e];
+  }
+  for (Eigen::Index i = 0; i < n; ++i) m(i, i) += s[static_cast<std::size_t>(i)];
+  return m;
+}
+
+std::vector<double> dense_solve(const Graph& graph, const std::vector<double>& g, const std::vector<double>& s,
+                                const std::vector<double>& rhs) {
+  const Eigen::VectorXd x =
+      dense_matrix(graph, g, s).partialPivLu().solve(Eigen::Map<const Eigen::VectorXd>(rhs.data(), rhs.size()));
+  return {x.data(), x.data() + x.size()};
+}
+
+// The 2-norm condition number: a dense solve is good to about cond * 1e-16, so the tests
+// that compare with one keep it below 1e4 (their tolerance, 1e-12, then holds with margin).
+double condition(const Graph& graph, const std::vector<double>& g, const std::vector<double>& s) {
+  const Eigen::VectorXd lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dense_matrix(graph, g, s)).eigenvalues();
+  return lambda.maxCoeff() / lambda.minCoeff();
+}
+
+// max_i |x_i - y_i| / max_i |y_i|
+double relative_difference(const std::vector<double>& x, const std::vector<double>& y) {
+  double diff = 0, scale = 0;
+  for (std::size_t i = 0; i < y.size(); ++i) {
+    diff = std::max(diff, std::abs(x[i] - y[i]));
+    scale = std::max(scale, std::abs(y[i]));
+  }
+  return diff / scale;
+}
+
+std::vector<double> solved(NodalSystem& system, const std::vector<double>& g, const std::vector<double>& s,
+                           const std::vector<double>& rhs) {
+  EXPECT_EQ(system.factorize(g, s), -1);
+  std::vector<double> x(rhs.size());
+  system.solve(rhs, x);
+  return x;
+}
+
+std::vector<double> uniform(std::size_t count, double low, double high, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(low, high);
+  std::vector<double> v(count);
+  for (double& x : v) x = u(rng);
+  return v;
+}
+
+// Conductances over four decades, as vessels' 1/R spread.
+std::vector<double> log_uniform(std::size_t count, double low, double high, std::mt19937_64& rng) {
+  std::vector<double> v = uniform(count, std::log(low), std::log(high), rng);
+  for (double& x : v) x = std::exp(x);
+  return v;
+}
+
+// A ring of five nodes with two chords (0-2, 1-3): loops, no parallel edge.
+Graph ring_with_chords() {
+  return {5, {0, 1, 2, 3, 4, 0, 1}, {1, 2, 3, 4, 0, 2, 3}};
+}
+
+// A random tree: node k > 0 hangs from a random earlier node, numbered so (as a grown network
+// is: the system takes its own order then) or under shuffled labels (it peels leaves then).
+Graph random_tree(std::size_t nodes, std::mt19937_64& rng, bool shuffled = true) {
+  std::vector<std::int32_t> label(nodes);
+  for (std::size_t k = 0; k < nodes; ++k) label[k] = static_cast<std::int32_t>(k);
+  if (shuffled) std::shuffle(label.begin(), label.end(), rng);
+  Graph t;
+  t.nodes = nodes;
+  for (std::size_t k = 1; k < nodes; ++k) {
+    std::uniform_int_distribution<std::size_t> earlier(0, k - 1);
+    t.a.push_back(label[earlier(rng)]);
+    t.b.push_back(label[k]);
+  }
+  return t;
+}
+
+}  // namespace
+
+TEST(NodalSystem, ALoopedGraphAgreesWithADenseSolve) {
+  std::mt19937_64 rng(7);
+  const Graph graph = ring_with_chords();
+  const std::vector<double> g = log_uniform(graph.a.size(), 1e-1, 1e1, rng);
+  const std::vector<double> s{0, 0.3, 0, 0, 2.5};
+  const std::vector<double> rhs = uniform(graph.nodes, -1, 1, rng);
+  ASSERT_LT(condition(graph, g, s), 1e4);
+  NodalSystem system(graph.nodes, graph.a, graph.b);
+  EXPECT_EQ(system.method(), Method::sparse_cholesky);
+  EXPECT_EQ(system.node_count(), 5u);
+  EXPECT_EQ(system.edge_count(), 7u);
+  const std::vector<double> x = solved(system, g, s, rhs);
+  EXPECT_LT(relative_difference(x, dense_solve(graph, g, s, rhs)), 1e-12);
+  // And the residual of the matrix built here, against its scale (entries up to ~30).
+  const Eigen::VectorXd residual = dense_matrix(graph, g, s) * Eigen::Map<const Eigen::VectorXd>(x.data(), 5) -
+                                   Eigen::Map<const Eigen::VectorXd>(rhs.data(), 5);
+  EXPECT_LT(residual.lpNorm<Eigen::Infinity>(), 1e-13);
+}
+
+TEST(NodalSystem, ADoubledEdgeAddsItsConductances) {
+  NodalSystem doubled(2, {0, 1}, {1, 0});
+  EXPECT_EQ(doubled.method(), Method::sparse_cholesky);
+  const std::vector<double> x = solved(doubled, {1.0, 3.0}, {0.0, 1.0}, {1.0, 0.0});
+  // 1 A into node 0, through 1/4 ohm to node 1, through 1 ohm to ground.
+  EXPECT_NEAR(x[1], 1.0, 1e-15);
+  EXPECT_NEAR(x[0], 1.25, 1e-15);
+}
+
+// A step of compliant vessels: conductances over two decades, C/dt at every node.
+TEST(NodalSystem, ALargeRandomTreeSolvesTheSameByBothMethods) {
+  std::mt19937_64 rng(2024);
+  for (const bool shuffled : {false, true}) {
+    const Graph tree = random_tree(2000, rng, shuffled);
+    const std::vector<double> g = log_uniform(tree.a.size(), 1e-1, 1e1, rng);
+    const std::vector<double> s = uniform(tree.nodes, 1e-2, 1e-1, rng);
+    const std::vector<double> rhs = uniform(tree.nodes, -1, 1, rng);
+    NodalSystem automatic(tree.nodes, tree.a, tree.b);
+    NodalSystem cholesky(tree.nodes, tree.a, tree.b, Method::sparse_cholesky);
+    EXPECT_EQ(automatic.method(), Method::tree_elimination);
+    EXPECT_EQ(cholesky.method(), Method::sparse_cholesky);
+    EXPECT_LT(relative_difference(solved(automatic, g, s, rhs), solved(cholesky, g, s, rhs)), 1e-12)
+        << "shuffled " << shuffled;
+  }
+}
+
+// Grounded at a tenth of its nodes, as a network at its outlets; numbered from its root and
+// not.
+TEST(NodalSystem, ATreeAgreesWithADenseSolve) {
+  std::mt19937_64 rng(99);
+  for (const bool shuffled : {false, true}) {
+    const Graph tree = random_tree(200, rng, shuffled);
+    const std::vector<double> g = log_uniform(tree.a.size(), 1e-1, 1e1, rng);
+    std::vector<double> s(tree.nodes, 0.0);
+    for (std::size_t i = 0; i < tree.nodes; i += 10) s[i] = 0.5;
+    const std::vector<double> rhs = uniform(tree.nodes, -1, 1, rng);
+    ASSERT_LT(condition(tree, g, s), 1e4);
+    NodalSystem elimination(tree.nodes, tree.a, tree.b, Method::tree_elimination);
+    NodalSystem cholesky(tree.nodes, tree.a, tree.b, Method::sparse_cholesky);
+    const std::vector<double> exact = dense_solve(tree, g, s, rhs);
+    EXPECT_LT(relative_difference(solved(elimination, g, s, rhs), exact), 1e-12) << "shuffled " << shuffled;
+    EXPECT_LT(relative_difference(solved(cholesky, g, s, rhs), exact), 1e-12) << "shuffled " << shuffled;
+  }
+}
+
+// A chain of 1000 nodes, conductances over twelve decades, grounded through 1 at its far end
+// and fed 1 at node 0: node k sits at the sum of the resistances from it to ground. The
+// elimination adds series conductances as g S / (g + S), never subtracting, so it gets every
+// node's potential to a few ulps per node of the chain (measured: 4e-15), where the condition
+// number allows a factorisation that subtracts far less: the sparse Cholesky, in its AMD
+// order, is off by 7e-4 here.
+TEST(NodalSystem, TheEliminationIsExactToRoundingAlongAnIllConditionedChain) {
+  std::mt19937_64 rng(3);
+  const std::size_t n = 1000;
+  Graph chain{n, {}, {}};
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    chain.a.push_back(static_cast<std::int32_t>(k));
+    chain.b.push_back(static_cast<std::int32_t>(k + 1));
+  }
+  const std::vector<double> g = log_uniform(n - 1, 1e-6, 1e6, rng);
+  std::vector<double> s(n, 0.0), rhs(n, 0.0);
+  s[n - 1] = 1.0;
+  rhs[0] = 1.0;
+  NodalSystem system(chain.nodes, chain.a, chain.b);
+  ASSERT_EQ(system.method(), Method::tree_elimination);
+  const std::vector<double> x = solved(system, g, s, rhs);
+  long double beyond = 1;  // the resistance from node k to ground, summed from the far end
+  for (std::size_t k = n; k-- > 0;) {
+    EXPECT_NEAR(x[k], static_cast<double>(beyond), 1e-12 * static_cast<double>(beyond)) << "node " << k;
+    if (k > 0) beyond += 1.0L / g[k - 1];
+  }
+}
+
+// A chain 0 - 1 - 2 - 3 of unit conductances grounded at 3 through 1: a current I into node 0
+// flows through all four resistances in series, so node k sits at (4 - k) I.
+TEST(NodalSystem, AChainIsFourResistancesInSeries) {
+  for (const Method method : {Method::tree_elimination, Method::sparse_cholesky}) {
+    NodalSystem chain(4, {2, 1, 0}, {3, 2, 1}, method);
+    const std::vector<double> x = solved(chain, {1, 1, 1}, {0, 0, 0, 1}, {2, 0, 0, 0});
+    for (std::size_t k = 0; k < 4; ++k) EXPECT_NEAR(x[k], 2.0 * (4.0 - static_cast<double>(k)), 1e-14);
+  }
+}
+
+TEST(NodalSystem, AForestOfTwoTreesEachWithAShunt) {
+  std::mt19937_64 rng(5);
+  // Nodes 0..3 a star around 2, nodes 4..6 a chain; interleaved labels would not matter.
+  const Graph forest{7, {2, 2, 2, 4, 5}, {0, 1, 3, 5, 6}};
+  const std::vector<double> g = uniform(forest.a.size(), 0.5, 2, rng);
+  const std::vector<double> s{0, 0, 0, 0.7, 0, 0, 1.3};
+  const std::vector<double> rhs = uniform(forest.nodes, -1, 1, rng);
+  for (const Method method : {Method::automatic, Method::sparse_cholesky}) {
+    NodalSystem system(forest.nodes, forest.a, forest.b, method);
+    EXPECT_EQ(system.method(), method == Method::automatic ? Method::tree_elimination : method);
+    EXPECT_LT(relative_difference(solved(system, g, s, rhs), dense_solve(forest, g, s, rhs)), 1e-12);
+  }
+}
+
+// The second tree of the forest has no shunt: its lowest node (4) is named, by both methods;
+// on the looped graph, the whole graph when no node has a shunt.
+TEST(NodalSystem, AComponentWithoutAPathToGroundIsNamed) {
+  const Graph forest{7, {2, 2, 2, 5, 4}, {0, 1, 3, 6, 5}};
+  const std::vector<double> g(forest.a.size(), 1.0);
+  const std::vector<double> s{0, 0.2, 0, 0, 0, 0, 0};
+  for (const Method method : {Method::tree_elimination, Method::sparse_cholesky}) {
+    NodalSystem system(forest.nodes, forest.a, forest.b, method);
+    EXPECT_EQ(system.factorize(g, s), 4);
+    std::vector<double> x(forest.nodes);
+    EXPECT_THROW(system.solve(x, x), std::logic_error);  // nothing to solve with
+  }
+  const Graph ring = ring_with_chords();
+  NodalSystem looped(ring.nodes, ring.a, ring.b);
+  EXPECT_EQ(looped.factorize(std::vector<double>(ring.a.size(), 1.0), std::vector<double>(ring.nodes, 0.0)), 0);
+  // An isolated node without a shunt is a component of its own.
+  NodalSystem lonely(3, {0}, {1});
+  EXPECT_EQ(lonely.factorize(std::vector<double>{1.0}, std::vector<double>{1.0, 0, 0}), 2);
+}
+
+// A shunt lost in rounding (1e-16 against conductances of 1): the sparse Cholesky's last pivot
+// is rounding noise, and it reports the system singular rather than solve it; the tree
+// elimination adds the series conductances without subtracting and solves it exactly: 1 into
+// node 0 through two unit resistances and 1e16 to ground.
+TEST(NodalSystem, AShuntLostInRoundingIsSingularOnlyToTheCholesky) {
+  const std::vector<double> g{1.0, 1.0}, s{0, 0, 1e-16};
+  NodalSystem cholesky(3, {0, 1}, {1, 2}, Method::sparse_cholesky);
+  EXPECT_EQ(cholesky.factorize(g, s), 0);
+  NodalSystem elimination(3, {0, 1}, {1, 2}, Method::tree_elimination);
+  const std::vector<double> x = solved(elimination, g, s, {1, 0, 0});
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(x[k], 1e16 + static_cast<double>(2 - k), 1e-15 * 1e16);
+}
+
+TEST(NodalSystem, RefusesMalformedGraphs) {
+  EXPECT_THROW(NodalSystem(3, {0, 1}, {1, 1}), std::invalid_argument);   // a self-loop
+  EXPECT_THROW(NodalSystem(3, {0, 1}, {1, 3}), std::invalid_argument);   // node 3 of 3
+  EXPECT_THROW(NodalSystem(3, {0, -1}, {1, 2}), std::invalid_argument);  // negative
+  EXPECT_THROW(NodalSystem(3, {0, 1}, {1}), std::invalid_argument);      // ends unpaired
+  const Graph ring = ring_with_chords();
+  EXPECT_THROW(NodalSystem(ring.nodes, ring.a, ring.b, Method::tree_elimination), std::invalid_argument);
+  EXPECT_THROW(NodalSystem(2, {0, 1}, {1, 0}, Method::tree_elimination), std::invalid_argument);
+  NodalSystem chain(3, {0, 1}, {1, 2});
+  EXPECT_THROW(chain.factorize(std::vector<double>{1.0}, std::vector<double>{1, 1, 1}), std::invalid_argument);
+  EXPECT_THROW(chain.factorize(std::vector<double>{1.0, 0.0}, std::vector<double>{1, 1, 1}), std::invalid_argument);
+  EXPECT_THROW(chain.factorize(std::vector<double>{1.0, 1.0}, std::vector<double>{1, -1, 1}), std::invalid_argument);
+}
+
+// A second factorisation with other conductances and shunts solves the new system, and the
+// solution may overwrite the right-hand side.
+TEST(NodalSystem, RefactorisingSolvesTheNewSystem) {
+  std::mt19937_64 rng(31);
+  const Graph tree = random_tree(300, rng);
+  const Graph ring = ring_with_chords();
+  for (const Graph* graph : {&tree, &ring})
+    for (const Method method : {Method::automatic, Method::sparse_cholesky}) {
+      NodalSystem system(graph->nodes, graph->a, graph->b, method);
+      const std::vector<double> rhs = uniform(graph->nodes, -1, 1, rng);
+      const std::vector<double> g1 = log_uniform(graph->a.size(), 1e-1, 1e1, rng);
+      const std::vector<double> s1 = uniform(graph->nodes, 0, 1, rng);
+      const std::vector<double> g2 = log_uniform(graph->a.size(), 1, 1e1, rng);
+      std::vector<double> s2(graph->nodes, 0.0);
+      for (std::size_t i = 3; i < graph->nodes; i += 4) s2[i] = 4.0;
+      ASSERT_LT(condition(*graph, g1, s1), 1e4);
+      ASSERT_LT(condition(*graph, g2, s2), 1e4);
+      EXPECT_LT(relative_difference(solved(system, g1, s1, rhs), dense_solve(*graph, g1, s1, rhs)), 1e-12);
+      ASSERT_EQ(system.factorize(g2, s2), -1);
+      std::vector<double> x = rhs;
+      system.solve(x, x);  // in place
+      EXPECT_LT(relative_difference(x, dense_solve(*graph, g2, s2, rhs)), 1e-12);
+    }
+}
+
+TEST(NodalSystem, MovesKeepTheFactorisation) {
+  NodalSystem chain(3, {0, 1}, {1, 2});
+  ASSERT_EQ(chain.factorize(std::vector<double>{1.0, 1.0}, std::vector<double>{0, 0, 1}), -1);
+  NodalSystem moved(std::move(chain));
+  std::vector<double> x{1, 0, 0};
+  moved.solve(x, x);
+  EXPECT_NEAR(x[0], 3.0, 1e-15);
+  NodalSystem looped(2, {0, 1}, {1, 0});
+  looped = std::move(moved);
+  EXPECT_EQ(looped.method(), Method::tree_elimination);
+  x = {0, 0, 1};
+  looped.solve(x, x);
+  EXPECT_NEAR(x[0], 1.0, 1e-15);
+}
