@@ -1,6 +1,7 @@
-// A linear resistive tree with loads: the network's vessels (Poiseuille resistances) and
-// outlets (R to ground; RCR as R1 to a capacitor node and R2 to ground), the inlet open, and
-// at every node and every capacitor node a conductance to ground and an injected current.
+// A linear resistive network with loads (a tree, as a rule): the network's vessels
+// (Poiseuille resistances) and outlets (R to ground; RCR as R1 to a capacitor node and R2 to
+// ground), the inlet open, and at every node and every capacitor node a conductance to ground
+// and an injected current.
 // Its potentials are what the slow drift of the network's compliances towards the periodic
 // state needs (PulseSolver::balance_compliances): pressure shifts in Pa for volume rates in
 // m^3/s. Outflow pressures are zero: the tree is the network's response to disturbances.
@@ -22,9 +23,12 @@ struct TreePotentials {
   std::vector<double> capacitor;  // per outlet: the capacitor node's (RCR), else 0 [Pa]
 };
 
-// Series and parallel reduction from the leaves up, potentials from the root down: O(vessels).
-// Throws InputError as solve_steady_flow does (not a rooted tree, a terminal vessel without
-// an outlet, a reflection outlet), and where a subtree has no path to ground.
+// The nodal system (network_flow/nodal_system.hpp) of the network's nodes and the RCR outlets'
+// capacitor nodes (node -R1- capacitor node -R2- ground): on a tree the elimination from the
+// leaves up, O(vessels); the network may have loops too (a sparse Cholesky factorisation
+// then). Throws InputError where steady_outlets does (a terminal vessel without an outlet, an
+// outlet on a vessel that is not terminal, a reflection outlet), and where a part of the
+// network has no path to ground.
 TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& resistance, const TreeLoads& loads);
 
 }  // namespace hemotree

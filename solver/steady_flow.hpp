@@ -4,6 +4,7 @@
 // vprune checks its outlets with it; hemosolve starts from it instead of from rest.
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -31,16 +32,29 @@ struct Equivalent {
 };
 
 // For every vessel of a rooted tree, what lies beyond its distal node (its daughters'
-// subtrees in parallel, or its outlet) reduced to a Thevenin equivalent.
+// subtrees in parallel, or its outlet) reduced to a Thevenin equivalent: series and parallel
+// reduction from the leaves up, O(vessels). Throws InputError where check_rooted_tree does.
 std::vector<Equivalent> reduce_beyond(const Network& net, const std::vector<double>& resistance);
 
-// Solves the steady flow of a rooted tree (check_rooted_tree) fed by inlet_flow [m^3/s] at
-// the root, every terminal vessel ending in an outlet (RCR or R: their total resistance to
-// p_out). Series and parallel reduction from the leaves up, then flows and pressures from
-// the root down: O(vessels), exact up to rounding. InputError names a terminal vessel
-// without an outlet, an outlet on a vessel that is not terminal, or a reflection outlet
-// (which has no steady resistance).
-// beyond, when given, receives reduce_beyond's equivalents (computed on the way).
+// The outlet of every vessel (its index in net.outlets, -1 for none), having checked that the
+// outlets sit on exactly the terminal vessels (those whose distal node no vessel leaves), one
+// each, none a reflection outlet (which has no steady resistance) and each with a positive
+// resistance: InputError otherwise, naming the vessel.
+std::vector<std::int32_t> steady_outlets(const Network& net);
+
+// Solves the steady flow of a network fed by inlet_flow [m^3/s] at its inlet vessel's `from`
+// node (net.inlet's vessel; without one, the only vessel that no vessel feeds), every terminal
+// vessel ending in an outlet (RCR or R: their total resistance to p_out). The network may
+// have loops: its node pressures solve the nodal system (network_flow/nodal_system.hpp) of
+// the vessels' conductances 1/R and the outlets' shunts 1/R to p_out, and each vessel's flow
+// is its pressure drop over R. On a tree that is the elimination from the leaves up, O(vessels)
+// and exact to rounding (as the series/parallel reduction it replaces); with loops, a sparse
+// Cholesky factorisation. InputError where steady_outlets throws, for an inlet that another
+// vessel feeds, a vessel that no vessel feeds and does not start at the inlet's node (an
+// open end with neither inflow nor outlet), a vessel not connected to the inlet, or a
+// network with no outlet.
+// beyond, when given, receives reduce_beyond's equivalents (a pass of its own, for a rooted
+// tree only: InputError on any other network).
 SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
                              double inlet_flow, std::vector<Equivalent>* beyond = nullptr);
 
@@ -53,8 +67,9 @@ SteadyFlow solve_steady_flow(const Network& net);
 // the inlet at 68.6 mmHg, the distended vessels at 62.6 mmHg). Fixed-point
 // iteration from the rigid solution: resistances at the distended lumens, then flows and
 // pressures again, until no pressure changes by more than 1e-9 of the inlet's (about 20
-// sweeps). resistance, when given, receives the final ones. Throws InputError where
-// solve_steady_flow does, or where a lumen collapses.
+// sweeps; the nodal system is analysed once and refactorised each sweep). resistance, when
+// given, receives the final ones. Throws InputError where solve_steady_flow does, or where a
+// lumen collapses.
 // blood: the run's (its rheology may differ from the file's).
 SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const VesselLaw> laws,
                                        const ViscosityTable& viscosity, double inlet_flow,

@@ -1,12 +1,15 @@
 // The steady Poiseuille-Pries solver against hand calculations.
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "cli/errors.hpp"
 #include "formats/network_io.hpp"
 #include "physics/rheology.hpp"
+#include "solver/loaded_tree.hpp"
 #include "solver/steady_flow.hpp"
 #include "tests/network_builders.hpp"
 
@@ -114,4 +117,107 @@ TEST(SteadyFlow, RefusesNetworksItCannotSolve) {
   net.outlets.push_back(reflecting);
   EXPECT_THROW(solve_steady_flow(net, r, 1e-6), InputError);
   EXPECT_THROW(solve_steady_flow(bifurcation(1e-3, 8e-4, 6e-4)), InputError);  // no inlet
+}
+
+// A network with a loop: vessel 0 splits at node 1 into two branches (vessels 1 then 3, and
+// 2 then 4) that rejoin at node 4, and vessel 5 leads to the one outlet. By hand: the whole
+// inflow passes vessels 0 and 5 and the outlet, and the branches (3 + 4 = 7 and 2 + 8 = 10,
+// in 1e9 Pa s/m^3) share it in inverse proportion to their resistances: in parallel, 70/17.
+TEST(SteadyFlow, ALoopSplitsTheFlowAsParallelResistances) {
+  Network net;
+  for (int n = 0; n < 6; ++n) net.add_node(n);
+  const int from[] = {0, 1, 1, 2, 3, 4}, to[] = {1, 2, 3, 4, 4, 5};
+  for (int v = 0; v < 6; ++v) net.add_vessel(v, from[v], to[v], 0.01, 1e-3, 1e-4, 2e5, v == 0 ? 0 : 1);
+  net.outlets.push_back(resistance_outlet(5, 7e9, 1000.0));
+  const std::vector<double> r{1e9, 3e9, 2e9, 4e9, 8e9, 6e9};
+  const double q = 2e-6;
+  const SteadyFlow s = solve_steady_flow(net, r, q);
+  const double p5 = 1000 + q * 7e9, p4 = p5 + q * 6e9;
+  const double r_a = 3e9 + 4e9, r_b = 2e9 + 8e9, parallel = r_a * r_b / (r_a + r_b);
+  const double p1 = p4 + q * parallel, q_a = q * r_b / (r_a + r_b), q_b = q - q_a;
+  EXPECT_NEAR(s.node_pressure[5], p5, 1e-12 * p5);
+  EXPECT_NEAR(s.node_pressure[4], p4, 1e-12 * p4);
+  EXPECT_NEAR(s.node_pressure[1], p1, 1e-12 * p1);
+  EXPECT_NEAR(s.node_pressure[2], p1 - q_a * 3e9, 1e-12 * p1);
+  EXPECT_NEAR(s.node_pressure[3], p1 - q_b * 2e9, 1e-12 * p1);
+  EXPECT_NEAR(s.inlet_pressure, p1 + q * 1e9, 1e-12 * p1);
+  EXPECT_NEAR(s.node_pressure[0], s.inlet_pressure, 0.0);
+  const double expected_flow[] = {q, q_a, q_b, q_a, q_b, q};
+  for (int v = 0; v < 6; ++v) EXPECT_NEAR(s.flow[v], expected_flow[v], 1e-12 * q) << "vessel " << v;
+  // The loaded network (its outflow pressures zero) with the inflow injected at the inlet's
+  // node is the same system: its potentials are the pressures above p_out.
+  TreeLoads loads;
+  loads.node_shunt.assign(6, 0.0);
+  loads.node_current.assign(6, 0.0);
+  loads.node_current[0] = q;
+  loads.capacitor_shunt.assign(1, 0.0);
+  loads.capacitor_current.assign(1, 0.0);
+  const TreePotentials loaded = solve_loaded_tree(net, r, loads);
+  for (std::size_t k = 0; k < 6; ++k)
+    EXPECT_NEAR(loaded.node[k], s.node_pressure[k] - 1000, 1e-12 * p1) << "node " << k;
+  // Through the network's own file fields too: with an inlet, blood, and Poiseuille resistances
+  // it solves (the equal branches then split the flow evenly).
+  net.inlet = Inlet{};
+  net.inlet->waveform.mean = q;
+  const SteadyFlow own = solve_steady_flow(net);
+  EXPECT_NEAR(own.flow[1], q / 2, 1e-12 * q);
+  EXPECT_NEAR(own.flow[5], q, 1e-12 * q);
+  // The two branches as two vessels between the same nodes 1 and 2 (2 and 4 in parallel,
+  // 4/3), then vessel 3 to the outlet.
+  Network doubled;
+  for (int n = 0; n < 4; ++n) doubled.add_node(n);
+  doubled.add_vessel(0, 0, 1, 0.01, 1e-3, 1e-4, 2e5, 0);
+  doubled.add_vessel(1, 1, 2, 0.01, 1e-3, 1e-4, 2e5, 1);
+  doubled.add_vessel(2, 1, 2, 0.01, 1e-3, 1e-4, 2e5, 1);
+  doubled.add_vessel(3, 2, 3, 0.01, 1e-3, 1e-4, 2e5, 2);
+  doubled.outlets.push_back(resistance_outlet(3, 7e9, 1000.0));
+  const SteadyFlow d = solve_steady_flow(doubled, {1e9, 2e9, 4e9, 6e9}, q);
+  EXPECT_NEAR(d.inlet_pressure, 1000 + q * (1e9 + 4e9 / 3 + 6e9 + 7e9), 1e-12 * d.inlet_pressure);
+  EXPECT_NEAR(d.flow[1], 2 * q / 3, 1e-12 * q);
+  EXPECT_NEAR(d.flow[2], q / 3, 1e-12 * q);
+  // A loop is no rooted tree: the Thevenin equivalents (reduce_beyond) refuse it.
+  std::vector<Equivalent> beyond;
+  EXPECT_THROW(solve_steady_flow(net, r, q, &beyond), InputError);
+}
+
+// Where the network does not hang together as one inflow to its outlets.
+TEST(SteadyFlow, RefusesOpenEndsAndPartsApartFromTheInlet) {
+  auto expect_refusal = [&](const Network& net, const std::string& fragment) {
+    try {
+      solve_steady_flow(net, std::vector<double>(net.vessel_count(), 1e9), 1e-6);
+      ADD_FAILURE() << "no refusal, expected: " << fragment;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  // A second vessel fed by no vessel: 0 -> 1 <- 2, then 1 -> 3.
+  Network two_roots;
+  for (int n = 0; n < 4; ++n) two_roots.add_node(n);
+  two_roots.add_vessel(0, 0, 1, 0.01, 1e-3, 1e-4, 2e5, 0);
+  two_roots.add_vessel(1, 2, 1, 0.01, 1e-3, 1e-4, 2e5, 0);
+  two_roots.add_vessel(2, 1, 3, 0.01, 1e-3, 1e-4, 2e5, 1);
+  two_roots.outlets.push_back(resistance_outlet(2, 1e9, 0));
+  expect_refusal(two_roots, "vessel 0 and vessel 1 are both fed by no vessel");
+  two_roots.inlet = Inlet{};
+  expect_refusal(two_roots, "vessel 1 is fed by no vessel and does not start at the inlet");
+  two_roots.inlet->vessel = 2;
+  expect_refusal(two_roots, "inlet: vessel 2 is not a root");
+  // A closed loop beside the tree, drained by an outlet: 0 -> 1 (outlet), and 2 -> 3 -> 4 -> 2
+  // with 4 -> 5 (outlet).
+  Network apart;
+  for (int n = 0; n < 6; ++n) apart.add_node(n);
+  apart.add_vessel(0, 0, 1, 0.01, 1e-3, 1e-4, 2e5, 0);
+  apart.add_vessel(1, 2, 3, 0.01, 1e-3, 1e-4, 2e5, 0);
+  apart.add_vessel(2, 3, 4, 0.01, 1e-3, 1e-4, 2e5, 0);
+  apart.add_vessel(3, 4, 2, 0.01, 1e-3, 1e-4, 2e5, 0);
+  apart.add_vessel(4, 4, 5, 0.01, 1e-3, 1e-4, 2e5, 0);
+  apart.outlets = {resistance_outlet(0, 1e9, 0), resistance_outlet(4, 1e9, 0)};
+  expect_refusal(apart, "vessel 1 is not connected to the inlet");
+  // A loop without a way out: 0 -> 1 -> 2 -> 1, no terminal vessel, no outlet.
+  Network closed;
+  for (int n = 0; n < 3; ++n) closed.add_node(n);
+  closed.add_vessel(0, 0, 1, 0.01, 1e-3, 1e-4, 2e5, 0);
+  closed.add_vessel(1, 1, 2, 0.01, 1e-3, 1e-4, 2e5, 1);
+  closed.add_vessel(2, 2, 1, 0.01, 1e-3, 1e-4, 2e5, 1);
+  expect_refusal(closed, "no outlet");
 }
