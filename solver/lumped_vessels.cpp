@@ -1,0 +1,388 @@
+#include "solver/lumped_vessels.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "cli/errors.hpp"
+#include "solver/solution_breakdown.hpp"
+
+namespace hemotree {
+
+LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws, const ViscosityTable& viscosity,
+                             const Blood& blood, const std::vector<bool>& zero_d)
+    : density_(blood.density), friction_k_(friction_coefficient(blood.alpha)), viscosity_(&viscosity) {
+  const std::size_t n = net.vessel_count();
+  node_of_.assign(net.node_count(), -1);
+  index_of_vessel_.assign(n, -1);
+  auto node = [&](std::int64_t network_node) {
+    auto& k = node_of_[static_cast<std::size_t>(network_node)];
+    if (k < 0) {
+      k = static_cast<std::int32_t>(network_node_.size());
+      network_node_.push_back(network_node);
+    }
+    return k;
+  };
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!zero_d[v]) continue;
+    index_of_vessel_[v] = static_cast<std::int32_t>(vessels_.size());
+    vessels_.push_back(static_cast<std::int32_t>(v));
+    vessel_ids_.push_back(net.id[v]);
+    a_.push_back(node(net.from[v]));
+    b_.push_back(node(net.to[v]));
+    const VesselLaw& law = laws[v];
+    edge_length_.push_back(net.length[v]);
+    edge_root_slope_.push_back(1 / law.beta);
+    edge_root_intercept_.push_back(std::sqrt(law.reference_area) - law.reference_pressure / law.beta);
+  }
+  if (vessels_.empty()) return;
+  network_nodes_ = network_node_.size();
+  nodes_ = network_nodes_;
+  shunt_.assign(network_nodes_, 0.0);
+  shunt_pressure_.assign(network_nodes_, 0.0);
+  linear_.assign(network_nodes_, 0.0);
+
+  // Outlets on 0D vessels: shunts, or R1 to a capacitor node with R2 and C.
+  capacitor_of_outlet_.assign(net.outlets.size(), -1);
+  for (std::size_t k = 0; k < net.outlets.size(); ++k) {
+    const Outlet& o = net.outlets[k];
+    const auto v = static_cast<std::size_t>(o.vessel);
+    if (!zero_d[v]) continue;
+    const auto at = static_cast<std::size_t>(node_of_[static_cast<std::size_t>(net.to[v])]);
+    if (o.type == OutletType::reflection)
+      throw InputError("vessel " + std::to_string(net.id[v]) +
+                       ": a reflection outlet needs a 1D vessel (--model 1d, or auto, keeps it 1D)");
+    if (o.type == OutletType::rcr && o.c > 0) {
+      capacitor_of_outlet_[k] = static_cast<std::int32_t>(outlet_of_capacitor_.size());
+      const auto c = static_cast<std::int32_t>(nodes_++);
+      outlet_of_capacitor_.push_back(static_cast<std::int32_t>(k));
+      capacitor_vessel_edge_.push_back(index_of_vessel_[v]);
+      a_.push_back(static_cast<std::int32_t>(at));
+      b_.push_back(c);
+      edge_fixed_resistance_.push_back(o.r1);
+      shunt_.push_back(1 / o.r2);
+      shunt_pressure_.push_back(o.p_out);
+      linear_.push_back(o.c);
+    } else {
+      shunt_[at] = 1 / o.resistance();
+      shunt_pressure_[at] = o.p_out;
+      shunt_outlet_node_.push_back(static_cast<std::int32_t>(at));
+    }
+  }
+  if (net.inlet) {
+    const std::int64_t inlet = net.index_of(net.inlet->vessel);
+    if (inlet >= 0 && zero_d[static_cast<std::size_t>(inlet)])
+      inlet_node_ = node_of_[static_cast<std::size_t>(net.from[static_cast<std::size_t>(inlet)])];
+  }
+
+  // Each 0D vessel's volume L A(p) = L (c + p / beta)^2, half at each of its nodes.
+  term_offset_.assign(nodes_ + 1, 0);
+  for (std::size_t e = 0; e < vessels_.size(); ++e)
+    for (const std::int32_t k : {a_[e], b_[e]}) ++term_offset_[static_cast<std::size_t>(k) + 1];
+  for (std::size_t k = 0; k < nodes_; ++k) term_offset_[k + 1] += term_offset_[k];
+  term_weight_.resize(static_cast<std::size_t>(term_offset_[nodes_]));
+  term_intercept_.resize(term_weight_.size());
+  term_slope_.resize(term_weight_.size());
+  std::vector<std::int64_t> fill(term_offset_.begin(), term_offset_.end() - 1);
+  for (std::size_t e = 0; e < vessels_.size(); ++e)
+    for (const std::int32_t k : {a_[e], b_[e]}) {
+      const auto t = static_cast<std::size_t>(fill[static_cast<std::size_t>(k)]++);
+      term_weight_[t] = edge_length_[e] / 2;
+      term_intercept_[t] = edge_root_intercept_[e];
+      term_slope_[t] = edge_root_slope_[e];
+    }
+
+  system_ = NodalSystem(nodes_, a_, b_);
+  const std::size_t edges = a_.size();
+  volume_.assign(nodes_, 0.0);
+  previous_volume_ = pressure_ = predicted_ = system_shunt_ = rhs_ = held_inflow_ = impedance_ = dynamic_ = volume_;
+  flow_.assign(edges, 0.0);
+  previous_flow_ = conductance_ = history_ = next_flow_ = flow_;
+}
+
+void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
+  coupling_nodes_ = std::move(nodes);
+  std::vector<std::int32_t> slot(nodes_, -1);
+  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) slot[static_cast<std::size_t>(coupling_nodes_[j])] = static_cast<std::int32_t>(j);
+  coupling_edge_offset_.assign(coupling_nodes_.size() + 1, 0);
+  for (std::size_t e = 0; e < vessels_.size(); ++e)
+    for (const std::int32_t k : {a_[e], b_[e]})
+      if (slot[static_cast<std::size_t>(k)] >= 0) ++coupling_edge_offset_[static_cast<std::size_t>(slot[static_cast<std::size_t>(k)]) + 1];
+  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_edge_offset_[j + 1] += coupling_edge_offset_[j];
+  coupling_edge_.resize(static_cast<std::size_t>(coupling_edge_offset_.back()));
+  std::vector<std::int64_t> fill(coupling_edge_offset_.begin(), coupling_edge_offset_.end() - 1);
+  for (std::size_t e = 0; e < vessels_.size(); ++e)
+    for (const std::int32_t k : {a_[e], b_[e]})
+      if (const auto j = slot[static_cast<std::size_t>(k)]; j >= 0)
+        coupling_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(j)]++)] = static_cast<std::int32_t>(e);
+  update_dynamic_pressures();
+}
+
+void LumpedVessels::update_dynamic_pressures() {
+  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) {
+    const auto k = static_cast<std::size_t>(coupling_nodes_[j]);
+    double weighted = 0, weight = 0;
+    for (auto i = coupling_edge_offset_[j]; i < coupling_edge_offset_[j + 1]; ++i) {
+      const auto e = static_cast<std::size_t>(coupling_edge_[static_cast<std::size_t>(i)]);
+      const double s = edge_root_intercept_[e] + edge_root_slope_[e] * pressure_[k];
+      const double q = std::abs(flow_[e]), u = q / (s * s);
+      weighted += q * u;
+      weight += q;
+    }
+    const double u = weight > 0 ? weighted / weight : 0.0;
+    dynamic_[k] = 0.5 * density_ * u * u;
+  }
+}
+
+// ---- the tube laws of the nodes -------------------------------------------------------------
+
+double LumpedVessels::node_volume(std::size_t k, double p) const {
+  double v = linear_[k] * p;
+  for (auto t = term_offset_[k]; t < term_offset_[k + 1]; ++t) {
+    const auto i = static_cast<std::size_t>(t);
+    const double s = term_intercept_[i] + term_slope_[i] * p;
+    v += term_weight_[i] * s * s;
+  }
+  return v;
+}
+
+double LumpedVessels::node_compliance(std::size_t k, double p) const {
+  double c = linear_[k];
+  for (auto t = term_offset_[k]; t < term_offset_[k + 1]; ++t) {
+    const auto i = static_cast<std::size_t>(t);
+    c += 2 * term_weight_[i] * term_slope_[i] * (term_intercept_[i] + term_slope_[i] * p);
+  }
+  return c;
+}
+
+double LumpedVessels::compliance(std::int32_t node) const {
+  const auto k = static_cast<std::size_t>(node);
+  return node_compliance(k, pressure_[k]);
+}
+
+double LumpedVessels::pressure_from_volume(std::size_t k, double volume, double p) const {
+  // V(p) is increasing and convex where every lumen is open: Newton converges from the last
+  // pressure (a step's change is small) in two or three iterations.
+  for (int it = 0; it < 60; ++it) {
+    const double step = (node_volume(k, p) - volume) / node_compliance(k, p);
+    p -= step;
+    if (std::abs(step) <= 1e-13 * (std::abs(p) + 1e3)) break;
+  }
+  return p;
+}
+
+// ---- initial states -----------------------------------------------------------------------
+
+void LumpedVessels::start(const std::vector<double>& network_node_pressure, const std::vector<double>& vessel_flow) {
+  if (empty()) return;
+  for (std::size_t k = 0; k < network_nodes_; ++k)
+    pressure_[k] = network_node_pressure[static_cast<std::size_t>(network_node_[k])];
+  for (std::size_t e = 0; e < vessels_.size(); ++e) flow_[e] = vessel_flow[static_cast<std::size_t>(vessels_[e])];
+  for (std::size_t j = 0; j < outlet_of_capacitor_.size(); ++j) {
+    // R1 edges follow the vessels: edge vessels_.size() + j joins the vessel's end to capacitor j.
+    const std::size_t e = vessels_.size() + j;
+    const double q = flow_[static_cast<std::size_t>(capacitor_vessel_edge_[j])];
+    const double pc = pressure_[static_cast<std::size_t>(a_[e])] - edge_fixed_resistance_[j] * q;
+    pressure_[static_cast<std::size_t>(b_[e])] = pc;
+    flow_[e] = q;
+  }
+  for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_volume(k, pressure_[k]);
+  predicted_ = pressure_;
+  restart_history();
+  update_dynamic_pressures();
+}
+
+void LumpedVessels::start_at_rest(std::span<const VesselLaw> laws) {
+  if (empty()) return;
+  // Each node at the mean reference pressure of its vessels, no flow; capacitors at p_out.
+  std::vector<double> sum(network_nodes_, 0.0), count(network_nodes_, 0.0);
+  for (std::size_t e = 0; e < vessels_.size(); ++e)
+    for (const std::int32_t k : {a_[e], b_[e]}) {
+      sum[static_cast<std::size_t>(k)] += laws[static_cast<std::size_t>(vessels_[e])].reference_pressure;
+      count[static_cast<std::size_t>(k)] += 1;
+    }
+  for (std::size_t k = 0; k < network_nodes_; ++k) pressure_[k] = sum[k] / count[k];
+  for (std::size_t k = network_nodes_; k < nodes_; ++k) pressure_[k] = shunt_pressure_[k];
+  std::fill(flow_.begin(), flow_.end(), 0.0);
+  for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_volume(k, pressure_[k]);
+  predicted_ = pressure_;
+  restart_history();
+}
+
+void LumpedVessels::restart_history() {
+  // BDF2 from a constant past: exact for a state at rest or steady, and the conserved
+  // volume (3 V - V_prev) / 2 is V itself.
+  previous_volume_ = volume_;
+  previous_flow_ = flow_;
+}
+
+// ---- a step -----------------------------------------------------------------------------------
+
+void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, double inlet_flow) {
+  if (empty()) return;
+  dt_ = dt;
+  inlet_flow_ = inlet_flow;
+  const std::size_t vessels = vessels_.size(), edges = a_.size();
+  // Picard: the nonlinear coefficients at the start's pressures, then at the first prediction.
+  predicted_ = pressure_;
+  for (int pass = 0; pass < 2; ++pass) {
+    // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
+    // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
+    for (std::size_t e = 0; e < vessels; ++e) {
+      const double pa = predicted_[static_cast<std::size_t>(a_[e])], pb = predicted_[static_cast<std::size_t>(b_[e])];
+      const double p = 0.5 * (pa + pb);
+      const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p, area = s * s;
+      const double capacity = (flow_capacity(e, pa) + 4 * flow_capacity(e, p) + flow_capacity(e, pb)) / 6;
+      const double resistance = edge_length_[e] / capacity;
+      const double inertance = density_ * edge_length_[e] / area;
+      conductance_[e] = 1 / (resistance + 1.5 * inertance / dt);
+      history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
+    }
+    for (std::size_t e = vessels; e < edges; ++e) {
+      conductance_[e] = 1 / edge_fixed_resistance_[e - vessels];
+      history_[e] = 0;
+    }
+    // BDF2 for a node's volume, V(p) linearised at the last iterate p*:
+    // (3 (V* + C* (p - p*)) - 4 V^n + V^(n-1)) / (2 dt) = inflows at t1.
+    for (std::size_t k = 0; k < nodes_; ++k) {
+      const double ps = predicted_[k], c = node_compliance(k, ps);
+      system_shunt_[k] = 1.5 * c / dt + shunt_[k];
+      rhs_[k] = (1.5 * (c * ps - node_volume(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt +
+                shunt_[k] * shunt_pressure_[k];
+    }
+    for (std::size_t k = 0; k < network_nodes_ && !coupled_inflow.empty(); ++k) rhs_[k] += coupled_inflow[k];
+    if (inlet_node_ >= 0) rhs_[static_cast<std::size_t>(inlet_node_)] += inlet_flow;
+    for (std::size_t e = 0; e < edges; ++e) {
+      rhs_[static_cast<std::size_t>(a_[e])] -= history_[e];
+      rhs_[static_cast<std::size_t>(b_[e])] += history_[e];
+    }
+    const std::int64_t singular = system_.factorize(conductance_, system_shunt_);
+    if (singular >= 0) throw InputError("the 0D vessels have a part with no path to an outlet");
+    system_.solve(rhs_, predicted_);
+  }
+  if (!coupled_inflow.empty()) std::copy(coupled_inflow.begin(), coupled_inflow.begin() + network_nodes_, held_inflow_.begin());
+  // Z_i = (K^-1)_ii by a solve per coupling node.
+  // TODO(issue 12): the O(nodes) selected inversion on trees (Z_i = 1/d_i + l_i^2 Z_parent) for the full tree.
+  for (const std::int32_t k : coupling_nodes_) {
+    std::fill(rhs_.begin(), rhs_.end(), 0.0);
+    rhs_[static_cast<std::size_t>(k)] = 1;
+    system_.solve(rhs_, rhs_);
+    impedance_[static_cast<std::size_t>(k)] = rhs_[static_cast<std::size_t>(k)];
+  }
+  for (std::size_t e = 0; e < edges; ++e)
+    next_flow_[e] = conductance_[e] * (predicted_[static_cast<std::size_t>(a_[e])] - predicted_[static_cast<std::size_t>(b_[e])]) +
+                    history_[e];
+}
+
+void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out) {
+  if (empty()) return;
+  const double dt = dt_;
+  // The departure of the 1D ends' mean inflows from those held, through the same system.
+  if (!coupling_nodes_.empty()) {
+    std::fill(rhs_.begin(), rhs_.end(), 0.0);
+    for (const std::int32_t k : coupling_nodes_) {
+      const auto i = static_cast<std::size_t>(k);
+      rhs_[i] = coupled_volume[i] / dt - held_inflow_[i];
+    }
+    system_.solve(rhs_, rhs_);
+    for (std::size_t k = 0; k < nodes_; ++k) predicted_[k] += rhs_[k];
+    for (std::size_t e = 0; e < a_.size(); ++e)
+      next_flow_[e] = conductance_[e] * (predicted_[static_cast<std::size_t>(a_[e])] - predicted_[static_cast<std::size_t>(b_[e])]) +
+                      history_[e];
+  }
+  // Each node's net inflow at t1 (BDF2 takes the right-hand side there), as the solve had it.
+  std::vector<double>& inflow = rhs_;  // scratch: the solve is done
+  for (std::size_t k = 0; k < nodes_; ++k) inflow[k] = -shunt_[k] * (predicted_[k] - shunt_pressure_[k]);
+  for (std::size_t e = 0; e < a_.size(); ++e) {
+    inflow[static_cast<std::size_t>(a_[e])] -= next_flow_[e];
+    inflow[static_cast<std::size_t>(b_[e])] += next_flow_[e];
+  }
+  if (inlet_node_ >= 0) inflow[static_cast<std::size_t>(inlet_node_)] += inlet_flow_;
+  // The volumes: exactly what came in (3 V - 4 V^n + V^(n-1)) / 2 = dt inflow + 1D volume.
+  for (std::size_t k = 0; k < nodes_; ++k) {
+    const double coupled = k < network_nodes_ && !coupled_volume.empty() ? coupled_volume[k] : 0.0;
+    const double next = (4 * volume_[k] - previous_volume_[k] + 2 * dt * inflow[k] + 2 * coupled) / 3;
+    previous_volume_[k] = volume_[k];
+    volume_[k] = next;
+    pressure_[k] = k < network_nodes_ ? pressure_from_volume(k, next, predicted_[k]) : next / linear_[k];
+  }
+  previous_flow_.swap(flow_);
+  flow_ = next_flow_;
+  update_dynamic_pressures();
+  // Across the network's boundary: the inlet, outlet shunts, and the R1 of RCR outlets.
+  if (inlet_node_ >= 0) exchanged_in += dt * inlet_flow_;
+  for (const std::int32_t k : shunt_outlet_node_) {
+    const auto i = static_cast<std::size_t>(k);
+    exchanged_out += dt * shunt_[i] * (predicted_[i] - shunt_pressure_[i]);
+  }
+  for (std::size_t e = vessels_.size(); e < a_.size(); ++e) exchanged_out += dt * flow_[e];
+}
+
+// ---- what the rest of the solver reads -------------------------------------------------------
+
+double LumpedVessels::pressure_at(std::int32_t index, double x) const {
+  const auto e = static_cast<std::size_t>(index);
+  const double pa = pressure_[static_cast<std::size_t>(a_[e])], pb = pressure_[static_cast<std::size_t>(b_[e])];
+  const double drop = pa - pb;
+  if (drop == 0 || x <= 0) return pa;
+  // With G = A^2 / (k mu) linear in p between G_a and G_b, int_p^pa G dp = x int_pb^pa G dp
+  // is a quadratic in d = pa - p: G_a d - g d^2 / 2 = x F, g = (G_a - G_b) / (pa - pb).
+  const double ga = flow_capacity(e, pa), gb = flow_capacity(e, pb);
+  const double slope = (ga - gb) / drop, f = x * drop * 0.5 * (ga + gb);
+  const double disc = ga * ga - 2 * slope * f;
+  return pa - 2 * f / (ga + std::sqrt(std::max(disc, 0.0)));
+}
+
+double LumpedVessels::stored_volume() const {
+  double v = 0;
+  for (std::size_t k = 0; k < network_nodes_; ++k) v += 0.5 * (3 * volume_[k] - previous_volume_[k]);
+  return v;
+}
+
+double LumpedVessels::capacitor_pressure(std::size_t outlet) const {
+  if (empty() || capacitor_of_outlet_[outlet] < 0) return std::numeric_limits<double>::quiet_NaN();
+  return pressure_[network_nodes_ + static_cast<std::size_t>(capacitor_of_outlet_[outlet])];
+}
+
+void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std::span<const double> outlet_dp) {
+  if (empty()) return;
+  for (std::size_t k = 0; k < nodes_; ++k) {
+    pressure_[k] += k < network_nodes_
+                        ? network_node_dp[static_cast<std::size_t>(network_node_[k])]
+                        : outlet_dp[static_cast<std::size_t>(outlet_of_capacitor_[k - network_nodes_])];
+    volume_[k] = node_volume(k, pressure_[k]);
+  }
+  predicted_ = pressure_;
+  restart_history();
+  update_dynamic_pressures();
+}
+
+void LumpedVessels::check(double time) const {
+  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+    const double s_a = edge_root_intercept_[e] + edge_root_slope_[e] * pressure_[static_cast<std::size_t>(a_[e])];
+    const double s_b = edge_root_intercept_[e] + edge_root_slope_[e] * pressure_[static_cast<std::size_t>(b_[e])];
+    if (!(s_a > 0) || !(s_b > 0) || !std::isfinite(flow_[e]) || !std::isfinite(s_a * s_b))
+      throw SolutionBreakdown(vessel_ids_[e], time);
+  }
+}
+
+// ---- checkpoint ---------------------------------------------------------------------------------
+
+void LumpedVessels::save(CheckpointWriter& out) const {
+  out.section("0D vessels");
+  for (const auto* v : {&volume_, &previous_volume_, &pressure_, &flow_, &previous_flow_}) out.put(*v);
+}
+
+void LumpedVessels::restore(CheckpointReader& in) {
+  in.section("0D vessels");
+  for (auto* v : {&volume_, &previous_volume_, &pressure_, &flow_, &previous_flow_}) {
+    const std::size_t size = v->size();
+    *v = in.get_vector();
+    if (v->size() != size) in.fail("0D vessels of another network or model");
+  }
+  predicted_ = pressure_;
+  update_dynamic_pressures();
+}
+
+}  // namespace hemotree

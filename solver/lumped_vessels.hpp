@@ -1,0 +1,162 @@
+// The 0D (lumped) vessels of a network, advanced together, implicitly, by BDF2.
+//
+// A vessel much shorter than the pulse's wavelength holds no travelling wave: its flow is
+// quasi-steady, one number along it. Each such vessel is a pi circuit: its compliance
+// C = L dA/dp (tube law, at the current pressure) split between its two nodes, and between
+// them its resistance in series with its inertance rho L / A. The resistance is that of a
+// compliant tube in steady flow, (p_a - p_b) / Q with Q = (1/L) int A^2 / (k mu(A)) dp from
+// p_b to p_a (Simpson): Poiseuille's k mu(A) L / A^2 (the run's viscosity and velocity profile,
+// k = 2 pi alpha / (alpha - 1), as in the 1D friction) where the lumen is uniform, and right
+// where the pressure drop narrows the lumen along the vessel (the narrowest capillaries). The state is the volume at every node (half of each adjacent 0D
+// vessel's) and the flow in every vessel: volume is the conserved variable, so mass is
+// conserved to round-off whatever the nonlinear iteration leaves.
+//
+// BDF2 (L-stable: the capillaries' R C and L / R are micro- to nanoseconds, far below the
+// step) with the flows eliminated leaves one system in the node pressures, the weighted
+// Laplacian plus C/dt of network_flow/nodal_system: on a tree, O(nodes) per step. The
+// nonlinear R(A), L(A) and C(p) are taken at the last iterate, twice per step (Picard).
+//
+// Outlets on 0D vessels are part of the system (R: a shunt to p_out; RCR: R1 to a
+// capacitor node, R2 from there to p_out). A 1D vessel end at a node of 0D vessels is a
+// coupling end: the 1D vessel sees the node's pressure, and the node receives the volume the
+// 1D scheme let through that end (docs/solver.md §8).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "formats/network.hpp"
+#include "network_flow/nodal_system.hpp"
+#include "physics/viscosity_table.hpp"
+#include "solver/checkpoint.hpp"
+#include "solver/vessel_equations.hpp"
+
+namespace hemotree {
+
+class LumpedVessels {
+ public:
+  LumpedVessels() = default;  // none
+  // zero_d: per vessel, whether it is 0D. Throws InputError for a reflection outlet on a 0D
+  // vessel (it needs the waves of a 1D one).
+  LumpedVessels(const Network& net, std::span<const VesselLaw> laws, const ViscosityTable& viscosity,
+                const Blood& blood, const std::vector<bool>& zero_d);
+
+  bool empty() const { return vessels_.empty(); }
+  std::size_t vessel_count() const { return vessels_.size(); }
+  std::size_t node_count() const { return nodes_; }  // network nodes of 0D vessels, then capacitors
+  // Its node for a network node, or -1 where no 0D vessel ends.
+  std::int32_t node_of(std::int64_t network_node) const { return node_of_[static_cast<std::size_t>(network_node)]; }
+  bool feeds_inlet() const { return inlet_node_ >= 0; }
+
+  // Initial states: every node at the given pressure of its network node (steady: the steady
+  // solution; rest: reference pressures), vessels at the given flows; capacitors at
+  // p - R1 Q of their vessel's end (R1 edges and outlets follow from the pressures).
+  void start(const std::vector<double>& network_node_pressure, const std::vector<double>& vessel_flow);
+  void start_at_rest(std::span<const VesselLaw> laws);
+
+  // The nodes where 1D vessel ends meet 0D vessels (each once).
+  void set_coupling_nodes(std::vector<std::int32_t> nodes);
+  // rho u^2 / 2 of the 0D vessels at a coupling node (u their flow-weighted mean velocity
+  // there, now): what a 1D end's total pressure adds to the node's (static) pressure.
+  double dynamic_pressure(std::int32_t node) const { return dynamic_[static_cast<std::size_t>(node)]; }
+
+  // One step of length dt to t1, in two halves around the 1D vessels' substeps.
+  // predict: the pressures at t1 with the coupled 1D ends' inflows held at coupled_inflow
+  // (per node, their flows at t0), and every coupling node's response to a change of it:
+  // the impedance dp(t1)/dQ_in, the diagonal of the system's inverse there.
+  // inlet_flow: the prescribed inflow at t1 where the inlet vessel is 0D.
+  void predict(double dt, std::span<const double> coupled_inflow, double inlet_flow);
+  // The pressure of a node at a fraction s in [0, 1] of the step being taken (linear
+  // between the start and the prediction), and its impedance: a coupled end whose inflow
+  // departs from the predicted by dQ sees p + s Z dQ (solver/pulse_solver.cpp).
+  double pressure_during_step(std::int32_t node, double s) const {
+    const auto i = static_cast<std::size_t>(node);
+    return pressure_[i] + s * (predicted_[i] - pressure_[i]);
+  }
+  double impedance(std::int32_t node) const { return impedance_[static_cast<std::size_t>(node)]; }
+  // Completes the step with the volumes the 1D ends actually let into each node
+  // (coupled_volume, per node): the pressures at t1 corrected for the departure from the
+  // predicted inflows (the same factorisation), the flows, then the node volumes from them
+  // and the pressures from the tube laws. Adds what crossed the network's boundary (inlet,
+  // outlets) to exchanged (in, out) [m^3].
+  void complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out);
+
+  // The state a vessel's samples come from.
+  double node_pressure(std::int32_t node) const { return pressure_[static_cast<std::size_t>(node)]; }
+  std::int32_t vessel_index(std::size_t vessel) const { return index_of_vessel_[vessel]; }  // -1: 1D
+  double flow(std::int32_t index) const { return flow_[static_cast<std::size_t>(index)]; }
+  // The pressure at fraction x along a 0D vessel: on the steady profile of a compliant tube
+  // between its end pressures (the flow is quasi-steady there), not on a line.
+  double pressure_at(std::int32_t index, double x) const;
+  // The volume the 0D vessels hold now (what BDF2 conserves: (3 V^n - V^(n-1)) / 2, which
+  // is V at a steady state), capacitors not included [m^3].
+  double stored_volume() const;
+  // A capacitor's pressure, by the network's outlet index, or NaN if that outlet is not here.
+  double capacitor_pressure(std::size_t outlet) const;
+  // Compliance of a node at its pressure now [m^3/Pa].
+  double compliance(std::int32_t node) const;
+
+  // Shifts every node's pressure by dp of its network node (network_node_dp) or of its
+  // outlet (outlet_dp, capacitors), and its volume with it; the multistep history restarts.
+  void shift_pressures(std::span<const double> network_node_dp, std::span<const double> outlet_dp);
+  // Throws SolutionBreakdown (naming a vessel) where a volume is not finite or a lumen
+  // not positive.
+  void check(double time) const;
+
+  void save(CheckpointWriter& out) const;
+  void restore(CheckpointReader& in);
+
+ private:
+  double node_volume(std::size_t node, double p) const;
+  // A^2 / (k mu(A)) at pressure p in 0D vessel e: the steady flow is (1/L) times its integral
+  // over the pressure from the distal to the proximal end.
+  double flow_capacity(std::size_t e, double p) const {
+    const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p, area = s * s;
+    return area * area / (friction_k_ * (*viscosity_)(area));
+  }
+  double node_compliance(std::size_t node, double p) const;
+  double pressure_from_volume(std::size_t node, double volume, double guess) const;
+  void restart_history();
+  void update_dynamic_pressures();
+
+  std::size_t nodes_ = 0, network_nodes_ = 0;  // network nodes first, then capacitor nodes
+  std::vector<std::int32_t> node_of_;          // per network node
+  std::vector<std::int64_t> network_node_;     // per node below network_nodes_
+  std::vector<std::int32_t> index_of_vessel_;  // per network vessel
+  std::vector<std::int32_t> vessels_;          // per 0D vessel: its network index
+  std::vector<std::int64_t> vessel_ids_;       // and its id, for messages
+  std::int32_t inlet_node_ = -1;
+
+  // Edges: the 0D vessels (first), then the R1 of every RCR outlet on them.
+  std::vector<std::int32_t> a_, b_;
+  std::vector<double> edge_length_, edge_root_intercept_, edge_root_slope_;  // vessels: L, s(p) = c + p / beta
+  std::vector<double> edge_fixed_resistance_;  // R1 edges
+  double density_ = 0, friction_k_ = 0;
+  const ViscosityTable* viscosity_ = nullptr;
+  std::vector<std::int32_t> capacitor_vessel_edge_;  // per R1 edge: the 0D vessel ending at it
+
+  // Node volume V(p) = linear p + sum over terms w (c + d p)^2 (half of each 0D vessel).
+  std::vector<std::int64_t> term_offset_;
+  std::vector<double> term_weight_, term_intercept_, term_slope_, linear_;
+  // Shunts to ground: conductance and the pressure behind it (outlets, R2).
+  std::vector<double> shunt_, shunt_pressure_;
+  std::vector<std::int32_t> outlet_of_capacitor_;  // per capacitor node
+  std::vector<std::int32_t> capacitor_of_outlet_;  // per network outlet, -1 if none here
+  std::vector<std::int32_t> shunt_outlet_node_;    // network nodes whose shunt is an outlet (exchanged)
+
+  NodalSystem system_;
+  // State: node volumes and pressures, edge flows, and the last step's (BDF2 history).
+  std::vector<double> volume_, previous_volume_, pressure_, flow_, previous_flow_;
+  // The step being taken: predicted pressures, and the edges' conductances and history
+  // terms of the last linearisation (Q = g (p_a - p_b) + f), the inflows and prediction.
+  std::vector<double> predicted_, conductance_, history_, system_shunt_, rhs_, next_flow_;
+  std::vector<std::int32_t> coupling_nodes_;
+  std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
+  std::vector<std::int32_t> coupling_edge_;
+  std::vector<double> dynamic_;  // per node (coupling nodes only)
+  std::vector<double> held_inflow_, impedance_;  // per node: the coupled inflows predicted with, Z
+  double dt_ = 0, inlet_flow_ = 0;
+};
+
+}  // namespace hemotree
