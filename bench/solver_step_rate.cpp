@@ -61,8 +61,9 @@ int main(int argc, char** argv) {
   // hemosolve's cost model (solver/run_estimate), against the measured step.
   std::vector<double> elements_of_degree(static_cast<std::size_t>(solver.max_degree()) + 1, 0.0);
   for (std::size_t v = 0; v < net.vessel_count(); ++v)
-    elements_of_degree[static_cast<std::size_t>(solver.degree(v))] += options.elements;
-  const double model = estimate_run(elements_of_degree, 1, options.threads).seconds;
+    if (!solver.is_lumped(v)) elements_of_degree[static_cast<std::size_t>(solver.degree(v))] += options.elements;
+  const double model = estimate_run(elements_of_degree, 1, options.threads, solver.substeps(),
+                                    static_cast<double>(solver.lumped_count())).seconds;
   std::printf("cost model: %.3g us per step, measured %.3g us (model / measured %.2f)\n", model * 1e6,
               1e6 / rate, model * rate);
   return 0;

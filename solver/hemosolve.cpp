@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
                "discontinuous Galerkin) and report flows, pressures and pulsatility.",
                "hemosolve"};
   std::string input, out_dir, resume_dir, rheology, scheme = "etd2", start = "steady", dt_text,
-      sample_text = "1ms", external_text = "10mmHg", degree_text = "auto";
+      sample_text = "1ms", external_text = "10mmHg", degree_text = "auto", model = "1d";
   int cycles = 1, max_cycles = 50, frames = 0, checkpoint_every = 0;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
@@ -129,6 +129,17 @@ int main(int argc, char** argv) {
   app.add_option("--linear-error", options.degree_rule.linear_error,
                  "auto: a short vessel whose steady pressure profile departs further than this from a "
                  "line (relative, in [0, inf]; inf: never; docs/solver.md) takes degree 2")
+      ->capture_default_str();
+  app.add_option("--model", model,
+                 "vessel model: 1d (DG, waves), 0d (lumped R, L, C, implicit) or auto: 0d where a wave crosses "
+                 "the vessel in less than --lumped-transit of the period, 1d elsewhere (docs/solver.md §8)")
+      ->capture_default_str();
+  app.add_option("--lumped-transit", options.lumped_transit,
+                 "auto: the wave transit time L/c, as a fraction of the period, below which a vessel is 0D, in [0, 1]")
+      ->capture_default_str();
+  app.add_option("--lumped-step", options.lumped_step,
+                 "with 0D vessels: the step of the 0D vessels, as a fraction of the period, in (0, 0.1]; the 1D "
+                 "vessels take substeps within it")
       ->capture_default_str();
   app.add_option("--elements", options.elements, "elements per vessel, in [1, 1000]")->capture_default_str();
   app.add_option("--dt", dt_text,
@@ -178,6 +189,12 @@ int main(int argc, char** argv) {
     else if (scheme == "ab2") options.scheme = TimeScheme::adams_bashforth2;
     else if (scheme == "etd2") options.scheme = TimeScheme::exponential_ab2;
     else throw InputError("--scheme must be etd2, ab2 or rk4 (got '" + scheme + "')");
+    if (model == "auto") options.model = ModelChoice::automatic;
+    else if (model == "1d") options.model = ModelChoice::one_d;
+    else if (model == "0d") options.model = ModelChoice::zero_d;
+    else throw InputError("--model must be auto, 1d or 0d (got '" + model + "')");
+    check_range(options.lumped_transit, {0, 1}, "--lumped-transit");
+    check_range(options.lumped_step, {0, 0.1, true, false}, "--lumped-step");
     if (start == "rest") options.steady_start = false;
     else if (start != "steady") throw InputError("--start must be steady or rest (got '" + start + "')");
     if (!rheology.empty()) {
@@ -262,7 +279,8 @@ int main(int argc, char** argv) {
       throw InputError("--frames " + std::to_string(frames) + " exceeds the " + std::to_string(steps_per_cycle) +
                        " steps of a cycle");
     std::map<int, std::size_t> degrees;  // elements per degree
-    for (std::size_t v = 0; v < net.vessel_count(); ++v) degrees[run.degree(v)] += static_cast<std::size_t>(options.elements);
+    for (std::size_t v = 0; v < net.vessel_count(); ++v)
+      if (!run.is_lumped(v)) degrees[run.degree(v)] += static_cast<std::size_t>(options.elements);
     std::vector<double> elements_of_degree(static_cast<std::size_t>(run.max_degree()) + 1, 0.0);
     std::string degree_list;
     for (const auto& [p, count] : degrees) {
@@ -270,17 +288,27 @@ int main(int argc, char** argv) {
       degree_list += (degree_list.empty() ? "" : ", ") + std::to_string(count) + " of degree " + std::to_string(p);
     }
     const int planned = until_periodic ? max_cycles : cycles;
-    const RunEstimate per_cycle = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), options.threads);
-    const RunEstimate whole = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned, options.threads);
+    const double lumped = static_cast<double>(run.lumped_count()), substeps = run.substeps();
+    const RunEstimate per_cycle =
+        estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), options.threads, substeps, lumped);
+    const RunEstimate whole = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned,
+                                           options.threads, substeps, lumped);
     if (per_cycle.seconds > one_day && !force)
       throw InputError("one cycle would take about " + describe_duration(per_cycle.seconds) + " (" +
                        format_rounded(static_cast<double>(steps_per_cycle)) + " steps of " + format_quantity(dt, "s") +
                        ", set by the " + dt_reason + "; " + plural(run.element_count(), "element") +
                        "): refused, more than a day. Check that vessel's wall and length and the inlet's "
                        "flow, use fewer --elements or a lower --degree, or --force to run it anyway");
+    const std::size_t one_d = net.vessel_count() - run.lumped_count();
+    if (!quiet)
+      note(plural(one_d, "vessel") + " 1D, " + std::to_string(run.lumped_count()) + " 0D (--model " + model + ")" +
+           (run.lumped_count() > 0 && one_d > 0
+                ? "; " + std::to_string(run.substeps()) + " 1D substeps of " + format_quantity(run.substep(), "s") +
+                      " per step"
+                : std::string()));
     if (!quiet)
       note("time step " + format_quantity(dt, "s") + " (" + dt_reason + "), " + std::to_string(steps_per_cycle) +
-           " steps per cycle, " + plural(run.element_count(), "element") + ": " + degree_list +
+           " steps per cycle, " + plural(run.element_count(), "element") + (degree_list.empty() ? "" : ": ") + degree_list +
            "; estimated " + describe_duration(per_cycle.seconds) + " per cycle, " + describe_duration(whole.seconds) +
            (until_periodic ? " for at most " : " for ") + plural(planned, "cycle") + " on " +
            plural(options.threads, "thread"));
@@ -298,7 +326,8 @@ int main(int argc, char** argv) {
 
     // ---- the run ------------------------------------------------------------------------------
     std::ostringstream shaping;  // the options a checkpoint must share with the run resuming it
-    shaping << "scheme " << scheme << ", degree " << degree_text << " (" << options.degree_rule.low << "/"
+    shaping << "model " << model << " (" << options.lumped_transit << ", " << options.lumped_step << "), scheme "
+            << scheme << ", degree " << degree_text << " (" << options.degree_rule.low << "/"
             << options.degree_rule.raise_to << "/" << options.degree_rule.high << ", linear error "
             << options.degree_rule.linear_error << "), elements " << options.elements << ", time step " << dt
             << ", rheology " << to_string(run.blood().rheology) << ", start " << start << ", external pressure "
@@ -356,6 +385,10 @@ int main(int argc, char** argv) {
                                {"degree", options.degree == SolverOptions::automatic ? nlohmann::json("auto")
                                                                                      : nlohmann::json(options.degree)},
                                {"elements_per_vessel", options.elements}, {"scheme", scheme},
+                               {"model", model},
+                               {"vessels_1d", one_d},
+                               {"vessels_0d", run.lumped_count()},
+                               {"substeps", run.substeps()},
                                {"threads", options.threads},
                                {"rheology", to_string(run.blood().rheology)},
                                {"start", steady_start ? "steady" : "rest"},

@@ -7,7 +7,7 @@
 namespace hemotree {
 
 NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element,
-                                   int elements_per_vessel) {
+                                   int elements_per_vessel, const std::vector<bool>& zero_d) {
   auto name = [&](std::size_t v) { return "vessel " + std::to_string(net.id[v]); };
   const std::size_t n = net.vessel_count();
   if (n == 0) throw InputError("the network has no vessels");
@@ -26,18 +26,27 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
 
   NetworkBoundaries b;
   b.end_state.resize(2 * n);
+  b.inlet.vessel = -1;
+  b.inflow = net.inlet->waveform;
   for (std::size_t node = 0; node < at_node.size(); ++node) {
     const auto& ends = at_node[node];
     if (ends.empty()) continue;
     const auto v0 = static_cast<std::size_t>(ends[0].vessel);
+    const bool lumped = std::any_of(ends.begin(), ends.end(), [&](const VesselEnd& e) { return zero_d[e.vessel]; });
     if (ends.size() == 1) {
+      if (lumped) {  // the 0D vessel's inlet or outlet: solver/lumped_vessels
+        if (!ends[0].distal && static_cast<std::int64_t>(v0) != inlet)
+          throw InputError(name(v0) + " starts at node " + std::to_string(net.node_id[node]) +
+                           ", which no vessel feeds and which is not the inlet");
+        if (ends[0].distal && outlet_of[v0] < 0) throw InputError(name(v0) + " is terminal but has no outlet");
+        continue;
+      }
       const VesselEnd e = ends[0];
       if (!e.distal) {
         if (static_cast<std::int64_t>(v0) != inlet)
           throw InputError(name(v0) + " starts at node " + std::to_string(net.node_id[node]) +
                            ", which no vessel feeds and which is not the inlet");
         b.inlet = e;
-        b.inflow = net.inlet->waveform;
       } else {
         if (outlet_of[v0] < 0)
           throw InputError(name(v0) + " is terminal but has no outlet");
@@ -58,6 +67,11 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
       if (e.distal && outlet_of[e.vessel] >= 0)
         throw InputError(name(static_cast<std::size_t>(e.vessel)) +
                          " has an outlet but other vessels continue from its end");
+    }
+    if (lumped) {
+      for (const VesselEnd& e : ends)
+        if (!zero_d[e.vessel]) b.coupled.push_back({e, static_cast<std::int64_t>(node)});
+      continue;
     }
     if (ends.size() > 16)
       throw InputError("node " + std::to_string(net.node_id[node]) + " joins more than 16 vessels");

@@ -1,6 +1,6 @@
-// Where the vessels' ends meet: junctions, the inlet and the outlets of a network, in flat
-// lists the solver sweeps every stage. Built once from the network; refuses, naming the
-// vessel, a network it cannot run.
+// Where the 1D vessels' ends meet: junctions, the inlet, the outlets, and the nodes of 0D
+// vessels (coupling ends), in flat lists the solver sweeps every stage. Built once from the
+// network; refuses, naming the vessel, a network it cannot run.
 #pragma once
 
 #include <cstdint>
@@ -27,8 +27,15 @@ struct NetworkBoundaries {
   std::vector<VesselEnd> junction_ends;
   std::vector<std::int64_t> junction_node;  // node id, for messages
 
-  VesselEnd inlet;
+  VesselEnd inlet;  // vessel -1: the inlet vessel is 0D
   Waveform inflow;
+
+  // 1D vessel ends at a node where 0D vessels end: the node's pressure is given to them.
+  struct CoupledEnd {
+    VesselEnd end;
+    std::int64_t node = 0;  // network node index
+  };
+  std::vector<CoupledEnd> coupled;
 
   struct OutletEnd {
     VesselEnd end;
@@ -44,8 +51,9 @@ struct NetworkBoundaries {
   std::vector<EndState> end_state;
 };
 
-// Vessel v's elements are first_element[v] .. first_element[v] + elements_per_vessel - 1.
+// Vessel v's elements are first_element[v] .. first_element[v] + elements_per_vessel - 1;
+// zero_d[v]: vessel v is 0D (no elements: its ends belong to solver/lumped_vessels).
 NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element,
-                                   int elements_per_vessel);
+                                   int elements_per_vessel, const std::vector<bool>& zero_d);
 
 }  // namespace hemotree

@@ -24,6 +24,7 @@ void PulseState::set_zero_like(const PulseState& other) {
   flow.setZero(other.flow.rows(), other.flow.cols());
   capacitor.setZero(other.capacitor.size());
   exchanged.setZero();
+  coupled.setZero(other.coupled.size());
 }
 
 void PulseState::add_scaled(double factor, const PulseState& other) {
@@ -31,6 +32,7 @@ void PulseState::add_scaled(double factor, const PulseState& other) {
   flow += factor * other.flow;
   capacitor += factor * other.capacitor;
   exchanged += factor * other.exchanged;
+  coupled += factor * other.coupled;
 }
 
 namespace {
@@ -39,6 +41,7 @@ Blood effective_blood(const Network& net, const SolverOptions& options) {
   if (options.rheology_override >= 0) blood.rheology = static_cast<Rheology>(options.rheology_override);
   return blood;
 }
+double period_of(const Network& net) { return net.inlet ? net.inlet->waveform.period : 1.0; }
 }  // namespace
 
 PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
@@ -74,6 +77,9 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     }
   }
 
+  choose_models(options);
+  lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_);
+
   // The steady Poiseuille solution, where the network has one (not with reflection outlets
   // or loops): the degrees follow its pressure profiles, and the run starts from it.
   std::optional<SteadyFlow> steady;
@@ -95,7 +101,17 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
         entering != net.to.end() ? entering - net.to.begin() : leaving - net.from.begin());
   }
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
-  boundaries_ = build_boundaries(net, first_element_, elements_per_vessel_);
+  boundaries_ = build_boundaries(net, first_element_, elements_per_vessel_, zero_d_);
+  for (const auto& c : boundaries_.coupled) coupled_node_.push_back(lumped_.node_of(c.node));
+  {
+    std::vector<std::int32_t> nodes = coupled_node_;
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    lumped_.set_coupling_nodes(std::move(nodes));
+  }
+  held_end_flow_.assign(boundaries_.coupled.size(), 0.0);
+  coupled_inflow_.assign(lumped_.node_count(), 0.0);
+  coupled_volume_ = coupled_inflow_;
 
   const auto rows = static_cast<Eigen::Index>(element_vessel_.size());
   Eigen::Index points = 0;
@@ -104,6 +120,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   state_.area.setZero(rows, modes);
   state_.flow.setZero(rows, modes);
   state_.capacitor.setZero(static_cast<Eigen::Index>(boundaries_.capacitors));
+  state_.coupled.setZero(static_cast<Eigen::Index>(boundaries_.coupled.size()));
   area_q_.resize(rows, points);
   flow_q_.resize(rows, points);
   flux_q_.resize(rows, points);
@@ -113,11 +130,51 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   if (started_from_steady_) start_from_steady_flow(*steady);
   else start_at_rest();
   choose_time_step(options);
+  stable_1d_ = dt_;
   stable_dt_ = dt_;
   stable_dt_reason_ = dt_reason_;
+  if (!lumped_.empty()) {
+    // The 0D step follows the pulse (it has no stability limit); the 1D vessels take as
+    // many substeps of at most their own limit as fit in it.
+    const double target = options.lumped_step * period_of(net);
+    const double substeps = std::isfinite(stable_1d_) ? std::max(1.0, std::floor(target / stable_1d_)) : 1.0;
+    dt_ = std::isfinite(stable_1d_) ? std::min(target, substeps * stable_1d_) : target;
+    std::ostringstream why;
+    why << "0D step of " << options.lumped_step << " of the period";
+    if (std::isfinite(stable_1d_)) why << ", " << substeps << " 1D substeps set by the " << dt_reason_;
+    dt_reason_ = why.str();
+    stable_dt_ = std::numeric_limits<double>::infinity();
+    stable_dt_reason_ = "the 0D step is implicit; the 1D substeps keep their own limit";
+  }
+  set_time_step(dt_);
   if (options.dt > 0) {
-    dt_ = options.dt;
+    set_time_step(options.dt);
     dt_reason_ = "given by --dt";
+  }
+  // The coupled ends' first linearisation needs their end states.
+  if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);
+}
+
+void PulseSolver::set_time_step(double dt) {
+  dt_ = dt;
+  substeps_ = lumped_.empty() || !std::isfinite(stable_1d_)
+                  ? 1
+                  : static_cast<int>(std::max(1.0, std::ceil(dt / stable_1d_ - 1e-9)));
+}
+
+void PulseSolver::choose_models(const SolverOptions& options) {
+  const std::size_t n = net_.vessel_count();
+  zero_d_.assign(n, options.model == ModelChoice::zero_d);
+  if (options.model != ModelChoice::automatic) return;
+  // A wave crossing the vessel in a small fraction of the period: the whole vessel moves in
+  // phase, as a lumped element (docs/solver.md §8 measures the error against the fraction).
+  std::vector<bool> reflecting(n, false);
+  for (const Outlet& o : net_.outlets)
+    if (o.type == OutletType::reflection) reflecting[static_cast<std::size_t>(o.vessel)] = true;
+  const double period = period_of(net_);
+  for (std::size_t v = 0; v < n; ++v) {
+    const double transit = net_.length[v] / laws_[v].wave_speed(laws_[v].reference_area);
+    zero_d_[v] = !reflecting[v] && transit < options.lumped_transit * period;
   }
 }
 
@@ -128,7 +185,8 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
   if (options.degree == SolverOptions::automatic) {
     std::vector<double> transit(n), linear_error;
     for (std::size_t v = 0; v < n; ++v)
-      transit[v] = net_.length[v] / e / laws_[v].wave_speed(laws_[v].reference_area);
+      transit[v] = zero_d_[v] ? std::numeric_limits<double>::infinity()  // no step limit of its own
+                              : net_.length[v] / e / laws_[v].wave_speed(laws_[v].reference_area);
     if (steady) {
       // Over one element of the vessel: its share of the drop.
       linear_error.resize(n);
@@ -144,10 +202,14 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
   } else {
     vessel_degree_.assign(n, options.degree);
   }
-  const int top = n == 0 ? 0 : *std::max_element(vessel_degree_.begin(), vessel_degree_.end());
+  std::size_t one_d = 0;
+  for (std::size_t v = 0; v < n; ++v)
+    if (zero_d_[v]) vessel_degree_[v] = -1;
+    else ++one_d;
+  const int top = std::max(0, n == 0 ? 0 : *std::max_element(vessel_degree_.begin(), vessel_degree_.end()));
   bases_.assign(static_cast<std::size_t>(top) + 1, ModalBasis{});
-  first_element_.resize(n);
-  element_vessel_.resize(n * static_cast<std::size_t>(e));
+  first_element_.assign(n, -1);
+  element_vessel_.resize(one_d * static_cast<std::size_t>(e));
   half_length_.resize(static_cast<Eigen::Index>(element_vessel_.size()));
   element_beta_.resize(half_length_.size());
   blocks_.clear();
@@ -176,6 +238,7 @@ void PulseSolver::start_at_rest() {
   for (std::size_t v = 0; v < net_.vessel_count(); ++v)
     for (auto el = first_element_[v]; el < end_element(v); ++el)
       state_.area(el, 0) = laws_[v].reference_area;
+  lumped_.start_at_rest(laws_);
   for (auto& o : boundaries_.outlets) {
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) = o.outlet.p_out;
     o.rest_area = laws_[static_cast<std::size_t>(o.end.vessel)].reference_area;
@@ -185,7 +248,9 @@ void PulseSolver::start_at_rest() {
 
 void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
   const Network& net = net_;
+  lumped_.start(s.node_pressure, s.flow);
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    if (zero_d_[v]) continue;
     const ModalBasis& basis = bases_[static_cast<std::size_t>(vessel_degree_[v])];
     const Eigen::Index points = basis.points;
     const double p0 = s.node_pressure[net.from[v]], p1 = s.node_pressure[net.to[v]];
@@ -204,7 +269,7 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
   }
   for (auto& o : boundaries_.outlets) {
     const auto v = static_cast<std::size_t>(o.end.vessel);
-    const double q = s.flow[v], p = s.node_pressure[net.to[v]];
+    const double q = s.flow[v], p = s.node_pressure[net.to[v]];  // 1D vessels only
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) = p - o.outlet.r1 * q;
     o.rest_area = laws_[v].area(p);
     o.rest_flow = q;
@@ -225,6 +290,7 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
   double wave = std::numeric_limits<double>::infinity(), friction = wave;
   std::size_t wave_vessel = 0, friction_vessel = 0;
   for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    if (zero_d_[v]) continue;
     const VesselLaw& law = laws_[v];
     const auto el = first_element_[v];
     const double a = state_.area(el, 0), q = state_.flow(el, 0);
@@ -261,7 +327,8 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
   }
   std::ostringstream why;
   dt_ = std::min({wave, friction, capacitor});
-  if (dt_ == wave) why << "wave speed (CFL) in vessel " << net_.id[wave_vessel];
+  if (!std::isfinite(dt_)) why << "no 1D vessels";
+  else if (dt_ == wave) why << "wave speed (CFL) in vessel " << net_.id[wave_vessel];
   else if (dt_ == friction) why << "friction stiffness in vessel " << net_.id[friction_vessel];
   else why << "RCR outlet capacitor of vessel " << net_.id[capacitor_vessel];
   dt_reason_ = why.str();
@@ -282,13 +349,12 @@ void phi_functions(double z, double& e, double& phi1, double& phi2) {
 }
 }  // namespace
 
-void PulseSolver::step_exponential() {
+void PulseSolver::step_exponential(double h) {
   // ETD2 (Cox & Matthews 2002): Q+ = e^z Q + h (phi1(z) N + phi2(z) (N - N_prev)), z = -r h,
   // with N = rate + r Q the non-stiff part; A and the capacitors (r = 0) take plain AB2.
   // Both N are taken with this step's r (N_prev = rate_prev + r Q_prev): with the previous
   // step's r the scheme falls to first order wherever the area, and so r, pulsates.
   evaluate(time_, state_, rate_);
-  const double h = dt_;
   if (!have_previous_rate_) {
     previous_rate_ = rate_;
     previous_flow_ = state_.flow;
@@ -318,46 +384,90 @@ void PulseSolver::step_exponential() {
   state_.area += h * (1.5 * rate_.area - 0.5 * previous_rate_.area);
   state_.capacitor += h * (1.5 * rate_.capacitor - 0.5 * previous_rate_.capacitor);
   state_.exchanged += h * (1.5 * rate_.exchanged - 0.5 * previous_rate_.exchanged);
+  state_.coupled += h * (1.5 * rate_.coupled - 0.5 * previous_rate_.coupled);
   std::swap(previous_rate_, rate_);
 }
 
 void PulseSolver::step() {
+  if (lumped_.empty()) {
+    step_1d(dt_);
+    time_ += dt_;
+  } else {
+    step_coupled();
+  }
+  ++steps_;
+}
+
+void PulseSolver::step_coupled() {
+  // The 0D vessels step first with the coupled ends' inflows held at their last values; the
+  // 1D ends then see each node's pressure move to the prediction, plus the node's own
+  // response to their departure from the held inflow: a Robin condition. Without it the
+  // coupling is explicit, and unstable once the step exceeds the node's C / Y; with the
+  // response of BDF2 (Z = (K^-1)_ii) it broke down at 4 substeps, with 3/2 Z, the backward
+  // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §8).
+  std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
+  for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
+    const VesselEnd& end = boundaries_.coupled[k].end;
+    const EndState& u = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
+    held_end_flow_[k] = end.distal ? u.flow : -u.flow;
+    coupled_inflow_[static_cast<std::size_t>(coupled_node_[k])] += held_end_flow_[k];
+  }
+  step_start_ = time_;
+  const double t1 = time_ + dt_;
+  lumped_.predict(dt_, coupled_inflow_, lumped_.feeds_inlet() ? boundaries_.inflow(t1) : 0.0);
+  // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
+  if (element_count() > 0) {
+    const Eigen::VectorXd before = state_.coupled;
+    const double h = dt_ / substeps_;
+    for (int k = 0; k < substeps_; ++k) {
+      step_1d(h);
+      time_ = step_start_ + (k + 1) * h;
+    }
+    std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
+    for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
+      coupled_volume_[static_cast<std::size_t>(coupled_node_[k])] +=
+          state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
+  }
+  // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
+  lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1));
+  time_ = t1;
+}
+
+void PulseSolver::step_1d(double dt) {
   if (scheme_ == TimeScheme::exponential_ab2) {
-    step_exponential();
+    step_exponential(dt);
   } else if (scheme_ == TimeScheme::runge_kutta4) {
     // Classical fourth-order Runge-Kutta.
     evaluate(time_, state_, stage_[0]);
     PulseState y = state_;
-    y.add_scaled(0.5 * dt_, stage_[0]);
-    evaluate(time_ + 0.5 * dt_, y, stage_[1]);
+    y.add_scaled(0.5 * dt, stage_[0]);
+    evaluate(time_ + 0.5 * dt, y, stage_[1]);
     y = state_;
-    y.add_scaled(0.5 * dt_, stage_[1]);
-    evaluate(time_ + 0.5 * dt_, y, stage_[2]);
+    y.add_scaled(0.5 * dt, stage_[1]);
+    evaluate(time_ + 0.5 * dt, y, stage_[2]);
     y = state_;
-    y.add_scaled(dt_, stage_[2]);
-    evaluate(time_ + dt_, y, stage_[3]);
-    state_.add_scaled(dt_ / 6, stage_[0]);
-    state_.add_scaled(dt_ / 3, stage_[1]);
-    state_.add_scaled(dt_ / 3, stage_[2]);
-    state_.add_scaled(dt_ / 6, stage_[3]);
+    y.add_scaled(dt, stage_[2]);
+    evaluate(time_ + dt, y, stage_[3]);
+    state_.add_scaled(dt / 6, stage_[0]);
+    state_.add_scaled(dt / 3, stage_[1]);
+    state_.add_scaled(dt / 3, stage_[2]);
+    state_.add_scaled(dt / 6, stage_[3]);
   } else {
     // Second-order Adams-Bashforth (the paper's); its first step is Heun's, second order too.
     evaluate(time_, state_, rate_);
     if (!have_previous_rate_) {
       PulseState y = state_;
-      y.add_scaled(dt_, rate_);
-      evaluate(time_ + dt_, y, stage_[0]);
-      state_.add_scaled(0.5 * dt_, rate_);
-      state_.add_scaled(0.5 * dt_, stage_[0]);
+      y.add_scaled(dt, rate_);
+      evaluate(time_ + dt, y, stage_[0]);
+      state_.add_scaled(0.5 * dt, rate_);
+      state_.add_scaled(0.5 * dt, stage_[0]);
       have_previous_rate_ = true;
     } else {
-      state_.add_scaled(1.5 * dt_, rate_);
-      state_.add_scaled(-0.5 * dt_, previous_rate_);
+      state_.add_scaled(1.5 * dt, rate_);
+      state_.add_scaled(-0.5 * dt, previous_rate_);
     }
     std::swap(previous_rate_, rate_);
   }
-  time_ += dt_;
-  ++steps_;
 }
 
 // ---- the right-hand side -------------------------------------------------------------------
@@ -414,7 +524,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Every used mode of every rate is written below; the padding columns of lower degrees
   // must stay zero, so the storage is cleared only when it is (re)allocated.
   if (rate.area.rows() != elements || rate.area.cols() != s.area.cols() ||
-      rate.capacitor.size() != s.capacitor.size())
+      rate.capacitor.size() != s.capacitor.size() || rate.coupled.size() != s.coupled.size())
     rate.set_zero_like(s);
   friction_rate_.resize(elements);
   for (Eigen::VectorXd* v : {&area_left_, &area_right_, &flow_left_, &flow_right_, &flux_a_left_,
@@ -470,11 +580,29 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     q = end.distal ? flow_right_(end.element) : flow_left_(end.element);
   };
 
-  {
+  if (boundaries_.inlet.vessel >= 0) {
     double a, q;
     const VesselEnd& end = boundaries_.inlet;
     trace(end, a, q);
     set_end_flux(end, inflow_state(laws_[static_cast<std::size_t>(end.vessel)], a, q, boundaries_.inflow(t)));
+  }
+  // Ends at nodes of 0D vessels: the node's pressure, moving through the 0D step.
+  for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
+    const auto& c = boundaries_.coupled[k];
+    double a, q;
+    trace(c.end, a, q);
+    // Total pressure p(t) + rho u^2 / 2 + r (Q_in - Q_held): the node's pressure at this point
+    // of the step, the kinetic energy of its 0D vessels, and its response, r = 3/2 Z
+    // (docs/solver.md §8).
+    const double s = dt_ > 0 ? std::clamp((t - step_start_) / dt_, 0.0, 1.0) : 0.0;
+    const std::int32_t node = coupled_node_[k];
+    const double r = 1.5 * lumped_.impedance(node);
+    const EndState u = pressure_state(laws_[static_cast<std::size_t>(c.end.vessel)], a, q,
+                                      lumped_.pressure_during_step(node, s) + lumped_.dynamic_pressure(node) -
+                                          r * held_end_flow_[k],
+                                      c.end.distal, r);
+    set_end_flux(c.end, u);
+    rate.coupled(static_cast<Eigen::Index>(k)) = c.end.distal ? u.flow : -u.flow;
   }
   const auto outlets = static_cast<std::int64_t>(boundaries_.outlets.size());
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
@@ -510,7 +638,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     const double q = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)].flow;
     return end.distal ? q : -q;
   };
-  rate.exchanged(0) = -leaving(boundaries_.inlet);
+  rate.exchanged(0) = boundaries_.inlet.vessel >= 0 ? -leaving(boundaries_.inlet) : 0.0;
   rate.exchanged(1) = 0;
   for (const auto& o : boundaries_.outlets) rate.exchanged(1) += leaving(o.end);
   // Junctions are independent: each writes only its own ends' fluxes.
@@ -590,6 +718,7 @@ double PulseSolver::evaluate_modes(const Eigen::MatrixXd& c, std::size_t element
 }
 
 double PulseSolver::area_at(std::size_t vessel, double x) const {
+  if (zero_d_[vessel]) return laws_[vessel].area(pressure_at(vessel, x));
   std::size_t el;
   double xi;
   locate(vessel, x, el, xi);
@@ -597,6 +726,7 @@ double PulseSolver::area_at(std::size_t vessel, double x) const {
 }
 
 double PulseSolver::flow_at(std::size_t vessel, double x) const {
+  if (zero_d_[vessel]) return lumped_.flow(lumped_.vessel_index(vessel));
   std::size_t el;
   double xi;
   locate(vessel, x, el, xi);
@@ -604,6 +734,7 @@ double PulseSolver::flow_at(std::size_t vessel, double x) const {
 }
 
 double PulseSolver::pressure_at(std::size_t vessel, double x) const {
+  if (zero_d_[vessel]) return lumped_.pressure_at(lumped_.vessel_index(vessel), std::clamp(x, 0.0, 1.0));
   return laws_[vessel].pressure(area_at(vessel, x));
 }
 
@@ -616,13 +747,19 @@ void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<do
   area.resize(n);
   flow.resize(n);
   if (n == 0) return;
-  std::size_t element;
-  double xi;
-  locate(0, x, element, xi);
-  const auto k = static_cast<std::int32_t>(element) - first_element_[0];  // the same in every vessel
+  // The same element k and point xi in every vessel (locate's arithmetic).
+  const double s = std::clamp(x, 0.0, 1.0) * elements_per_vessel_;
+  const auto k = std::min(static_cast<std::int32_t>(s), elements_per_vessel_ - 1);
+  const double xi = 2 * (s - k) - 1;
   std::array<double, 32> phi;  // degrees are at most 30
   for (std::size_t j = 0; j <= static_cast<std::size_t>(max_degree()); ++j) phi[j] = legendre(static_cast<int>(j), xi);
   for (std::size_t v = 0; v < n; ++v) {
+    if (zero_d_[v]) {
+      const std::int32_t e = lumped_.vessel_index(v);
+      area[v] = laws_[v].area(lumped_.pressure_at(e, std::clamp(x, 0.0, 1.0)));
+      flow[v] = lumped_.flow(e);
+      continue;
+    }
     const Eigen::Index el = first_element_[v] + k;
     double a = 0, q = 0;
     for (int j = 0; j <= vessel_degree_[v]; ++j) {
@@ -635,21 +772,38 @@ void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<do
 }
 
 double PulseSolver::mean_flow(std::size_t vessel) const {
+  if (zero_d_[vessel]) return lumped_.flow(lumped_.vessel_index(vessel));
   double sum = 0;
   for (auto el = first_element_[vessel]; el < end_element(vessel); ++el) sum += state_.flow(el, 0);
   return sum / elements_per_vessel_;
 }
 
 double PulseSolver::network_volume() const {
-  double volume = 0;
-  for (const double v : vessel_volumes()) volume += v;
+  // The 1D vessels' volumes and what the 0D scheme conserves (lumped_vessels.hpp).
+  double volume = lumped_.stored_volume();
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
+    for (auto el = first_element_[v]; el < end_element(v); ++el) volume += 2 * half_length_(el) * state_.area(el, 0);
   return volume;
+}
+
+std::vector<double> PulseSolver::capacitor_pressures() const {
+  std::vector<double> p(net_.outlets.size(), std::numeric_limits<double>::quiet_NaN());
+  for (const auto& o : boundaries_.outlets)
+    if (o.capacitor >= 0) p[static_cast<std::size_t>(o.index)] = state_.capacitor(o.capacitor);
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (std::isnan(p[k])) p[k] = lumped_.capacitor_pressure(k);
+  return p;
 }
 
 std::vector<double> PulseSolver::vessel_volumes() const {
   std::vector<double> volume(net_.vessel_count(), 0.0);
-  for (std::size_t v = 0; v < volume.size(); ++v)
+  for (std::size_t v = 0; v < volume.size(); ++v) {
+    if (zero_d_[v]) {  // half at each node's pressure, as the 0D scheme holds it
+      const std::int32_t e = lumped_.vessel_index(v);
+      volume[v] = net_.length[v] * 0.5 * (laws_[v].area(lumped_.pressure_at(e, 0)) + laws_[v].area(lumped_.pressure_at(e, 1)));
+    }
     for (auto el = first_element_[v]; el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
+  }
   return volume;
 }
 
@@ -660,9 +814,10 @@ std::size_t PulseSolver::balance_compliances(double period) {
   const std::vector<double> volume = vessel_volumes();
   std::vector<double> area_per_pressure(n);
   for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = 2 * std::sqrt(volume[v] / net_.length[v]) / laws_[v].beta;
+  const std::vector<double> capacitor_now = capacitor_pressures();
   if (cycle_volume_.empty()) {
     cycle_volume_ = volume;
-    cycle_capacitor_ = state_.capacitor;
+    cycle_capacitor_ = capacitor_now;
     return 0;
   }
   // Volume rates over the last cycle: each vessel's half to each of its nodes.
@@ -679,11 +834,10 @@ std::size_t PulseSolver::balance_compliances(double period) {
       node_compliance[static_cast<std::size_t>(node)] += compliance / 2;
     }
   }
-  for (const auto& o : boundaries_.outlets) {
-    if (o.capacitor < 0) continue;
-    const auto k = static_cast<std::size_t>(o.index);
-    capacitor_compliance[k] = o.outlet.c;
-    loads.capacitor_current[k] = o.outlet.c * (state_.capacitor(o.capacitor) - cycle_capacitor_(o.capacitor)) / period;
+  for (std::size_t k = 0; k < net_.outlets.size(); ++k) {
+    if (std::isnan(capacitor_now[k])) continue;
+    capacitor_compliance[k] = net_.outlets[k].c;
+    loads.capacitor_current[k] = net_.outlets[k].c * (capacitor_now[k] - cycle_capacitor_[k]) / period;
   }
   // delta = K^-1 I: the shifts that cancel the rates in the linear network (K its conductance).
   const TreePotentials delta = solve_loaded_tree(net_, steady_resistance_, loads);
@@ -712,6 +866,7 @@ std::size_t PulseSolver::balance_compliances(double period) {
   for (auto& y : move.node) y *= scale;
   for (auto& y : move.capacitor) y *= scale;
   for (std::size_t v = 0; v < n; ++v) {
+    if (zero_d_[v]) continue;
     const double y0 = move.node[static_cast<std::size_t>(net_.from[v])], y1 = move.node[static_cast<std::size_t>(net_.to[v])];
     for (int k = 0; k < e; ++k) {
       const auto el = first_element_[v] + k;
@@ -721,13 +876,15 @@ std::size_t PulseSolver::balance_compliances(double period) {
   }
   for (const auto& o : boundaries_.outlets)
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) += move.capacitor[static_cast<std::size_t>(o.index)];
+  lumped_.shift_pressures(move.node, move.capacitor);
   cycle_volume_ = vessel_volumes();
-  cycle_capacitor_ = state_.capacitor;
+  cycle_capacitor_ = capacitor_pressures();
   have_previous_rate_ = false;  // the multistep history belongs to the state before the move
   return n;
 }
 
 void PulseSolver::check_solution() const {
+  lumped_.check(time_);
   for (Eigen::Index el = 0; el < state_.area.rows(); ++el)
     if (!(state_.area(el, 0) > 0) || !state_.area.row(el).allFinite() || !state_.flow.row(el).allFinite())
       throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], time_);
@@ -749,6 +906,7 @@ void PulseSolver::save(CheckpointWriter& out) const {
     out.put(s->capacitor);
     out.put(s->exchanged(0));
     out.put(s->exchanged(1));
+    out.put(s->coupled);
   }
   out.put(previous_flow_);
   out.put(cycle_volume_);
@@ -767,6 +925,7 @@ void PulseSolver::save(CheckpointWriter& out) const {
     rest.push_back(o.rest_flow);
   }
   out.put(rest);
+  lumped_.save(out);
 }
 
 void PulseSolver::restore(CheckpointReader& in) {
@@ -783,19 +942,21 @@ void PulseSolver::restore(CheckpointReader& in) {
   in.get_into(state_.capacitor, "capacitors");
   state_.exchanged(0) = in.get_double();
   state_.exchanged(1) = in.get_double();
+  in.get_into(state_.coupled, "coupled ends");
   // The multistep history: empty until a multistep scheme has taken a step.
   previous_rate_.area = in.get_matrix();
   previous_rate_.flow = in.get_matrix();
   previous_rate_.capacitor = in.get_eigen_vector();
   previous_rate_.exchanged(0) = in.get_double();
   previous_rate_.exchanged(1) = in.get_double();
+  previous_rate_.coupled = in.get_eigen_vector();
   if (previous_rate_.area.size() != 0 &&
       (previous_rate_.area.rows() != state_.area.rows() || previous_rate_.area.cols() != state_.area.cols() ||
        previous_rate_.flow.rows() != state_.flow.rows() || previous_rate_.capacitor.size() != state_.capacitor.size()))
     in.fail("multistep history of another discretisation");
   previous_flow_ = in.get_matrix();
   cycle_volume_ = in.get_vector();
-  cycle_capacitor_ = in.get_eigen_vector();
+  cycle_capacitor_ = in.get_vector();
   const std::vector<double> ends = in.get_vector();
   if (ends.size() != 2 * boundaries_.end_state.size()) in.fail("vessel ends of another network");
   for (std::size_t k = 0; k < boundaries_.end_state.size(); ++k)
@@ -806,6 +967,7 @@ void PulseSolver::restore(CheckpointReader& in) {
     boundaries_.outlets[k].rest_area = rest[2 * k];
     boundaries_.outlets[k].rest_flow = rest[2 * k + 1];
   }
+  lumped_.restore(in);
 }
 
 }  // namespace hemotree

@@ -1,9 +1,11 @@
 // The spectral/hp discontinuous Galerkin solver of pulsatile flow in a compliant network
-// (the paper's "Numerical approximation method"): modal Legendre elements in every vessel,
+// (the paper's "Numerical approximation method"): modal Legendre elements in every 1D vessel,
 // upwind (Roe) fluxes between elements, junctions and boundaries solved through the
 // characteristics, second-order Adams-Bashforth (or classical Runge-Kutta) in time.
 // The state of all elements lives in flat matrices (one row per element), and each stage
 // of the right-hand side acts on all of them at once.
+// Vessels far shorter than the pulse's wavelength may be 0D instead (solver/lumped_vessels,
+// implicit): then a step is one 0D step with several explicit 1D substeps inside it.
 #pragma once
 
 #include <limits>
@@ -16,6 +18,7 @@
 #include "physics/viscosity_table.hpp"
 #include "solver/degree_choice.hpp"
 #include "solver/legendre_basis.hpp"
+#include "solver/lumped_vessels.hpp"
 #include "solver/network_boundaries.hpp"
 #include "solver/checkpoint.hpp"
 #include "solver/steady_flow.hpp"
@@ -24,8 +27,16 @@
 
 namespace hemotree {
 
+// Which vessels are 1D (DG) and which 0D (lumped): all of one kind, or chosen per vessel.
+enum class ModelChoice { automatic, one_d, zero_d };
+
 struct SolverOptions {
   static constexpr int automatic = -1;
+  ModelChoice model = ModelChoice::one_d;
+  // automatic: a vessel is 0D when a wave crosses it in less than this fraction of the
+  // period (L / c0 < lumped_transit T), unless it ends in a reflection outlet.
+  double lumped_transit = 1e-3;
+  double lumped_step = 1e-3;  // the 0D step, as a fraction of the period (at most)
   int degree = automatic;   // p in every vessel, or chosen per vessel by degree_rule
   DegreeRule degree_rule;
   int elements = 1;         // per vessel
@@ -52,6 +63,7 @@ struct PulseState {
   Eigen::MatrixXd area, flow;  // elements x modes
   Eigen::VectorXd capacitor;   // one per RCR outlet [Pa]
   Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();  // in at the inlet, out at the outlets [m^3]
+  Eigen::VectorXd coupled;     // per 1D end at a 0D node: the volume it let into the node [m^3]
 
   void set_zero_like(const PulseState& other);
   void add_scaled(double factor, const PulseState& other);  // this += factor * other
@@ -61,11 +73,16 @@ class PulseSolver {
  public:
   PulseSolver(const Network& net, const SolverOptions& options);
 
-  void step();  // advances one time step
+  void step();  // advances one time step (one 0D step, with its 1D substeps, where there are 0D vessels)
   double time() const { return time_; }
   double dt() const { return dt_; }
   // Replaces the chosen step (e.g. by one that divides the period); the reason stays.
-  void set_time_step(double dt) { dt_ = dt; }
+  void set_time_step(double dt);
+  // The 1D substeps of a step (1 without 0D vessels), and their length.
+  int substeps() const { return substeps_; }
+  double substep() const { return dt_ / substeps_; }
+  bool is_lumped(std::size_t vessel) const { return zero_d_[vessel]; }
+  std::size_t lumped_count() const { return lumped_.vessel_count(); }
   const std::string& dt_reason() const { return dt_reason_; }
   // The largest stable step of the scheme (at --cfl 1 would be the limit itself; this is
   // cfl times it), whatever --dt asked for, and what sets it.
@@ -87,7 +104,7 @@ class PulseSolver {
 
   const VesselLaw& law(std::size_t vessel) const { return laws_[vessel]; }
   const Blood& blood() const { return blood_; }
-  int degree(std::size_t vessel) const { return vessel_degree_[vessel]; }
+  int degree(std::size_t vessel) const { return vessel_degree_[vessel]; }  // -1: 0D
   int max_degree() const { return static_cast<int>(bases_.size()) - 1; }
   std::size_t element_count() const { return static_cast<std::size_t>(state_.area.rows()); }
   const PulseState& state() const { return state_; }
@@ -127,14 +144,20 @@ class PulseSolver {
   // Returns the first element whose area is not positive and finite, or -1.
   Eigen::Index element_terms(const PulseState& s, PulseState& rate, const ModalBasis& basis, Eigen::Index first,
                              Eigen::Index count);
-  void step_exponential();
+  void step_exponential(double h);
+  void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
+  void step_coupled();     // a 0D step around its 1D substeps
+  void choose_models(const SolverOptions& options);
   void choose_time_step(const SolverOptions& options);
   void start_from_steady_flow(const SteadyFlow& steady);
   std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
   void start_at_rest();
   // steady: the network's steady flow, or null where it has none.
   void choose_degrees_and_elements(const SolverOptions& options, const SteadyFlow* steady);
-  std::int32_t end_element(std::size_t vessel) const { return first_element_[vessel] + elements_per_vessel_; }
+  std::int32_t end_element(std::size_t vessel) const {
+    return zero_d_[vessel] ? first_element_[vessel] : first_element_[vessel] + elements_per_vessel_;
+  }
+  std::vector<double> capacitor_pressures() const;  // per network outlet (NaN: none)
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
   double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;
 
@@ -149,6 +172,14 @@ class PulseSolver {
     int degree;
     Eigen::Index first, count;
   };
+  std::vector<bool> zero_d_;               // per vessel
+  LumpedVessels lumped_;
+  int substeps_ = 1;
+  double stable_1d_ = 0;                   // the 1D vessels' stable step (inf without any)
+  double step_start_ = 0;                  // time at the start of the 0D step being taken
+  std::vector<std::int32_t> coupled_node_; // per coupled end: its 0D node
+  std::vector<double> held_end_flow_;      // per coupled end: its inflow to the node at the step's start
+  std::vector<double> coupled_inflow_, coupled_volume_;  // per 0D node
   std::vector<ModalBasis> bases_;          // by degree; empty where unused
   std::vector<DegreeBlock> blocks_;
   std::vector<int> vessel_degree_;         // per vessel
@@ -166,7 +197,7 @@ class PulseSolver {
   Eigen::VectorXd friction_rate_;
   std::vector<double> steady_resistance_;  // Poiseuille, per vessel; empty without a steady solution
   std::vector<double> cycle_volume_;       // per vessel, at the last cycle end
-  Eigen::VectorXd cycle_capacitor_;        // the capacitors there
+  std::vector<double> cycle_capacitor_;    // the capacitors there, per network outlet
   Eigen::VectorXd decay_, phi1_, phi2_, next_flow_;  // ETD2: e^(-r h), phi1, phi2 per element; scratch
   Eigen::MatrixXd previous_flow_;
   bool have_previous_rate_ = false;

@@ -49,6 +49,22 @@ EndState resistance_state(const VesselLaw& law, double a, double q, double r, do
   return {x, q + mu * (x - a)};
 }
 
+EndState pressure_state(const VesselLaw& law, double a, double q, double p_node, bool distal, double r) {
+  // Q* = q + mu (A* - a); solve p(A*) + rho (Q*/A*)^2 / 2 - r Q_in = p_node by Newton, as at a junction.
+  const double mu = incoming_speed(law, a, q, distal), sign = distal ? 1.0 : -1.0;
+  double x = a;
+  for (int it = 0; it < 50; ++it) {
+    const double qs = q + mu * (x - a), u = qs / x;
+    const double g = law.pressure(x) + 0.5 * law.density * u * u - r * sign * qs - p_node;
+    const double dg = law.beta / (2 * std::sqrt(x)) + law.density * u * (mu - u) / x - r * sign * mu;
+    const double step = g / dg;
+    x -= step;
+    if (x <= 0) x = 0.5 * (x + step);  // stay in the physical range
+    if (std::abs(step) <= 1e-14 * x) break;
+  }
+  return {x, q + mu * (x - a)};
+}
+
 EndState reflection_state(const VesselLaw& law, double a, double q, double a0, double q0, double rt) {
   // Outgoing: Q* - q = mu_in (A* - a) (linearised at the trace).
   // Incoming, measured from rest: w_in = -rt w_out with w_k = l_k(U0) . (U* - U0),

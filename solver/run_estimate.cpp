@@ -14,6 +14,9 @@ namespace {
 constexpr double step_cost = 10e-6;    // [s per step]
 constexpr double fixed_cost = 300e-9;  // [s per element and step]
 constexpr double modal_cost = 18e-9;   // [s per element, step and (p + 1)^2]
+// 0D vessels: two linearisations, factorisations and solves of the nodal system per step
+// (bench/README.md, "0D vessels"); not threaded.
+constexpr double lumped_cost = 250e-9;  // [s per 0D vessel and step]
 }  // namespace
 
 double element_step_seconds(int degree) {
@@ -24,13 +27,14 @@ double element_step_seconds(int degree) {
   return fixed_cost + modal_cost * modes * modes;
 }
 
-RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads) {
-  double step = step_cost;
+RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads, double substeps,
+                         double lumped_vessels) {
+  double substep = step_cost;
   for (std::size_t p = 0; p < elements_of_degree.size(); ++p)
-    step += elements_of_degree[p] * element_step_seconds(static_cast<int>(p));
+    substep += elements_of_degree[p] * element_step_seconds(static_cast<int>(p));
   // Two threads gave 1.8 times one thread's speed from 5000 vessels up (bench/README.md).
   const double speedup = threads > 1 ? 0.9 * threads : 1.0;
-  return {steps, steps * step / speedup};
+  return {steps, steps * (substeps * substep / speedup + lumped_vessels * lumped_cost)};
 }
 
 std::string describe_duration(double seconds) {

@@ -15,8 +15,10 @@ struct RunEstimate {
   double seconds = 0;  // wall time on one core of the reference machine, over threads
 };
 
-// elements_of_degree[p]: elements of degree p.
-RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads);
+// elements_of_degree[p]: 1D elements of degree p, each step of the run substeps steps of
+// theirs; lumped_vessels: 0D vessels, one implicit step per step.
+RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads,
+                         double substeps = 1, double lumped_vessels = 0);
 
 // Seconds of one step of one element of degree p (the cost model).
 double element_step_seconds(int degree);

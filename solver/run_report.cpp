@@ -44,7 +44,8 @@ nlohmann::json vessel_results(const Network& net, const PulseSolver& solver, con
                        {"diameter", net.diameter[v]},
                        {"length", net.length[v]},
                        {"class", to_string(net.vessel_class[v])},
-                       {"degree", solver.degree(v)},
+                       {"model", solver.is_lumped(v) ? "0d" : "1d"},
+                       {"degree", solver.is_lumped(v) ? nlohmann::json(nullptr) : nlohmann::json(solver.degree(v))},
                        {"mean_flow", c.mean_flow},
                        {"mean_pressure", c.mean_pressure},
                        {"systolic_pressure", c.systolic_pressure},
@@ -94,6 +95,10 @@ void write_results_vtk(const std::filesystem::path& file, const Network& net, co
     }
   std::vector<CellField> fields;
   for (std::size_t f = 0; f < names.size(); ++f) fields.push_back({names[f], columns[f]});
+  // The vessel model as a number ParaView can colour by: 1 for 0D, 0 for 1D.
+  std::vector<double> lumped(vessels.size());
+  for (std::size_t v = 0; v < vessels.size(); ++v) lumped[v] = vessels[v].value("model", "1d") == "0d" ? 1.0 : 0.0;
+  fields.push_back({"model_0d", lumped});
   OutputStream out(file.string());
   write_vtk(net, out, fields);
   out.commit();

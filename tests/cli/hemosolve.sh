@@ -44,7 +44,7 @@ assert abs(s["inlet_mean_flow"] - q_in) <= 1e-3 * q_in, (s["inlet_mean_flow"], q
 assert abs(s["mass_balance"] - (s["inlet_mean_flow"] - s["outlets_mean_flow"]) / s["inlet_mean_flow"]) < 1e-12
 assert abs(s["mass_balance"]) < 0.2, s["mass_balance"]
 
-keys = {"id", "diameter", "length", "class", "degree", "mean_flow", "mean_pressure", "systolic_pressure",
+keys = {"id", "diameter", "length", "class", "model", "degree", "mean_flow", "mean_pressure", "systolic_pressure",
         "diastolic_pressure", "pulsatility_index", "peak_flow", "least_flow", "mean_wss", "reynolds", "womersley", "pwv_pressure",
         "pwv_velocity", "pwv_elastic", "pwv_theory"}
 by_id = {v["id"]: v for v in net["vessels"]}
@@ -59,8 +59,8 @@ for r in rows:
     expected = ("artery" if d >= 500e-6 else "small_artery" if d >= 100e-6
                 else "arteriole" if d >= 10e-6 else "capillary")
     assert r["class"] == expected, (r["id"], r["class"], d)
-    assert r["degree"] == 2, r
-    for k in keys - {"id", "class", "degree", "pwv_pressure", "pwv_velocity"}:
+    assert r["degree"] == 2 and r["model"] == "1d", r
+    for k in keys - {"id", "class", "model", "degree", "pwv_pressure", "pwv_velocity"}:
         assert isinstance(r[k], (int, float)) and math.isfinite(r[k]), (r["id"], k, r[k])
     for k in ("pwv_pressure", "pwv_velocity"):  # null where no forward wave is measurable
         assert r[k] is None or (math.isfinite(r[k]) and r[k] > 0), (r["id"], k, r[k])
@@ -118,7 +118,7 @@ def cell_arrays(path):
     return {a.get("Name"): [float(x) for x in a.text.split()] for a in piece.find("CellData")}
 results = cell_arrays(os.path.join(run, "results.vtp"))
 for key in ("mean_flow", "mean_pressure", "pulsatility_index", "mean_wss", "pwv_pressure", "pwv_theory",
-            "womersley", "reynolds", "degree"):
+            "womersley", "reynolds", "degree", "model_0d"):
     assert key in results and len(results[key]) == n, key
 for row, value in zip(s["vessels"], results["mean_pressure"]):
     assert abs(value - row["mean_pressure"]) <= 1e-8 * row["mean_pressure"], (row["id"], value)
