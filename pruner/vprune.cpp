@@ -114,7 +114,8 @@ int main(int argc, char** argv) {
   app.add_option("input", input, "full tree (vnet JSON), - for standard input")->capture_default_str();
   app.add_option("--budget", budget_text,
                  "profile strategy: number of vessels to keep, an integer in 1.." + int64_max +
-                     " (the result has it within 1 %; at least the tree's size keeps it whole)");
+                     " (the result has it within 1 %), or all: the whole tree, its leaves' outlets "
+                     "calibrated (as any budget of at least the tree's size)");
   app.add_option("-o,--output", output, "output file, - for standard output")->capture_default_str();
   app.add_option("--format", format_name, "json (vnet), vtk, graphml, dot or csv")->capture_default_str();
   app.add_option("--strategy", strategy, "profile (the paper's), diameter or generation")
@@ -210,8 +211,10 @@ int main(int argc, char** argv) {
     if (strategy == "generation" && max_generation_text.empty())
       throw InputError("--strategy generation needs --max-generation");
 
+    const bool budget_all = budget_text == "all";
     const long long budget =
         budget_text.empty() ? 0
+        : budget_all        ? std::numeric_limits<std::int64_t>::max()
                             : static_cast<long long>(parse_count(
                                   budget_text, "--budget", 1, std::numeric_limits<std::int64_t>::max()));
     const int max_generation =
@@ -320,7 +323,8 @@ int main(int argc, char** argv) {
          {"external_pressure", outlets.external_pressure},
          {"rcr_min_diameter", outlets.rcr_min_diameter},
          {"thick_wall_ratio", outlets.thick_wall_ratio}}}};
-    if (budget > 0) parameters["budget"] = budget;
+    if (budget_all) parameters["budget"] = "all";
+    else if (budget > 0) parameters["budget"] = budget;
     if (!cutoff_text.empty()) parameters["cutoff"] = cutoff;
     if (max_generation >= 0) parameters["max_generation"] = max_generation;
     if (keep_subtree) parameters["keep_subtree"] = subtree_id;
@@ -334,7 +338,9 @@ int main(int argc, char** argv) {
     }
     pruned.provenance = provenance;
 
-    if (keeping_all)
+    if (keeping_all && budget_all)
+      note("--budget all: keeping every one of the tree's " + std::to_string(size) + " vessels");
+    else if (keeping_all)
       note("the budget (" + std::to_string(budget) + ") is not below the tree's " +
            std::to_string(size) + " vessels: keeping every vessel");
     note("kept " + std::to_string(pruned.vessel_count()) + " of " + std::to_string(size) +

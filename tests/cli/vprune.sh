@@ -37,6 +37,14 @@ cmp -s "$WORK/a.json" "$WORK/net.json" && pass "file and pipe agree" || fail "fi
 
 "$VPRUNE" --budget 99999999 "$WORK/full.json" -o "$WORK/all.json" 2>"$WORK/log"
 grep -q "keeping every vessel" "$WORK/log" && pass "budget above the tree keeps all" || fail "big budget: $(cat "$WORK/log")"
+"$VPRUNE" --budget all "$WORK/full.json" -o "$WORK/all2.json" 2>"$WORK/log"
+grep -q "keeping every one of the tree's" "$WORK/log" && /usr/bin/python3 - "$WORK/all.json" "$WORK/all2.json" <<'PY' \
+  && pass "--budget all keeps the whole tree, as a budget above its size" || fail "--budget all: $(cat "$WORK/log")"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:])
+assert a["vessels"] == b["vessels"] and a["inlet"] == b["inlet"], "networks differ"
+assert b["provenance"]["parameters"]["budget"] == "all", b["provenance"]["parameters"]
+PY
 "$VPRUNE" --strategy generation --max-generation 3 "$WORK/full.json" -o "$WORK/g.json" 2>/dev/null \
   && [ "$("$VSTATS" --json "$WORK/g.json" | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)["vessels"])')" -eq 15 ] \
   && pass "generation strategy" || fail "generation strategy"
