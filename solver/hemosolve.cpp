@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--model", model,
                  "vessel model: 1d (DG, waves), 0d (lumped R, L, C, implicit) or auto: 0d where a wave crosses "
-                 "the vessel in less than --lumped-transit of the period, 1d elsewhere (docs/solver.md §8)")
+                 "the vessel in less than --lumped-transit of the period, 1d elsewhere (docs/solver.md §10)")
       ->capture_default_str();
   app.add_option("--lumped-transit", options.lumped_transit,
                  "auto: the wave transit time L/c, as a fraction of the period, below which a vessel is 0D, in [0, 1]")

@@ -99,6 +99,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
   previous_volume_ = pressure_ = predicted_ = system_shunt_ = rhs_ = held_inflow_ = impedance_ = dynamic_ = volume_;
   flow_.assign(edges, 0.0);
   previous_flow_ = conductance_ = history_ = next_flow_ = flow_;
+  capacity_a_.assign(vessels_.size(), 0.0);
+  capacity_b_ = capacity_a_;
 }
 
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
@@ -117,6 +119,13 @@ void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
       if (const auto j = slot[static_cast<std::size_t>(k)]; j >= 0)
         coupling_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(j)]++)] = static_cast<std::int32_t>(e);
   update_dynamic_pressures();
+}
+
+void LumpedVessels::update_end_capacities() {
+  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+    capacity_a_[e] = flow_capacity(e, pressure_[static_cast<std::size_t>(a_[e])]);
+    capacity_b_[e] = flow_capacity(e, pressure_[static_cast<std::size_t>(b_[e])]);
+  }
 }
 
 void LumpedVessels::update_dynamic_pressures() {
@@ -190,6 +199,7 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_volume(k, pressure_[k]);
   predicted_ = pressure_;
   restart_history();
+  update_end_capacities();
   update_dynamic_pressures();
 }
 
@@ -208,6 +218,8 @@ void LumpedVessels::start_at_rest(std::span<const VesselLaw> laws) {
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_volume(k, pressure_[k]);
   predicted_ = pressure_;
   restart_history();
+  update_end_capacities();
+  update_dynamic_pressures();
 }
 
 void LumpedVessels::restart_history() {
@@ -233,7 +245,8 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, d
       const double pa = predicted_[static_cast<std::size_t>(a_[e])], pb = predicted_[static_cast<std::size_t>(b_[e])];
       const double p = 0.5 * (pa + pb);
       const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p, area = s * s;
-      const double capacity = (flow_capacity(e, pa) + 4 * flow_capacity(e, p) + flow_capacity(e, pb)) / 6;
+      const double ends = pass == 0 ? capacity_a_[e] + capacity_b_[e] : flow_capacity(e, pa) + flow_capacity(e, pb);
+      const double capacity = (ends + 4 * flow_capacity(e, p)) / 6;
       const double resistance = edge_length_[e] / capacity;
       const double inertance = density_ * edge_length_[e] / area;
       conductance_[e] = 1 / (resistance + 1.5 * inertance / dt);
@@ -309,6 +322,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   }
   previous_flow_.swap(flow_);
   flow_ = next_flow_;
+  update_end_capacities();
   update_dynamic_pressures();
   // Across the network's boundary: the inlet, outlet shunts, and the R1 of RCR outlets.
   if (inlet_node_ >= 0) exchanged_in += dt * inlet_flow_;
@@ -328,7 +342,7 @@ double LumpedVessels::pressure_at(std::int32_t index, double x) const {
   if (drop == 0 || x <= 0) return pa;
   // With G = A^2 / (k mu) linear in p between G_a and G_b, int_p^pa G dp = x int_pb^pa G dp
   // is a quadratic in d = pa - p: G_a d - g d^2 / 2 = x F, g = (G_a - G_b) / (pa - pb).
-  const double ga = flow_capacity(e, pa), gb = flow_capacity(e, pb);
+  const double ga = capacity_a_[e], gb = capacity_b_[e];
   const double slope = (ga - gb) / drop, f = x * drop * 0.5 * (ga + gb);
   const double disc = ga * ga - 2 * slope * f;
   return pa - 2 * f / (ga + std::sqrt(std::max(disc, 0.0)));
@@ -355,6 +369,7 @@ void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std
   }
   predicted_ = pressure_;
   restart_history();
+  update_end_capacities();
   update_dynamic_pressures();
 }
 
@@ -382,6 +397,7 @@ void LumpedVessels::restore(CheckpointReader& in) {
     if (v->size() != size) in.fail("0D vessels of another network or model");
   }
   predicted_ = pressure_;
+  update_end_capacities();
   update_dynamic_pressures();
 }
 

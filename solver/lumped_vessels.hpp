@@ -19,7 +19,7 @@
 // Outlets on 0D vessels are part of the system (R: a shunt to p_out; RCR: R1 to a
 // capacitor node, R2 from there to p_out). A 1D vessel end at a node of 0D vessels is a
 // coupling end: the 1D vessel sees the node's pressure, and the node receives the volume the
-// 1D scheme let through that end (docs/solver.md §8).
+// 1D scheme let through that end (docs/solver.md §10).
 #pragma once
 
 #include <cstdint>
@@ -119,6 +119,7 @@ class LumpedVessels {
   double pressure_from_volume(std::size_t node, double volume, double guess) const;
   void restart_history();
   void update_dynamic_pressures();
+  void update_end_capacities();  // after the pressures changed
 
   std::size_t nodes_ = 0, network_nodes_ = 0;  // network nodes first, then capacitor nodes
   std::vector<std::int32_t> node_of_;          // per network node
@@ -155,6 +156,9 @@ class LumpedVessels {
   std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
   std::vector<std::int32_t> coupling_edge_;
   std::vector<double> dynamic_;  // per node (coupling nodes only)
+  // flow_capacity at each 0D vessel's two ends at the pressures now: the interior profile
+  // and the next step's first linearisation read them (the viscosity is most of the cost).
+  std::vector<double> capacity_a_, capacity_b_;
   std::vector<double> held_inflow_, impedance_;  // per node: the coupled inflows predicted with, Z
   double dt_ = 0, inlet_flow_ = 0;
 };

@@ -80,8 +80,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_);
 
-  // The steady Poiseuille solution, where the network has one (not with reflection outlets
-  // or loops): the degrees follow its pressure profiles, and the run starts from it.
+  // The steady Poiseuille solution, where the network has one (not with reflection outlets):
+  // the degrees follow its pressure profiles, and the run starts from it.
   std::optional<SteadyFlow> steady;
   if (net.inlet) {
     try {
@@ -167,7 +167,7 @@ void PulseSolver::choose_models(const SolverOptions& options) {
   zero_d_.assign(n, options.model == ModelChoice::zero_d);
   if (options.model != ModelChoice::automatic) return;
   // A wave crossing the vessel in a small fraction of the period: the whole vessel moves in
-  // phase, as a lumped element (docs/solver.md §8 measures the error against the fraction).
+  // phase, as a lumped element (docs/solver.md §10 measures the error against the fraction).
   std::vector<bool> reflecting(n, false);
   for (const Outlet& o : net_.outlets)
     if (o.type == OutletType::reflection) reflecting[static_cast<std::size_t>(o.vessel)] = true;
@@ -404,7 +404,7 @@ void PulseSolver::step_coupled() {
   // response to their departure from the held inflow: a Robin condition. Without it the
   // coupling is explicit, and unstable once the step exceeds the node's C / Y; with the
   // response of BDF2 (Z = (K^-1)_ii) it broke down at 4 substeps, with 3/2 Z, the backward
-  // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §8).
+  // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §10).
   std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
     const VesselEnd& end = boundaries_.coupled[k].end;
@@ -593,7 +593,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     trace(c.end, a, q);
     // Total pressure p(t) + rho u^2 / 2 + r (Q_in - Q_held): the node's pressure at this point
     // of the step, the kinetic energy of its 0D vessels, and its response, r = 3/2 Z
-    // (docs/solver.md §8).
+    // (docs/solver.md §10).
     const double s = dt_ > 0 ? std::clamp((t - step_start_) / dt_, 0.0, 1.0) : 0.0;
     const std::int32_t node = coupled_node_[k];
     const double r = 1.5 * lumped_.impedance(node);
