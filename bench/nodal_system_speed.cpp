@@ -3,7 +3,10 @@
 // (an implicit step of compliant 0D vessels). Times, medians of 5: the analysis (once per
 // graph: the elimination order, or the pattern, AMD ordering and symbolic factorisation),
 // factorize and solve, for the tree elimination and the sparse Cholesky, and the largest
-// difference between their solutions relative to the largest potential.
+// difference between their solutions relative to the largest potential. Then the diagonal
+// of the inverse (inverse_diagonal): of every node (the elimination only), of 10,000 nodes
+// drawn at random and of 100 of them (both), and the largest relative difference between the
+// methods over the 10,000.
 // usage: nodal_system_speed [N (3800000)] [--shuffled]
 //   The nodes are numbered breadth first from the root, as vgen numbers its trees (every
 //   sweep of the elimination then streams through memory); --shuffled: at random (the
@@ -16,6 +19,7 @@
 #include <cstdlib>
 #include <numeric>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -106,7 +110,10 @@ int main(int argc, char** argv) {
   for (double& x : rhs) x = 2 * unit(rng) - 1;
   std::printf("random binary tree: %zu nodes, %s\n", n, shuffled ? "random labels" : "numbered breadth first");
 
-  std::vector<std::vector<double>> solution;
+  std::vector<std::int32_t> every(n), drawn(10'000);
+  std::iota(every.begin(), every.end(), 0);
+  for (std::int32_t& i : drawn) i = std::uniform_int_distribution<std::int32_t>(0, static_cast<std::int32_t>(n) - 1)(rng);
+  std::vector<std::vector<double>> solution, drawn_diagonal;
   for (const Method method : {Method::tree_elimination, Method::sparse_cholesky}) {
     const auto start = std::chrono::steady_clock::now();
     NodalSystem system(n, a, b, method);
@@ -123,6 +130,17 @@ int main(int argc, char** argv) {
                 method == Method::tree_elimination ? "tree_elimination" : "sparse_cholesky", analysis, factorize,
                 solve);
     solution.push_back(std::move(x));
+    std::vector<double> z(drawn.size());
+    const double some = median_of_5([&] { system.inverse_diagonal(drawn, z); });
+    const std::span<const std::int32_t> hundred(drawn.data(), 100);
+    const double few = median_of_5([&] { system.inverse_diagonal(hundred, std::span<double>(z.data(), 100)); });
+    std::printf("%-17s inverse diagonal:", "");
+    if (method == Method::tree_elimination) {
+      std::vector<double> all(n);
+      std::printf(" every node %8.4f s ", median_of_5([&] { system.inverse_diagonal(every, all); }));
+    }
+    std::printf("  %zu drawn nodes %8.4f s   100 of them %8.5f s\n", drawn.size(), some, few);
+    drawn_diagonal.push_back(std::move(z));
   }
   double difference = 0, scale = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -130,4 +148,8 @@ int main(int argc, char** argv) {
     scale = std::max(scale, std::abs(solution[0][i]));
   }
   std::printf("max |x_tree - x_cholesky| / max |x_tree| = %.2e\n", difference / scale);
+  double worst = 0;
+  for (std::size_t k = 0; k < drawn.size(); ++k)
+    worst = std::max(worst, std::abs(drawn_diagonal[0][k] - drawn_diagonal[1][k]) / drawn_diagonal[0][k]);
+  std::printf("max |z_tree - z_cholesky| / z_tree over the drawn nodes = %.2e\n", worst);
 }

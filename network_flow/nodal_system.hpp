@@ -51,6 +51,22 @@ class NodalSystem {
   std::int64_t factorize(std::span<const double> conductance, std::span<const double> shunt);
   // x = system^-1 b with the last factorisation (x may alias b).
   void solve(std::span<const double> b, std::span<double> x) const;
+  // (system^-1)_ii for each node i of `nodes` (any order, repeats allowed), with the last
+  // factorisation, into out (of nodes' size): each node's own response, the potential that a
+  // unit current into it alone raises there (the impedance to ground seen from the node).
+  // std::invalid_argument for a size mismatch or a node not below node_count(), before
+  // anything is written; std::logic_error without a successful factorisation.
+  //   Tree elimination: the selected inversion (Takahashi, Fagan & Chin 1973), down from
+  // each requested node's root to it, sharing what one node computed with the next: the work
+  // is the number of distinct nodes on the paths from the requested nodes to their roots;
+  // past 1/32 of the nodes, one O(nodes) pass over all of them instead. So O(nodes) at most,
+  // for any request.
+  // Sparse Cholesky: per requested node, the forward solve with the unit vector restricted to
+  // its path up the elimination tree (O(path x column counts), not a full solve).
+  // Not thread-safe against itself: it works in scratch kept in the system (8 bytes a node,
+  // allocated at the first call, none after), so two calls on one system must not overlap;
+  // solve() does not touch it and may run alongside.
+  void inverse_diagonal(std::span<const std::int32_t> nodes, std::span<double> out) const;
 
  private:
   std::size_t nodes_ = 0;
@@ -68,6 +84,11 @@ class NodalSystem {
   std::vector<std::int32_t> component_;
   std::vector<unsigned char> grounded_;
   bool factorized_ = false;
+  // inverse_diagonal's scratch: per node (tree: Sigma_ii, -1 where not yet computed) or per
+  // position of the Cholesky order (the forward solve, 0 outside its path), back to that
+  // state after every call; and the tree's path stack.
+  mutable std::vector<double> inverse_scratch_;
+  mutable std::vector<std::int32_t> path_scratch_;
 };
 
 }  // namespace hemotree
