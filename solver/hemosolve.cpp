@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
                "discontinuous Galerkin) and report flows, pressures and pulsatility.",
                "hemosolve"};
   std::string input, out_dir, resume_dir, rheology, scheme = "etd2", start = "steady", dt_text,
-      sample_text = "1ms", external_text = "10mmHg", degree_text = "auto", model = "1d";
+      sample_text = "1ms", external_text = "10mmHg", degree_text = "auto", model = "auto";
   int cycles = 1, max_cycles = 50, frames = 0, checkpoint_every = 0;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;

@@ -275,13 +275,12 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, d
     system_.solve(rhs_, predicted_);
   }
   if (!coupled_inflow.empty()) std::copy(coupled_inflow.begin(), coupled_inflow.begin() + network_nodes_, held_inflow_.begin());
-  // Z_i = (K^-1)_ii by a solve per coupling node.
-  // TODO(issue 12): the O(nodes) selected inversion on trees (Z_i = 1/d_i + l_i^2 Z_parent) for the full tree.
-  for (const std::int32_t k : coupling_nodes_) {
-    std::fill(rhs_.begin(), rhs_.end(), 0.0);
-    rhs_[static_cast<std::size_t>(k)] = 1;
-    system_.solve(rhs_, rhs_);
-    impedance_[static_cast<std::size_t>(k)] = rhs_[static_cast<std::size_t>(k)];
+  // Z_i = (K^-1)_ii at the coupling nodes: O(nodes) on a tree (selected inversion).
+  if (!coupling_nodes_.empty()) {
+    coupling_impedance_.resize(coupling_nodes_.size());
+    system_.inverse_diagonal(coupling_nodes_, coupling_impedance_);
+    for (std::size_t j = 0; j < coupling_nodes_.size(); ++j)
+      impedance_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_impedance_[j];
   }
   for (std::size_t e = 0; e < edges; ++e)
     next_flow_[e] = conductance_[e] * (predicted_[static_cast<std::size_t>(a_[e])] - predicted_[static_cast<std::size_t>(b_[e])]) +

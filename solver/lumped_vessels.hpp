@@ -160,6 +160,7 @@ class LumpedVessels {
   // and the next step's first linearisation read them (the viscosity is most of the cost).
   std::vector<double> capacity_a_, capacity_b_;
   std::vector<double> held_inflow_, impedance_;  // per node: the coupled inflows predicted with, Z
+  std::vector<double> coupling_impedance_;       // per coupling node, scratch
   double dt_ = 0, inlet_flow_ = 0;
 };
 

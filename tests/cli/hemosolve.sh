@@ -11,7 +11,7 @@ PY=/usr/bin/python3
 "$VGEN" --root-diameter 150um --min-diameter 8.5um \
   | "$VPRUNE" --budget 31 --mean-flow 0.01ml/min 2>"$WORK/prune.log" \
   | tee "$WORK/net.json" \
-  | "$HEMOSOLVE" - --out "$WORK/run" --cycles 1 --degree 2 --quiet --probe 0:0 --probe 1:1 --vtk --frames 4 \
+  | "$HEMOSOLVE" - --out "$WORK/run" --cycles 1 --model 1d --degree 2 --quiet --probe 0:0 --probe 1:1 --vtk --frames 4 \
     >"$WORK/solve.out" 2>"$WORK/solve.err"
 status=("${PIPESTATUS[@]}")
 if [ "${status[0]}" -eq 0 ] && [ "${status[1]}" -eq 0 ] && [ "${status[2]}" -eq 0 ] && [ "${status[3]}" -eq 0 ]; then

@@ -1,5 +1,6 @@
-# hemosolve's fast defaults (--degree auto, the step at 0.9 of the stability limit, ETD2)
-# against the reference discretization of issue 5 (p = 7 in every vessel, half the step) on a
+# hemosolve's fast defaults (--model auto: 0D where waves cannot travel, --degree auto in the
+# 1D vessels, the step at 0.9 of the stability limit, ETD2) against the reference
+# discretization of issue 5 (1D, p = 7 in every vessel, half the step) on a
 # 31-vessel microvascular tree, with the pulse ten times faster than the paper's (a harder
 # test, and ten times cheaper): every vessel's mean pressure and flow within 0.5 %, its
 # pulsatility index within 2 %. Two threads against one: the same to round-off (the
@@ -21,7 +22,7 @@ w["period"], w["systole"] = w["period"] / 10, w["systole"] / 10
 json.dump(net, open(sys.argv[2], "w"))
 PY
 
-"$HEMOSOLVE" "$WORK/net.json" --out "$WORK/reference" --cycles 2 --degree 7 --cfl 0.45 --quiet \
+"$HEMOSOLVE" "$WORK/net.json" --out "$WORK/reference" --cycles 2 --model 1d --degree 7 --cfl 0.45 --quiet \
   && "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/fast" --cycles 2 --quiet \
   && "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/threads" --cycles 2 --threads 2 --quiet \
   || fail "hemosolve runs"
@@ -42,13 +43,13 @@ PY
 # Narrow capillaries (5.5 to 10 um) at the real pulse, one cycle: where the pressure drop
 # narrows the lumen along a capillary, its pressure profile bends, and a linear one (degree 1)
 # misses the pulsatility at the centre (measured 5.4 % here, 10.6 % on the 1001-vessel
-# network). The defaults give such vessels degree 2 (--linear-error) and pass; without that
-# rule the same network fails. The reference's step halved changes it by < 2e-8.
+# network). The DG solver's defaults (--model 1d) give such vessels degree 2 (--linear-error)
+# and pass; without that rule the same network fails. The reference's step halved changes it by < 2e-8.
 "$VGEN" --seed 1 --root-diameter 80um --min-diameter 5.5um | "$VPRUNE" --seed 1 --budget 31 \
   --mean-flow 0.0006ml/min -o "$WORK/capillaries.json" 2>/dev/null
-"$HEMOSOLVE" "$WORK/capillaries.json" --out "$WORK/cap-reference" --cycles 1 --degree 7 --quiet \
-  && "$HEMOSOLVE" "$WORK/capillaries.json" --out "$WORK/cap-fast" --cycles 1 --quiet \
-  && "$HEMOSOLVE" "$WORK/capillaries.json" --out "$WORK/cap-linear" --cycles 1 --linear-error 1e9 --quiet \
+"$HEMOSOLVE" "$WORK/capillaries.json" --out "$WORK/cap-reference" --cycles 1 --model 1d --degree 7 --quiet \
+  && "$HEMOSOLVE" "$WORK/capillaries.json" --out "$WORK/cap-fast" --cycles 1 --model 1d --quiet \
+  && "$HEMOSOLVE" "$WORK/capillaries.json" --out "$WORK/cap-linear" --cycles 1 --model 1d --linear-error 1e9 --quiet \
   || fail "capillary runs"
 "$PY" "$ROOT/bench/compare-summaries" "$WORK/cap-reference/summary.json" "$WORK/cap-fast/summary.json" \
   >"$WORK/cap-cmp" && pass "narrow capillaries: defaults within tolerance of p = 7" \
