@@ -132,10 +132,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--model", model,
                  "vessel model: 1d (DG, waves), 0d (lumped R, L, C, implicit) or auto: 0d where a wave crosses "
-                 "the vessel in less than --lumped-transit of the period, 1d elsewhere (docs/solver.md §10)")
+                 "the vessel in less than --lumped-transit of the period and --lumped-rc holds, 1d elsewhere "
+                 "(docs/solver.md §10)")
       ->capture_default_str();
   app.add_option("--lumped-transit", options.lumped_transit,
                  "auto: the wave transit time L/c, as a fraction of the period, below which a vessel is 0D, in [0, 1]")
+      ->capture_default_str();
+  app.add_option("--lumped-rc", options.lumped_rc,
+                 "auto: the largest w R C (the vessel's resistance times its compliance at the pulse's "
+                 "fundamental: the pressure's diffusion along a viscous vessel) of a 0D vessel, in [0, inf]")
       ->capture_default_str();
   app.add_option("--lumped-step", options.lumped_step,
                  "with 0D vessels: the step of the 0D vessels, as a fraction of the period, in (0, 0.1]; the 1D "
@@ -194,6 +199,7 @@ int main(int argc, char** argv) {
     else if (model == "0d") options.model = ModelChoice::zero_d;
     else throw InputError("--model must be auto, 1d or 0d (got '" + model + "')");
     check_range(options.lumped_transit, {0, 1}, "--lumped-transit");
+    check_range(options.lumped_rc, {0, INFINITY}, "--lumped-rc");
     check_range(options.lumped_step, {0, 0.1, true, false}, "--lumped-step");
     if (start == "rest") options.steady_start = false;
     else if (start != "steady") throw InputError("--start must be steady or rest (got '" + start + "')");
@@ -326,7 +332,8 @@ int main(int argc, char** argv) {
 
     // ---- the run ------------------------------------------------------------------------------
     std::ostringstream shaping;  // the options a checkpoint must share with the run resuming it
-    shaping << "model " << model << " (" << options.lumped_transit << ", " << options.lumped_step << "), scheme "
+    shaping << "model " << model << " (" << options.lumped_transit << ", " << options.lumped_rc << ", "
+            << options.lumped_step << "), scheme "
             << scheme << ", degree " << degree_text << " (" << options.degree_rule.low << "/"
             << options.degree_rule.raise_to << "/" << options.degree_rule.high << ", linear error "
             << options.degree_rule.linear_error << "), elements " << options.elements << ", time step " << dt

@@ -166,15 +166,25 @@ void PulseSolver::choose_models(const SolverOptions& options) {
   const std::size_t n = net_.vessel_count();
   zero_d_.assign(n, options.model == ModelChoice::zero_d);
   if (options.model != ModelChoice::automatic) return;
-  // A wave crossing the vessel in a small fraction of the period: the whole vessel moves in
-  // phase, as a lumped element (docs/solver.md §10 measures the error against the fraction).
+  // A vessel moves in phase along its length, as a lumped element, when |gamma L| =
+  // |sqrt((R + i w L_q) i w C)| is small at the pulse's frequencies (R, L_q, C the vessel's
+  // own resistance, inertance and compliance). Its two limits are the two tests: where
+  // friction is weak (arteries), w L / c, bounded by the wave transit L / c against
+  // --lumped-transit of the period; where it dominates (capillaries), w R C, the pressure's
+  // diffusion along the vessel, bounded at the fundamental by --lumped-rc (docs/solver.md §10
+  // gives the measurements behind both).
   std::vector<bool> reflecting(n, false);
   for (const Outlet& o : net_.outlets)
     if (o.type == OutletType::reflection) reflecting[static_cast<std::size_t>(o.vessel)] = true;
-  const double period = period_of(net_);
+  const double period = period_of(net_), omega = 2 * std::numbers::pi / period;
   for (std::size_t v = 0; v < n; ++v) {
-    const double transit = net_.length[v] / laws_[v].wave_speed(laws_[v].reference_area);
-    zero_d_[v] = !reflecting[v] && transit < options.lumped_transit * period;
+    const VesselLaw& law = laws_[v];
+    const double area = law.reference_area, length = net_.length[v];
+    const double transit = length / law.wave_speed(area);
+    const double compliance = length * 2 * std::sqrt(area) / law.beta;
+    const double resistance = friction_k_ * viscosity_(area) * length / (area * area);
+    zero_d_[v] = !reflecting[v] && transit < options.lumped_transit * period &&
+                 omega * resistance * compliance < options.lumped_rc;
   }
 }
 

@@ -34,8 +34,10 @@ struct SolverOptions {
   static constexpr int automatic = -1;
   ModelChoice model = ModelChoice::one_d;  // the DG solver; hemosolve defaults to automatic
   // automatic: a vessel is 0D when a wave crosses it in less than this fraction of the
-  // period (L / c0 < lumped_transit T), unless it ends in a reflection outlet.
+  // period (L / c0 < lumped_transit T) and the pressure diffuses along it fast enough
+  // (w R C < lumped_rc at the pulse's fundamental), unless it ends in a reflection outlet.
   double lumped_transit = 3e-3;
+  double lumped_rc = 1.6;
   double lumped_step = 1e-3;  // the 0D step, as a fraction of the period (at most)
   int degree = automatic;   // p in every vessel, or chosen per vessel by degree_rule
   DegreeRule degree_rule;
