@@ -1,5 +1,6 @@
 #include "solver/run_report.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -74,11 +75,43 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
   summary["conservation_error"] = cycle.conservation_error;
   summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}, {"wss", "Pa"},
                       {"speed", "m/s"}, {"frequency", "Hz"}};
-  summary["vessels"] = vessels;
+  // The run's facts, then the vessels one by one: no string of the whole report in memory
+  // (a million vessels are a gigabyte of text). Strings from outside (a file name that is not
+  // UTF-8) must not stop the report: such bytes are written as U+FFFD.
+  constexpr auto replace = nlohmann::json::error_handler_t::replace;
+  std::string head = summary.dump(1, ' ', false, replace);
+  head.resize(head.rfind('}'));  // the run's facts, open for the vessels
+  while (!head.empty() && (head.back() == '\n' || head.back() == ' ')) head.pop_back();
   OutputStream out(file.string());
-  // Strings from outside (a file name that is not UTF-8) must not stop the report: such bytes
-  // are written as U+FFFD.
-  out << summary.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
+  out << head << ",\n \"vessels\": [";
+  for (std::size_t v = 0; v < vessels.size(); ++v)
+    out << (v ? ",\n  " : "\n  ") << vessels[v].dump(-1, ' ', false, replace);
+  out << (vessels.empty() ? "]\n}\n" : "\n ]\n}\n");
+  out.commit();
+}
+
+void write_vessel_table(const std::filesystem::path& file, const nlohmann::json& vessels) {
+  OutputStream out(file.string());
+  if (vessels.empty()) {
+    out.commit();
+    return;
+  }
+  std::vector<std::string> names;
+  for (const auto& [key, value] : vessels.front().items()) names.push_back(key);
+  for (std::size_t f = 0; f < names.size(); ++f) out << (f ? "," : "") << names[f];
+  out << '\n';
+  char text[32];  // the shortest text that reads back to the same double, as summary.json's
+  for (const auto& row : vessels) {
+    for (std::size_t f = 0; f < names.size(); ++f) {
+      if (f) out << ',';
+      const auto& x = row[names[f]];
+      if (x.is_number_integer()) out << x.get<std::int64_t>();
+      else if (x.is_number()) out << std::string_view(text, std::to_chars(text, text + sizeof text, x.get<double>()).ptr);
+      else if (x.is_string()) out << x.get<std::string>();  // class and model names: no commas
+      // null: an empty field, which pandas and numpy read as NaN
+    }
+    out << '\n';
+  }
   out.commit();
 }
 

@@ -39,6 +39,10 @@ nlohmann::json vessel_results(const Network& net, const PulseSolver& solver, con
 void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const nlohmann::json& vessels,
                    const CycleSummary& cycle);
 
+// vessels.csv: the same rows as a table, one line per vessel, a header of the fields (SI
+// units; an empty field where summary.json has null), for pandas, numpy or a spreadsheet.
+void write_vessel_table(const std::filesystem::path& file, const nlohmann::json& vessels);
+
 // The network as VTK PolyData with every numeric per-vessel result as cell data (null -> NaN).
 void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels);
 

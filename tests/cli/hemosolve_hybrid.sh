@@ -2,7 +2,8 @@
 # paper's pulse), three cycles from the same steady start: every vessel's mean pressure and
 # flow within 0.5 %, its pulsatility index within 2 % (issue 5's tolerances, measured by
 # bench/compare-summaries), with a --lumped-transit that leaves arteries 1D and the rest 0D;
-# mass to round-off in both; summary.json names each vessel's model, and the run says how many.
+# mass to round-off in both; summary.json names each vessel's model, and the run says how many;
+# vessels.csv holds summary.json's rows.
 source "$(dirname "$0")/lib.sh"
 VPRUNE=$BUILD/pruner/vprune
 HEMOSOLVE=$BUILD/solver/hemosolve
@@ -23,9 +24,18 @@ for run in auto zero_d; do
 done
 grep -qE "hemosolve: [0-9]+ vessels 1D, [0-9]+ 0D \(--model auto\)" "$WORK/log" && pass "the run says its models" \
   || fail "no model count: $(cat "$WORK/log")"
-"$PY" - "$WORK/auto/summary.json" "$WORK/zero_d/summary.json" <<'PY' && pass "summary.json: models and mass" || fail "summary.json"
-import json, sys
-auto, zero = (json.load(open(f)) for f in sys.argv[1:])
+"$PY" - "$WORK/auto/summary.json" "$WORK/zero_d/summary.json" "$WORK/auto/vessels.csv" <<'PY' \
+  && pass "summary.json: models and mass; vessels.csv: the same rows" || fail "summary.json or vessels.csv"
+import csv, json, sys
+auto, zero = (json.load(open(f)) for f in sys.argv[1:3])
+rows = list(csv.DictReader(open(sys.argv[3])))
+assert len(rows) == len(auto["vessels"]), (len(rows), len(auto["vessels"]))
+for row, v in zip(rows, auto["vessels"]):
+    assert set(row) == set(v), set(row) ^ set(v)
+    for k, x in v.items():
+        if x is None: assert row[k] == "", (k, row[k])
+        elif isinstance(x, str): assert row[k] == x, (k, row[k], x)
+        else: assert float(row[k]) == x, (k, row[k], x)  # the same double
 models = [v["model"] for v in auto["vessels"]]
 assert 0 < models.count("0d") < len(models), models
 assert auto["vessels_0d"] == models.count("0d") and auto["vessels_1d"] == models.count("1d")
