@@ -442,6 +442,7 @@ int main(int argc, char** argv) {
     pulsatile.probes().write(dir / "probes.csv");
     const nlohmann::json results =
         last.vessels.empty() ? nlohmann::json::array() : vessel_results(net, run, last, analysis_frequency(net.inlet->waveform));
+    if (!last.vessels.empty()) run_info["statistics"] = group_statistics(net, results);
     write_summary(dir / "summary.json", run_info, results, last);
     write_vessel_table(dir / "vessels.csv", results);
     if (vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results);

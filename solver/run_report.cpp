@@ -1,6 +1,8 @@
 #include "solver/run_report.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <map>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -88,6 +90,53 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
     out << (v ? ",\n  " : "\n  ") << vessels[v].dump(-1, ' ', false, replace);
   out << (vessels.empty() ? "]\n}\n" : "\n ]\n}\n");
   out.commit();
+}
+
+nlohmann::json group_statistics(const Network& net, const nlohmann::json& vessels) {
+  // Per group: how many vessels, and of each quantity the median, the 5th and 95th
+  // percentiles (nearest rank) over the group's vessels where it is defined.
+  static const char* quantities[] = {"mean_pressure", "pulsatility_index", "mean_flow", "mean_wss"};
+  auto describe = [&](const std::vector<std::size_t>& members) {
+    nlohmann::json g = {{"vessels", members.size()}};
+    std::vector<double> values;
+    for (const char* q : quantities) {
+      values.clear();
+      for (const std::size_t v : members)
+        if (vessels[v][q].is_number()) values.push_back(vessels[v][q].get<double>());
+      if (values.empty()) continue;
+      std::sort(values.begin(), values.end());
+      auto rank = [&](double f) { return values[static_cast<std::size_t>(std::llround(f * static_cast<double>(values.size() - 1)))]; };
+      g[q] = {{"median", rank(0.5)}, {"p5", rank(0.05)}, {"p95", rank(0.95)}};
+    }
+    return g;
+  };
+  std::map<std::string, std::vector<std::size_t>> by_class, by_model;
+  std::map<std::int32_t, std::vector<std::size_t>> by_generation, by_diameter;
+  for (std::size_t v = 0; v < vessels.size(); ++v) {
+    by_class[vessels[v]["class"].get<std::string>()].push_back(v);
+    by_model[vessels[v].value("model", "1d")].push_back(v);
+    if (!net.generation.empty()) by_generation[net.generation[v]].push_back(v);
+    // Diameter bins a factor sqrt(2) wide: bin k holds [2^(k/2), 2^((k+1)/2)) um.
+    by_diameter[static_cast<std::int32_t>(std::floor(2 * std::log2(net.diameter[v] * 1e6)))].push_back(v);
+  }
+  nlohmann::json out;
+  for (const auto& [name, members] : by_class) out["by_class"][name] = describe(members);
+  for (const auto& [name, members] : by_model) out["by_model"][name] = describe(members);
+  // Generations and diameter bins as arrays in their order (an object's keys would sort as text).
+  out["by_generation"] = nlohmann::json::array();
+  for (const auto& [g, members] : by_generation) {
+    nlohmann::json row = describe(members);
+    row["generation"] = g;
+    out["by_generation"].push_back(row);
+  }
+  out["by_diameter"] = nlohmann::json::array();
+  for (const auto& [k, members] : by_diameter) {
+    nlohmann::json row = describe(members);
+    row["diameter_from"] = 1e-6 * std::exp2(k / 2.0);  // [m]
+    row["diameter_to"] = 1e-6 * std::exp2((k + 1) / 2.0);
+    out["by_diameter"].push_back(row);
+  }
+  return out;
 }
 
 void write_vessel_table(const std::filesystem::path& file, const nlohmann::json& vessels) {

@@ -3,7 +3,8 @@
 # flow within 0.5 %, its pulsatility index within 2 % (issue 5's tolerances, measured by
 # bench/compare-summaries), with a --lumped-transit that leaves arteries 1D and the rest 0D;
 # mass to round-off in both; summary.json names each vessel's model, and the run says how many;
-# vessels.csv holds summary.json's rows.
+# vessels.csv holds summary.json's rows; the statistics per class, model, generation and
+# diameter bin count every vessel once.
 source "$(dirname "$0")/lib.sh"
 VPRUNE=$BUILD/pruner/vprune
 HEMOSOLVE=$BUILD/solver/hemosolve
@@ -43,5 +44,18 @@ assert all((v["degree"] is None) == (v["model"] == "0d") for v in auto["vessels"
 assert zero["vessels_0d"] == len(zero["vessels"]) and zero["substeps"] == 1
 for s in (auto, zero):
     assert s["status"] == "complete" and abs(s["conservation_error"]) < 1e-12, s["conservation_error"]
+# Group statistics: every vessel in one class, one model; the medians by nearest rank.
+st = auto["statistics"]
+for key in ("by_class", "by_model"):
+    assert sum(g["vessels"] for g in st[key].values()) == len(auto["vessels"]), key
+for key in ("by_generation", "by_diameter"):
+    assert sum(g["vessels"] for g in st[key]) == len(auto["vessels"]), key
+bins = st["by_diameter"]
+assert all(a["diameter_to"] <= b["diameter_from"] * (1 + 1e-12) for a, b in zip(bins, bins[1:])), bins
+for v in auto["vessels"]:
+    assert sum(b["diameter_from"] <= v["diameter"] < b["diameter_to"] for b in bins) == 1, v["diameter"]
+for name, g in st["by_model"].items():
+    values = sorted(v["mean_pressure"] for v in auto["vessels"] if v["model"] == name)
+    assert g["vessels"] == len(values) and g["mean_pressure"]["median"] == values[int(0.5 * (len(values) - 1) + 0.5)], name
 PY
 finish
