@@ -3,7 +3,9 @@
 // straight into the output stream, so a tree of millions of vessels never sits in memory
 // as text.
 #include <cmath>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "cli/errors.hpp"
 #include "formats/exports.hpp"
@@ -44,25 +46,40 @@ void write_data_array(OutputStream& out, std::string_view type, std::string_view
   out << "        </DataArray>\n";
 }
 
-template <class Number>
-void write_cell_array(OutputStream& out, std::string_view type, std::string_view name,
-                      std::span<const Number> values) {
-  write_data_array(out, type, name, 1, values.size(), [&](std::size_t v) { out << values[v]; });
-}
 
 }  // namespace
 
-void write_vtk(const Network& net, OutputStream& out, const std::vector<CellField>& extra) {
+void write_vtk(const Network& net, OutputStream& out, const std::vector<CellField>& extra,
+               std::span<const std::uint8_t> keep) {
   if (!net.has_coordinates())
     throw InputError("VTK export needs node coordinates; this network has none");
-  const std::size_t vessels = net.vessel_count();
-  const std::size_t nodes = net.node_count();
   // Check before writing anything: a short field found halfway would leave half a file.
   for (const CellField& field : extra)
-    if (field.values.size() != vessels)
+    if (field.values.size() != net.vessel_count())
       throw InputError("cell field '" + field.name + "' has " +
                        std::to_string(field.values.size()) + " values for " +
-                       std::to_string(vessels) + " vessels");
+                       std::to_string(net.vessel_count()) + " vessels");
+  if (!keep.empty() && keep.size() != net.vessel_count())
+    throw std::invalid_argument("write_vtk: a keep mask of " + std::to_string(keep.size()) + " for " +
+                                std::to_string(net.vessel_count()) + " vessels");
+  // The cells written (every vessel, or those kept) and the points they use, renumbered.
+  std::vector<std::int64_t> cell, point, point_of(keep.empty() ? 0 : net.node_count(), -1);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (keep.empty() || keep[v]) cell.push_back(static_cast<std::int64_t>(v));
+  if (!keep.empty())
+    for (const std::int64_t v : cell)
+      for (const std::int32_t n : {net.from[static_cast<std::size_t>(v)], net.to[static_cast<std::size_t>(v)]})
+        if (point_of[static_cast<std::size_t>(n)] < 0) {
+          point_of[static_cast<std::size_t>(n)] = static_cast<std::int64_t>(point.size());
+          point.push_back(n);
+        }
+  const std::size_t vessels = cell.size();
+  const std::size_t nodes = keep.empty() ? net.node_count() : point.size();
+  auto node = [&](std::size_t k) { return keep.empty() ? k : static_cast<std::size_t>(point[k]); };
+  auto renumbered = [&](std::int32_t n) {
+    return keep.empty() ? static_cast<std::int64_t>(n) : point_of[static_cast<std::size_t>(n)];
+  };
+  auto vessel = [&](std::size_t i) { return static_cast<std::size_t>(cell[i]); };
 
   out << "<?xml version=\"1.0\"?>\n"
          "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
@@ -73,31 +90,41 @@ void write_vtk(const Network& net, OutputStream& out, const std::vector<CellFiel
 
   out << "      <Points>\n";
   write_data_array(out, "Float64", "Points", 3, nodes,
-                   [&](std::size_t n) { out << net.x[n] << ' ' << net.y[n] << ' ' << net.z[n]; });
+                   [&](std::size_t k) {
+                     const std::size_t n = node(k);
+                     out << net.x[n] << ' ' << net.y[n] << ' ' << net.z[n];
+                   });
   out << "      </Points>\n";
 
   // Line cells: every vessel joins its two nodes, so the offsets are 2, 4, 6, ...
   out << "      <Lines>\n";
   write_data_array(out, "Int64", "connectivity", 1, vessels,
-                   [&](std::size_t v) { out << net.from[v] << ' ' << net.to[v]; });
+                   [&](std::size_t i) {
+                     out << static_cast<long long>(renumbered(net.from[vessel(i)])) << ' '
+                         << static_cast<long long>(renumbered(net.to[vessel(i)]));
+                   });
   write_data_array(out, "Int64", "offsets", 1, vessels,
                    [&](std::size_t v) { out << static_cast<long long>(2 * (v + 1)); });
   out << "      </Lines>\n";
 
   out << "      <CellData Scalars=\"diameter\">\n";
-  write_cell_array<std::int64_t>(out, "Int64", "id", net.id);
-  write_cell_array<double>(out, "Float64", "diameter", net.diameter);
-  write_cell_array<double>(out, "Float64", "length", net.length);
-  write_cell_array<double>(out, "Float64", "wall_thickness", net.wall_thickness);
-  write_cell_array<double>(out, "Float64", "youngs_modulus", net.youngs_modulus);
-  write_cell_array<std::int32_t>(out, "Int32", "generation", net.generation);
+  auto cells_of = [&](std::string_view type, std::string_view name, const auto& values) {
+    write_data_array(out, type, name, 1, vessels, [&](std::size_t i) { out << values[vessel(i)]; });
+  };
+  cells_of("Int64", "id", net.id);
+  cells_of("Float64", "diameter", net.diameter);
+  cells_of("Float64", "length", net.length);
+  cells_of("Float64", "wall_thickness", net.wall_thickness);
+  cells_of("Float64", "youngs_modulus", net.youngs_modulus);
+  cells_of("Int32", "generation", net.generation);
   write_data_array(out, "UInt8", "class", 1, vessels,
-                   [&](std::size_t v) { out << static_cast<int>(net.vessel_class[v]); });
+                   [&](std::size_t i) { out << static_cast<int>(net.vessel_class[vessel(i)]); });
   // Results may be undefined in some vessels (a wave speed with no forward wave): VTK's
   // ASCII reader takes "nan" (ParaView shows it in the NaN colour), unlike JSON.
   for (const CellField& field : extra)
-    write_data_array(out, "Float64", field.name, 1, field.values.size(), [&](std::size_t v) {
-      if (std::isfinite(field.values[v])) out << field.values[v];
+    write_data_array(out, "Float64", field.name, 1, vessels, [&](std::size_t i) {
+      const double x = field.values[vessel(i)];
+      if (std::isfinite(x)) out << x;
       else out << "nan";
     });
   out << "      </CellData>\n"

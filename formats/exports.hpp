@@ -26,7 +26,10 @@ struct CellField {
 // Points are the node coordinates (InputError if the network has none), one line cell per
 // vessel; cell data: id, diameter, length, wall_thickness, youngs_modulus, generation,
 // class (0 artery, 1 small_artery, 2 arteriole, 3 capillary), then the extra fields.
-void write_vtk(const Network& net, OutputStream& out, const std::vector<CellField>& extra = {});
+// keep: one entry per vessel, 1 = written (empty: every vessel); only the nodes the written
+// vessels use become points.
+void write_vtk(const Network& net, OutputStream& out, const std::vector<CellField>& extra = {},
+               std::span<const std::uint8_t> keep = {});
 
 // Text escaped for an XML attribute value (& < > ").
 std::string xml_attribute(std::string_view text);

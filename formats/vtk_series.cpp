@@ -23,8 +23,9 @@ std::string time_text(double time) {
 
 }  // namespace
 
-VtkTimeSeries::VtkTimeSeries(const Network& net, std::filesystem::path dir, std::string stem)
-    : net_(&net), dir_(std::move(dir)), stem_(std::move(stem)) {
+VtkTimeSeries::VtkTimeSeries(const Network& net, std::filesystem::path dir, std::string stem,
+                             std::vector<std::uint8_t> keep)
+    : net_(&net), keep_(std::move(keep)), dir_(std::move(dir)), stem_(std::move(stem)) {
   // Fail before a long simulation starts rather than at its first output.
   if (!net.has_coordinates())
     throw InputError("VTK time series needs node coordinates; this network has none");
@@ -58,7 +59,7 @@ void VtkTimeSeries::add_frame(double time, const std::vector<CellField>& fields)
                      ") at 9 significant digits");
 
   OutputStream out((dir_ / frame_file_name(times_.size())).string());
-  write_vtk(*net_, out, fields);
+  write_vtk(*net_, out, fields, keep_);
   out.commit();
   times_.push_back(time_in_collection);
 }

@@ -21,7 +21,8 @@ class VtkTimeSeries {
  public:
   // InputError if the network has no node coordinates or the stem is empty or has a path
   // separator; removes a .pvd left by an earlier run, as its frames are about to be replaced.
-  VtkTimeSeries(const Network& net, std::filesystem::path dir, std::string stem);
+  // keep: the vessels written (one entry per vessel, 1 = written; empty: all).
+  VtkTimeSeries(const Network& net, std::filesystem::path dir, std::string stem, std::vector<std::uint8_t> keep = {});
 
   // Writes one frame now. Times must be finite and increase at the 9 digits the .pvd keeps
   // (InputError otherwise). IoError if the file cannot be written (e.g. DIR is missing);
@@ -37,6 +38,7 @@ class VtkTimeSeries {
 
  private:
   const Network* net_;
+  std::vector<std::uint8_t> keep_;
   std::filesystem::path dir_;
   std::string stem_;
   std::vector<double> times_;  // as printed in the .pvd, one per written frame

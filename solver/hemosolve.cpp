@@ -1,4 +1,5 @@
 // hemosolve: pulsatile flow in a compliant network by the spectral/hp DG method.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -88,7 +89,7 @@ int main(int argc, char** argv) {
                "discontinuous Galerkin) and report flows, pressures and pulsatility.",
                "hemosolve"};
   std::string input, out_dir, resume_dir, rheology, scheme = "etd2", start = "steady", dt_text,
-      sample_text = "1ms", external_text = "10mmHg", degree_text = "auto", model = "auto";
+      sample_text = "1ms", external_text = "10mmHg", degree_text = "auto", model = "auto", vtk_min_text;
   int cycles = 1, max_cycles = 50, frames = 0, checkpoint_every = 0;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
@@ -165,6 +166,9 @@ int main(int argc, char** argv) {
                      "] (this machine's cores; use the idle ones: results agree to round-off)")
       ->capture_default_str();
   app.add_flag("--vtk", vtk, "also write the network with every per-vessel result as VTK (results.vtp, for ParaView)");
+  app.add_option("--vtk-min-diameter", vtk_min_text,
+                 "--vtk and --frames write only the vessels of at least this diameter (e.g. 20um; a "
+                 "full tree's millions of capillaries are more than ParaView wants)");
   app.add_option("--frames", frames,
                  "write N frames of the last cycle (p, Q, A, u per vessel) as a ParaView time series "
                  "(frames/frames.pvd), N in [0, 10000] and at most the steps of a cycle");
@@ -235,6 +239,20 @@ int main(int argc, char** argv) {
     // Ctrl-C and kill are answered at a step's end from here on (cli/interrupt.hpp).
     InterruptRequests interrupts;
     const Network net = read_network(input);
+    std::vector<std::uint8_t> vtk_keep;
+    if (!vtk_min_text.empty()) {
+      if (!vtk && frames == 0) throw InputError("--vtk-min-diameter applies to --vtk and --frames only");
+      const double low = parse_quantity(vtk_min_text, Dimension::length, "--vtk-min-diameter", {0, 1}, "um");
+      vtk_keep.resize(net.vessel_count());
+      std::size_t kept = 0;
+      for (std::size_t v = 0; v < net.vessel_count(); ++v) kept += (vtk_keep[v] = net.diameter[v] >= low ? 1 : 0);
+      if (kept == 0)
+        throw InputError("--vtk-min-diameter " + vtk_min_text + " keeps no vessel (the largest is " +
+                         format_quantity(*std::max_element(net.diameter.begin(), net.diameter.end()), "um") + ")");
+      if (!quiet)
+        note("--vtk-min-diameter " + vtk_min_text + ": the VTK output shows " + std::to_string(kept) + " of the " +
+             std::to_string(net.vessel_count()) + " vessels (summary.json and vessels.csv hold all)");
+    }
     if ((vtk || frames > 0) && net.x.empty())
       throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
     if (!net.inlet) throw InputError("the network has no \"inlet\": hemosolve needs one (vprune adds it)");
@@ -348,6 +366,7 @@ int main(int argc, char** argv) {
     plan.max_cycles = max_cycles;
     plan.balance_compliances = balance;
     plan.frames = frames;
+    plan.vtk_keep = vtk_keep;
     plan.steps_per_cycle = steps_per_cycle;
     plan.sample_every = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(sample_interval / dt)));
     plan.checkpoint_every = checkpoint_every;
@@ -445,7 +464,7 @@ int main(int argc, char** argv) {
     if (!last.vessels.empty()) run_info["statistics"] = group_statistics(net, results);
     write_summary(dir / "summary.json", run_info, results, last);
     write_vessel_table(dir / "vessels.csv", results);
-    if (vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results);
+    if (vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results, vtk_keep);
     folder.publish();
 
     if (status == RunStatus::interrupted) {

@@ -123,7 +123,7 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
   try {
     while (done_ < planned && !periodic()) {
       std::optional<VtkTimeSeries> series;  // each cycle could be the last: its frames replace the previous
-      if (plan_.frames > 0) series.emplace(net_, folder_ / "frames", "frames");
+      if (plan_.frames > 0) series.emplace(net_, folder_ / "frames", "frames", plan_.vtk_keep);
       std::size_t frames_written = 0;
       stats_.begin(solver_);
       double sampled_until = solver_.time();

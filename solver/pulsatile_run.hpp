@@ -26,6 +26,7 @@ struct RunPlan {
   int max_cycles = 50;          // with until_periodic
   bool balance_compliances = true;
   int frames = 0;               // of the last cycle, in folder/frames
+  std::vector<std::uint8_t> vtk_keep;  // the vessels the frames show (empty: all)
   std::size_t steps_per_cycle = 1;
   std::size_t sample_every = 1;  // steps between probe samples
   int checkpoint_every = 0;     // cycles; 0: only in memory (written on an interrupt)

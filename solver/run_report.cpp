@@ -164,7 +164,8 @@ void write_vessel_table(const std::filesystem::path& file, const nlohmann::json&
   out.commit();
 }
 
-void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels) {
+void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels,
+                       std::span<const std::uint8_t> keep) {
   std::vector<std::string> names;
   for (const auto& [key, value] : vessels.front().items())
     if ((value.is_number() || value.is_null()) && key != "id" && key != "diameter" && key != "length")
@@ -182,7 +183,7 @@ void write_results_vtk(const std::filesystem::path& file, const Network& net, co
   for (std::size_t v = 0; v < vessels.size(); ++v) lumped[v] = vessels[v].value("model", "1d") == "0d" ? 1.0 : 0.0;
   fields.push_back({"model_0d", lumped});
   OutputStream out(file.string());
-  write_vtk(net, out, fields);
+  write_vtk(net, out, fields, keep);
   out.commit();
 }
 

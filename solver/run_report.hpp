@@ -49,7 +49,9 @@ nlohmann::json group_statistics(const Network& net, const nlohmann::json& vessel
 void write_vessel_table(const std::filesystem::path& file, const nlohmann::json& vessels);
 
 // The network as VTK PolyData with every numeric per-vessel result as cell data (null -> NaN).
-void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels);
+// keep: the vessels written (one entry per vessel; empty: all).
+void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels,
+                       std::span<const std::uint8_t> keep = {});
 
 // Appends the solution now, at every vessel's centre (p, Q, A, u), as a frame at the solver's time.
 void add_solution_frame(VtkTimeSeries& series, const PulseSolver& solver);

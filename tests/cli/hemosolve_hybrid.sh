@@ -58,4 +58,28 @@ for name, g in st["by_model"].items():
     values = sorted(v["mean_pressure"] for v in auto["vessels"] if v["model"] == name)
     assert g["vessels"] == len(values) and g["mean_pressure"]["median"] == values[int(0.5 * (len(values) - 1) + 0.5)], name
 PY
+# --vtk-min-diameter: the VTK output holds the vessels of at least that diameter and the
+# nodes they use; summary.json all of them.
+"$HEMOSOLVE" "$WORK/net.json" --out "$WORK/subset" --cycles 1 --vtk --frames 2 --vtk-min-diameter 50um \
+  2>"$WORK/log" || fail "--vtk-min-diameter: $(cat "$WORK/log")"
+"$PY" - "$WORK/net.json" "$WORK/subset" <<'PY' && pass "--vtk-min-diameter 50um: the subset in results.vtp and the frames" \
+  || fail "--vtk-min-diameter subset"
+import json, os, sys
+import xml.etree.ElementTree as ET
+net, run = json.load(open(sys.argv[1])), sys.argv[2]
+kept = [v for v in net["vessels"] if v["diameter"] >= 50e-6]
+nodes = {n for v in kept for n in (v["from"], v["to"])}
+assert 0 < len(kept) < len(net["vessels"])
+for f in ("results.vtp", "frames/frames_0000.vtp", "frames/frames_0001.vtp"):
+    piece = ET.parse(os.path.join(run, f)).getroot().find("./PolyData/Piece")
+    assert int(piece.get("NumberOfLines")) == len(kept) and int(piece.get("NumberOfPoints")) == len(nodes), (f, piece.attrib)
+    ids = [int(x) for a in piece.find("CellData") if a.get("Name") == "id" for x in a.text.split()]
+    assert ids == [v["id"] for v in kept], f
+assert len(json.load(open(os.path.join(run, "summary.json")))["vessels"]) == len(net["vessels"])
+PY
+grep -q "the VTK output shows" "$WORK/log" && pass "--vtk-min-diameter says what it kept" || fail "no note: $(cat "$WORK/log")"
+expect_error "--vtk-min-diameter above every vessel" 2 "keeps no vessel" -- \
+  "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --vtk --vtk-min-diameter 1mm
+expect_error "--vtk-min-diameter without --vtk" 2 "applies to --vtk and --frames only" -- \
+  "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --vtk-min-diameter 20um
 finish
