@@ -7,12 +7,13 @@
 // compliant tube in steady flow, (p_a - p_b) / Q with Q = (1/L) int A^2 / (k mu(A)) dp from
 // p_b to p_a (Simpson): Poiseuille's k mu(A) L / A^2 (the run's viscosity and velocity profile,
 // k = 2 pi alpha / (alpha - 1), as in the 1D friction) where the lumen is uniform, and right
-// where the pressure drop narrows the lumen along the vessel (the narrowest capillaries). The state is the volume at every node (half of each adjacent 0D
-// vessel's) and the flow in every vessel: volume is the conserved variable, so mass is
-// conserved to round-off whatever the nonlinear iteration leaves.
+// where the pressure drop narrows the lumen along the vessel (the narrowest capillaries).
+// The state is the volume at every node (half of each adjacent 0D vessel's) and the flow in
+// every vessel: volume is the conserved variable, so mass is conserved to round-off whatever
+// the nonlinear iteration leaves.
 //
-// BDF2 (L-stable: the capillaries' R C and L / R are micro- to nanoseconds, far below the
-// step) with the flows eliminated leaves one system in the node pressures, the weighted
+// BDF2 (L-stable: L / R, nanoseconds in a capillary, lies far below the step, and is damped
+// rather than resolved) with the flows eliminated leaves one system in the node pressures, the weighted
 // Laplacian plus C/dt of network_flow/nodal_system: on a tree, O(nodes) per step. The
 // nonlinear R(A), L(A) and C(p) are taken at the last iterate, twice per step (Picard).
 //
