@@ -13,9 +13,10 @@
 // the nonlinear iteration leaves.
 //
 // BDF2 (L-stable: L / R, nanoseconds in a capillary, lies far below the step, and is damped
-// rather than resolved) with the flows eliminated leaves one system in the node pressures, the weighted
-// Laplacian plus C/dt of network_flow/nodal_system: on a tree, O(nodes) per step. The
-// nonlinear R(A), L(A) and C(p) are taken at the last iterate, twice per step (Picard).
+// rather than resolved) with the flows eliminated leaves one system in the node pressures,
+// the weighted Laplacian plus C/dt of network_flow/nodal_system: on a tree, O(nodes) per
+// step. The nonlinear R(A), L(A) and C(p) are taken at the last iterate, twice per step
+// (Picard).
 //
 // Outlets on 0D vessels are part of the system (R: a shunt to p_out; RCR: R1 to a
 // capacitor node, R2 from there to p_out). A 1D vessel end at a node of 0D vessels is a
