@@ -197,4 +197,10 @@ left=$(cd "$WORK/kill" && ls | tr '\n' ' ')
 kill $alive
 [ "$left" = "tree.json tree.json.partial-$(uname -n)-$alive " ] \
   && pass "stale partials of dead processes removed, a live one kept" || fail "after the rerun: $left"
+# A flag given a value beyond a 64-bit integer: CLI11 let std::out_of_range escape and
+# hemosolve aborted (found by fuzzing, tests/fuzz/regressions/cli_hemosolve/flag_value_overflow).
+HEMOSOLVE=$BUILD/solver/hemosolve
+expect_error "hemosolve --no-balance-compliances=2^67" 2 \
+  "'--no-balance-compliances=99999999999999999999': the value is out of range for that option" \
+  -- "$HEMOSOLVE" x --no-balance-compliances=99999999999999999999
 finish
