@@ -72,4 +72,15 @@ inline Outlet resistance_outlet(std::int32_t vessel, double r, double p_out) {
   return o;
 }
 
+inline Outlet rcr_outlet(std::int32_t vessel, double r1, double c, double r2, double p_out) {
+  Outlet o;
+  o.vessel = vessel;
+  o.type = OutletType::rcr;
+  o.r1 = r1;
+  o.c = c;
+  o.r2 = r2;
+  o.p_out = p_out;
+  return o;
+}
+
 }  // namespace hemotree::test_networks

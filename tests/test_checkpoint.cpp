@@ -83,14 +83,7 @@ Network pulsed_chain() {
   Network net = chain(3, 0.3, d, beta_for_wave_speed(5.0, a), 1e4, newtonian(4e-3));
   auto inflow = [](double t) { return 5e-6 + 3e-6 * std::sin(2 * std::numbers::pi * t / 0.8); };
   net.inlet = Inlet{0, tabulate(inflow, 0.8, 801, 0.8)};
-  Outlet o;
-  o.vessel = 2;
-  o.type = OutletType::rcr;
-  o.r1 = 2e8;
-  o.c = 2e-10;
-  o.r2 = 1.6e9;
-  o.p_out = 0;
-  net.outlets.push_back(o);
+  net.outlets.push_back(rcr_outlet(2, 2e8, 2e-10, 1.6e9, 0));
   return net;
 }
 

@@ -7,6 +7,7 @@
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;
+using test_networks::rcr_outlet;
 using test_networks::resistance_outlet;
 
 namespace {
@@ -59,13 +60,7 @@ TEST(LoadedTree, ACurrentIntoTheJunctionDividesByConductance) {
 // 2 + (4 + 6) = 12), so 1 / (1/7 + 1/13); the junction is the divider's share of it.
 TEST(LoadedTree, ACapacitorNodeOfAnRcrOutlet) {
   Network net = bifurcation();
-  Outlet rcr;
-  rcr.vessel = 1;
-  rcr.type = OutletType::rcr;
-  rcr.r1 = 1;
-  rcr.r2 = 7;
-  rcr.c = 1e-9;
-  net.outlets = {rcr, resistance_outlet(2, 6, 1333)};
+  net.outlets = {rcr_outlet(1, 1, 1e-9, 7, 0), resistance_outlet(2, 6, 1333)};
   TreeLoads loads = no_loads(net);
   loads.capacitor_current[0] = 2.0;
   const TreePotentials p = solve_loaded_tree(net, resistance, loads);

@@ -158,14 +158,7 @@ TEST(LumpedVessels, ConserveMassToRoundOff) {
   net.beta.assign(3, beta);
   net.reference_pressure.assign(3, 1e4);
   net.blood = blood;
-  Outlet rcr;
-  rcr.vessel = 1;
-  rcr.type = OutletType::rcr;
-  rcr.r1 = 1e8;
-  rcr.c = 1e-10;
-  rcr.r2 = 1e9;
-  rcr.p_out = 1e3;
-  net.outlets.push_back(rcr);
+  net.outlets.push_back(rcr_outlet(1, 1e8, 1e-10, 1e9, 1e3));
   net.outlets.push_back(resistance_outlet(2, 2e9, 1e3));
   net.inlet = Inlet{0, Waveform{}};
   std::vector<VesselLaw> laws(3);

@@ -266,14 +266,7 @@ TEST(PulseSolverVerification, SteadyFlowThroughAnRCROutlet) {
   const double viscosity = 4e-3, q = 2e-8;
   const double r1 = 1e10, r2 = 2e10, p_out = 1333.0;
   Network net = chain(1, length, diameter, beta_for_wave_speed(5.0, area), p_out, newtonian(viscosity));
-  Outlet rcr;
-  rcr.vessel = 0;
-  rcr.type = OutletType::rcr;
-  rcr.r1 = r1;
-  rcr.c = 1e-13;  // R2 C = 2 ms
-  rcr.r2 = r2;
-  rcr.p_out = p_out;
-  net.outlets.push_back(rcr);
+  net.outlets.push_back(rcr_outlet(0, r1, 1e-13, r2, p_out));  // R2 C = 2 ms
   const SteadyRun run = run_to_steady_state(net, q, 1.0, high_degree());
   VesselLaw law;
   law.beta = net.beta[0];
@@ -664,13 +657,7 @@ TEST(PulseSolverVerification, ThreadsGiveTheSameSolution) {
   net.blood = newtonian(4e-3);
   auto inflow = [](double t) { return 2e-6 * std::exp(-std::pow((t - 0.03) / 0.01, 2)); };
   net.inlet = Inlet{0, tabulate(inflow, 0.06, 601, 10.0)};
-  Outlet rcr;
-  rcr.vessel = 1;
-  rcr.type = OutletType::rcr;
-  rcr.r1 = 1e8;
-  rcr.c = 1e-10;
-  rcr.r2 = 1e9;
-  net.outlets.push_back(rcr);
+  net.outlets.push_back(rcr_outlet(1, 1e8, 1e-10, 1e9, 0));
   net.outlets.push_back(resistance_outlet(2, 1.5e9, 1000));
   std::vector<PulseState> states;
   for (const int threads : {1, 2}) {
