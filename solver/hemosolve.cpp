@@ -147,6 +147,11 @@ int main(int argc, char** argv) {
                  "with 0D vessels: the step of the 0D vessels, as a fraction of the period, in (0, 0.1]; the 1D "
                  "vessels take substeps within it")
       ->capture_default_str();
+  app.add_option("--lumped-passes", options.lumped_passes,
+                 "with 0D vessels: linear solves per 0D step, in [1, 10]: 1 takes R, L and C at the state "
+                 "extrapolated to the step's end (second order); each more pass takes them again at the last "
+                 "solution (Picard)")
+      ->capture_default_str();
   app.add_option("--elements", options.elements, "elements per vessel, in [1, 1000]")->capture_default_str();
   app.add_option("--dt", dt_text,
                  "time step, at most the stability limit unless --force (default: from the CFL and friction limits)");
@@ -205,6 +210,8 @@ int main(int argc, char** argv) {
     check_range(options.lumped_transit, {0, 1}, "--lumped-transit");
     check_range(options.lumped_rc, {0, INFINITY}, "--lumped-rc");
     check_range(options.lumped_step, {0, 0.1, true, false}, "--lumped-step");
+    if (options.lumped_passes < 1 || options.lumped_passes > 10)
+      throw InputError("--lumped-passes must be in [1, 10] (got " + std::to_string(options.lumped_passes) + ")");
     if (start == "rest") options.steady_start = false;
     else if (start != "steady") throw InputError("--start must be steady or rest (got '" + start + "')");
     if (!rheology.empty()) {
@@ -351,7 +358,7 @@ int main(int argc, char** argv) {
     // ---- the run ------------------------------------------------------------------------------
     std::ostringstream shaping;  // the options a checkpoint must share with the run resuming it
     shaping << "model " << model << " (" << options.lumped_transit << ", " << options.lumped_rc << ", "
-            << options.lumped_step << "), scheme "
+            << options.lumped_step << ", " << options.lumped_passes << " passes), scheme "
             << scheme << ", degree " << degree_text << " (" << options.degree_rule.low << "/"
             << options.degree_rule.raise_to << "/" << options.degree_rule.high << ", linear error "
             << options.degree_rule.linear_error << "), elements " << options.elements << ", time step " << dt

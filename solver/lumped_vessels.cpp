@@ -41,7 +41,7 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
   nodes_ = network_nodes_;
   shunt_.assign(network_nodes_, 0.0);
   shunt_pressure_.assign(network_nodes_, 0.0);
-  linear_.assign(network_nodes_, 0.0);
+  volume_b_.assign(network_nodes_, 0.0);
 
   // Outlets on 0D vessels: shunts, or R1 to a capacitor node with R2 and C.
   capacitor_of_outlet_.assign(net.outlets.size(), -1);
@@ -63,7 +63,7 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
       edge_fixed_resistance_.push_back(o.r1);
       shunt_.push_back(1 / o.r2);
       shunt_pressure_.push_back(o.p_out);
-      linear_.push_back(o.c);
+      volume_b_.push_back(o.c);
     } else {
       shunt_[at] = 1 / o.resistance();
       shunt_pressure_[at] = o.p_out;
@@ -76,31 +76,29 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
       inlet_node_ = node_of_[static_cast<std::size_t>(net.from[static_cast<std::size_t>(inlet)])];
   }
 
-  // Each 0D vessel's volume L A(p) = L (c + p / beta)^2, half at each of its nodes.
-  term_offset_.assign(nodes_ + 1, 0);
-  for (std::size_t e = 0; e < vessels_.size(); ++e)
-    for (const std::int32_t k : {a_[e], b_[e]}) ++term_offset_[static_cast<std::size_t>(k) + 1];
-  for (std::size_t k = 0; k < nodes_; ++k) term_offset_[k + 1] += term_offset_[k];
-  term_weight_.resize(static_cast<std::size_t>(term_offset_[nodes_]));
-  term_intercept_.resize(term_weight_.size());
-  term_slope_.resize(term_weight_.size());
-  std::vector<std::int64_t> fill(term_offset_.begin(), term_offset_.end() - 1);
-  for (std::size_t e = 0; e < vessels_.size(); ++e)
+  // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes:
+  // (L / 2) (d^2 p^2 + 2 c d p + c^2).
+  volume_a_.assign(nodes_, 0.0);
+  volume_c_.assign(nodes_, 0.0);
+  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+    const double w = edge_length_[e] / 2, c = edge_root_intercept_[e], d = edge_root_slope_[e];
     for (const std::int32_t k : {a_[e], b_[e]}) {
-      const auto t = static_cast<std::size_t>(fill[static_cast<std::size_t>(k)]++);
-      term_weight_[t] = edge_length_[e] / 2;
-      term_intercept_[t] = edge_root_intercept_[e];
-      term_slope_[t] = edge_root_slope_[e];
+      const auto i = static_cast<std::size_t>(k);
+      volume_a_[i] += w * d * d;
+      volume_b_[i] += 2 * w * c * d;
+      volume_c_[i] += w * c * c;
     }
+  }
 
   system_ = NodalSystem(nodes_, a_, b_);
   const std::size_t edges = a_.size();
   volume_.assign(nodes_, 0.0);
-  previous_volume_ = pressure_ = predicted_ = system_shunt_ = rhs_ = held_inflow_ = impedance_ = dynamic_ = volume_;
+  previous_volume_ = pressure_ = previous_pressure_ = predicted_ = system_shunt_ = rhs_ = held_inflow_ = impedance_ =
+      dynamic_ = volume_;
   flow_.assign(edges, 0.0);
   previous_flow_ = conductance_ = history_ = next_flow_ = flow_;
   capacity_a_.assign(vessels_.size(), 0.0);
-  capacity_b_ = capacity_a_;
+  capacity_b_ = resistance_ = previous_resistance_ = extrapolated_ = capacity_a_;
 }
 
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
@@ -121,10 +119,15 @@ void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
   update_dynamic_pressures();
 }
 
-void LumpedVessels::update_end_capacities() {
-  for (std::size_t e = 0; e < vessels_.size(); ++e) {
-    capacity_a_[e] = flow_capacity(e, pressure_[static_cast<std::size_t>(a_[e])]);
-    capacity_b_[e] = flow_capacity(e, pressure_[static_cast<std::size_t>(b_[e])]);
+void LumpedVessels::update_resistances() {
+  const auto vessels = static_cast<std::int64_t>(vessels_.size());
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
+  for (std::int64_t i = 0; i < vessels; ++i) {
+    const auto e = static_cast<std::size_t>(i);
+    const double pa = pressure_[static_cast<std::size_t>(a_[e])], pb = pressure_[static_cast<std::size_t>(b_[e])];
+    capacity_a_[e] = flow_capacity(e, pa);
+    capacity_b_[e] = flow_capacity(e, pb);
+    resistance_[e] = resistance(e, pa, pb, capacity_a_[e], capacity_b_[e]);
   }
 }
 
@@ -146,39 +149,17 @@ void LumpedVessels::update_dynamic_pressures() {
 
 // ---- the tube laws of the nodes -------------------------------------------------------------
 
-double LumpedVessels::node_volume(std::size_t k, double p) const {
-  double v = linear_[k] * p;
-  for (auto t = term_offset_[k]; t < term_offset_[k + 1]; ++t) {
-    const auto i = static_cast<std::size_t>(t);
-    const double s = term_intercept_[i] + term_slope_[i] * p;
-    v += term_weight_[i] * s * s;
-  }
-  return v;
-}
-
-double LumpedVessels::node_compliance(std::size_t k, double p) const {
-  double c = linear_[k];
-  for (auto t = term_offset_[k]; t < term_offset_[k + 1]; ++t) {
-    const auto i = static_cast<std::size_t>(t);
-    c += 2 * term_weight_[i] * term_slope_[i] * (term_intercept_[i] + term_slope_[i] * p);
-  }
-  return c;
-}
-
 double LumpedVessels::compliance(std::int32_t node) const {
   const auto k = static_cast<std::size_t>(node);
   return node_compliance(k, pressure_[k]);
 }
 
-double LumpedVessels::pressure_from_volume(std::size_t k, double volume, double p) const {
-  // V(p) is increasing and convex where every lumen is open: Newton converges from the last
-  // pressure (a step's change is small) in two or three iterations.
-  for (int it = 0; it < 60; ++it) {
-    const double step = (node_volume(k, p) - volume) / node_compliance(k, p);
-    p -= step;
-    if (std::abs(step) <= 1e-13 * (std::abs(p) + 1e3)) break;
-  }
-  return p;
+double LumpedVessels::pressure_from_volume(std::size_t k, double volume) const {
+  // The root of a p^2 + b p + (c - V) on the branch where the compliance 2 a p + b is
+  // positive (every lumen open), in the form that does not cancel.
+  const double a = volume_a_[k], b = volume_b_[k], excess = volume - volume_c_[k];
+  const double root = std::sqrt(std::max(b * b + 4 * a * excess, 0.0));
+  return b > 0 ? 2 * excess / (b + root) : (root - b) / (2 * a);
 }
 
 // ---- initial states -----------------------------------------------------------------------
@@ -198,8 +179,8 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
   }
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_volume(k, pressure_[k]);
   predicted_ = pressure_;
+  update_resistances();
   restart_history();
-  update_end_capacities();
   update_dynamic_pressures();
 }
 
@@ -217,59 +198,96 @@ void LumpedVessels::start_at_rest(std::span<const VesselLaw> laws) {
   std::fill(flow_.begin(), flow_.end(), 0.0);
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_volume(k, pressure_[k]);
   predicted_ = pressure_;
+  update_resistances();
   restart_history();
-  update_end_capacities();
   update_dynamic_pressures();
 }
 
 void LumpedVessels::restart_history() {
   // BDF2 from a constant past: exact for a state at rest or steady, and the conserved
-  // volume (3 V - V_prev) / 2 is V itself.
+  // volume (3 V - V_prev) / 2 is V itself. The extrapolation starts constant too.
   previous_volume_ = volume_;
   previous_flow_ = flow_;
+  previous_pressure_ = pressure_;
+  previous_resistance_ = resistance_;
 }
 
 // ---- a step -----------------------------------------------------------------------------------
+
+void LumpedVessels::linearise(std::span<const double> at, std::span<const double> vessel_resistance,
+                              std::span<const double> coupled_inflow, double inlet_flow) {
+  const double dt = dt_;
+  const std::size_t vessels = vessels_.size(), edges = a_.size();
+  const auto vessels_i = static_cast<std::int64_t>(vessels), nodes_i = static_cast<std::int64_t>(nodes_);
+  // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
+  // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
+#pragma omp parallel num_threads(threads_) if (threads_ > 1)
+  {
+#pragma omp for schedule(static) nowait
+    for (std::int64_t i = 0; i < vessels_i; ++i) {
+      const auto e = static_cast<std::size_t>(i);
+      const double p = 0.5 * (at[static_cast<std::size_t>(a_[e])] + at[static_cast<std::size_t>(b_[e])]);
+      const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p;
+      const double inertance = density_ * edge_length_[e] / (s * s);
+      conductance_[e] = 1 / (vessel_resistance[e] + 1.5 * inertance / dt);
+      history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
+    }
+    // BDF2 for a node's volume, V(p) linearised at p*:
+    // (3 (V* + C* (p - p*)) - 4 V^n + V^(n-1)) / (2 dt) = inflows at t1.
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < nodes_i; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double ps = at[k], c = node_compliance(k, ps);
+      system_shunt_[k] = 1.5 * c / dt + shunt_[k];
+      rhs_[k] = (1.5 * (c * ps - node_volume(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt +
+                shunt_[k] * shunt_pressure_[k];
+    }
+  }
+  for (std::size_t e = vessels; e < edges; ++e) {
+    conductance_[e] = 1 / edge_fixed_resistance_[e - vessels];
+    history_[e] = 0;
+  }
+  for (std::size_t k = 0; k < network_nodes_ && !coupled_inflow.empty(); ++k) rhs_[k] += coupled_inflow[k];
+  if (inlet_node_ >= 0) rhs_[static_cast<std::size_t>(inlet_node_)] += inlet_flow;
+  for (std::size_t e = 0; e < edges; ++e) {
+    rhs_[static_cast<std::size_t>(a_[e])] -= history_[e];
+    rhs_[static_cast<std::size_t>(b_[e])] += history_[e];
+  }
+}
 
 void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, double inlet_flow) {
   if (empty()) return;
   dt_ = dt;
   inlet_flow_ = inlet_flow;
   const std::size_t vessels = vessels_.size(), edges = a_.size();
-  // Picard: the nonlinear coefficients at the start's pressures, then at the first prediction.
-  predicted_ = pressure_;
-  for (int pass = 0; pass < 2; ++pass) {
-    // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
-    // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
-    for (std::size_t e = 0; e < vessels; ++e) {
-      const double pa = predicted_[static_cast<std::size_t>(a_[e])], pb = predicted_[static_cast<std::size_t>(b_[e])];
-      const double p = 0.5 * (pa + pb);
-      const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p, area = s * s;
-      const double ends = pass == 0 ? capacity_a_[e] + capacity_b_[e] : flow_capacity(e, pa) + flow_capacity(e, pb);
-      const double capacity = (ends + 4 * flow_capacity(e, p)) / 6;
-      const double resistance = edge_length_[e] / capacity;
-      const double inertance = density_ * edge_length_[e] / area;
-      conductance_[e] = 1 / (resistance + 1.5 * inertance / dt);
-      history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
+  const auto vessels_i = static_cast<std::int64_t>(vessels), nodes_i = static_cast<std::int64_t>(nodes_);
+  // The first linearisation at the state extrapolated to t1, x* = 2 x^n - x^(n-1): an error
+  // of O(dt^2) in the coefficients keeps BDF2 second order with one solve. The resistance is
+  // extrapolated itself (no viscosity to evaluate), within a factor of two of today's.
+#pragma omp parallel num_threads(threads_) if (threads_ > 1)
+  {
+#pragma omp for schedule(static) nowait
+    for (std::int64_t i = 0; i < nodes_i; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      predicted_[k] = 2 * pressure_[k] - previous_pressure_[k];
     }
-    for (std::size_t e = vessels; e < edges; ++e) {
-      conductance_[e] = 1 / edge_fixed_resistance_[e - vessels];
-      history_[e] = 0;
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < vessels_i; ++i) {
+      const auto e = static_cast<std::size_t>(i);
+      extrapolated_[e] = std::clamp(2 * resistance_[e] - previous_resistance_[e], 0.5 * resistance_[e], 2 * resistance_[e]);
     }
-    // BDF2 for a node's volume, V(p) linearised at the last iterate p*:
-    // (3 (V* + C* (p - p*)) - 4 V^n + V^(n-1)) / (2 dt) = inflows at t1.
-    for (std::size_t k = 0; k < nodes_; ++k) {
-      const double ps = predicted_[k], c = node_compliance(k, ps);
-      system_shunt_[k] = 1.5 * c / dt + shunt_[k];
-      rhs_[k] = (1.5 * (c * ps - node_volume(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt +
-                shunt_[k] * shunt_pressure_[k];
+  }
+  for (int pass = 0; pass < passes_; ++pass) {
+    if (pass > 0) {
+      // Picard: the coefficients again, at the last solution.
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
+      for (std::int64_t i = 0; i < vessels_i; ++i) {
+        const auto e = static_cast<std::size_t>(i);
+        const double pa = predicted_[static_cast<std::size_t>(a_[e])], pb = predicted_[static_cast<std::size_t>(b_[e])];
+        extrapolated_[e] = resistance(e, pa, pb, flow_capacity(e, pa), flow_capacity(e, pb));
+      }
     }
-    for (std::size_t k = 0; k < network_nodes_ && !coupled_inflow.empty(); ++k) rhs_[k] += coupled_inflow[k];
-    if (inlet_node_ >= 0) rhs_[static_cast<std::size_t>(inlet_node_)] += inlet_flow;
-    for (std::size_t e = 0; e < edges; ++e) {
-      rhs_[static_cast<std::size_t>(a_[e])] -= history_[e];
-      rhs_[static_cast<std::size_t>(b_[e])] += history_[e];
-    }
+    linearise(predicted_, extrapolated_, coupled_inflow, inlet_flow);
     const std::int64_t singular = system_.factorize(conductance_, system_shunt_);
     if (singular >= 0) throw InputError("the 0D vessels have a part with no path to an outlet");
     system_.solve(rhs_, predicted_);
@@ -312,16 +330,21 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   }
   if (inlet_node_ >= 0) inflow[static_cast<std::size_t>(inlet_node_)] += inlet_flow_;
   // The volumes: exactly what came in (3 V - 4 V^n + V^(n-1)) / 2 = dt inflow + 1D volume.
-  for (std::size_t k = 0; k < nodes_; ++k) {
+  const auto nodes_i = static_cast<std::int64_t>(nodes_);
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
+  for (std::int64_t i = 0; i < nodes_i; ++i) {
+    const auto k = static_cast<std::size_t>(i);
     const double coupled = k < network_nodes_ && !coupled_volume.empty() ? coupled_volume[k] : 0.0;
     const double next = (4 * volume_[k] - previous_volume_[k] + 2 * dt * inflow[k] + 2 * coupled) / 3;
     previous_volume_[k] = volume_[k];
     volume_[k] = next;
-    pressure_[k] = k < network_nodes_ ? pressure_from_volume(k, next, predicted_[k]) : next / linear_[k];
+    previous_pressure_[k] = pressure_[k];
+    pressure_[k] = pressure_from_volume(k, next);
   }
   previous_flow_.swap(flow_);
-  flow_ = next_flow_;
-  update_end_capacities();
+  flow_.swap(next_flow_);
+  previous_resistance_.swap(resistance_);
+  update_resistances();
   update_dynamic_pressures();
   // Across the network's boundary: the inlet, outlet shunts, and the R1 of RCR outlets.
   if (inlet_node_ >= 0) exchanged_in += dt * inlet_flow_;
@@ -367,8 +390,8 @@ void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std
     volume_[k] = node_volume(k, pressure_[k]);
   }
   predicted_ = pressure_;
+  update_resistances();
   restart_history();
-  update_end_capacities();
   update_dynamic_pressures();
 }
 
@@ -385,18 +408,24 @@ void LumpedVessels::check(double time) const {
 
 void LumpedVessels::save(CheckpointWriter& out) const {
   out.section("0D vessels");
-  for (const auto* v : {&volume_, &previous_volume_, &pressure_, &flow_, &previous_flow_}) out.put(*v);
+  for (const auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_, &flow_, &previous_flow_})
+    out.put(*v);
 }
 
 void LumpedVessels::restore(CheckpointReader& in) {
   in.section("0D vessels");
-  for (auto* v : {&volume_, &previous_volume_, &pressure_, &flow_, &previous_flow_}) {
+  for (auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_, &flow_, &previous_flow_}) {
     const std::size_t size = v->size();
     *v = in.get_vector();
     if (v->size() != size) in.fail("0D vessels of another network or model");
   }
   predicted_ = pressure_;
-  update_end_capacities();
+  // The resistances are functions of the pressures: the same bits as the run had.
+  std::swap(pressure_, previous_pressure_);
+  update_resistances();
+  previous_resistance_ = resistance_;
+  std::swap(pressure_, previous_pressure_);
+  update_resistances();
   update_dynamic_pressures();
 }
 

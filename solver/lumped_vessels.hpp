@@ -15,8 +15,9 @@
 // BDF2 (L-stable: L / R, nanoseconds in a capillary, lies far below the step, and is damped
 // rather than resolved) with the flows eliminated leaves one system in the node pressures,
 // the weighted Laplacian plus C/dt of network_flow/nodal_system: on a tree, O(nodes) per
-// step. The nonlinear R(A), L(A) and C(p) are taken at the last iterate, twice per step
-// (Picard).
+// step. The nonlinear R(A), L(A) and C(p) are taken at the state extrapolated to the step's
+// end (2 x^n - x^(n-1): linearly implicit BDF2, second order with one solve a step); each
+// further Picard pass (`passes`) takes them again at the last solution.
 //
 // Outlets on 0D vessels are part of the system (R: a shunt to p_out; RCR: R1 to a
 // capacitor node, R2 from there to p_out). A 1D vessel end at a node of 0D vessels is a
@@ -43,6 +44,10 @@ class LumpedVessels {
   // vessel (it needs the waves of a 1D one).
   LumpedVessels(const Network& net, std::span<const VesselLaw> laws, const ViscosityTable& viscosity,
                 const Blood& blood, const std::vector<bool>& zero_d);
+  // Solves a step takes (1: the extrapolated linearisation alone), and the threads of its
+  // loops over vessels and nodes (the elimination itself runs on one).
+  void set_passes(int passes) { passes_ = passes; }
+  void set_threads(int threads) { threads_ = threads; }
 
   bool empty() const { return vessels_.empty(); }
   std::size_t vessel_count() const { return vessels_.size(); }
@@ -110,18 +115,31 @@ class LumpedVessels {
   void restore(CheckpointReader& in);
 
  private:
-  double node_volume(std::size_t node, double p) const;
+  // A node's volume is a quadratic in its pressure (each vessel's L A(p) / 2 is, with the
+  // tube law's A = (c + p / beta)^2, and a capacitor's C p is linear): V = a p^2 + b p + c.
+  double node_volume(std::size_t k, double p) const {
+    return (volume_a_[k] * p + volume_b_[k]) * p + volume_c_[k];
+  }
+  double node_compliance(std::size_t k, double p) const { return 2 * volume_a_[k] * p + volume_b_[k]; }
+  double pressure_from_volume(std::size_t node, double volume) const;
   // A^2 / (k mu(A)) at pressure p in 0D vessel e: the steady flow is (1/L) times its integral
   // over the pressure from the distal to the proximal end.
   double flow_capacity(std::size_t e, double p) const {
     const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p, area = s * s;
     return area * area / (friction_k_ * (*viscosity_)(area));
   }
-  double node_compliance(std::size_t node, double p) const;
-  double pressure_from_volume(std::size_t node, double volume, double guess) const;
+  // The resistance L / (Simpson's mean of the capacity) between end pressures pa and pb, with
+  // the capacities at the ends already known.
+  double resistance(std::size_t e, double pa, double pb, double capacity_a, double capacity_b) const {
+    return 6 * edge_length_[e] / (capacity_a + capacity_b + 4 * flow_capacity(e, 0.5 * (pa + pb)));
+  }
+  // The linearisation of a step: edge conductances and history terms, node shunts and
+  // right-hand sides, at the pressures `at` (resistances given per vessel).
+  void linearise(std::span<const double> at, std::span<const double> vessel_resistance,
+                 std::span<const double> coupled_inflow, double inlet_flow);
   void restart_history();
   void update_dynamic_pressures();
-  void update_end_capacities();  // after the pressures changed
+  void update_resistances();  // after the pressures changed: capacities at the ends, R
 
   std::size_t nodes_ = 0, network_nodes_ = 0;  // network nodes first, then capacitor nodes
   std::vector<std::int32_t> node_of_;          // per network node
@@ -139,9 +157,8 @@ class LumpedVessels {
   const ViscosityTable* viscosity_ = nullptr;
   std::vector<std::int32_t> capacitor_vessel_edge_;  // per R1 edge: the 0D vessel ending at it
 
-  // Node volume V(p) = linear p + sum over terms w (c + d p)^2 (half of each 0D vessel).
-  std::vector<std::int64_t> term_offset_;
-  std::vector<double> term_weight_, term_intercept_, term_slope_, linear_;
+  // Node volume V(p) = a p^2 + b p + c (half of each 0D vessel, capacitors).
+  std::vector<double> volume_a_, volume_b_, volume_c_;
   // Shunts to ground: conductance and the pressure behind it (outlets, R2).
   std::vector<double> shunt_, shunt_pressure_;
   std::vector<std::int32_t> outlet_of_capacitor_;  // per capacitor node
@@ -149,8 +166,9 @@ class LumpedVessels {
   std::vector<std::int32_t> shunt_outlet_node_;    // network nodes whose shunt is an outlet (exchanged)
 
   NodalSystem system_;
-  // State: node volumes and pressures, edge flows, and the last step's (BDF2 history).
-  std::vector<double> volume_, previous_volume_, pressure_, flow_, previous_flow_;
+  // State: node volumes and pressures, edge flows, and the last step's (BDF2 history and
+  // the extrapolation).
+  std::vector<double> volume_, previous_volume_, pressure_, previous_pressure_, flow_, previous_flow_;
   // The step being taken: predicted pressures, and the edges' conductances and history
   // terms of the last linearisation (Q = g (p_a - p_b) + f), the inflows and prediction.
   std::vector<double> predicted_, conductance_, history_, system_shunt_, rhs_, next_flow_;
@@ -158,12 +176,14 @@ class LumpedVessels {
   std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
   std::vector<std::int32_t> coupling_edge_;
   std::vector<double> dynamic_;  // per node (coupling nodes only)
-  // flow_capacity at each 0D vessel's two ends at the pressures now: the interior profile
-  // and the next step's first linearisation read them (the viscosity is most of the cost).
-  std::vector<double> capacity_a_, capacity_b_;
+  // flow_capacity at each 0D vessel's two ends at the pressures now (the interior profile
+  // reads them), and its resistance now and a step before (the next step's extrapolation):
+  // the viscosity is most of the cost, three evaluations a vessel and step.
+  std::vector<double> capacity_a_, capacity_b_, resistance_, previous_resistance_, extrapolated_;
   std::vector<double> held_inflow_, impedance_;  // per node: the coupled inflows predicted with, Z
   std::vector<double> coupling_impedance_;       // per coupling node, scratch
   double dt_ = 0, inlet_flow_ = 0;
+  int passes_ = 1, threads_ = 1;
 };
 
 }  // namespace hemotree

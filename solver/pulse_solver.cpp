@@ -79,6 +79,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
 
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_);
+  lumped_.set_passes(options.lumped_passes);
+  lumped_.set_threads(threads_);
 
   // The steady Poiseuille solution, where the network has one (not with reflection outlets):
   // the degrees follow its pressure profiles, and the run starts from it.
@@ -558,15 +560,16 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   }
   if (bad >= 0) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad])], t);
 
-  // Interfaces inside vessels.
-  const auto vessels = static_cast<std::int64_t>(net_.vessel_count());
+  // Interfaces inside vessels: between consecutive elements of one vessel (a loop over the
+  // elements, not the vessels: a full tree's millions of 0D vessels have none).
+  if (elements_per_vessel_ > 1) {
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t vi = 0; vi < vessels; ++vi) {
-    const auto v = static_cast<std::size_t>(vi);
-    const VesselLaw& law = laws_[v];
-    for (auto el = first_element_[v]; el + 1 < end_element(v); ++el) {
+    for (Eigen::Index el = 0; el < elements - 1; ++el) {
+      const std::int32_t v = element_vessel_[static_cast<std::size_t>(el)];
+      if (element_vessel_[static_cast<std::size_t>(el) + 1] != v) continue;
       double fa, fq;
-      upwind_flux(law, area_right_(el), flow_right_(el), area_left_(el + 1), flow_left_(el + 1), fa, fq);
+      upwind_flux(laws_[static_cast<std::size_t>(v)], area_right_(el), flow_right_(el), area_left_(el + 1),
+                  flow_left_(el + 1), fa, fq);
       flux_a_right_(el) = flux_a_left_(el + 1) = fa;
       flux_q_right_(el) = flux_q_left_(el + 1) = fq;
     }

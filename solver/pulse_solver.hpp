@@ -39,6 +39,7 @@ struct SolverOptions {
   double lumped_transit = 3e-3;
   double lumped_rc = 1.6;
   double lumped_step = 1e-3;  // the 0D step, as a fraction of the period (at most)
+  int lumped_passes = 1;      // linear solves per 0D step (1: at the extrapolated state)
   int degree = automatic;   // p in every vessel, or chosen per vessel by degree_rule
   DegreeRule degree_rule;
   int elements = 1;         // per vessel
