@@ -37,10 +37,14 @@ void CycleStatistics::begin(const PulseSolver& solver) {
 void CycleStatistics::sample(const PulseSolver& solver, double t, double weight) {
   // Rectangle rule: spectrally accurate for the means of periodic signals.
   const double rho = solver.blood().density, alpha = solver.blood().alpha;
-  solver.sample_all(0.5, area_, q_);
-  for (std::size_t v = 0; v < flow_.size(); ++v) {
-    const double a = area_[v], q = q_[v], u = q / a;
-    const double p = solver.law(v).pressure(a), mu = solver.viscosity(a);
+  const int threads = solver.threads();
+  const auto vessels = static_cast<std::int64_t>(flow_.size());
+  solver.sample_all(0.5, area_, q_, &p_);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t vi = 0; vi < vessels; ++vi) {
+    const auto v = static_cast<std::size_t>(vi);
+    const double a = area_[v], q = q_[v], u = q / a, p = p_[v];
+    const double mu = solver.viscosity(a);
     const double radius = std::sqrt(a / std::numbers::pi);
     flow_[v] += weight * solver.mean_flow(v);
     pressure_[v] += weight * p;
@@ -52,30 +56,38 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     reynolds_[v] += weight * rho * u * 2 * radius / mu;
   }
   const std::complex<double> phase = weight * std::polar(1.0, -omega_ * t);
-  const bool first = duration_ == 0;
-  if (first) first_time_ = t;
-  last_time_ = t;
-  auto record = [&](std::size_t k, double value) {
-    if (first) first_[k] = value;
-    last_[k] = value;
-  };
-  solver.sample_all(0.0, area_end_, q_end_);
-  for (std::size_t v = 0; v < flow_.size(); ++v) {
-    const double p = solver.law(v).pressure(area_end_[v]), u = q_end_[v] / area_end_[v];
-    p_in_[v] += phase * p;
-    u_in_[v] += phase * u;
-    record(4 * v, p);
-    record(4 * v + 2, u);
+  if (duration_ == 0) {
+    first_time_ = t;
+    record_ends(solver, first_);
   }
-  solver.sample_all(1.0, area_end_, q_end_);
-  for (std::size_t v = 0; v < flow_.size(); ++v) {
-    const double p = solver.law(v).pressure(area_end_[v]), u = q_end_[v] / area_end_[v];
-    p_out_[v] += phase * p;
-    u_out_[v] += phase * u;
-    record(4 * v + 1, p);
-    record(4 * v + 3, u);
+  last_time_ = t;
+  solver.sample_all(0.0, area_end_, q_end_, &p_end_);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t vi = 0; vi < vessels; ++vi) {
+    const auto v = static_cast<std::size_t>(vi);
+    p_in_[v] += phase * p_end_[v];
+    u_in_[v] += phase * (q_end_[v] / area_end_[v]);
+  }
+  solver.sample_all(1.0, area_end_, q_end_, &p_end_);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t vi = 0; vi < vessels; ++vi) {
+    const auto v = static_cast<std::size_t>(vi);
+    p_out_[v] += phase * p_end_[v];
+    u_out_[v] += phase * (q_end_[v] / area_end_[v]);
   }
   duration_ += weight;
+}
+
+void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>& values) {
+  // Kept apart from sample(): the first and last samples alone (the drift between them),
+  // rather than four more values written per vessel at every sample.
+  for (const int end : {0, 1}) {
+    solver.sample_all(end, area_end_, q_end_, &p_end_);
+    for (std::size_t v = 0; v < flow_.size(); ++v) {
+      values[4 * v + static_cast<std::size_t>(end)] = p_end_[v];
+      values[4 * v + 2 + static_cast<std::size_t>(end)] = q_end_[v] / area_end_[v];
+    }
+  }
 }
 
 CycleSummary CycleStatistics::close(const PulseSolver& solver) {
@@ -85,6 +97,7 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   summary.outlets_mean_flow = exchanged(1) / duration_;
   summary.volume_change = solver.network_volume() - volume_start_;
   summary.conservation_error = (exchanged(0) - exchanged(1) - summary.volume_change) / exchanged(0);
+  if (duration_ > 0) record_ends(solver, last_);  // the state of the cycle's last sample
   begin(solver);  // the next cycle starts here unless begin() is called again
   std::vector<VesselCycle>& out = summary.vessels;
   out.resize(flow_.size());

@@ -54,7 +54,8 @@ class CycleStatistics {
   CycleStatistics(const Network& net, double analysis_frequency);
   // Marks the start of a cycle (after any compliance balance, which moves volume).
   void begin(const PulseSolver& solver);
-  // Samples the solver's state at time t, standing for the `weight` seconds before it.
+  // Samples the solver's state at time t, standing for the `weight` seconds before it. The
+  // last sample of a cycle is at the state close() sees.
   void sample(const PulseSolver& solver, double t, double weight);
   // Closes the cycle at the solver's state now: returns the statistics.
   CycleSummary close(const PulseSolver& solver);
@@ -70,7 +71,8 @@ class CycleStatistics {
   std::vector<std::complex<double>> p_in_, p_out_, u_in_, u_out_;
   std::vector<double> first_, last_;  // per vessel: p_in, p_out, u_in, u_out
   double first_time_ = 0, last_time_ = 0;
-  std::vector<double> area_, q_, area_end_, q_end_;  // scratch
+  std::vector<double> area_, q_, p_, area_end_, q_end_, p_end_;  // scratch
+  void record_ends(const PulseSolver& solver, std::vector<double>& values);  // p_in, p_out, u_in, u_out
   double duration_ = 0;
 };
 

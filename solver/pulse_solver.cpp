@@ -755,10 +755,12 @@ double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
   return viscosity_(area_at(vessel, x));
 }
 
-void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<double>& flow) const {
+void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
+                             std::vector<double>* pressure) const {
   const std::size_t n = net_.vessel_count();
   area.resize(n);
   flow.resize(n);
+  if (pressure) pressure->resize(n);
   if (n == 0) return;
   // The same element k and point xi in every vessel (locate's arithmetic).
   const double s = std::clamp(x, 0.0, 1.0) * elements_per_vessel_;
@@ -766,11 +768,17 @@ void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<do
   const double xi = 2 * (s - k) - 1;
   std::array<double, 32> phi;  // degrees are at most 30
   for (std::size_t j = 0; j <= static_cast<std::size_t>(max_degree()); ++j) phi[j] = legendre(static_cast<int>(j), xi);
-  for (std::size_t v = 0; v < n; ++v) {
+  const double at = std::clamp(x, 0.0, 1.0);
+  const auto vessels = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
+  for (std::int64_t vi = 0; vi < vessels; ++vi) {
+    const auto v = static_cast<std::size_t>(vi);
     if (zero_d_[v]) {
       const std::int32_t e = lumped_.vessel_index(v);
-      area[v] = laws_[v].area(lumped_.pressure_at(e, std::clamp(x, 0.0, 1.0)));
+      const double p = lumped_.pressure_at(e, at);
+      area[v] = laws_[v].area(p);
       flow[v] = lumped_.flow(e);
+      if (pressure) (*pressure)[v] = p;
       continue;
     }
     const Eigen::Index el = first_element_[v] + k;
@@ -781,6 +789,7 @@ void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<do
     }
     area[v] = a;
     flow[v] = q;
+    if (pressure) (*pressure)[v] = laws_[v].pressure(a);
   }
 }
 

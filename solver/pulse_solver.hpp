@@ -101,9 +101,11 @@ class PulseSolver {
   double mean_flow(std::size_t vessel) const;
   double viscosity_at(std::size_t vessel, double x) const;  // [Pa s]
   double viscosity(double area) const { return viscosity_(area); }  // [Pa s] at a lumen area
-  // Area and flow of every vessel at the same fraction x along each, in one pass (the cycle
-  // statistics sample all vessels every few steps).
-  void sample_all(double x, std::vector<double>& area, std::vector<double>& flow) const;
+  // Area, flow and pressure of every vessel at the same fraction x along each, in one pass
+  // (the cycle statistics sample all vessels every few steps); pressure may be null.
+  void sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
+                  std::vector<double>* pressure = nullptr) const;
+  int threads() const { return threads_; }
 
   const VesselLaw& law(std::size_t vessel) const { return laws_[vessel]; }
   const Blood& blood() const { return blood_; }

@@ -19,7 +19,7 @@ TEST(ViscosityTable, MatchesThePriesLawEverywhere) {
       const double exact = apparent_viscosity(blood, d);
       worst = std::max(worst, std::abs(table(area) - exact) / exact);
     }
-    EXPECT_LT(worst, 1e-9) << "hematocrit " << hematocrit;  // measured 1.8e-10
+    EXPECT_LT(worst, 1e-9) << "hematocrit " << hematocrit;  // measured 1.3e-10 (crossing every octave)
   }
 }
 
