@@ -466,8 +466,8 @@ int main(int argc, char** argv) {
     const std::filesystem::path dir = folder.staging();
     if (status == RunStatus::interrupted || checkpoint_every > 0) pulsatile.write_checkpoint();
     pulsatile.probes().write(dir / "probes.csv");
-    const nlohmann::json results =
-        last.vessels.empty() ? nlohmann::json::array() : vessel_results(net, run, last, analysis_frequency(net.inlet->waveform));
+    const VesselTable results =
+        last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(net.inlet->waveform));
     if (!last.vessels.empty()) run_info["statistics"] = group_statistics(net, results);
     write_summary(dir / "summary.json", run_info, results, last);
     write_vessel_table(dir / "vessels.csv", results);

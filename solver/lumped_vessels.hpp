@@ -96,6 +96,9 @@ class LumpedVessels {
   // The pressure at fraction x along a 0D vessel: on the steady profile of a compliant tube
   // between its end pressures (the flow is quasi-steady there), not on a line.
   double pressure_at(std::int32_t index, double x) const;
+  // Every 0D vessel's lumen area, flow and (unless empty) pressure at fraction x along it,
+  // into the network's per-vessel arrays (the cycle statistics' samples).
+  void sample(double x, std::span<double> area, std::span<double> flow, std::span<double> pressure, int threads) const;
   // The volume the 0D vessels hold now (what BDF2 conserves: (3 V^n - V^(n-1)) / 2, which
   // is V at a steady state), capacitors not included [m^3].
   double stored_volume() const;

@@ -768,19 +768,13 @@ void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<do
   const double xi = 2 * (s - k) - 1;
   std::array<double, 32> phi;  // degrees are at most 30
   for (std::size_t j = 0; j <= static_cast<std::size_t>(max_degree()); ++j) phi[j] = legendre(static_cast<int>(j), xi);
-  const double at = std::clamp(x, 0.0, 1.0);
-  const auto vessels = static_cast<std::int64_t>(n);
+  // The 0D vessels from their own state, then the 1D ones (the first of each one's elements
+  // names it).
+  lumped_.sample(std::clamp(x, 0.0, 1.0), area, flow, pressure ? std::span<double>(*pressure) : std::span<double>(), threads_);
+  const auto one_d = static_cast<std::int64_t>(element_vessel_.size()) / elements_per_vessel_;
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t vi = 0; vi < vessels; ++vi) {
-    const auto v = static_cast<std::size_t>(vi);
-    if (zero_d_[v]) {
-      const std::int32_t e = lumped_.vessel_index(v);
-      const double p = lumped_.pressure_at(e, at);
-      area[v] = laws_[v].area(p);
-      flow[v] = lumped_.flow(e);
-      if (pressure) (*pressure)[v] = p;
-      continue;
-    }
+  for (std::int64_t j = 0; j < one_d; ++j) {
+    const auto v = static_cast<std::size_t>(element_vessel_[static_cast<std::size_t>(j * elements_per_vessel_)]);
     const Eigen::Index el = first_element_[v] + k;
     double a = 0, q = 0;
     for (int j = 0; j <= vessel_degree_[v]; ++j) {

@@ -32,42 +32,56 @@ WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_
   return t;
 }
 
-namespace {
-nlohmann::json finite_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
-}  // namespace
-
-nlohmann::json vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
-                              double frequency) {
+VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle, double frequency) {
   const double omega = 2 * std::numbers::pi * frequency;
-  nlohmann::json vessels = nlohmann::json::array();
-  for (std::size_t v = 0; v < cycle.vessels.size(); ++v) {
-    const VesselCycle& c = cycle.vessels[v];
-    const WaveTheory theory = wave_theory(solver, net, v, omega);
-    vessels.push_back({{"id", net.id[v]},
-                       {"diameter", net.diameter[v]},
-                       {"length", net.length[v]},
-                       {"class", to_string(net.vessel_class[v])},
-                       {"model", solver.is_lumped(v) ? "0d" : "1d"},
-                       {"degree", solver.is_lumped(v) ? nlohmann::json(nullptr) : nlohmann::json(solver.degree(v))},
-                       {"mean_flow", c.mean_flow},
-                       {"mean_pressure", c.mean_pressure},
-                       {"systolic_pressure", c.systolic_pressure},
-                       {"diastolic_pressure", c.diastolic_pressure},
-                       {"pulsatility_index", c.pulsatility_index()},
-                       {"peak_flow", c.peak_flow},
-                       {"least_flow", c.least_flow},
-                       {"mean_wss", c.mean_wss},
-                       {"reynolds", c.reynolds},
-                       {"womersley", theory.womersley},
-                       {"pwv_pressure", finite_or_null(c.pwv_pressure)},
-                       {"pwv_velocity", finite_or_null(c.pwv_velocity)},
-                       {"pwv_elastic", theory.pwv_elastic},
-                       {"pwv_theory", theory.pwv_theory}});
+  const std::size_t n = cycle.vessels.size();
+  VesselTable table(n);
+  std::vector<std::int64_t> degree(n);
+  std::vector<std::uint8_t> vessel_class(n), model(n);
+  std::vector<std::string> class_names;
+  for (int k = 0; k <= static_cast<int>(VesselClass::capillary); ++k)
+    class_names.emplace_back(to_string(static_cast<VesselClass>(k)));
+  for (std::size_t v = 0; v < n; ++v) {
+    degree[v] = solver.is_lumped(v) ? VesselTable::null_integer : solver.degree(v);
+    vessel_class[v] = static_cast<std::uint8_t>(net.vessel_class[v]);
+    model[v] = solver.is_lumped(v) ? 1 : 0;
   }
-  return vessels;
+  table.add_integer("id", net.id);
+  table.add_number("diameter", net.diameter);
+  table.add_number("length", net.length);
+  table.add_text("class", std::move(vessel_class), std::move(class_names));
+  table.add_text("model", std::move(model), {"1d", "0d"});
+  table.add_integer("degree", std::move(degree));
+  auto column = [&](const char* name, auto value) {
+    std::vector<double> x(n);
+    for (std::size_t v = 0; v < n; ++v) x[v] = value(cycle.vessels[v]);
+    table.add_number(name, std::move(x));
+  };
+  column("mean_flow", [](const VesselCycle& c) { return c.mean_flow; });
+  column("mean_pressure", [](const VesselCycle& c) { return c.mean_pressure; });
+  column("systolic_pressure", [](const VesselCycle& c) { return c.systolic_pressure; });
+  column("diastolic_pressure", [](const VesselCycle& c) { return c.diastolic_pressure; });
+  column("pulsatility_index", [](const VesselCycle& c) { return c.pulsatility_index(); });
+  column("peak_flow", [](const VesselCycle& c) { return c.peak_flow; });
+  column("least_flow", [](const VesselCycle& c) { return c.least_flow; });
+  column("mean_wss", [](const VesselCycle& c) { return c.mean_wss; });
+  column("reynolds", [](const VesselCycle& c) { return c.reynolds; });
+  column("pwv_pressure", [](const VesselCycle& c) { return c.pwv_pressure; });
+  column("pwv_velocity", [](const VesselCycle& c) { return c.pwv_velocity; });
+  std::vector<double> womersley(n), elastic(n), theory(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const WaveTheory t = wave_theory(solver, net, v, omega);
+    womersley[v] = t.womersley;
+    elastic[v] = t.pwv_elastic;
+    theory[v] = t.pwv_theory;
+  }
+  table.add_number("womersley", std::move(womersley));
+  table.add_number("pwv_elastic", std::move(elastic));
+  table.add_number("pwv_theory", std::move(theory));
+  return table;
 }
 
-void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const nlohmann::json& vessels,
+void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const VesselTable& vessels,
                    const CycleSummary& cycle) {
   nlohmann::json summary = run;
   summary["inlet_mean_flow"] = cycle.inlet_mean_flow;
@@ -77,47 +91,58 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
   summary["conservation_error"] = cycle.conservation_error;
   summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}, {"wss", "Pa"},
                       {"speed", "m/s"}, {"frequency", "Hz"}};
-  // The run's facts, then the vessels one by one: no string of the whole report in memory
-  // (a million vessels are a gigabyte of text). Strings from outside (a file name that is not
-  // UTF-8) must not stop the report: such bytes are written as U+FFFD.
+  // The run's facts, then the vessels one by one, a line each: no string of the whole report
+  // in memory (a million vessels are a gigabyte of text). Strings from outside (a file name
+  // that is not UTF-8) must not stop the report: such bytes are written as U+FFFD.
   constexpr auto replace = nlohmann::json::error_handler_t::replace;
   std::string head = summary.dump(1, ' ', false, replace);
   head.resize(head.rfind('}'));  // the run's facts, open for the vessels
   while (!head.empty() && (head.back() == '\n' || head.back() == ' ')) head.pop_back();
   OutputStream out(file.string());
   out << head << ",\n \"vessels\": [";
-  for (std::size_t v = 0; v < vessels.size(); ++v)
-    out << (v ? ",\n  " : "\n  ") << vessels[v].dump(-1, ' ', false, replace);
-  out << (vessels.empty() ? "]\n}\n" : "\n ]\n}\n");
+  for (std::size_t v = 0; v < vessels.rows(); ++v) {
+    out << (v ? ",\n  " : "\n  ");
+    vessels.write_json_row(out, v);
+  }
+  out << (vessels.rows() == 0 ? "]\n}\n" : "\n ]\n}\n");
   out.commit();
 }
 
-nlohmann::json group_statistics(const Network& net, const nlohmann::json& vessels) {
+nlohmann::json group_statistics(const Network& net, const VesselTable& vessels) {
   // Per group: how many vessels, and of each quantity the median, the 5th and 95th
   // percentiles (nearest rank) over the group's vessels where it is defined.
   static const char* quantities[] = {"mean_pressure", "pulsatility_index", "mean_flow", "mean_wss"};
-  auto describe = [&](const std::vector<std::size_t>& members) {
+  auto describe = [&](const std::vector<std::uint32_t>& members) {
     nlohmann::json g = {{"vessels", members.size()}};
     std::vector<double> values;
     for (const char* q : quantities) {
+      const VesselTable::Column* column = vessels.find(q);
+      if (!column) continue;
       values.clear();
-      for (const std::size_t v : members)
-        if (vessels[v][q].is_number()) values.push_back(vessels[v][q].get<double>());
+      for (const std::uint32_t v : members)
+        if (std::isfinite(column->number[v])) values.push_back(column->number[v]);
       if (values.empty()) continue;
-      std::sort(values.begin(), values.end());
-      auto rank = [&](double f) { return values[static_cast<std::size_t>(std::llround(f * static_cast<double>(values.size() - 1)))]; };
-      g[q] = {{"median", rank(0.5)}, {"p5", rank(0.05)}, {"p95", rank(0.95)}};
+      auto rank = [&](double f) {
+        const auto k = static_cast<std::size_t>(std::llround(f * static_cast<double>(values.size() - 1)));
+        std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+        return values[k];
+      };
+      const double p5 = rank(0.05), median = rank(0.5), p95 = rank(0.95);
+      g[q] = {{"median", median}, {"p5", p5}, {"p95", p95}};
     }
     return g;
   };
-  std::map<std::string, std::vector<std::size_t>> by_class, by_model;
-  std::map<std::int32_t, std::vector<std::size_t>> by_generation, by_diameter;
-  for (std::size_t v = 0; v < vessels.size(); ++v) {
-    by_class[vessels[v]["class"].get<std::string>()].push_back(v);
-    by_model[vessels[v].value("model", "1d")].push_back(v);
-    if (!net.generation.empty()) by_generation[net.generation[v]].push_back(v);
+  const VesselTable::Column& vessel_class = *vessels.find("class");
+  const VesselTable::Column& model = *vessels.find("model");
+  std::map<std::string, std::vector<std::uint32_t>> by_class, by_model;
+  std::map<std::int32_t, std::vector<std::uint32_t>> by_generation, by_diameter;
+  for (std::size_t v = 0; v < vessels.rows(); ++v) {
+    const auto row = static_cast<std::uint32_t>(v);
+    by_class[vessel_class.labels[vessel_class.code[v]]].push_back(row);
+    by_model[model.labels[model.code[v]]].push_back(row);
+    if (!net.generation.empty()) by_generation[net.generation[v]].push_back(row);
     // Diameter bins a factor sqrt(2) wide: bin k holds [2^(k/2), 2^((k+1)/2)) um.
-    by_diameter[static_cast<std::int32_t>(std::floor(2 * std::log2(net.diameter[v] * 1e6)))].push_back(v);
+    by_diameter[static_cast<std::int32_t>(std::floor(2 * std::log2(net.diameter[v] * 1e6)))].push_back(row);
   }
   nlohmann::json out;
   for (const auto& [name, members] : by_class) out["by_class"][name] = describe(members);
@@ -139,49 +164,56 @@ nlohmann::json group_statistics(const Network& net, const nlohmann::json& vessel
   return out;
 }
 
-void write_vessel_table(const std::filesystem::path& file, const nlohmann::json& vessels) {
+void write_vessel_table(const std::filesystem::path& file, const VesselTable& vessels) {
   OutputStream out(file.string());
-  if (vessels.empty()) {
-    out.commit();
-    return;
+  const auto& columns = vessels.columns();
+  if (vessels.rows() > 0) {
+    for (std::size_t f = 0; f < columns.size(); ++f) out << (f ? "," : "") << columns[f].name;
+    out << '\n';
   }
-  std::vector<std::string> names;
-  for (const auto& [key, value] : vessels.front().items()) names.push_back(key);
-  for (std::size_t f = 0; f < names.size(); ++f) out << (f ? "," : "") << names[f];
-  out << '\n';
-  char text[32];  // the shortest text that reads back to the same double, as summary.json's
-  for (const auto& row : vessels) {
-    for (std::size_t f = 0; f < names.size(); ++f) {
+  for (std::size_t v = 0; v < vessels.rows(); ++v) {
+    for (std::size_t f = 0; f < columns.size(); ++f) {
       if (f) out << ',';
-      const auto& x = row[names[f]];
-      if (x.is_number_integer()) out << x.get<std::int64_t>();
-      else if (x.is_number()) out << std::string_view(text, std::to_chars(text, text + sizeof text, x.get<double>()).ptr);
-      else if (x.is_string()) out << x.get<std::string>();  // class and model names: no commas
+      const VesselTable::Column& c = columns[f];
       // null: an empty field, which pandas and numpy read as NaN
+      if (c.kind == VesselTable::Kind::integer) {
+        if (c.integer[v] != VesselTable::null_integer) out << std::to_string(c.integer[v]);
+      } else if (c.kind == VesselTable::Kind::number) {
+        write_csv_number(out, c.number[v]);  // summary.json's text of the same double
+      } else {
+        out << c.labels[c.code[v]];  // class and model names: no commas
+      }
     }
     out << '\n';
   }
   out.commit();
 }
 
-void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels,
+void write_results_vtk(const std::filesystem::path& file, const Network& net, const VesselTable& vessels,
                        std::span<const std::uint8_t> keep) {
-  std::vector<std::string> names;
-  for (const auto& [key, value] : vessels.front().items())
-    if ((value.is_number() || value.is_null()) && key != "id" && key != "diameter" && key != "length")
-      names.push_back(key);
-  std::vector<std::vector<double>> columns(names.size(), std::vector<double>(vessels.size()));
-  for (std::size_t v = 0; v < vessels.size(); ++v)
-    for (std::size_t f = 0; f < names.size(); ++f) {
-      const auto& x = vessels[v][names[f]];
-      columns[f][v] = x.is_number() ? x.get<double>() : std::numeric_limits<double>::quiet_NaN();
-    }
+  // Every number per vessel but the geometry the PolyData has already (null -> NaN).
+  std::vector<std::vector<double>> converted;
   std::vector<CellField> fields;
-  for (std::size_t f = 0; f < names.size(); ++f) fields.push_back({names[f], columns[f]});
+  for (const VesselTable::Column& c : vessels.columns()) {
+    if (c.name == "id" || c.name == "diameter" || c.name == "length" || c.kind == VesselTable::Kind::text) continue;
+    if (c.kind == VesselTable::Kind::number) {
+      fields.push_back({c.name, c.number});
+      continue;
+    }
+    std::vector<double>& x = converted.emplace_back(c.integer.size());
+    for (std::size_t v = 0; v < x.size(); ++v)
+      x[v] = c.integer[v] == VesselTable::null_integer ? std::numeric_limits<double>::quiet_NaN()
+                                                        : static_cast<double>(c.integer[v]);
+  }
   // The vessel model as a number ParaView can colour by: 1 for 0D, 0 for 1D.
-  std::vector<double> lumped(vessels.size());
-  for (std::size_t v = 0; v < vessels.size(); ++v) lumped[v] = vessels[v].value("model", "1d") == "0d" ? 1.0 : 0.0;
-  fields.push_back({"model_0d", lumped});
+  const VesselTable::Column& model = *vessels.find("model");
+  std::vector<double>& lumped = converted.emplace_back(vessels.rows());
+  for (std::size_t v = 0; v < vessels.rows(); ++v) lumped[v] = model.labels[model.code[v]] == "0d" ? 1.0 : 0.0;
+  // The converted columns' addresses are final only now (emplace_back may move them).
+  std::size_t k = 0;
+  for (const VesselTable::Column& c : vessels.columns())
+    if (c.kind == VesselTable::Kind::integer && c.name != "id") fields.push_back({c.name, converted[k++]});
+  fields.push_back({"model_0d", converted[k]});
   OutputStream out(file.string());
   write_vtk(net, out, fields, keep);
   out.commit();

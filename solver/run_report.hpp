@@ -13,6 +13,7 @@
 #include "formats/vtk_series.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/pulse_solver.hpp"
+#include "solver/vessel_table.hpp"
 
 namespace hemotree {
 
@@ -32,25 +33,26 @@ struct WaveTheory {
 WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_t vessel, double omega);
 
 // The per-vessel results, one row per vessel in the network's order.
-nlohmann::json vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
-                              double analysis_frequency);
+VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
+                           double analysis_frequency);
 
-// summary.json: the run's facts (`run`), the mass balance and the vessels' results.
-void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const nlohmann::json& vessels,
+// summary.json: the run's facts (`run`), the mass balance and the vessels' results, one
+// vessel a line.
+void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const VesselTable& vessels,
                    const CycleSummary& cycle);
 
 // The results summarised per class, model, generation and diameter bin (a factor sqrt(2)
 // wide): each group's vessel count and the median, 5th and 95th percentile of its mean
 // pressure, pulsatility index, mean flow and wall shear stress (summary.json "statistics").
-nlohmann::json group_statistics(const Network& net, const nlohmann::json& vessels);
+nlohmann::json group_statistics(const Network& net, const VesselTable& vessels);
 
 // vessels.csv: the same rows as a table, one line per vessel, a header of the fields (SI
 // units; an empty field where summary.json has null), for pandas, numpy or a spreadsheet.
-void write_vessel_table(const std::filesystem::path& file, const nlohmann::json& vessels);
+void write_vessel_table(const std::filesystem::path& file, const VesselTable& vessels);
 
 // The network as VTK PolyData with every numeric per-vessel result as cell data (null -> NaN).
 // keep: the vessels written (one entry per vessel; empty: all).
-void write_results_vtk(const std::filesystem::path& file, const Network& net, const nlohmann::json& vessels,
+void write_results_vtk(const std::filesystem::path& file, const Network& net, const VesselTable& vessels,
                        std::span<const std::uint8_t> keep = {});
 
 // Appends the solution now, at every vessel's centre (p, Q, A, u), as a frame at the solver's time.

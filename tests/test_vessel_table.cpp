@@ -1,0 +1,68 @@
+// The columnar table every per-vessel output is written from: each row read back from its
+// JSON text gives the stored values bit for bit, nulls where a value is not finite or absent.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "solver/vessel_table.hpp"
+
+using namespace hemotree;
+
+namespace {
+std::string written(const std::function<void(OutputStream&)>& write) {
+  const auto path = std::filesystem::temp_directory_path() / ("vessel_table_" + std::to_string(::getpid()));
+  {
+    OutputStream out(path.string());
+    write(out);
+    out.commit();
+  }
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::filesystem::remove(path);
+  return text.str();
+}
+
+VesselTable table() {
+  VesselTable t(3);
+  t.add_integer("id", {7, -2, 40000000000});
+  t.add_text("model", {1, 0, 1}, {"1d", "0d"});
+  t.add_integer("degree", {VesselTable::null_integer, 7, VesselTable::null_integer});
+  t.add_number("mean_pressure", {0.1 + 0.2, 1e-300, -3.0});
+  t.add_number("pwv", {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), 5e-7});
+  return t;
+}
+}  // namespace
+
+TEST(VesselTable, JsonRowsReadBackBitForBit) {
+  const VesselTable t = table();
+  for (std::size_t row = 0; row < t.rows(); ++row) {
+    const auto j = nlohmann::json::parse(written([&](OutputStream& out) { t.write_json_row(out, row); }));
+    EXPECT_EQ(j["id"].get<std::int64_t>(), t.find("id")->integer[row]);
+    EXPECT_EQ(j["model"].get<std::string>(), row == 1 ? "1d" : "0d");
+    EXPECT_EQ(j["degree"].is_null(), row != 1);
+    EXPECT_EQ(j["mean_pressure"].get<double>(), t.find("mean_pressure")->number[row]);  // exact
+    EXPECT_TRUE(j["mean_pressure"].is_number_float());  // -3.0, not -3
+    EXPECT_EQ(j["pwv"].is_null(), row != 2);
+  }
+}
+
+TEST(VesselTable, CsvFieldsAreTheShortestTextOfTheDouble) {
+  EXPECT_EQ(written([](OutputStream& out) { write_csv_number(out, 0.1 + 0.2); }), "0.30000000000000004");
+  EXPECT_EQ(written([](OutputStream& out) { write_csv_number(out, -3.0); }), "-3");
+  EXPECT_EQ(written([](OutputStream& out) { write_csv_number(out, std::nan("")); }), "");
+  EXPECT_EQ(written([](OutputStream& out) { write_json_number(out, -3.0); }), "-3.0");
+  EXPECT_EQ(written([](OutputStream& out) { write_json_number(out, 1e-300); }), "1e-300");
+}
+
+TEST(VesselTable, RefusesAColumnOfAnotherLength) {
+  VesselTable t(2);
+  EXPECT_THROW(t.add_number("x", {1.0}), std::invalid_argument);
+  EXPECT_THROW(t.add_text("c", {0, 2}, {"a", "b"}), std::invalid_argument);
+  EXPECT_EQ(t.find("x"), nullptr);
+}
