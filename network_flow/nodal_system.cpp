@@ -130,7 +130,8 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
 
   if (method_ == Method::tree_elimination) {
     pivot_.assign(nodes_, 0.0);
-    coupling_.assign(nodes_, 0.0);
+    inverse_pivot_.assign(nodes_, 0.0);
+    divider_.assign(nodes_, 0.0);
   } else {
     order_ = {};
     parent_ = {};
@@ -209,16 +210,20 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
         // A root's S is its whole component's conductance to ground: a sum of non-negative
         // terms, zero exactly when no node of the component has a shunt.
         singular |= !(pivot_[c] > 0);
+        inverse_pivot_[c] = 1 / pivot_[c];
         continue;
       }
       const auto e = static_cast<std::size_t>(parent_edge_[c]);
       const double g = conductance[e];
       if (!(g > 0 && g < std::numeric_limits<double>::infinity())) throw bad_value("conductance of edge", e, g);
-      const double s = pivot_[c];
-      pivot_[c] = g + s;
-      coupling_[c] = g;
-      pivot_[static_cast<std::size_t>(p)] += g * s / (g + s);
+      const double s = pivot_[c], d = g + s, inverse = 1 / d;
+      pivot_[c] = d;
+      // What the sweeps multiply by: no division left in a solve (two per node were most of it).
+      inverse_pivot_[c] = inverse;
+      divider_[c] = g * inverse;
+      pivot_[static_cast<std::size_t>(p)] += g * s * inverse;
     }
+
     if (!singular) {
       factorized_ = true;
       return -1;
@@ -298,12 +303,12 @@ void NodalSystem::solve(std::span<const double> b, std::span<double> x) const {
     for (std::size_t k = nodes_; k-- > 0;) {
       const auto c = static_cast<std::size_t>(order_[k]);
       const std::int32_t p = parent_[c];
-      if (p >= 0) x[static_cast<std::size_t>(p)] += coupling_[c] * x[c] / pivot_[c];
+      if (p >= 0) x[static_cast<std::size_t>(p)] += divider_[c] * x[c];
     }
     for (std::size_t k = 0; k < nodes_; ++k) {
       const auto i = static_cast<std::size_t>(order_[k]);
       const std::int32_t p = parent_[i];
-      x[i] = (p >= 0 ? x[i] + coupling_[i] * x[static_cast<std::size_t>(p)] : x[i]) / pivot_[i];
+      x[i] = x[i] * inverse_pivot_[i] + (p >= 0 ? divider_[i] * x[static_cast<std::size_t>(p)] : 0.0);
     }
     return;
   }
@@ -331,7 +336,7 @@ void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::spa
       // The selected inversion. Eliminating the nodes leaves first (order_ backwards) factors
       // the system as K = L D L^T with D = diag(d), d = pivot_, and L unit lower triangular in
       // that order with one entry below the diagonal in column c, at its parent p:
-      //   L_pc = K_pc / d_c = -g_c / d_c      (g_c = coupling_[c], the edge to the parent),
+      //   L_pc = K_pc / d_c = -g_c / d_c      (g_c the conductance of the edge to the parent),
       // so l_c = -g_c / d_c = -g_c / (g_c + S_c), with S_c the conductance of c's subtree (see
       // factorize): the voltage divider of the edge and the subtree, in (0, 1]. From
       // L^T Sigma = D^-1 L^-1 for Sigma = K^-1 (Takahashi, Fagan & Chin 1973; Erisman &
@@ -358,12 +363,11 @@ void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::spa
       const std::size_t budget = nodes_ / 32 + 64;
       auto own = [&](std::size_t c) {
         const std::int32_t p = parent_[c];
-        const double d = pivot_[c];
         if (p < 0) {
-          sigma[c] = 1 / d;
+          sigma[c] = inverse_pivot_[c];
         } else {
-          const double divider = coupling_[c] / d;
-          sigma[c] = 1 / d + divider * divider * sigma[static_cast<std::size_t>(p)];
+          const double divider = divider_[c];
+          sigma[c] = inverse_pivot_[c] + divider * divider * sigma[static_cast<std::size_t>(p)];
         }
       };
       path.clear();

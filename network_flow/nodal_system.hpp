@@ -76,7 +76,9 @@ class NodalSystem {
   // every node hangs from a lower one, else the reverse of the order in which peeling leaves
   // removes them), each node's parent and the edge to it (-1 at roots), and the pivots.
   std::vector<std::int32_t> order_, parent_, parent_edge_;
-  std::vector<double> pivot_, coupling_;  // per node: d_i after eliminating its subtree; g to parent
+  // Per node: d_i after eliminating its subtree, 1 / d_i, and g_i / d_i (g_i its edge to the
+  // parent: the voltage divider of that edge and the subtree).
+  std::vector<double> pivot_, inverse_pivot_, divider_;
   struct Cholesky;  // Eigen's factorisation, out of this header
   std::unique_ptr<Cholesky> cholesky_;
   // Sparse Cholesky: each node's component, named by its lowest node, and per component
