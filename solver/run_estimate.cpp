@@ -14,11 +14,11 @@ namespace {
 constexpr double step_cost = 10e-6;    // [s per step]
 constexpr double fixed_cost = 300e-9;  // [s per element and step]
 constexpr double modal_cost = 18e-9;   // [s per element, step and (p + 1)^2]
-// 0D vessels: two linearisations, factorisations and solves of the nodal system per step,
-// and the cycle statistics' samples; not threaded. Measured 0.6 us a vessel and step on the
-// 100001-vessel network with the machine loaded (bench/README.md, "The hybrid model"): the
-// loaded figure, so that the estimate errs long.
-constexpr double lumped_cost = 600e-9;  // [s per 0D vessel and step]
+// 0D vessels: one linearisation, factorisation and two solves of the nodal system per step,
+// and the cycle statistics' samples. Measured on one thread 0.19 us a vessel and step on the
+// 100001-vessel network, and with two 0.10-0.11 us on 1 M and 3.8 M vessels (bench/README.md,
+// "The hybrid model"): the one-thread figure, so that the estimate errs long.
+constexpr double lumped_cost = 200e-9;  // [s per 0D vessel and step]
 }  // namespace
 
 double element_step_seconds(int degree) {
@@ -36,7 +36,7 @@ RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double s
     substep += elements_of_degree[p] * element_step_seconds(static_cast<int>(p));
   // Two threads gave 1.8 times one thread's speed from 5000 vessels up (bench/README.md).
   const double speedup = threads > 1 ? 0.9 * threads : 1.0;
-  return {steps, steps * (substeps * substep / speedup + lumped_vessels * lumped_cost)};
+  return {steps, steps * (substeps * substep + lumped_vessels * lumped_cost) / speedup};
 }
 
 std::string describe_duration(double seconds) {
