@@ -61,21 +61,22 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     record_ends(solver, first_);
   }
   last_time_ = t;
-  solver.sample_all(0.0, area_end_, q_end_, &p_end_);
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::int64_t vi = 0; vi < vessels; ++vi) {
-    const auto v = static_cast<std::size_t>(vi);
-    p_in_[v] += phase * p_end_[v];
-    u_in_[v] += phase * (q_end_[v] / area_end_[v]);
-  }
-  solver.sample_all(1.0, area_end_, q_end_, &p_end_);
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::int64_t vi = 0; vi < vessels; ++vi) {
-    const auto v = static_cast<std::size_t>(vi);
-    p_out_[v] += phase * p_end_[v];
-    u_out_[v] += phase * (q_end_[v] / area_end_[v]);
-  }
+  add_end(solver, 0.0, phase, p_in_, u_in_);
+  add_end(solver, 1.0, phase, p_out_, u_out_);
   duration_ += weight;
+}
+
+void CycleStatistics::add_end(const PulseSolver& solver, double x, std::complex<double> phase,
+                              std::vector<std::complex<double>>& p_sum, std::vector<std::complex<double>>& u_sum) {
+  solver.sample_all(x, area_end_, q_end_, &p_end_);
+  const int threads = solver.threads();
+  const auto vessels = static_cast<std::int64_t>(flow_.size());
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t vi = 0; vi < vessels; ++vi) {
+    const auto v = static_cast<std::size_t>(vi);
+    p_sum[v] += phase * p_end_[v];
+    u_sum[v] += phase * (q_end_[v] / area_end_[v]);
+  }
 }
 
 void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>& values) {

@@ -73,6 +73,9 @@ class CycleStatistics {
   double first_time_ = 0, last_time_ = 0;
   std::vector<double> area_, q_, p_, area_end_, q_end_, p_end_;  // scratch
   void record_ends(const PulseSolver& solver, std::vector<double>& values);  // p_in, p_out, u_in, u_out
+  // Adds phase times p and u at fraction x along every vessel to the Fourier sums.
+  void add_end(const PulseSolver& solver, double x, std::complex<double> phase,
+               std::vector<std::complex<double>>& p_sum, std::vector<std::complex<double>>& u_sum);
   double duration_ = 0;
 };
 

@@ -210,8 +210,7 @@ int main(int argc, char** argv) {
     check_range(options.lumped_transit, {0, 1}, "--lumped-transit");
     check_range(options.lumped_rc, {0, INFINITY}, "--lumped-rc");
     check_range(options.lumped_step, {0, 0.1, true, false}, "--lumped-step");
-    if (options.lumped_passes < 1 || options.lumped_passes > 10)
-      throw InputError("--lumped-passes must be in [1, 10] (got " + std::to_string(options.lumped_passes) + ")");
+    check_count(options.lumped_passes, 1, 10, "--lumped-passes");
     if (start == "rest") options.steady_start = false;
     else if (start != "steady") throw InputError("--start must be steady or rest (got '" + start + "')");
     if (!rheology.empty()) {

@@ -98,7 +98,7 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
   flow_.assign(edges, 0.0);
   previous_flow_ = conductance_ = history_ = next_flow_ = flow_;
   capacity_a_.assign(vessels_.size(), 0.0);
-  capacity_b_ = resistance_ = previous_resistance_ = extrapolated_ = capacity_a_;
+  capacity_b_ = resistance_ = previous_resistance_ = linearised_resistance_ = capacity_a_;
 }
 
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
@@ -124,19 +124,21 @@ void LumpedVessels::update_resistances() {
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t i = 0; i < vessels; ++i) {
     const auto e = static_cast<std::size_t>(i);
-    const double pa = pressure_[static_cast<std::size_t>(a_[e])], pb = pressure_[static_cast<std::size_t>(b_[e])];
-    // flow_capacity and resistance() at both ends and the middle over one common
-    // denominator: two divisions instead of four (they were most of this loop).
-    const double c = edge_root_intercept_[e], d = edge_root_slope_[e];
-    const double sa = c + d * pa, sb = c + d * pb, sm = c + d * 0.5 * (pa + pb);
-    const double aa = sa * sa, ab = sb * sb, am = sm * sm;
-    const double mu_a = (*viscosity_)(aa), mu_b = (*viscosity_)(ab), mu_m = (*viscosity_)(am);
-    const double ga = aa * aa * mu_b * mu_m, gb = ab * ab * mu_a * mu_m, gm = am * am * mu_a * mu_b;  // x k mu_a mu_b mu_m
-    const double product = friction_k_ * mu_a * mu_b * mu_m, inverse = 1 / product;
-    capacity_a_[e] = ga * inverse;
-    capacity_b_[e] = gb * inverse;
-    resistance_[e] = 6 * edge_length_[e] * product / (ga + gb + 4 * gm);
+    resistance_[e] = resistance(e, pressure_[static_cast<std::size_t>(a_[e])], pressure_[static_cast<std::size_t>(b_[e])],
+                                capacity_a_[e], capacity_b_[e]);
   }
+}
+
+double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const {
+  const double c = edge_root_intercept_[e], d = edge_root_slope_[e];
+  const double sa = c + d * pa, sb = c + d * pb, sm = c + d * 0.5 * (pa + pb);
+  const double aa = sa * sa, ab = sb * sb, am = sm * sm;
+  const double mu_a = (*viscosity_)(aa), mu_b = (*viscosity_)(ab), mu_m = (*viscosity_)(am);
+  const double ga = aa * aa * mu_b * mu_m, gb = ab * ab * mu_a * mu_m, gm = am * am * mu_a * mu_b;  // x k mu_a mu_b mu_m
+  const double product = friction_k_ * mu_a * mu_b * mu_m, inverse = 1 / product;
+  capacity_a = ga * inverse;
+  capacity_b = gb * inverse;
+  return 6 * edge_length_[e] * product / (ga + gb + 4 * gm);
 }
 
 void LumpedVessels::update_dynamic_pressures() {
@@ -222,8 +224,7 @@ void LumpedVessels::restart_history() {
 
 // ---- a step -----------------------------------------------------------------------------------
 
-void LumpedVessels::linearise(std::span<const double> at, std::span<const double> vessel_resistance,
-                              std::span<const double> coupled_inflow, double inlet_flow) {
+void LumpedVessels::linearise(std::span<const double> at, std::span<const double> coupled_inflow, double inlet_flow) {
   const double dt = dt_;
   const std::size_t vessels = vessels_.size(), edges = a_.size();
   const auto vessels_i = static_cast<std::int64_t>(vessels), nodes_i = static_cast<std::int64_t>(nodes_);
@@ -237,7 +238,7 @@ void LumpedVessels::linearise(std::span<const double> at, std::span<const double
       const double p = 0.5 * (at[static_cast<std::size_t>(a_[e])] + at[static_cast<std::size_t>(b_[e])]);
       const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p;
       const double inertance = density_ * edge_length_[e] / (s * s);
-      conductance_[e] = 1 / (vessel_resistance[e] + 1.5 * inertance / dt);
+      conductance_[e] = 1 / (linearised_resistance_[e] + 1.5 * inertance / dt);
       history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
     }
     // BDF2 for a node's volume, V(p) linearised at p*:
@@ -281,7 +282,7 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, d
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < vessels_i; ++i) {
       const auto e = static_cast<std::size_t>(i);
-      extrapolated_[e] = std::clamp(2 * resistance_[e] - previous_resistance_[e], 0.5 * resistance_[e], 2 * resistance_[e]);
+      linearised_resistance_[e] = std::clamp(2 * resistance_[e] - previous_resistance_[e], 0.5 * resistance_[e], 2 * resistance_[e]);
     }
   }
   for (int pass = 0; pass < passes_; ++pass) {
@@ -291,10 +292,11 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, d
       for (std::int64_t i = 0; i < vessels_i; ++i) {
         const auto e = static_cast<std::size_t>(i);
         const double pa = predicted_[static_cast<std::size_t>(a_[e])], pb = predicted_[static_cast<std::size_t>(b_[e])];
-        extrapolated_[e] = resistance(e, pa, pb, flow_capacity(e, pa), flow_capacity(e, pb));
+        double capacity_a, capacity_b;
+        linearised_resistance_[e] = resistance(e, pa, pb, capacity_a, capacity_b);
       }
     }
-    linearise(predicted_, extrapolated_, coupled_inflow, inlet_flow);
+    linearise(predicted_, coupled_inflow, inlet_flow);
     const std::int64_t singular = system_.factorize(conductance_, system_shunt_);
     if (singular >= 0) throw InputError("the 0D vessels have a part with no path to an outlet");
     system_.solve(rhs_, predicted_);
@@ -445,10 +447,11 @@ void LumpedVessels::restore(CheckpointReader& in) {
   }
   predicted_ = pressure_;
   // The resistances are functions of the pressures: the same bits as the run had.
-  std::swap(pressure_, previous_pressure_);
-  update_resistances();
-  previous_resistance_ = resistance_;
-  std::swap(pressure_, previous_pressure_);
+  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+    double capacity_a, capacity_b;
+    previous_resistance_[e] = resistance(e, previous_pressure_[static_cast<std::size_t>(a_[e])],
+                                         previous_pressure_[static_cast<std::size_t>(b_[e])], capacity_a, capacity_b);
+  }
   update_resistances();
   update_dynamic_pressures();
 }

@@ -125,21 +125,14 @@ class LumpedVessels {
   }
   double node_compliance(std::size_t k, double p) const { return 2 * volume_a_[k] * p + volume_b_[k]; }
   double pressure_from_volume(std::size_t node, double volume) const;
-  // A^2 / (k mu(A)) at pressure p in 0D vessel e: the steady flow is (1/L) times its integral
-  // over the pressure from the distal to the proximal end.
-  double flow_capacity(std::size_t e, double p) const {
-    const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p, area = s * s;
-    return area * area / (friction_k_ * (*viscosity_)(area));
-  }
-  // The resistance L / (Simpson's mean of the capacity) between end pressures pa and pb, with
-  // the capacities at the ends already known.
-  double resistance(std::size_t e, double pa, double pb, double capacity_a, double capacity_b) const {
-    return 6 * edge_length_[e] / (capacity_a + capacity_b + 4 * flow_capacity(e, 0.5 * (pa + pb)));
-  }
+  // The resistance of 0D vessel e between end pressures pa and pb: L over Simpson's mean of
+  // its flow capacity G(p) = A^2 / (k mu(A)) (the steady flow is (1/L) times the integral of G
+  // from pb to pa), and G at the two ends (the interior profile reads them). Over one common
+  // denominator: two divisions, not four (they were most of a step's evaluation).
+  double resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const;
   // The linearisation of a step: edge conductances and history terms, node shunts and
-  // right-hand sides, at the pressures `at` (resistances given per vessel).
-  void linearise(std::span<const double> at, std::span<const double> vessel_resistance,
-                 std::span<const double> coupled_inflow, double inlet_flow);
+  // right-hand sides, at the pressures `at` with linearised_resistance_.
+  void linearise(std::span<const double> at, std::span<const double> coupled_inflow, double inlet_flow);
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R
@@ -179,10 +172,11 @@ class LumpedVessels {
   std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
   std::vector<std::int32_t> coupling_edge_;
   std::vector<double> dynamic_;  // per node (coupling nodes only)
-  // flow_capacity at each 0D vessel's two ends at the pressures now (the interior profile
+  // The flow capacity G at each 0D vessel's two ends at the pressures now (the interior profile
   // reads them), and its resistance now and a step before (the next step's extrapolation):
   // the viscosity is most of the cost, three evaluations a vessel and step.
-  std::vector<double> capacity_a_, capacity_b_, resistance_, previous_resistance_, extrapolated_;
+  std::vector<double> capacity_a_, capacity_b_, resistance_, previous_resistance_;
+  std::vector<double> linearised_resistance_;  // per vessel: the step's (extrapolated, then Picard)
   std::vector<double> held_inflow_, impedance_;  // per node: the coupled inflows predicted with, Z
   std::vector<double> coupling_impedance_;       // per coupling node, scratch
   double dt_ = 0, inlet_flow_ = 0;

@@ -1,7 +1,7 @@
 #include "solver/run_report.hpp"
 
 #include <algorithm>
-#include <charconv>
+#include <deque>
 #include <map>
 #include <cmath>
 #include <limits>
@@ -191,9 +191,10 @@ void write_vessel_table(const std::filesystem::path& file, const VesselTable& ve
 
 void write_results_vtk(const std::filesystem::path& file, const Network& net, const VesselTable& vessels,
                        std::span<const std::uint8_t> keep) {
-  // Every number per vessel but the geometry the PolyData has already (null -> NaN).
-  std::vector<std::vector<double>> converted;
-  std::vector<CellField> fields;
+  // Every number per vessel but the geometry the PolyData has already (null -> NaN): the real
+  // columns as they are, then the integer ones converted (a deque: the fields point into it).
+  std::deque<std::vector<double>> converted;
+  std::vector<CellField> fields, integer_fields;
   for (const VesselTable::Column& c : vessels.columns()) {
     if (c.name == "id" || c.name == "diameter" || c.name == "length" || c.kind == VesselTable::Kind::text) continue;
     if (c.kind == VesselTable::Kind::number) {
@@ -204,29 +205,24 @@ void write_results_vtk(const std::filesystem::path& file, const Network& net, co
     for (std::size_t v = 0; v < x.size(); ++v)
       x[v] = c.integer[v] == VesselTable::null_integer ? std::numeric_limits<double>::quiet_NaN()
                                                         : static_cast<double>(c.integer[v]);
+    integer_fields.push_back({c.name, x});
   }
+  fields.insert(fields.end(), integer_fields.begin(), integer_fields.end());
   // The vessel model as a number ParaView can colour by: 1 for 0D, 0 for 1D.
   const VesselTable::Column& model = *vessels.find("model");
   std::vector<double>& lumped = converted.emplace_back(vessels.rows());
   for (std::size_t v = 0; v < vessels.rows(); ++v) lumped[v] = model.labels[model.code[v]] == "0d" ? 1.0 : 0.0;
-  // The converted columns' addresses are final only now (emplace_back may move them).
-  std::size_t k = 0;
-  for (const VesselTable::Column& c : vessels.columns())
-    if (c.kind == VesselTable::Kind::integer && c.name != "id") fields.push_back({c.name, converted[k++]});
-  fields.push_back({"model_0d", converted[k]});
+  fields.push_back({"model_0d", lumped});
   OutputStream out(file.string());
   write_vtk(net, out, fields, keep);
   out.commit();
 }
 
 void add_solution_frame(VtkTimeSeries& series, const PulseSolver& solver) {
-  std::vector<double> area, flow;
-  solver.sample_all(0.5, area, flow);
-  std::vector<double> pressure(area.size()), velocity(area.size());
-  for (std::size_t v = 0; v < area.size(); ++v) {
-    pressure[v] = solver.law(v).pressure(area[v]);
-    velocity[v] = flow[v] / area[v];
-  }
+  std::vector<double> area, flow, pressure;
+  solver.sample_all(0.5, area, flow, &pressure);
+  std::vector<double> velocity(area.size());
+  for (std::size_t v = 0; v < area.size(); ++v) velocity[v] = flow[v] / area[v];
   series.add_frame(solver.time(), {{"p", pressure}, {"Q", flow}, {"A", area}, {"u", velocity}});
 }
 

@@ -99,7 +99,7 @@ grep -q "the VTK output shows" "$WORK/log" && pass "--vtk-min-diameter says what
     --mean-tol 5e-4 --pi-tol 5e-4 >"$WORK/cmp" \
   && pass "--lumped-passes 2 against 1: within 0.05 % ($(grep 'pulsatility' "$WORK/cmp" | sed 's/ *tolerance.*//'))" \
   || fail "--lumped-passes 2 against 1: $(cat "$WORK/cmp")"
-expect_error "--lumped-passes 0" 2 "--lumped-passes must be in [1, 10]" -- \
+expect_error "--lumped-passes 0" 2 "--lumped-passes must lie in [1, 10]" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --lumped-passes 0
 expect_error "--vtk-min-diameter above every vessel" 2 "keeps no vessel" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --vtk --vtk-min-diameter 1mm
