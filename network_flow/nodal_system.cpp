@@ -132,6 +132,7 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
     pivot_.assign(nodes_, 0.0);
     inverse_pivot_.assign(nodes_, 0.0);
     divider_.assign(nodes_, 0.0);
+    plan_subtrees();
   } else {
     order_ = {};
     parent_ = {};
@@ -181,6 +182,18 @@ NodalSystem::NodalSystem(NodalSystem&&) noexcept = default;
 NodalSystem& NodalSystem::operator=(NodalSystem&&) noexcept = default;
 
 std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::span<const double> shunt) {
+  return factorize(conductance, shunt, nullptr);
+}
+
+std::int64_t NodalSystem::factorize_forward(std::span<const double> conductance, std::span<const double> shunt,
+                                            std::span<double> y) {
+  if (y.size() != nodes_)
+    throw std::invalid_argument("NodalSystem::factorize_forward: right-hand side of " + std::to_string(y.size()) +
+                                " for " + std::to_string(nodes_) + " nodes");
+  return factorize(conductance, shunt, y.data());
+}
+
+std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::span<const double> shunt, double* y) {
   if (conductance.size() != a_.size() || shunt.size() != nodes_)
     throw std::invalid_argument("NodalSystem::factorize: " + std::to_string(conductance.size()) +
                                 " conductances and " + std::to_string(shunt.size()) + " shunts for " +
@@ -198,32 +211,21 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
     // subtree: the Schur complement d_p - g^2 / d_c with d_c = g + S_c, but as a sum of
     // positive terms, without the cancellation of the subtraction (exact to a few ulps
     // however the conductances spread, as the series/parallel reduction is).
-    for (std::size_t i = 0; i < nodes_; ++i) {
-      if (!(shunt[i] >= 0 && shunt[i] < std::numeric_limits<double>::infinity())) throw bad_value("shunt of node", i, shunt[i]);
-      pivot_[i] = shunt[i];
-    }
-    bool singular = false;
-    for (std::size_t k = nodes_; k-- > 0;) {
-      const auto c = static_cast<std::size_t>(order_[k]);
-      const std::int32_t p = parent_[c];
-      if (p < 0) {
-        // A root's S is its whole component's conductance to ground: a sum of non-negative
-        // terms, zero exactly when no node of the component has a shunt.
-        singular |= !(pivot_[c] > 0);
-        inverse_pivot_[c] = 1 / pivot_[c];
-        continue;
+    bool valid = true, singular = false;
+    const Elimination elimination{conductance, shunt, pivot_.data(), inverse_pivot_.data(), divider_.data()};
+    sweep_up(&elimination, y, valid, singular);
+    if (!valid) {
+      // Named as a one-thread pass meets them: shunts by node, then edges leaves up.
+      for (std::size_t i = 0; i < nodes_; ++i)
+        if (!(shunt[i] >= 0 && shunt[i] < std::numeric_limits<double>::infinity())) throw bad_value("shunt of node", i, shunt[i]);
+      for (std::size_t k = nodes_; k-- > 0;) {
+        const auto c = static_cast<std::size_t>(order_[k]);
+        if (parent_[c] < 0) continue;
+        const auto e = static_cast<std::size_t>(parent_edge_[c]);
+        if (!(conductance[e] > 0 && conductance[e] < std::numeric_limits<double>::infinity()))
+          throw bad_value("conductance of edge", e, conductance[e]);
       }
-      const auto e = static_cast<std::size_t>(parent_edge_[c]);
-      const double g = conductance[e];
-      if (!(g > 0 && g < std::numeric_limits<double>::infinity())) throw bad_value("conductance of edge", e, g);
-      const double s = pivot_[c], d = g + s, inverse = 1 / d;
-      pivot_[c] = d;
-      // What the sweeps multiply by: no division left in a solve (two per node were most of it).
-      inverse_pivot_[c] = inverse;
-      divider_[c] = g * inverse;
-      pivot_[static_cast<std::size_t>(p)] += g * s * inverse;
     }
-
     if (!singular) {
       factorized_ = true;
       return -1;
@@ -286,6 +288,7 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
   }
   if (singular >= 0) return singular;
   factorized_ = true;
+  if (y) forward(std::span<double>(y, nodes_));
   return -1;
 }
 
@@ -300,22 +303,242 @@ void NodalSystem::solve(std::span<const double> b, std::span<double> x) const {
     // current reaches its parent through the divider g / d_c; then roots down, each node from
     // its own row once its parent is known.
     if (x.data() != b.data()) std::copy(b.begin(), b.end(), x.begin());
-    for (std::size_t k = nodes_; k-- > 0;) {
-      const auto c = static_cast<std::size_t>(order_[k]);
-      const std::int32_t p = parent_[c];
-      if (p >= 0) x[static_cast<std::size_t>(p)] += divider_[c] * x[c];
-    }
-    for (std::size_t k = 0; k < nodes_; ++k) {
-      const auto i = static_cast<std::size_t>(order_[k]);
-      const std::int32_t p = parent_[i];
-      x[i] = x[i] * inverse_pivot_[i] + (p >= 0 ? divider_[i] * x[static_cast<std::size_t>(p)] : 0.0);
-    }
+    bool valid = true, singular = false;
+    sweep_up(nullptr, x.data(), valid, singular);
+    sweep_down(x.data());
     return;
   }
   // Eigen permutes b into x first (in place if they are one array) and works in x from there.
   const Eigen::Map<const Eigen::VectorXd> rhs(b.data(), static_cast<Eigen::Index>(nodes_));
   Eigen::Map<Eigen::VectorXd> solution(x.data(), static_cast<Eigen::Index>(nodes_));
   solution = cholesky_->ldlt.solve(rhs);
+}
+
+void NodalSystem::forward(std::span<double> y) const {
+  check_solvable(y.size(), "forward");
+  if (method_ == Method::tree_elimination) {
+    bool valid = true, singular = false;
+    sweep_up(nullptr, y.data(), valid, singular);
+    return;
+  }
+  const Cholesky& c = *cholesky_;
+  Eigen::Map<Eigen::VectorXd> v(y.data(), static_cast<Eigen::Index>(nodes_));
+  Eigen::VectorXd permuted = c.ldlt.permutationP() * v;
+  c.ldlt.matrixL().solveInPlace(permuted);
+  v = permuted;
+}
+
+void NodalSystem::add_forward(std::span<const std::int32_t> nodes, std::span<const double> values,
+                              std::span<double> y) const {
+  check_solvable(y.size(), "add_forward");
+  if (values.size() != nodes.size())
+    throw std::invalid_argument("NodalSystem::add_forward: " + std::to_string(nodes.size()) + " nodes but " +
+                                std::to_string(values.size()) + " values");
+  for (const std::int32_t i : nodes)
+    if (i < 0 || static_cast<std::size_t>(i) >= nodes_)
+      throw std::invalid_argument("NodalSystem::add_forward: node " + std::to_string(i) + " is not below " +
+                                  std::to_string(nodes_));
+  if (method_ == Method::tree_elimination) {
+    // The forward half is linear: a current v added at node j reaches y_j, then its parent
+    // through the divider, and so on up to the root (the sweep's own products).
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      double v = values[k];
+      for (auto j = static_cast<std::size_t>(nodes[k]);;) {
+        y[j] += v;
+        const std::int32_t p = parent_[j];
+        if (p < 0) break;
+        v *= divider_[j];
+        j = static_cast<std::size_t>(p);
+      }
+    }
+    return;
+  }
+  std::vector<double> b(nodes_, 0.0);
+  for (std::size_t k = 0; k < nodes.size(); ++k) b[static_cast<std::size_t>(nodes[k])] += values[k];
+  forward(b);
+  for (std::size_t i = 0; i < nodes_; ++i) y[i] += b[i];
+}
+
+void NodalSystem::backward(std::span<const double> y, std::span<double> x) const {
+  check_solvable(y.size(), "backward");
+  if (x.size() != nodes_)
+    throw std::invalid_argument("NodalSystem::backward: solution of " + std::to_string(x.size()) + " for " +
+                                std::to_string(nodes_) + " nodes");
+  if (x.data() != y.data()) std::copy(y.begin(), y.end(), x.begin());
+  if (method_ == Method::tree_elimination) {
+    sweep_down(x.data());
+    return;
+  }
+  const Cholesky& c = *cholesky_;
+  Eigen::Map<Eigen::VectorXd> v(x.data(), static_cast<Eigen::Index>(nodes_));
+  Eigen::VectorXd scaled = c.ldlt.pivots().cwiseInverse().cwiseProduct(v);
+  c.ldlt.matrixU().solveInPlace(scaled);
+  v = c.ldlt.permutationPinv() * scaled;
+}
+
+void NodalSystem::backward_at(std::span<const std::int32_t> nodes, std::span<const double> y,
+                              std::span<double> out) const {
+  check_solvable(y.size(), "backward_at");
+  if (out.size() != nodes.size())
+    throw std::invalid_argument("NodalSystem::backward_at: " + std::to_string(nodes.size()) + " nodes but " +
+                                std::to_string(out.size()) + " outputs");
+  for (const std::int32_t i : nodes)
+    if (i < 0 || static_cast<std::size_t>(i) >= nodes_)
+      throw std::invalid_argument("NodalSystem::backward_at: node " + std::to_string(i) + " is not below " +
+                                  std::to_string(nodes_));
+  if (method_ == Method::tree_elimination) {
+    // Each node's value needs its parent's: down its path from the root, by the sweep's own
+    // expression (the same bits as backward()).
+    std::vector<std::int32_t> path;
+    std::vector<double> value;
+    const std::size_t budget = nodes_ / 32 + 64;
+    std::size_t walked = 0;
+    for (std::size_t k = 0; k < nodes.size() && walked <= budget; ++k) {
+      path.clear();
+      for (std::int32_t j = nodes[k]; j >= 0; j = parent_[static_cast<std::size_t>(j)]) path.push_back(j);
+      walked += path.size();
+      double above = 0;
+      for (std::size_t q = path.size(); q-- > 0;) {
+        const auto i = static_cast<std::size_t>(path[q]);
+        above = y[i] * inverse_pivot_[i] + (parent_[i] >= 0 ? divider_[i] * above : 0.0);
+      }
+      out[k] = above;
+    }
+    if (walked <= budget) return;
+  }
+  std::vector<double> x(y.begin(), y.end());
+  backward(x, x);
+  for (std::size_t k = 0; k < nodes.size(); ++k) out[k] = x[static_cast<std::size_t>(nodes[k])];
+}
+
+void NodalSystem::check_solvable(std::size_t size, const char* what) const {
+  if (size != nodes_)
+    throw std::invalid_argument("NodalSystem::" + std::string(what) + ": vector of " + std::to_string(size) +
+                                " for " + std::to_string(nodes_) + " nodes");
+  if (!factorized_) throw std::logic_error("NodalSystem::" + std::string(what) + ": no successful factorisation");
+}
+
+// ---- the tree's sweeps --------------------------------------------------------------------
+
+void NodalSystem::plan_subtrees() {
+  // Below this many nodes a sweep is a few hundred microseconds: threads would only wait.
+  if (nodes_ < (std::size_t{1} << 16)) return;
+  std::vector<std::int32_t> size(nodes_, 1);
+  for (std::size_t k = nodes_; k-- > 0;) {
+    const auto c = static_cast<std::size_t>(order_[k]);
+    if (parent_[c] >= 0) size[static_cast<std::size_t>(parent_[c])] += size[c];
+  }
+  // Subtrees of at most 1/256 of the nodes: enough tasks for dynamic scheduling to balance
+  // two or a few threads, few enough top nodes (those above them) for the serial part.
+  const auto limit = std::max<std::int32_t>(4096, static_cast<std::int32_t>(nodes_ / 256));
+  std::vector<std::int32_t> task(nodes_, -1), count;
+  for (const std::int32_t c : order_) {
+    const std::int32_t p = parent_[static_cast<std::size_t>(c)];
+    if (size[static_cast<std::size_t>(c)] > limit) {
+      top_.push_back(c);
+    } else if (p < 0 || task[static_cast<std::size_t>(p)] < 0) {
+      task[static_cast<std::size_t>(c)] = static_cast<std::int32_t>(count.size());
+      count.push_back(0);
+      top_.push_back(~c);
+    } else {
+      task[static_cast<std::size_t>(c)] = task[static_cast<std::size_t>(p)];
+    }
+    if (task[static_cast<std::size_t>(c)] >= 0) ++count[static_cast<std::size_t>(task[static_cast<std::size_t>(c)])];
+  }
+  task_offset_.assign(count.size() + 1, 0);
+  for (std::size_t t = 0; t < count.size(); ++t) task_offset_[t + 1] = task_offset_[t] + count[t];
+  task_nodes_.resize(static_cast<std::size_t>(task_offset_.back()));
+  std::vector<std::int32_t> cursor(task_offset_.begin(), task_offset_.end() - 1);
+  for (const std::int32_t c : order_)
+    if (const std::int32_t t = task[static_cast<std::size_t>(c)]; t >= 0)
+      task_nodes_[static_cast<std::size_t>(cursor[static_cast<std::size_t>(t)]++)] = c;
+}
+
+bool NodalSystem::parallel_sweeps() const { return threads_ > 1 && !task_offset_.empty(); }
+
+void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& valid, bool& singular) const {
+  constexpr double infinity = std::numeric_limits<double>::infinity();
+  const Elimination* el = elimination;
+  auto start = [&](std::size_t c, bool& ok) {
+    const double s = el->shunt[c];
+    ok &= s >= 0 && s < infinity;
+    el->pivot[c] = s;
+  };
+  // One node of the sweep: its subtree is eliminated, its pivot final once its edge is added.
+  auto up = [&](std::size_t c, bool& ok, bool& lost) {
+    const std::int32_t p = parent_[c];
+    if (p < 0) {
+      // A root's S is its whole component's conductance to ground: a sum of non-negative
+      // terms, zero exactly when no node of the component has a shunt.
+      if (el) {
+        lost |= !(el->pivot[c] > 0);
+        el->inverse_pivot[c] = 1 / el->pivot[c];
+      }
+      return;
+    }
+    if (el) {
+      const double g = el->conductance[static_cast<std::size_t>(parent_edge_[c])];
+      ok &= g > 0 && g < infinity;
+      const double s = el->pivot[c], d = g + s, inverse = 1 / d;
+      el->pivot[c] = d;
+      // What the sweeps multiply by: no division left in a solve.
+      el->inverse_pivot[c] = inverse;
+      el->divider[c] = g * inverse;
+      el->pivot[static_cast<std::size_t>(p)] += g * s * inverse;
+    }
+    if (y) y[static_cast<std::size_t>(p)] += divider_[c] * y[c];
+  };
+  bool ok = true, lost = false;
+  if (!parallel_sweeps()) {
+    if (el)
+      for (std::size_t i = 0; i < nodes_; ++i) start(i, ok);
+    for (std::size_t k = nodes_; k-- > 0;) up(static_cast<std::size_t>(order_[k]), ok, lost);
+  } else {
+    // Each task's nodes but its root in parallel (a node's children are in its own task);
+    // then the top and the tasks' roots, leaves up, serially: every pivot sums its children
+    // in the order of one thread.
+    if (el)
+      for (const std::int32_t c : top_)
+        if (c >= 0) start(static_cast<std::size_t>(c), ok);
+    const auto tasks = static_cast<std::int64_t>(task_offset_.size()) - 1;
+    bool tasks_ok = true;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_) reduction(&& : tasks_ok)
+    for (std::int64_t t = 0; t < tasks; ++t) {
+      const auto first = static_cast<std::size_t>(task_offset_[static_cast<std::size_t>(t)]);
+      const auto last = static_cast<std::size_t>(task_offset_[static_cast<std::size_t>(t) + 1]);
+      bool task_ok = true, unused = false;
+      if (el)
+        for (std::size_t j = first; j < last; ++j) start(static_cast<std::size_t>(task_nodes_[j]), task_ok);
+      for (std::size_t j = last; j-- > first + 1;) up(static_cast<std::size_t>(task_nodes_[j]), task_ok, unused);
+      tasks_ok = tasks_ok && task_ok;
+    }
+    ok &= tasks_ok;
+    for (std::size_t k = top_.size(); k-- > 0;) {
+      const std::int32_t c = top_[k];
+      up(static_cast<std::size_t>(c >= 0 ? c : ~c), ok, lost);
+    }
+  }
+  valid = ok;
+  singular = lost;
+}
+
+void NodalSystem::sweep_down(double* x) const {
+  auto down = [&](std::size_t i) {
+    const std::int32_t p = parent_[i];
+    x[i] = x[i] * inverse_pivot_[i] + (p >= 0 ? divider_[i] * x[static_cast<std::size_t>(p)] : 0.0);
+  };
+  if (!parallel_sweeps()) {
+    for (std::size_t k = 0; k < nodes_; ++k) down(static_cast<std::size_t>(order_[k]));
+    return;
+  }
+  for (const std::int32_t c : top_) down(static_cast<std::size_t>(c >= 0 ? c : ~c));
+  const auto tasks = static_cast<std::int64_t>(task_offset_.size()) - 1;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_)
+  for (std::int64_t t = 0; t < tasks; ++t) {
+    const auto first = static_cast<std::size_t>(task_offset_[static_cast<std::size_t>(t)]);
+    const auto last = static_cast<std::size_t>(task_offset_[static_cast<std::size_t>(t) + 1]);
+    for (std::size_t j = first + 1; j < last; ++j) down(static_cast<std::size_t>(task_nodes_[j]));
+  }
 }
 
 void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::span<double> out) const {

@@ -51,6 +51,27 @@ class NodalSystem {
   std::int64_t factorize(std::span<const double> conductance, std::span<const double> shunt);
   // x = system^-1 b with the last factorisation (x may alias b).
   void solve(std::span<const double> b, std::span<double> x) const;
+
+  // The solve in its two halves, K = P^T L D L^T P: forward, y = L^-1 P b, and backward,
+  // x = P^T L^-T D^-1 y. A step of the 0D vessels knows most of its right-hand side before
+  // the 1D vessels' part of it: the forward half of the known part goes with the
+  // factorisation (one pass), the rest is added later through add_forward, which on a tree
+  // touches only the nodes' paths to their roots, and one backward half gives every node.
+  // What the 1D vessels need in between, the potential at a few nodes, is backward_at.
+  // factorize, and y = L^-1 P y in the same pass (in place; y of node_count()).
+  std::int64_t factorize_forward(std::span<const double> conductance, std::span<const double> shunt,
+                                 std::span<double> y);
+  void forward(std::span<double> y) const;  // y = L^-1 P y, in place
+  // y += L^-1 P b for b zero but at `nodes` (values[k] at nodes[k]; repeats add).
+  void add_forward(std::span<const std::int32_t> nodes, std::span<const double> values, std::span<double> y) const;
+  void backward(std::span<const double> y, std::span<double> x) const;  // x may alias y
+  // x_i = (P^T L^-T D^-1 y)_i at each node i of `nodes` into out: on a tree only the nodes on
+  // their paths to their roots (past 1/32 of all, the whole backward half).
+  void backward_at(std::span<const std::int32_t> nodes, std::span<const double> y, std::span<double> out) const;
+
+  // Threads for the tree elimination's sweeps: subtrees in parallel, the top of the tree and
+  // each subtree's root serially in the one-thread order, so the bits do not depend on it.
+  void set_threads(int threads) { threads_ = threads; }
   // (system^-1)_ii for each node i of `nodes` (any order, repeats allowed), with the last
   // factorisation, into out (of nodes' size): each node's own response, the potential that a
   // unit current into it alone raises there (the impedance to ground seen from the node).
@@ -79,6 +100,25 @@ class NodalSystem {
   // Per node: d_i after eliminating its subtree, 1 / d_i, and g_i / d_i (g_i its edge to the
   // parent: the voltage divider of that edge and the subtree).
   std::vector<double> pivot_, inverse_pivot_, divider_;
+  // The sweeps' parallel plan: subtrees of at most a few ten thousand nodes whose parent (if
+  // any) roots a larger one are tasks, each with its nodes in elimination order (task_nodes_
+  // from task_offset_[t], the task's root first); top_ lists, in elimination order, the nodes
+  // of no task and (as ~node) the tasks' roots: what the serial part of a sweep visits.
+  std::vector<std::int32_t> task_nodes_, task_offset_, top_;
+  int threads_ = 1;
+  bool parallel_sweeps() const;
+  std::int64_t factorize(std::span<const double> conductance, std::span<const double> shunt, double* y);
+  void check_solvable(std::size_t size, const char* what) const;
+  void plan_subtrees();
+  // The tree's sweeps: leaves up, eliminating (where `elimination` is given: the pivots from
+  // its conductances and shunts, into its arrays) and the forward half of y (where given);
+  // roots down, the backward half.
+  struct Elimination {
+    std::span<const double> conductance, shunt;
+    double *pivot, *inverse_pivot, *divider;
+  };
+  void sweep_up(const Elimination* elimination, double* y, bool& valid, bool& singular) const;
+  void sweep_down(double* x) const;
   struct Cholesky;  // Eigen's factorisation, out of this header
   std::unique_ptr<Cholesky> cholesky_;
   // Sparse Cholesky: each node's component, named by its lowest node, and per component

@@ -6,6 +6,7 @@
 #include <utility>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -540,5 +541,79 @@ TEST(NodalSystem, TheInverseDiagonalOfTwoNodesAndItsRefusals) {
     // A singular factorisation leaves nothing to use.
     EXPECT_EQ(pair.factorize(std::vector<double>{1.0}, std::vector<double>{0.0, 0.0}), 0);
     EXPECT_THROW(pair.inverse_diagonal(std::vector<std::int32_t>{0, 1}, out), std::logic_error);
+  }
+}
+
+// The solve in halves, as a step of the 0D vessels takes it: the forward half with the
+// factorisation, a later change of the right-hand side at a few nodes through add_forward,
+// the potentials at some nodes through backward_at and at all through backward; equal to a
+// solve of the whole right-hand side, on a tree (both numberings) and on a looped graph.
+TEST(NodalSystem, TheSolveInHalvesEqualsTheWholeSolve) {
+  std::mt19937_64 rng(77);
+  std::vector<Graph> graphs = {random_tree(3000, rng, false), random_tree(3000, rng, true), ring_with_chords()};
+  for (std::size_t which = 0; which < graphs.size(); ++which) {
+    const Graph& graph = graphs[which];
+    const std::vector<double> g = log_uniform(graph.a.size(), 1e-1, 1e1, rng);
+    const std::vector<double> s = uniform(graph.nodes, 1e-2, 1e-1, rng);
+    const std::vector<double> rhs = uniform(graph.nodes, -1, 1, rng);
+    const std::vector<std::int32_t> late = {0, static_cast<std::int32_t>(graph.nodes / 2), 3, 0};
+    const std::vector<double> change = {0.5, -0.25, 2.0, 0.125};
+    std::vector<double> whole = rhs;
+    for (std::size_t k = 0; k < late.size(); ++k) whole[static_cast<std::size_t>(late[k])] += change[k];
+    for (const Method method : {Method::automatic, Method::sparse_cholesky}) {
+      NodalSystem system(graph.nodes, graph.a, graph.b, method);
+      const std::vector<double> reference = solved(system, g, s, whole);
+      const std::vector<double> before = solved(system, g, s, rhs);
+      std::vector<double> y = rhs;
+      ASSERT_EQ(system.factorize_forward(g, s, y), -1);
+      const std::vector<std::int32_t> asked = {late[1], late[2], 1};
+      std::vector<double> early(asked.size());
+      system.backward_at(asked, y, early);
+      for (std::size_t k = 0; k < asked.size(); ++k)
+        EXPECT_NEAR(early[k], before[static_cast<std::size_t>(asked[k])], 1e-13 * std::abs(before[static_cast<std::size_t>(asked[k])]) + 1e-15)
+            << "graph " << which << " node " << asked[k];
+      system.add_forward(late, change, y);
+      std::vector<double> x(graph.nodes);
+      system.backward(y, x);
+      EXPECT_LT(relative_difference(x, reference), 1e-12) << "graph " << which;
+      std::vector<double> z = whole;
+      system.forward(z);
+      system.backward(z, z);
+      EXPECT_LT(relative_difference(z, reference), 1e-12) << "graph " << which;
+    }
+  }
+}
+
+// Past 2^16 nodes the tree's sweeps run subtrees in parallel; the pivots still sum their
+// children in one thread's order, so two threads give the bits of one.
+TEST(NodalSystem, TwoThreadsEliminateATreeToTheBitsOfOne) {
+  std::mt19937_64 rng(5);
+  for (const bool shuffled : {false, true}) {
+    const Graph tree = random_tree(200000, rng, shuffled);
+    const std::vector<double> g = log_uniform(tree.a.size(), 1e-2, 1e2, rng);
+    const std::vector<double> s = uniform(tree.nodes, 1e-4, 1e-3, rng);
+    const std::vector<double> rhs = uniform(tree.nodes, -1, 1, rng);
+    NodalSystem one(tree.nodes, tree.a, tree.b), two(tree.nodes, tree.a, tree.b);
+    two.set_threads(2);
+    std::vector<double> y1 = rhs, y2 = rhs;
+    ASSERT_EQ(one.factorize_forward(g, s, y1), -1);
+    ASSERT_EQ(two.factorize_forward(g, s, y2), -1);
+    EXPECT_EQ(y1, y2) << "shuffled " << shuffled;
+    one.backward(y1, y1);
+    two.backward(y2, y2);
+    EXPECT_EQ(y1, y2) << "shuffled " << shuffled;
+    std::vector<double> x1(tree.nodes), x2(tree.nodes);
+    one.solve(rhs, x1);
+    two.solve(rhs, x2);
+    EXPECT_EQ(x1, x2);
+    EXPECT_EQ(x1, y1);
+    // And a bad conductance is named as one thread names it.
+    std::vector<double> bad = g;
+    bad[tree.a.size() / 3] = -1;
+    std::string one_message, two_message;
+    try { one.factorize(bad, s); } catch (const std::invalid_argument& e) { one_message = e.what(); }
+    try { two.factorize(bad, s); } catch (const std::invalid_argument& e) { two_message = e.what(); }
+    EXPECT_FALSE(one_message.empty());
+    EXPECT_EQ(one_message, two_message);
   }
 }
