@@ -26,15 +26,27 @@ ViscosityTable::ViscosityTable(const Blood& blood) : blood_(blood) {
   std::frexp(area_max_, &last);
   first_exponent_bits_ = std::bit_cast<std::uint64_t>(std::ldexp(1.0, first - 1)) >> 52;
   const int octaves = last - first + 1;
-  table_.resize(static_cast<std::size_t>(octaves) * (intervals + 3));
-  // The law itself (not clamped at the threshold) so the stencil never straddles a kink.
-  for (int o = 0; o < octaves; ++o)
+  table_.resize(static_cast<std::size_t>(octaves) * intervals * 4);
+  std::vector<double> f(intervals + 3);
+  for (int o = 0; o < octaves; ++o) {
+    // Per octave, N + 3 nodes m = 1 + (j - 1) / N, j = 0 .. N + 2 (one before the octave, two
+    // after it), the law itself (not clamped at the threshold) so that no stencil straddles
+    // a kink.
     for (std::size_t j = 0; j < intervals + 3; ++j) {
       const double m = 1 + (static_cast<double>(j) - 1) / intervals;
-      const double area = std::ldexp(m, first - 1 + o);
-      table_[static_cast<std::size_t>(o) * (intervals + 3) + j] =
-          blood.plasma_viscosity * pries_relative_viscosity(diameter_of(area), blood.hematocrit);
+      f[j] = blood.plasma_viscosity * pries_relative_viscosity(diameter_of(std::ldexp(m, first - 1 + o)), blood.hematocrit);
     }
+    // Interval k, t in [0, 1) from node k + 1: the Lagrange weights of nodes k .. k + 3,
+    // -t(t-1)(t-2)/6, (t+1)(t-1)(t-2)/2, -(t+1)t(t-2)/2, (t+1)t(t-1)/6, expanded in powers of t.
+    for (std::size_t k = 0; k < intervals; ++k) {
+      const double f0 = f[k], f1 = f[k + 1], f2 = f[k + 2], f3 = f[k + 3];
+      double* c = &table_[4 * (static_cast<std::size_t>(o) * intervals + k)];
+      c[0] = f1;
+      c[1] = -f0 / 3 - f1 / 2 + f2 - f3 / 6;
+      c[2] = f0 / 2 - f1 + f2 / 2;
+      c[3] = (f3 - f0) / 6 + (f1 - f2) / 2;
+    }
+  }
 }
 
 double ViscosityTable::below_table(double area) const { return apparent_viscosity(blood_, diameter_of(area)); }
