@@ -38,15 +38,19 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
   // Rectangle rule: spectrally accurate for the means of periodic signals.
   const double rho = solver.blood().density, alpha = solver.blood().alpha;
   const int threads = solver.threads();
-  const auto vessels = static_cast<std::int64_t>(flow_.size());
-  solver.sample_all(0.5, area_, q_, &p_);
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::int64_t vi = 0; vi < vessels; ++vi) {
-    const auto v = static_cast<std::size_t>(vi);
-    const double a = area_[v], q = q_[v], u = q / a, p = p_[v];
+  const std::complex<double> phase = weight * std::polar(1.0, -omega_ * t);
+  if (duration_ == 0) {
+    first_time_ = t;
+    record_ends(solver, first_);
+  }
+  last_time_ = t;
+  duration_ += weight;
+  // At the centre: means, extrema, wall shear stress, Reynolds number.
+  auto centre = [&](std::size_t v, double a, double q, double p, double mean_q) {
+    const double u = q / a;
     const double mu = solver.viscosity(a);
     const double radius = std::sqrt(a / std::numbers::pi);
-    flow_[v] += weight * solver.mean_flow(v);
+    flow_[v] += weight * mean_q;
     pressure_[v] += weight * p;
     p_min_[v] = std::min(p_min_[v], p);
     p_max_[v] = std::max(p_max_[v], p);
@@ -54,29 +58,36 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     q_max_[v] = std::max(q_max_[v], q);
     wss_[v] += weight * wall_shear_stress(mu, u, radius, alpha);
     reynolds_[v] += weight * rho * u * 2 * radius / mu;
-  }
-  const std::complex<double> phase = weight * std::polar(1.0, -omega_ * t);
-  if (duration_ == 0) {
-    first_time_ = t;
-    record_ends(solver, first_);
-  }
-  last_time_ = t;
-  add_end(solver, 0.0, phase, p_in_, u_in_);
-  add_end(solver, 1.0, phase, p_out_, u_out_);
-  duration_ += weight;
-}
-
-void CycleStatistics::add_end(const PulseSolver& solver, double x, std::complex<double> phase,
-                              std::vector<std::complex<double>>& p_sum, std::vector<std::complex<double>>& u_sum) {
-  solver.sample_all(x, area_end_, q_end_, &p_end_);
-  const int threads = solver.threads();
-  const auto vessels = static_cast<std::int64_t>(flow_.size());
+  };
+  // At the ends: the Fourier sums of pressure and velocity.
+  auto ends = [&](std::size_t v, double p_in, double u_in, double p_out, double u_out) {
+    p_in_[v] += phase * p_in;
+    u_in_[v] += phase * u_in;
+    p_out_[v] += phase * p_out;
+    u_out_[v] += phase * u_out;
+  };
+  // The 1D vessels through the solver's arrays, three points each.
+  const std::vector<std::int32_t>& one_d = solver.one_d_vessels();
+  if (!one_d.empty()) {
+    solver.sample_all(0.5, area_, q_, &p_, false);
+    solver.sample_all(0.0, area_end_, q_end_, &p_end_, false);
+    solver.sample_all(1.0, area_out_, q_out_, &p_out_end_, false);
+    const auto count = static_cast<std::int64_t>(one_d.size());
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::int64_t vi = 0; vi < vessels; ++vi) {
-    const auto v = static_cast<std::size_t>(vi);
-    p_sum[v] += phase * p_end_[v];
-    u_sum[v] += phase * (q_end_[v] / area_end_[v]);
+    for (std::int64_t j = 0; j < count; ++j) {
+      const auto v = static_cast<std::size_t>(one_d[static_cast<std::size_t>(j)]);
+      centre(v, area_[v], q_[v], p_[v], solver.mean_flow(v));
+      ends(v, p_end_[v], q_end_[v] / area_end_[v], p_out_end_[v], q_out_[v] / area_out_[v]);
+    }
   }
+  // The 0D vessels straight from their state, all three points in one pass (their flow is
+  // one along the vessel: its mean).
+  solver.lumped().for_each_sample(
+      [&](std::size_t v, const LumpedVessels::Sample& s) {
+        centre(v, s.area_centre, s.flow, s.pressure_centre, s.flow);
+        ends(v, s.pressure_in, s.flow / s.area_in, s.pressure_out, s.flow / s.area_out);
+      },
+      threads);
 }
 
 void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>& values) {

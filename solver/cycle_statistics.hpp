@@ -71,11 +71,9 @@ class CycleStatistics {
   std::vector<std::complex<double>> p_in_, p_out_, u_in_, u_out_;
   std::vector<double> first_, last_;  // per vessel: p_in, p_out, u_in, u_out
   double first_time_ = 0, last_time_ = 0;
-  std::vector<double> area_, q_, p_, area_end_, q_end_, p_end_;  // scratch
+  // Scratch: the 1D vessels' samples at the centre and the two ends (of every vessel's size).
+  std::vector<double> area_, q_, p_, area_end_, q_end_, p_end_, area_out_, q_out_, p_out_end_;
   void record_ends(const PulseSolver& solver, std::vector<double>& values);  // p_in, p_out, u_in, u_out
-  // Adds phase times p and u at fraction x along every vessel to the Fourier sums.
-  void add_end(const PulseSolver& solver, double x, std::complex<double> phase,
-               std::vector<std::complex<double>>& p_sum, std::vector<std::complex<double>>& u_sum);
   double duration_ = 0;
 };
 

@@ -67,7 +67,6 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
     } else {
       shunt_[at] = 1 / o.resistance();
       shunt_pressure_[at] = o.p_out;
-      shunt_outlet_node_.push_back(static_cast<std::int32_t>(at));
     }
   }
   if (net.inlet) {
@@ -93,16 +92,37 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
   system_ = NodalSystem(nodes_, a_, b_);
   const std::size_t edges = a_.size();
   volume_.assign(nodes_, 0.0);
-  previous_volume_ = pressure_ = previous_pressure_ = predicted_ = system_shunt_ = rhs_ = held_inflow_ = impedance_ =
-      dynamic_ = volume_;
+  previous_volume_ = pressure_ = previous_pressure_ = predicted_ = system_shunt_ = rhs_ = impedance_ = dynamic_ = volume_;
   flow_.assign(edges, 0.0);
   previous_flow_ = conductance_ = history_ = next_flow_ = flow_;
   capacity_a_.assign(vessels_.size(), 0.0);
-  capacity_b_ = resistance_ = previous_resistance_ = linearised_resistance_ = capacity_a_;
+  capacity_b_ = resistance_ = previous_resistance_ = capacity_a_;
+  // The R1 edges of RCR outlets keep their conductance, and have no inertance.
+  for (std::size_t e = vessels_.size(); e < edges; ++e) conductance_[e] = 1 / edge_fixed_resistance_[e - vessels_.size()];
+
+  if (2 * edges >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    throw InputError("too many 0D vessels for 32-bit indices");
+  incident_offset_.assign(nodes_ + 1, 0);
+  for (std::size_t e = 0; e < edges; ++e) {
+    ++incident_offset_[static_cast<std::size_t>(a_[e]) + 1];
+    ++incident_offset_[static_cast<std::size_t>(b_[e]) + 1];
+  }
+  for (std::size_t k = 0; k < nodes_; ++k) incident_offset_[k + 1] += incident_offset_[k];
+  incident_edge_.resize(2 * edges);
+  std::vector<std::int32_t> fill(incident_offset_.begin(), incident_offset_.end() - 1);
+  for (std::size_t e = 0; e < edges; ++e) {
+    const auto edge = static_cast<std::int32_t>(e);
+    incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(a_[e])]++)] = edge;
+    incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(b_[e])]++)] = ~edge;
+  }
+  node_source_.assign(nodes_, 0.0);
+  block_outflow_.assign((nodes_ + block - 1) / block, 0.0);
 }
 
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
   coupling_nodes_ = std::move(nodes);
+  held_inflow_.assign(coupling_nodes_.size(), 0.0);
+  coupling_scratch_.assign(coupling_nodes_.size(), 0.0);
   std::vector<std::int32_t> slot(nodes_, -1);
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) slot[static_cast<std::size_t>(coupling_nodes_[j])] = static_cast<std::int32_t>(j);
   coupling_edge_offset_.assign(coupling_nodes_.size() + 1, 0);
@@ -224,21 +244,46 @@ void LumpedVessels::restart_history() {
 
 // ---- a step -----------------------------------------------------------------------------------
 
-void LumpedVessels::linearise(std::span<const double> at, std::span<const double> coupled_inflow, double inlet_flow) {
+void LumpedVessels::set_sources(std::span<const double> coupled, double inlet) {
+  for (std::size_t j = 0; j < coupling_nodes_.size() && !coupled.empty(); ++j)
+    node_source_[static_cast<std::size_t>(coupling_nodes_[j])] += coupled[j];
+  if (inlet_node_ >= 0) node_source_[static_cast<std::size_t>(inlet_node_)] += inlet;
+}
+
+void LumpedVessels::clear_sources() {
+  for (const std::int32_t k : coupling_nodes_) node_source_[static_cast<std::size_t>(k)] = 0;
+  if (inlet_node_ >= 0) node_source_[static_cast<std::size_t>(inlet_node_)] = 0;
+}
+
+void LumpedVessels::linearise(bool extrapolated) {
   const double dt = dt_;
-  const std::size_t vessels = vessels_.size(), edges = a_.size();
-  const auto vessels_i = static_cast<std::int64_t>(vessels), nodes_i = static_cast<std::int64_t>(nodes_);
-  // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
-  // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
+  const auto vessels_i = static_cast<std::int64_t>(vessels_.size()), nodes_i = static_cast<std::int64_t>(nodes_);
+  // The state the coefficients are taken at: the extrapolation x* = 2 x^n - x^(n-1) to t1 (an
+  // error of O(dt^2) in the coefficients keeps BDF2 second order with one solve; the
+  // resistance is extrapolated itself, no viscosity to evaluate, within a factor of two of
+  // today's), or a Picard pass's last solution.
+  auto at = [&](std::int32_t k) {
+    const auto i = static_cast<std::size_t>(k);
+    return extrapolated ? 2 * pressure_[i] - previous_pressure_[i] : predicted_[i];
+  };
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
   {
-#pragma omp for schedule(static) nowait
+    // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
+    // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
+#pragma omp for schedule(static)
     for (std::int64_t i = 0; i < vessels_i; ++i) {
       const auto e = static_cast<std::size_t>(i);
-      const double p = 0.5 * (at[static_cast<std::size_t>(a_[e])] + at[static_cast<std::size_t>(b_[e])]);
-      const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p;
+      const double pa = at(a_[e]), pb = at(b_[e]);
+      double r;
+      if (extrapolated) {
+        r = std::clamp(2 * resistance_[e] - previous_resistance_[e], 0.5 * resistance_[e], 2 * resistance_[e]);
+      } else {
+        double capacity_a, capacity_b;
+        r = resistance(e, pa, pb, capacity_a, capacity_b);
+      }
+      const double s = edge_root_intercept_[e] + edge_root_slope_[e] * 0.5 * (pa + pb);
       const double inertance = density_ * edge_length_[e] / (s * s);
-      conductance_[e] = 1 / (linearised_resistance_[e] + 1.5 * inertance / dt);
+      conductance_[e] = 1 / (r + 1.5 * inertance / dt);
       history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
     }
     // BDF2 for a node's volume, V(p) linearised at p*:
@@ -246,21 +291,16 @@ void LumpedVessels::linearise(std::span<const double> at, std::span<const double
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < nodes_i; ++i) {
       const auto k = static_cast<std::size_t>(i);
-      const double ps = at[k], c = node_compliance(k, ps);
+      const double ps = at(static_cast<std::int32_t>(i)), c = node_compliance(k, ps);
       system_shunt_[k] = 1.5 * c / dt + shunt_[k];
-      rhs_[k] = (1.5 * (c * ps - node_volume(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt +
-                shunt_[k] * shunt_pressure_[k];
+      double rhs = (1.5 * (c * ps - node_volume(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt +
+                   shunt_[k] * shunt_pressure_[k] + node_source_[k];
+      for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
+        const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
+        rhs += e >= 0 ? -history_[static_cast<std::size_t>(e)] : history_[static_cast<std::size_t>(~e)];
+      }
+      rhs_[k] = rhs;
     }
-  }
-  for (std::size_t e = vessels; e < edges; ++e) {
-    conductance_[e] = 1 / edge_fixed_resistance_[e - vessels];
-    history_[e] = 0;
-  }
-  for (std::size_t k = 0; k < network_nodes_ && !coupled_inflow.empty(); ++k) rhs_[k] += coupled_inflow[k];
-  if (inlet_node_ >= 0) rhs_[static_cast<std::size_t>(inlet_node_)] += inlet_flow;
-  for (std::size_t e = 0; e < edges; ++e) {
-    rhs_[static_cast<std::size_t>(a_[e])] -= history_[e];
-    rhs_[static_cast<std::size_t>(b_[e])] += history_[e];
   }
 }
 
@@ -268,89 +308,77 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, d
   if (empty()) return;
   dt_ = dt;
   inlet_flow_ = inlet_flow;
-  const auto vessels_i = static_cast<std::int64_t>(vessels_.size()), nodes_i = static_cast<std::int64_t>(nodes_);
-  // The first linearisation at the state extrapolated to t1, x* = 2 x^n - x^(n-1): an error
-  // of O(dt^2) in the coefficients keeps BDF2 second order with one solve. The resistance is
-  // extrapolated itself (no viscosity to evaluate), within a factor of two of today's.
-#pragma omp parallel num_threads(threads_) if (threads_ > 1)
-  {
-#pragma omp for schedule(static) nowait
-    for (std::int64_t i = 0; i < nodes_i; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      predicted_[k] = 2 * pressure_[k] - previous_pressure_[k];
-    }
-#pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < vessels_i; ++i) {
-      const auto e = static_cast<std::size_t>(i);
-      linearised_resistance_[e] = std::clamp(2 * resistance_[e] - previous_resistance_[e], 0.5 * resistance_[e], 2 * resistance_[e]);
-    }
-  }
+  set_sources(coupled_inflow, inlet_flow);
   for (int pass = 0; pass < passes_; ++pass) {
-    if (pass > 0) {
-      // Picard: the coefficients again, at the last solution.
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-      for (std::int64_t i = 0; i < vessels_i; ++i) {
-        const auto e = static_cast<std::size_t>(i);
-        const double pa = predicted_[static_cast<std::size_t>(a_[e])], pb = predicted_[static_cast<std::size_t>(b_[e])];
-        double capacity_a, capacity_b;
-        linearised_resistance_[e] = resistance(e, pa, pb, capacity_a, capacity_b);
-      }
+    // Each further (Picard) pass takes the coefficients again at the last solution.
+    linearise(pass == 0);
+    // The forward half of the solve goes with the factorisation; complete() adds the 1D
+    // ends' departures from the held inflows to it and takes the backward half.
+    if (system_.factorize_forward(conductance_, system_shunt_, rhs_) >= 0) {
+      clear_sources();
+      throw InputError("the 0D vessels have a part with no path to an outlet");
     }
-    linearise(predicted_, coupled_inflow, inlet_flow);
-    const std::int64_t singular = system_.factorize(conductance_, system_shunt_);
-    if (singular >= 0) throw InputError("the 0D vessels have a part with no path to an outlet");
-    system_.solve(rhs_, predicted_);
+    if (pass + 1 < passes_) system_.backward(rhs_, predicted_);
   }
-  if (!coupled_inflow.empty()) std::copy(coupled_inflow.begin(), coupled_inflow.begin() + network_nodes_, held_inflow_.begin());
-  // Z_i = (K^-1)_ii at the coupling nodes: O(nodes) on a tree (selected inversion).
-  if (!coupling_nodes_.empty()) {
-    coupling_impedance_.resize(coupling_nodes_.size());
-    system_.inverse_diagonal(coupling_nodes_, coupling_impedance_);
-    for (std::size_t j = 0; j < coupling_nodes_.size(); ++j)
-      impedance_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_impedance_[j];
-  }
+  clear_sources();
+  if (coupling_nodes_.empty()) return;
+  std::copy(coupled_inflow.begin(), coupled_inflow.end(), held_inflow_.begin());
+  // The predicted pressures where the 1D ends read them, and Z_i = (K^-1)_ii there: both
+  // along the coupling nodes' paths to their roots only (selected inversion on a tree).
+  system_.backward_at(coupling_nodes_, rhs_, coupling_scratch_);
+  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j)
+    predicted_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_scratch_[j];
+  system_.inverse_diagonal(coupling_nodes_, coupling_scratch_);
+  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j)
+    impedance_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_scratch_[j];
 }
 
 void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out) {
   if (empty()) return;
   const double dt = dt_;
-  // The departure of the 1D ends' mean inflows from those held, through the same system.
+  // The departure of the 1D ends' mean inflows from those held, into the forward half.
   if (!coupling_nodes_.empty()) {
-    std::fill(rhs_.begin(), rhs_.end(), 0.0);
-    for (const std::int32_t k : coupling_nodes_) {
-      const auto i = static_cast<std::size_t>(k);
-      rhs_[i] = coupled_volume[i] / dt - held_inflow_[i];
-    }
-    system_.solve(rhs_, rhs_);
-    for (std::size_t k = 0; k < nodes_; ++k) predicted_[k] += rhs_[k];
+    for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_scratch_[j] = coupled_volume[j] / dt - held_inflow_[j];
+    system_.add_forward(coupling_nodes_, coupling_scratch_, rhs_);
   }
+  system_.backward(rhs_, predicted_);
+  set_sources(coupled_volume, dt * inlet_flow_);
   const auto edges = static_cast<std::int64_t>(a_.size());
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t i = 0; i < edges; ++i) {
-    const auto e = static_cast<std::size_t>(i);
-    next_flow_[e] = conductance_[e] * (predicted_[static_cast<std::size_t>(a_[e])] - predicted_[static_cast<std::size_t>(b_[e])]) +
-                    history_[e];
+  const auto blocks = static_cast<std::int64_t>(block_outflow_.size());
+#pragma omp parallel num_threads(threads_) if (threads_ > 1)
+  {
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < edges; ++i) {
+      const auto e = static_cast<std::size_t>(i);
+      next_flow_[e] = conductance_[e] * (predicted_[static_cast<std::size_t>(a_[e])] - predicted_[static_cast<std::size_t>(b_[e])]) +
+                      history_[e];
+    }
+    // Each node's net inflow at t1 (BDF2 takes the right-hand side there), as the solve had
+    // it, and from it the volume: exactly what came in, (3 V - 4 V^n + V^(n-1)) / 2 =
+    // dt inflow + the sources' volume; the pressure from the tube laws. The outlets'
+    // outflow is summed per block of nodes, in one order whatever the threads.
+#pragma omp for schedule(static)
+    for (std::int64_t b = 0; b < blocks; ++b) {
+      const std::size_t first = static_cast<std::size_t>(b) * block, last = std::min(first + block, nodes_);
+      double outflow = 0;
+      for (std::size_t k = first; k < last; ++k) {
+        const double shunted = shunt_[k] * (predicted_[k] - shunt_pressure_[k]);
+        if (k < network_nodes_) outflow += shunted;  // a capacitor's R2 is not the network's
+        double inflow = -shunted;
+        for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
+          const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
+          inflow += e >= 0 ? -next_flow_[static_cast<std::size_t>(e)] : next_flow_[static_cast<std::size_t>(~e)];
+        }
+        const double next = (4 * volume_[k] - previous_volume_[k] + 2 * dt * inflow + 2 * node_source_[k]) / 3;
+        previous_volume_[k] = volume_[k];
+        volume_[k] = next;
+        previous_pressure_[k] = pressure_[k];
+        pressure_[k] = pressure_from_volume(k, next);
+      }
+      block_outflow_[static_cast<std::size_t>(b)] = outflow;
+    }
   }
-  // Each node's net inflow at t1 (BDF2 takes the right-hand side there), as the solve had it.
-  std::vector<double>& inflow = rhs_;  // scratch: the solve is done
-  for (std::size_t k = 0; k < nodes_; ++k) inflow[k] = -shunt_[k] * (predicted_[k] - shunt_pressure_[k]);
-  for (std::size_t e = 0; e < a_.size(); ++e) {
-    inflow[static_cast<std::size_t>(a_[e])] -= next_flow_[e];
-    inflow[static_cast<std::size_t>(b_[e])] += next_flow_[e];
-  }
-  if (inlet_node_ >= 0) inflow[static_cast<std::size_t>(inlet_node_)] += inlet_flow_;
-  // The volumes: exactly what came in (3 V - 4 V^n + V^(n-1)) / 2 = dt inflow + 1D volume.
-  const auto nodes_i = static_cast<std::int64_t>(nodes_);
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t i = 0; i < nodes_i; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const double coupled = k < network_nodes_ && !coupled_volume.empty() ? coupled_volume[k] : 0.0;
-    const double next = (4 * volume_[k] - previous_volume_[k] + 2 * dt * inflow[k] + 2 * coupled) / 3;
-    previous_volume_[k] = volume_[k];
-    volume_[k] = next;
-    previous_pressure_[k] = pressure_[k];
-    pressure_[k] = pressure_from_volume(k, next);
-  }
+  clear_sources();
   previous_flow_.swap(flow_);
   flow_.swap(next_flow_);
   previous_resistance_.swap(resistance_);
@@ -358,11 +386,10 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   update_dynamic_pressures();
   // Across the network's boundary: the inlet, outlet shunts, and the R1 of RCR outlets.
   if (inlet_node_ >= 0) exchanged_in += dt * inlet_flow_;
-  for (const std::int32_t k : shunt_outlet_node_) {
-    const auto i = static_cast<std::size_t>(k);
-    exchanged_out += dt * shunt_[i] * (predicted_[i] - shunt_pressure_[i]);
-  }
-  for (std::size_t e = vessels_.size(); e < a_.size(); ++e) exchanged_out += dt * flow_[e];
+  double outflow = 0;
+  for (const double b : block_outflow_) outflow += b;
+  for (std::size_t e = vessels_.size(); e < a_.size(); ++e) outflow += flow_[e];
+  exchanged_out += dt * outflow;
 }
 
 // ---- what the rest of the solver reads -------------------------------------------------------

@@ -45,9 +45,12 @@ class LumpedVessels {
   LumpedVessels(const Network& net, std::span<const VesselLaw> laws, const ViscosityTable& viscosity,
                 const Blood& blood, const std::vector<bool>& zero_d);
   // Solves a step takes (1: the extrapolated linearisation alone), and the threads of its
-  // loops over vessels and nodes (the elimination itself runs on one).
+  // loops over vessels and nodes and of the elimination's subtrees.
   void set_passes(int passes) { passes_ = passes; }
-  void set_threads(int threads) { threads_ = threads; }
+  void set_threads(int threads) {
+    threads_ = threads;
+    system_.set_threads(threads);
+  }
 
   bool empty() const { return vessels_.empty(); }
   std::size_t vessel_count() const { return vessels_.size(); }
@@ -69,9 +72,10 @@ class LumpedVessels {
   double dynamic_pressure(std::int32_t node) const { return dynamic_[static_cast<std::size_t>(node)]; }
 
   // One step of length dt to t1, in two halves around the 1D vessels' substeps.
-  // predict: the pressures at t1 with the coupled 1D ends' inflows held at coupled_inflow
-  // (per node, their flows at t0), and every coupling node's response to a change of it:
-  // the impedance dp(t1)/dQ_in, the diagonal of the system's inverse there.
+  // predict: the pressures at t1 at the coupling nodes with the coupled 1D ends' inflows held
+  // at coupled_inflow (per coupling node, in set_coupling_nodes' order: their flows at t0),
+  // and each one's response to a change of it: the impedance dp(t1)/dQ_in, the diagonal of
+  // the system's inverse there.
   // inlet_flow: the prescribed inflow at t1 where the inlet vessel is 0D.
   void predict(double dt, std::span<const double> coupled_inflow, double inlet_flow);
   // The pressure of a node at a fraction s in [0, 1] of the step being taken (linear
@@ -82,10 +86,11 @@ class LumpedVessels {
     return pressure_[i] + s * (predicted_[i] - pressure_[i]);
   }
   double impedance(std::int32_t node) const { return impedance_[static_cast<std::size_t>(node)]; }
-  // Completes the step with the volumes the 1D ends actually let into each node
-  // (coupled_volume, per node): the pressures at t1 corrected for the departure from the
-  // predicted inflows (the same factorisation), the flows, then the node volumes from them
-  // and the pressures from the tube laws. Adds what crossed the network's boundary (inlet,
+  // Completes the step with the volumes the 1D ends actually let into each coupling node
+  // (coupled_volume, in set_coupling_nodes' order): the pressures at t1 with the departure
+  // from the predicted inflows (the same factorisation: its forward half along the coupling
+  // nodes' paths, then one backward half for every node), the flows, then the node volumes
+  // from them and the pressures from the tube laws. Adds what crossed the network's boundary (inlet,
   // outlets) to exchanged (in, out) [m^3].
   void complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out);
 
@@ -99,6 +104,31 @@ class LumpedVessels {
   // Every 0D vessel's lumen area, flow and (unless empty) pressure at fraction x along it,
   // into the network's per-vessel arrays (the cycle statistics' samples).
   void sample(double x, std::span<double> area, std::span<double> flow, std::span<double> pressure, int threads) const;
+  // Each 0D vessel's state at its two ends and its centre, as sample() gives them, passed to
+  // f(network vessel index, sample) in parallel over the vessels (f must touch only that
+  // vessel's data): all three points in one pass over the state, nothing written between.
+  struct Sample {
+    double flow, pressure_in, area_in, pressure_centre, area_centre, pressure_out, area_out;
+  };
+  template <class F>
+  void for_each_sample(F&& f, int threads) const {
+    const auto vessels = static_cast<std::int64_t>(vessels_.size());
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+    for (std::int64_t i = 0; i < vessels; ++i) {
+      const auto e = static_cast<std::size_t>(i);
+      const double c = edge_root_intercept_[e], d = edge_root_slope_[e];
+      Sample s;
+      s.flow = flow_[e];
+      s.pressure_in = pressure_at(static_cast<std::int32_t>(i), 0.0);
+      s.pressure_centre = pressure_at(static_cast<std::int32_t>(i), 0.5);
+      s.pressure_out = pressure_at(static_cast<std::int32_t>(i), 1.0);
+      const double root_in = c + d * s.pressure_in, root_centre = c + d * s.pressure_centre, root_out = c + d * s.pressure_out;
+      s.area_in = root_in * root_in;
+      s.area_centre = root_centre * root_centre;
+      s.area_out = root_out * root_out;
+      f(static_cast<std::size_t>(vessels_[e]), s);
+    }
+  }
   // The volume the 0D vessels hold now (what BDF2 conserves: (3 V^n - V^(n-1)) / 2, which
   // is V at a steady state), capacitors not included [m^3].
   double stored_volume() const;
@@ -131,8 +161,13 @@ class LumpedVessels {
   // denominator: two divisions, not four (they were most of a step's evaluation).
   double resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const;
   // The linearisation of a step: edge conductances and history terms, node shunts and
-  // right-hand sides, at the pressures `at` with linearised_resistance_.
-  void linearise(std::span<const double> at, std::span<const double> coupled_inflow, double inlet_flow);
+  // right-hand sides (with node_source_), at the state extrapolated to the step's end
+  // (extrapolated) or at the pressures predicted_ (a Picard pass).
+  void linearise(bool extrapolated);
+  // Sets node_source_ at the coupling nodes and the inlet node (per coupling node and the
+  // inlet's), or back to zero.
+  void set_sources(std::span<const double> coupled, double inlet);
+  void clear_sources();
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R
@@ -159,7 +194,6 @@ class LumpedVessels {
   std::vector<double> shunt_, shunt_pressure_;
   std::vector<std::int32_t> outlet_of_capacitor_;  // per capacitor node
   std::vector<std::int32_t> capacitor_of_outlet_;  // per network outlet, -1 if none here
-  std::vector<std::int32_t> shunt_outlet_node_;    // network nodes whose shunt is an outlet (exchanged)
 
   NodalSystem system_;
   // State: node volumes and pressures, edge flows, and the last step's (BDF2 history and
@@ -176,9 +210,17 @@ class LumpedVessels {
   // reads them), and its resistance now and a step before (the next step's extrapolation):
   // the viscosity is most of the cost, three evaluations a vessel and step.
   std::vector<double> capacity_a_, capacity_b_, resistance_, previous_resistance_;
-  std::vector<double> linearised_resistance_;  // per vessel: the step's (extrapolated, then Picard)
-  std::vector<double> held_inflow_, impedance_;  // per node: the coupled inflows predicted with, Z
-  std::vector<double> coupling_impedance_;       // per coupling node, scratch
+  std::vector<double> impedance_;     // per node (coupling nodes only): Z
+  std::vector<double> held_inflow_;   // per coupling node: the inflows predicted with
+  std::vector<double> coupling_scratch_;  // per coupling node
+  // Each node's edges, in increasing order (e where the edge leaves it, ~e where it enters):
+  // the sums into a node are gathers, in parallel and in one order whatever the threads.
+  std::vector<std::int32_t> incident_offset_, incident_edge_;
+  // Per node, zero but at the coupling nodes and the inlet's node during a step: the
+  // inflow [m^3/s] the linearisation adds, then the volume [m^3] the completion adds.
+  std::vector<double> node_source_;
+  static constexpr std::size_t block = 4096;
+  std::vector<double> block_outflow_;  // per block of nodes: the outlets' outflow (a fixed-order sum)
   double dt_ = 0, inlet_flow_ = 0;
   int passes_ = 1, threads_ = 1;
 };

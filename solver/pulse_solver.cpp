@@ -109,10 +109,12 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     std::vector<std::int32_t> nodes = coupled_node_;
     std::sort(nodes.begin(), nodes.end());
     nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    for (const std::int32_t node : coupled_node_)
+      coupled_slot_.push_back(static_cast<std::int32_t>(std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
+    coupled_inflow_.assign(nodes.size(), 0.0);
     lumped_.set_coupling_nodes(std::move(nodes));
   }
   held_end_flow_.assign(boundaries_.coupled.size(), 0.0);
-  coupled_inflow_.assign(lumped_.node_count(), 0.0);
   coupled_volume_ = coupled_inflow_;
 
   const auto rows = static_cast<Eigen::Index>(element_vessel_.size());
@@ -225,6 +227,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
   half_length_.resize(static_cast<Eigen::Index>(element_vessel_.size()));
   element_beta_.resize(half_length_.size());
   blocks_.clear();
+  one_d_vessels_.clear();
   std::int32_t next = 0;
   for (int p = 0; p <= top; ++p) {
     const std::int32_t first = next;
@@ -238,6 +241,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
       }
     }
     if (next == first) continue;
+    for (std::int32_t el = first; el < next; el += e) one_d_vessels_.push_back(element_vessel_[static_cast<std::size_t>(el)]);
     bases_[static_cast<std::size_t>(p)] = modal_basis(p, options.quadrature_points);
     blocks_.push_back({p, first, next - first});
   }
@@ -422,7 +426,7 @@ void PulseSolver::step_coupled() {
     const VesselEnd& end = boundaries_.coupled[k].end;
     const EndState& u = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
     held_end_flow_[k] = end.distal ? u.flow : -u.flow;
-    coupled_inflow_[static_cast<std::size_t>(coupled_node_[k])] += held_end_flow_[k];
+    coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
   }
   step_start_ = time_;
   const double t1 = time_ + dt_;
@@ -437,7 +441,7 @@ void PulseSolver::step_coupled() {
     }
     std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
     for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
-      coupled_volume_[static_cast<std::size_t>(coupled_node_[k])] +=
+      coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
           state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
   }
   // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
@@ -756,7 +760,7 @@ double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
 }
 
 void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
-                             std::vector<double>* pressure) const {
+                             std::vector<double>* pressure, bool zero_d) const {
   const std::size_t n = net_.vessel_count();
   area.resize(n);
   flow.resize(n);
@@ -770,11 +774,12 @@ void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<do
   for (std::size_t j = 0; j <= static_cast<std::size_t>(max_degree()); ++j) phi[j] = legendre(static_cast<int>(j), xi);
   // The 0D vessels from their own state, then the 1D ones (the first of each one's elements
   // names it).
-  lumped_.sample(std::clamp(x, 0.0, 1.0), area, flow, pressure ? std::span<double>(*pressure) : std::span<double>(), threads_);
-  const auto one_d = static_cast<std::int64_t>(element_vessel_.size()) / elements_per_vessel_;
+  if (zero_d)
+    lumped_.sample(std::clamp(x, 0.0, 1.0), area, flow, pressure ? std::span<double>(*pressure) : std::span<double>(), threads_);
+  const auto one_d = static_cast<std::int64_t>(one_d_vessels_.size());
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t j = 0; j < one_d; ++j) {
-    const auto v = static_cast<std::size_t>(element_vessel_[static_cast<std::size_t>(j * elements_per_vessel_)]);
+    const auto v = static_cast<std::size_t>(one_d_vessels_[static_cast<std::size_t>(j)]);
     const Eigen::Index el = first_element_[v] + k;
     double a = 0, q = 0;
     for (int j = 0; j <= vessel_degree_[v]; ++j) {

@@ -103,8 +103,13 @@ class PulseSolver {
   double viscosity(double area) const { return viscosity_(area); }  // [Pa s] at a lumen area
   // Area, flow and pressure of every vessel at the same fraction x along each, in one pass
   // (the cycle statistics sample all vessels every few steps); pressure may be null.
+  // With zero_d false the 0D vessels' entries are left as they are: their state is read
+  // whole from lumped() (the statistics take all three points of a 0D vessel in one pass).
   void sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
-                  std::vector<double>* pressure = nullptr) const;
+                  std::vector<double>* pressure = nullptr, bool zero_d = true) const;
+  const LumpedVessels& lumped() const { return lumped_; }
+  // The 1D vessels (indices), in the order of their elements.
+  const std::vector<std::int32_t>& one_d_vessels() const { return one_d_vessels_; }
   int threads() const { return threads_; }
 
   const VesselLaw& law(std::size_t vessel) const { return laws_[vessel]; }
@@ -184,7 +189,9 @@ class PulseSolver {
   double step_start_ = 0;                  // time at the start of the 0D step being taken
   std::vector<std::int32_t> coupled_node_; // per coupled end: its 0D node
   std::vector<double> held_end_flow_;      // per coupled end: its inflow to the node at the step's start
-  std::vector<double> coupled_inflow_, coupled_volume_;  // per 0D node
+  std::vector<double> coupled_inflow_, coupled_volume_;  // per coupling node (LumpedVessels' order)
+  std::vector<std::int32_t> one_d_vessels_;
+  std::vector<std::int32_t> coupled_slot_;                 // per coupled end: its coupling node's place there
   std::vector<ModalBasis> bases_;          // by degree; empty where unused
   std::vector<DegreeBlock> blocks_;
   std::vector<int> vessel_degree_;         // per vessel
