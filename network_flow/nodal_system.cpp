@@ -129,7 +129,6 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
   method_ = method == Method::automatic ? (forest ? Method::tree_elimination : Method::sparse_cholesky) : method;
 
   if (method_ == Method::tree_elimination) {
-    pivot_.assign(nodes_, 0.0);
     inverse_pivot_.assign(nodes_, 0.0);
     divider_.assign(nodes_, 0.0);
     plan_subtrees();
@@ -205,14 +204,15 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
   };
 
   if (method_ == Method::tree_elimination) {
-    // Leaves up. pivot_ first gathers S_i, the conductance to ground of node i's subtree seen
+    // Leaves up. inverse_pivot_ first gathers S_i, the conductance to ground of node i's subtree seen
     // from i (its shunt and its children's subtrees through their edges); eliminating child c
     // adds g S_c / (g + S_c) to its parent's, the series conductance of its edge and its
     // subtree: the Schur complement d_p - g^2 / d_c with d_c = g + S_c, but as a sum of
     // positive terms, without the cancellation of the subtraction (exact to a few ulps
-    // however the conductances spread, as the series/parallel reduction is).
+    // however the conductances spread, as the series/parallel reduction is). Once node i is
+    // eliminated its entry becomes 1 / d_i: the pivots themselves are never read again.
     bool valid = true, singular = false;
-    const Elimination elimination{conductance, shunt, pivot_.data(), inverse_pivot_.data(), divider_.data()};
+    const Elimination elimination{conductance, shunt, inverse_pivot_.data(), divider_.data()};
     sweep_up(&elimination, y, valid, singular);
     if (!valid) {
       // Named as a one-thread pass meets them: shunts by node, then edges leaves up.
@@ -238,7 +238,7 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
       root[static_cast<std::size_t>(i)] = p < 0 ? i : root[static_cast<std::size_t>(p)];
     }
     for (std::size_t i = 0; i < nodes_; ++i)
-      if (!(pivot_[static_cast<std::size_t>(root[i])] > 0)) return static_cast<std::int64_t>(i);
+      if (!(1 / inverse_pivot_[static_cast<std::size_t>(root[i])] > 0)) return static_cast<std::int64_t>(i);
   }
 
   // Sparse Cholesky: refill the analysed pattern's values, shunts on the diagonal.
@@ -462,7 +462,7 @@ void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& vali
   auto start = [&](std::size_t c, bool& ok) {
     const double s = el->shunt[c];
     ok &= s >= 0 && s < infinity;
-    el->pivot[c] = s;
+    el->inverse_pivot[c] = s;  // S_c, until c is eliminated
   };
   // One node of the sweep: its subtree is eliminated, its pivot final once its edge is added.
   auto up = [&](std::size_t c, bool& ok, bool& lost) {
@@ -471,20 +471,19 @@ void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& vali
       // A root's S is its whole component's conductance to ground: a sum of non-negative
       // terms, zero exactly when no node of the component has a shunt.
       if (el) {
-        lost |= !(el->pivot[c] > 0);
-        el->inverse_pivot[c] = 1 / el->pivot[c];
+        lost |= !(el->inverse_pivot[c] > 0);
+        el->inverse_pivot[c] = 1 / el->inverse_pivot[c];
       }
       return;
     }
     if (el) {
       const double g = el->conductance[static_cast<std::size_t>(parent_edge_[c])];
       ok &= g > 0 && g < infinity;
-      const double s = el->pivot[c], d = g + s, inverse = 1 / d;
-      el->pivot[c] = d;
+      const double s = el->inverse_pivot[c], inverse = 1 / (g + s);
       // What the sweeps multiply by: no division left in a solve.
       el->inverse_pivot[c] = inverse;
       el->divider[c] = g * inverse;
-      el->pivot[static_cast<std::size_t>(p)] += g * s * inverse;
+      el->inverse_pivot[static_cast<std::size_t>(p)] += g * s * inverse;
     }
     if (y) y[static_cast<std::size_t>(p)] += divider_[c] * y[c];
   };
@@ -557,7 +556,7 @@ void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::spa
   try {
     if (method_ == Method::tree_elimination) {
       // The selected inversion. Eliminating the nodes leaves first (order_ backwards) factors
-      // the system as K = L D L^T with D = diag(d), d = pivot_, and L unit lower triangular in
+      // the system as K = L D L^T with D = diag(d), 1/d = inverse_pivot_, and L unit lower triangular in
       // that order with one entry below the diagonal in column c, at its parent p:
       //   L_pc = K_pc / d_c = -g_c / d_c      (g_c the conductance of the edge to the parent),
       // so l_c = -g_c / d_c = -g_c / (g_c + S_c), with S_c the conductance of c's subtree (see

@@ -97,9 +97,9 @@ class NodalSystem {
   // every node hangs from a lower one, else the reverse of the order in which peeling leaves
   // removes them), each node's parent and the edge to it (-1 at roots), and the pivots.
   std::vector<std::int32_t> order_, parent_, parent_edge_;
-  // Per node: d_i after eliminating its subtree, 1 / d_i, and g_i / d_i (g_i its edge to the
-  // parent: the voltage divider of that edge and the subtree).
-  std::vector<double> pivot_, inverse_pivot_, divider_;
+  // Per node: 1 / d_i, d_i its pivot after eliminating its subtree, and g_i / d_i (g_i its
+  // edge to the parent: the voltage divider of that edge and the subtree).
+  std::vector<double> inverse_pivot_, divider_;
   // The sweeps' parallel plan: subtrees of at most a few ten thousand nodes whose parent (if
   // any) roots a larger one are tasks, each with its nodes in elimination order (task_nodes_
   // from task_offset_[t], the task's root first); top_ lists, in elimination order, the nodes
@@ -115,7 +115,7 @@ class NodalSystem {
   // roots down, the backward half.
   struct Elimination {
     std::span<const double> conductance, shunt;
-    double *pivot, *inverse_pivot, *divider;
+    double *inverse_pivot, *divider;
   };
   void sweep_up(const Elimination* elimination, double* y, bool& valid, bool& singular) const;
   void sweep_down(double* x) const;
