@@ -115,7 +115,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
     incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(a_[e])]++)] = edge;
     incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(b_[e])]++)] = ~edge;
   }
-  node_source_.assign(nodes_, 0.0);
+  shunt_current_.resize(nodes_);
+  for (std::size_t k = 0; k < nodes_; ++k) shunt_current_[k] = shunt_[k] * shunt_pressure_[k];
   block_outflow_.assign((nodes_ + block - 1) / block, 0.0);
 }
 
@@ -155,10 +156,14 @@ double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& ca
   const double aa = sa * sa, ab = sb * sb, am = sm * sm;
   const double mu_a = (*viscosity_)(aa), mu_b = (*viscosity_)(ab), mu_m = (*viscosity_)(am);
   const double ga = aa * aa * mu_b * mu_m, gb = ab * ab * mu_a * mu_m, gm = am * am * mu_a * mu_b;  // x k mu_a mu_b mu_m
-  const double product = friction_k_ * mu_a * mu_b * mu_m, inverse = 1 / product;
+  // One division: with D = product (ga + gb + 4 gm), 1 / product = sum / D and
+  // product / sum = product^2 / D (D stays far inside the doubles' range: ~1e-60 in a 3 um
+  // capillary).
+  const double product = friction_k_ * mu_a * mu_b * mu_m, sum = ga + gb + 4 * gm;
+  const double inverse_d = 1 / (product * sum), inverse = sum * inverse_d;
   capacity_a = ga * inverse;
   capacity_b = gb * inverse;
-  return 6 * edge_length_[e] * product / (ga + gb + 4 * gm);
+  return 6 * edge_length_[e] * product * product * inverse_d;
 }
 
 void LumpedVessels::update_dynamic_pressures() {
@@ -184,10 +189,10 @@ double LumpedVessels::compliance(std::int32_t node) const {
   return node_compliance(k, pressure_[k]);
 }
 
-double LumpedVessels::pressure_from_volume(std::size_t k, double volume) const {
-  // The root of a p^2 + b p + (c - V) on the branch where the compliance 2 a p + b is
-  // positive (every lumen open), in the form that does not cancel.
-  const double a = volume_a_[k], b = volume_b_[k], excess = volume - volume_c_[k];
+double LumpedVessels::pressure_from_excess(std::size_t k, double excess) const {
+  // The root of a p^2 + b p - W on the branch where the compliance 2 a p + b is positive
+  // (every lumen open), in the form that does not cancel.
+  const double a = volume_a_[k], b = volume_b_[k];
   const double root = std::sqrt(std::max(b * b + 4 * a * excess, 0.0));
   return b > 0 ? 2 * excess / (b + root) : (root - b) / (2 * a);
 }
@@ -207,7 +212,7 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
     pressure_[static_cast<std::size_t>(b_[e])] = pc;
     flow_[e] = q;
   }
-  for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_volume(k, pressure_[k]);
+  for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
   predicted_ = pressure_;
   update_resistances();
   restart_history();
@@ -226,7 +231,7 @@ void LumpedVessels::start_at_rest(std::span<const VesselLaw> laws) {
   for (std::size_t k = 0; k < network_nodes_; ++k) pressure_[k] = sum[k] / count[k];
   for (std::size_t k = network_nodes_; k < nodes_; ++k) pressure_[k] = shunt_pressure_[k];
   std::fill(flow_.begin(), flow_.end(), 0.0);
-  for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_volume(k, pressure_[k]);
+  for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
   predicted_ = pressure_;
   update_resistances();
   restart_history();
@@ -244,18 +249,7 @@ void LumpedVessels::restart_history() {
 
 // ---- a step -----------------------------------------------------------------------------------
 
-void LumpedVessels::set_sources(std::span<const double> coupled, double inlet) {
-  for (std::size_t j = 0; j < coupling_nodes_.size() && !coupled.empty(); ++j)
-    node_source_[static_cast<std::size_t>(coupling_nodes_[j])] += coupled[j];
-  if (inlet_node_ >= 0) node_source_[static_cast<std::size_t>(inlet_node_)] += inlet;
-}
-
-void LumpedVessels::clear_sources() {
-  for (const std::int32_t k : coupling_nodes_) node_source_[static_cast<std::size_t>(k)] = 0;
-  if (inlet_node_ >= 0) node_source_[static_cast<std::size_t>(inlet_node_)] = 0;
-}
-
-void LumpedVessels::linearise(bool extrapolated) {
+void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled_inflow) {
   const double dt = dt_;
   const auto vessels_i = static_cast<std::int64_t>(vessels_.size()), nodes_i = static_cast<std::int64_t>(nodes_);
   // The state the coefficients are taken at: the extrapolation x* = 2 x^n - x^(n-1) to t1 (an
@@ -293,8 +287,8 @@ void LumpedVessels::linearise(bool extrapolated) {
       const auto k = static_cast<std::size_t>(i);
       const double ps = at(static_cast<std::int32_t>(i)), c = node_compliance(k, ps);
       system_shunt_[k] = 1.5 * c / dt + shunt_[k];
-      double rhs = (1.5 * (c * ps - node_volume(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt +
-                   shunt_[k] * shunt_pressure_[k] + node_source_[k];
+      double rhs =
+          (1.5 * (c * ps - node_excess(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt + shunt_current_[k];
       for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
         const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
         rhs += e >= 0 ? -history_[static_cast<std::size_t>(e)] : history_[static_cast<std::size_t>(~e)];
@@ -302,25 +296,22 @@ void LumpedVessels::linearise(bool extrapolated) {
       rhs_[k] = rhs;
     }
   }
+  for_each_source(coupled_inflow, inlet_flow_, [&](std::size_t k, double inflow) { rhs_[k] += inflow; });
 }
 
 void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, double inlet_flow) {
   if (empty()) return;
   dt_ = dt;
   inlet_flow_ = inlet_flow;
-  set_sources(coupled_inflow, inlet_flow);
   for (int pass = 0; pass < passes_; ++pass) {
     // Each further (Picard) pass takes the coefficients again at the last solution.
-    linearise(pass == 0);
+    linearise(pass == 0, coupled_inflow);
     // The forward half of the solve goes with the factorisation; complete() adds the 1D
     // ends' departures from the held inflows to it and takes the backward half.
-    if (system_.factorize_forward(conductance_, system_shunt_, rhs_) >= 0) {
-      clear_sources();
+    if (system_.factorize_forward(conductance_, system_shunt_, rhs_) >= 0)
       throw InputError("the 0D vessels have a part with no path to an outlet");
-    }
     if (pass + 1 < passes_) system_.backward(rhs_, predicted_);
   }
-  clear_sources();
   if (coupling_nodes_.empty()) return;
   std::copy(coupled_inflow.begin(), coupled_inflow.end(), held_inflow_.begin());
   // The predicted pressures where the 1D ends read them, and Z_i = (K^-1)_ii there: both
@@ -342,7 +333,6 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     system_.add_forward(coupling_nodes_, coupling_scratch_, rhs_);
   }
   system_.backward(rhs_, predicted_);
-  set_sources(coupled_volume, dt * inlet_flow_);
   const auto edges = static_cast<std::int64_t>(a_.size());
   const auto blocks = static_cast<std::int64_t>(block_outflow_.size());
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
@@ -355,30 +345,35 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     }
     // Each node's net inflow at t1 (BDF2 takes the right-hand side there), as the solve had
     // it, and from it the volume: exactly what came in, (3 V - 4 V^n + V^(n-1)) / 2 =
-    // dt inflow + the sources' volume; the pressure from the tube laws. The outlets'
-    // outflow is summed per block of nodes, in one order whatever the threads.
+    // dt inflow (+ the 1D ends' and the inlet's volumes, below); the pressure from the tube
+    // laws. The new values go where the oldest were (the histories swap after), so a
+    // node's row is read and written once. The outlets' outflow is summed per block of
+    // nodes, in one order whatever the threads.
 #pragma omp for schedule(static)
     for (std::int64_t b = 0; b < blocks; ++b) {
       const std::size_t first = static_cast<std::size_t>(b) * block, last = std::min(first + block, nodes_);
       double outflow = 0;
       for (std::size_t k = first; k < last; ++k) {
-        const double shunted = shunt_[k] * (predicted_[k] - shunt_pressure_[k]);
+        const double shunted = shunt_[k] * predicted_[k] - shunt_current_[k];
         if (k < network_nodes_) outflow += shunted;  // a capacitor's R2 is not the network's
         double inflow = -shunted;
         for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
           const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
           inflow += e >= 0 ? -next_flow_[static_cast<std::size_t>(e)] : next_flow_[static_cast<std::size_t>(~e)];
         }
-        const double next = (4 * volume_[k] - previous_volume_[k] + 2 * dt * inflow + 2 * node_source_[k]) / 3;
-        previous_volume_[k] = volume_[k];
-        volume_[k] = next;
-        previous_pressure_[k] = pressure_[k];
-        pressure_[k] = pressure_from_volume(k, next);
+        const double next = (4 * volume_[k] - previous_volume_[k] + 2 * dt * inflow) / 3;
+        previous_volume_[k] = next;
+        previous_pressure_[k] = pressure_from_excess(k, next);
       }
       block_outflow_[static_cast<std::size_t>(b)] = outflow;
     }
   }
-  clear_sources();
+  volume_.swap(previous_volume_);
+  pressure_.swap(previous_pressure_);
+  for_each_source(coupled_volume, dt * inlet_flow_, [&](std::size_t k, double volume) {
+    volume_[k] += 2 * volume / 3;
+    pressure_[k] = pressure_from_excess(k, volume_[k]);
+  });
   previous_flow_.swap(flow_);
   flow_.swap(next_flow_);
   previous_resistance_.swap(resistance_);
@@ -425,7 +420,7 @@ void LumpedVessels::sample(double x, std::span<double> area, std::span<double> f
 
 double LumpedVessels::stored_volume() const {
   double v = 0;
-  for (std::size_t k = 0; k < network_nodes_; ++k) v += 0.5 * (3 * volume_[k] - previous_volume_[k]);
+  for (std::size_t k = 0; k < network_nodes_; ++k) v += volume_c_[k] + 0.5 * (3 * volume_[k] - previous_volume_[k]);
   return v;
 }
 
@@ -440,7 +435,7 @@ void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std
     pressure_[k] += k < network_nodes_
                         ? network_node_dp[static_cast<std::size_t>(network_node_[k])]
                         : outlet_dp[static_cast<std::size_t>(outlet_of_capacitor_[k - network_nodes_])];
-    volume_[k] = node_volume(k, pressure_[k]);
+    volume_[k] = node_excess(k, pressure_[k]);
   }
   predicted_ = pressure_;
   update_resistances();

@@ -150,24 +150,27 @@ class LumpedVessels {
  private:
   // A node's volume is a quadratic in its pressure (each vessel's L A(p) / 2 is, with the
   // tube law's A = (c + p / beta)^2, and a capacitor's C p is linear): V = a p^2 + b p + c.
-  double node_volume(std::size_t k, double p) const {
-    return (volume_a_[k] * p + volume_b_[k]) * p + volume_c_[k];
-  }
+  // The state is the excess W = V - c = a p^2 + b p: c drops out of every step (BDF2 is
+  // linear in V), and the steps read two coefficients a node, not three.
+  double node_excess(std::size_t k, double p) const { return (volume_a_[k] * p + volume_b_[k]) * p; }
   double node_compliance(std::size_t k, double p) const { return 2 * volume_a_[k] * p + volume_b_[k]; }
-  double pressure_from_volume(std::size_t node, double volume) const;
+  double pressure_from_excess(std::size_t node, double excess) const;
   // The resistance of 0D vessel e between end pressures pa and pb: L over Simpson's mean of
   // its flow capacity G(p) = A^2 / (k mu(A)) (the steady flow is (1/L) times the integral of G
   // from pb to pa), and G at the two ends (the interior profile reads them). Over one common
-  // denominator: two divisions, not four (they were most of a step's evaluation).
+  // denominator: one division, not four (they were most of a step's evaluation).
   double resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const;
   // The linearisation of a step: edge conductances and history terms, node shunts and
-  // right-hand sides (with node_source_), at the state extrapolated to the step's end
-  // (extrapolated) or at the pressures predicted_ (a Picard pass).
-  void linearise(bool extrapolated);
-  // Sets node_source_ at the coupling nodes and the inlet node (per coupling node and the
-  // inlet's), or back to zero.
-  void set_sources(std::span<const double> coupled, double inlet);
-  void clear_sources();
+  // right-hand sides (with the coupled inflows and the inlet's), at the state extrapolated to
+  // the step's end (extrapolated) or at the pressures predicted_ (a Picard pass).
+  void linearise(bool extrapolated, std::span<const double> coupled_inflow);
+  // Calls f(node, value) for the coupling nodes' values (per coupling node) and the inlet's.
+  template <class F>
+  void for_each_source(std::span<const double> coupled, double inlet, F&& f) const {
+    for (std::size_t j = 0; j < coupling_nodes_.size() && !coupled.empty(); ++j)
+      f(static_cast<std::size_t>(coupling_nodes_[j]), coupled[j]);
+    if (inlet_node_ >= 0) f(static_cast<std::size_t>(inlet_node_), inlet);
+  }
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R
@@ -189,14 +192,14 @@ class LumpedVessels {
   std::vector<std::int32_t> capacitor_vessel_edge_;  // per R1 edge: the 0D vessel ending at it
 
   // Node volume V(p) = a p^2 + b p + c (half of each 0D vessel, capacitors).
-  std::vector<double> volume_a_, volume_b_, volume_c_;
+  std::vector<double> volume_a_, volume_b_, volume_c_;  // c: only to report V
   // Shunts to ground: conductance and the pressure behind it (outlets, R2).
-  std::vector<double> shunt_, shunt_pressure_;
+  std::vector<double> shunt_, shunt_pressure_, shunt_current_;  // current: shunt x pressure
   std::vector<std::int32_t> outlet_of_capacitor_;  // per capacitor node
   std::vector<std::int32_t> capacitor_of_outlet_;  // per network outlet, -1 if none here
 
   NodalSystem system_;
-  // State: node volumes and pressures, edge flows, and the last step's (BDF2 history and
+  // State: node volumes (W, above c) and pressures, edge flows, and the last step's (BDF2 history and
   // the extrapolation).
   std::vector<double> volume_, previous_volume_, pressure_, previous_pressure_, flow_, previous_flow_;
   // The step being taken: predicted pressures, and the edges' conductances and history
@@ -216,9 +219,6 @@ class LumpedVessels {
   // Each node's edges, in increasing order (e where the edge leaves it, ~e where it enters):
   // the sums into a node are gathers, in parallel and in one order whatever the threads.
   std::vector<std::int32_t> incident_offset_, incident_edge_;
-  // Per node, zero but at the coupling nodes and the inlet's node during a step: the
-  // inflow [m^3/s] the linearisation adds, then the volume [m^3] the completion adds.
-  std::vector<double> node_source_;
   static constexpr std::size_t block = 4096;
   std::vector<double> block_outflow_;  // per block of nodes: the outlets' outflow (a fixed-order sum)
   double dt_ = 0, inlet_flow_ = 0;
