@@ -168,7 +168,9 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
       previous_ = std::move(last_);
       last_ = stats_.close(solver_);
       if (series) series->finish();
-      if (plan_.balance_compliances && solver_.balance_compliances(period) > 0) ++balances_;
+      std::vector<double> mean_pressure(last_.vessels.size());
+      for (std::size_t v = 0; v < mean_pressure.size(); ++v) mean_pressure[v] = last_.vessels[v].mean_pressure;
+      if (plan_.balance_compliances && solver_.balance_compliances(period, &mean_pressure) > 0) ++balances_;
       if (has_change()) change_ = cycle_change(previous_.vessels, last_.vessels);
       ++done_;
       snapshot();

@@ -147,7 +147,9 @@ class PulseSolver {
   // limit follow from two O(vessels) solves of that tree (docs/solver.md §6).
   // Every vessel's area and every capacitor moves by them. At the periodic state the rates
   // vanish and nothing moves. Returns the vessels moved (0 without a steady solution).
-  std::size_t balance_compliances(double period);
+  // mean_pressure (per vessel, the last cycle's), where given, is the state the network's
+  // conductances are taken at; else the steady solution's.
+  std::size_t balance_compliances(double period, const std::vector<double>* mean_pressure = nullptr);
 
  private:
   void evaluate(double t, const PulseState& s, PulseState& rate);

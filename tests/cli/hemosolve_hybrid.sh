@@ -4,7 +4,8 @@
 # bench/compare-summaries), with a --lumped-transit that leaves arteries 1D and the rest 0D;
 # mass to round-off in both; summary.json names each vessel's model, and the run says how many;
 # one solve a step agrees with two; vessels.csv holds summary.json's rows; the statistics per class, model, generation and
-# diameter bin count every vessel once; a resumed hybrid run is bit-identical; and
+# diameter bin count every vessel once; a resumed hybrid run is bit-identical, and so is one
+# on two threads; and
 # --vtk-min-diameter writes the subset it says.
 source "$(dirname "$0")/lib.sh"
 VPRUNE=$BUILD/pruner/vprune
@@ -69,6 +70,17 @@ PY
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:])
 assert a["vessels_0d"] > 0 and a["vessels"] == b["vessels"], "results differ"
+PY
+
+# Two threads give the bits of one: the 0D loops are gathers in a fixed order, the outlets'
+# outflow a sum over fixed blocks, and the tree's sweeps keep one thread's order.
+"$HEMOSOLVE" "$WORK/net.json" --out "$WORK/two_threads" --cycles 2 --threads 2 --quiet \
+  && "$PY" - "$WORK/straight/summary.json" "$WORK/two_threads/summary.json" <<'PY' \
+  && pass "a hybrid run on two threads gives the one-thread results, bit for bit" || fail "hybrid threads differ"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:])
+assert a["vessels_0d"] > 0 and a["vessels"] == b["vessels"], "results differ"
+assert a["conservation_error"] == b["conservation_error"], (a["conservation_error"], b["conservation_error"])
 PY
 
 # --vtk-min-diameter: the VTK output holds the vessels of at least that diameter and the
