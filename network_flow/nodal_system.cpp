@@ -330,14 +330,8 @@ void NodalSystem::forward(std::span<double> y) const {
 
 void NodalSystem::add_forward(std::span<const std::int32_t> nodes, std::span<const double> values,
                               std::span<double> y) const {
+  check_node_list(nodes, values.size(), "add_forward", "values");
   check_solvable(y.size(), "add_forward");
-  if (values.size() != nodes.size())
-    throw std::invalid_argument("NodalSystem::add_forward: " + std::to_string(nodes.size()) + " nodes but " +
-                                std::to_string(values.size()) + " values");
-  for (const std::int32_t i : nodes)
-    if (i < 0 || static_cast<std::size_t>(i) >= nodes_)
-      throw std::invalid_argument("NodalSystem::add_forward: node " + std::to_string(i) + " is not below " +
-                                  std::to_string(nodes_));
   if (method_ == Method::tree_elimination) {
     // The forward half is linear: a current v added at node j reaches y_j, then its parent
     // through the divider, and so on up to the root (the sweep's own products).
@@ -378,19 +372,12 @@ void NodalSystem::backward(std::span<const double> y, std::span<double> x) const
 
 void NodalSystem::backward_at(std::span<const std::int32_t> nodes, std::span<const double> y,
                               std::span<double> out) const {
+  check_node_list(nodes, out.size(), "backward_at", "outputs");
   check_solvable(y.size(), "backward_at");
-  if (out.size() != nodes.size())
-    throw std::invalid_argument("NodalSystem::backward_at: " + std::to_string(nodes.size()) + " nodes but " +
-                                std::to_string(out.size()) + " outputs");
-  for (const std::int32_t i : nodes)
-    if (i < 0 || static_cast<std::size_t>(i) >= nodes_)
-      throw std::invalid_argument("NodalSystem::backward_at: node " + std::to_string(i) + " is not below " +
-                                  std::to_string(nodes_));
   if (method_ == Method::tree_elimination) {
     // Each node's value needs its parent's: down its path from the root, by the sweep's own
     // expression (the same bits as backward()).
     std::vector<std::int32_t> path;
-    std::vector<double> value;
     const std::size_t budget = nodes_ / 32 + 64;
     std::size_t walked = 0;
     for (std::size_t k = 0; k < nodes.size() && walked <= budget; ++k) {
@@ -409,6 +396,17 @@ void NodalSystem::backward_at(std::span<const std::int32_t> nodes, std::span<con
   std::vector<double> x(y.begin(), y.end());
   backward(x, x);
   for (std::size_t k = 0; k < nodes.size(); ++k) out[k] = x[static_cast<std::size_t>(nodes[k])];
+}
+
+void NodalSystem::check_node_list(std::span<const std::int32_t> nodes, std::size_t values, const char* what,
+                                  const char* values_name) const {
+  const std::string name = "NodalSystem::" + std::string(what) + ": ";
+  if (values != nodes.size())
+    throw std::invalid_argument(name + std::to_string(nodes.size()) + " nodes but " + std::to_string(values) + " " +
+                                values_name);
+  for (const std::int32_t i : nodes)
+    if (i < 0 || static_cast<std::size_t>(i) >= nodes_)
+      throw std::invalid_argument(name + "node " + std::to_string(i) + " is not below " + std::to_string(nodes_));
 }
 
 void NodalSystem::check_solvable(std::size_t size, const char* what) const {
@@ -541,13 +539,7 @@ void NodalSystem::sweep_down(double* x) const {
 }
 
 void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::span<double> out) const {
-  if (out.size() != nodes.size())
-    throw std::invalid_argument("NodalSystem::inverse_diagonal: " + std::to_string(nodes.size()) + " nodes but " +
-                                std::to_string(out.size()) + " outputs");
-  for (const std::int32_t i : nodes)
-    if (i < 0 || static_cast<std::size_t>(i) >= nodes_)
-      throw std::invalid_argument("NodalSystem::inverse_diagonal: node " + std::to_string(i) + " is not below " +
-                                  std::to_string(nodes_));
+  check_node_list(nodes, out.size(), "inverse_diagonal", "outputs");
   if (!factorized_) throw std::logic_error("NodalSystem::inverse_diagonal: no successful factorisation to use");
   if (nodes.empty()) return;
 

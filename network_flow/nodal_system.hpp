@@ -108,7 +108,10 @@ class NodalSystem {
   int threads_ = 1;
   bool parallel_sweeps() const;
   std::int64_t factorize(std::span<const double> conductance, std::span<const double> shunt, double* y);
-  void check_solvable(std::size_t size, const char* what) const;
+  void check_solvable(std::size_t size, const char* what) const;  // a vector of every node, and a factorisation
+  // std::invalid_argument unless `values` matches the node list and every node is below node_count().
+  void check_node_list(std::span<const std::int32_t> nodes, std::size_t values, const char* what,
+                       const char* values_name) const;
   void plan_subtrees();
   // The tree's sweeps: leaves up, eliminating (where `elimination` is given: the pivots from
   // its conductances and shunts, into its arrays) and the forward half of y (where given);

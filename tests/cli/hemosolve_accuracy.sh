@@ -66,7 +66,7 @@ cat "$WORK/cap-cmp"
 # The compliance balance (on by default) against plain cycling (--no-balance-compliances), on
 # a 101-vessel tree with 13 RCR outlets at the real pulse: the same periodic state (within
 # 1e-3: plain cycling at a change of 1e-4 per cycle is still a few 1e-4 from its limit), in
-# at most half the cycles (measured: 5 against 20 to 1e-4), and a mass balance (mean inflow
+# at most half the cycles (measured: 4 against 17 to 1e-4), and a mass balance (mean inflow
 # against outflow) that closes, as a periodic state's must.
 "$VGEN" --root-diameter 400um | "$VPRUNE" --budget 101 --mean-flow 0.15ml/min -o "$WORK/rcr.json" 2>/dev/null
 "$HEMOSOLVE" "$WORK/rcr.json" --out "$WORK/balanced" --until-periodic 1e-4 --quiet \
