@@ -17,7 +17,10 @@
 // the weighted Laplacian plus C/dt of network_flow/nodal_system: on a tree, O(nodes) per
 // step. The nonlinear R(A), L(A) and C(p) are taken at the state extrapolated to the step's
 // end (2 x^n - x^(n-1): linearly implicit BDF2, second order with one solve a step); each
-// further Picard pass (`passes`) takes them again at the last solution.
+// further Picard pass (`passes`) takes them again at the last solution. The solve is split
+// in its forward and backward halves around the 1D substeps (network_flow), and every node
+// sums its edges by a gather, in one order whatever the threads: the loops are bound by
+// memory bandwidth, so each is written to read a node's or a vessel's row once.
 //
 // Outlets on 0D vessels are part of the system (R: a shunt to p_out; RCR: R1 to a
 // capacitor node, R2 from there to p_out). A 1D vessel end at a node of 0D vessels is a
