@@ -172,7 +172,7 @@ void LumpedVessels::update_dynamic_pressures() {
     double weighted = 0, weight = 0;
     for (auto i = coupling_edge_offset_[j]; i < coupling_edge_offset_[j + 1]; ++i) {
       const auto e = static_cast<std::size_t>(coupling_edge_[static_cast<std::size_t>(i)]);
-      const double s = edge_root_intercept_[e] + edge_root_slope_[e] * pressure_[k];
+      const double s = lumen_root(e, pressure_[k]);
       const double q = std::abs(flow_[e]), u = q / (s * s);
       weighted += q * u;
       weight += q;
@@ -411,7 +411,7 @@ void LumpedVessels::sample(double x, std::span<double> area, std::span<double> f
     const auto e = static_cast<std::size_t>(i);
     const auto v = static_cast<std::size_t>(vessels_[e]);
     const double p = pressure_at(static_cast<std::int32_t>(i), x);
-    const double s = edge_root_intercept_[e] + edge_root_slope_[e] * p;
+    const double s = lumen_root(e, p);
     area[v] = s * s;
     flow[v] = flow_[e];
     if (!pressure.empty()) pressure[v] = p;
@@ -445,8 +445,8 @@ void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std
 
 void LumpedVessels::check(double time) const {
   for (std::size_t e = 0; e < vessels_.size(); ++e) {
-    const double s_a = edge_root_intercept_[e] + edge_root_slope_[e] * pressure_[static_cast<std::size_t>(a_[e])];
-    const double s_b = edge_root_intercept_[e] + edge_root_slope_[e] * pressure_[static_cast<std::size_t>(b_[e])];
+    const double s_a = lumen_root(e, pressure_[static_cast<std::size_t>(a_[e])]);
+    const double s_b = lumen_root(e, pressure_[static_cast<std::size_t>(b_[e])]);
     if (!(s_a > 0) || !(s_b > 0) || !std::isfinite(flow_[e]) || !std::isfinite(s_a * s_b))
       throw SolutionBreakdown(vessel_ids_[e], time);
   }

@@ -119,13 +119,13 @@ class LumpedVessels {
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
     for (std::int64_t i = 0; i < vessels; ++i) {
       const auto e = static_cast<std::size_t>(i);
-      const double c = edge_root_intercept_[e], d = edge_root_slope_[e];
       Sample s;
       s.flow = flow_[e];
       s.pressure_in = pressure_at(static_cast<std::int32_t>(i), 0.0);
       s.pressure_centre = pressure_at(static_cast<std::int32_t>(i), 0.5);
       s.pressure_out = pressure_at(static_cast<std::int32_t>(i), 1.0);
-      const double root_in = c + d * s.pressure_in, root_centre = c + d * s.pressure_centre, root_out = c + d * s.pressure_out;
+      const double root_in = lumen_root(e, s.pressure_in), root_centre = lumen_root(e, s.pressure_centre),
+                   root_out = lumen_root(e, s.pressure_out);
       s.area_in = root_in * root_in;
       s.area_centre = root_centre * root_centre;
       s.area_out = root_out * root_out;
@@ -156,6 +156,8 @@ class LumpedVessels {
   // The state is the excess W = V - c = a p^2 + b p: c drops out of every step (BDF2 is
   // linear in V), and the steps read two coefficients a node, not three.
   double node_excess(std::size_t k, double p) const { return (volume_a_[k] * p + volume_b_[k]) * p; }
+  // sqrt(A) of 0D vessel e at pressure p: the tube law's root, linear in p.
+  double lumen_root(std::size_t e, double p) const { return edge_root_intercept_[e] + edge_root_slope_[e] * p; }
   double node_compliance(std::size_t k, double p) const { return 2 * volume_a_[k] * p + volume_b_[k]; }
   double pressure_from_excess(std::size_t node, double excess) const;
   // The resistance of 0D vessel e between end pressures pa and pb: L over Simpson's mean of
