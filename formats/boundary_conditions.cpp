@@ -21,6 +21,19 @@ std::string_view to_string(OutletType type) {
   return "";
 }
 
+std::string_view to_string(BoundaryType type) {
+  switch (type) {
+    case BoundaryType::flow: return "flow";
+    case BoundaryType::pressure: return "pressure";
+    case BoundaryType::rcr: return "RCR";
+    case BoundaryType::resistance: return "R";
+    case BoundaryType::reflection: return "reflection";
+  }
+  return "";
+}
+
+double Blood::pries_diameter_scale() const { return std::cbrt(human_mean_cell_volume / mean_cell_volume); }
+
 std::string_view to_string(Rheology rheology) {
   return rheology == Rheology::pries ? "pries" : "newtonian";
 }
@@ -28,11 +41,13 @@ std::string_view to_string(Rheology rheology) {
 // ---- the inflow waveform --------------------------------------------------------------
 
 double Waveform::peak() const {
+  if (shape == Shape::constant) return mean;
   if (shape == Shape::half_sine) return mean * std::numbers::pi * period / (2 * systole);
-  return *std::max_element(flow.begin(), flow.end());
+  return *std::max_element(value.begin(), value.end());
 }
 
 double Waveform::operator()(double t) const {
+  if (shape == Shape::constant) return mean;
   double phase = std::fmod(t, period);
   if (phase < 0) phase += period;
   if (shape == Shape::half_sine)
@@ -41,21 +56,21 @@ double Waveform::operator()(double t) const {
   const auto k = static_cast<std::size_t>(std::upper_bound(time.begin(), time.end(), phase) - time.begin());
   const std::size_t n = time.size();
   const double t0 = k == 0 ? time[n - 1] - period : time[k - 1];
-  const double q0 = k == 0 ? flow[n - 1] : flow[k - 1];
+  const double q0 = k == 0 ? value[n - 1] : value[k - 1];
   const double t1 = k == n ? time[0] + period : time[k];
-  const double q1 = k == n ? flow[0] : flow[k];
+  const double q1 = k == n ? value[0] : value[k];
   return q0 + (q1 - q0) * (phase - t0) / (t1 - t0);
 }
 
-double Waveform::mean_flow() const {
-  if (shape == Shape::half_sine) return mean;
+double Waveform::mean_value() const {
+  if (shape != Shape::table) return mean;
   // Trapezoids over one period, with the wrap-around segment.
   const std::size_t n = time.size();
   double integral = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double t1 = k + 1 < n ? time[k + 1] : time[0] + period;
-    const double q1 = k + 1 < n ? flow[k + 1] : flow[0];
-    integral += 0.5 * (flow[k] + q1) * (t1 - time[k]);
+    const double q1 = k + 1 < n ? value[k + 1] : value[0];
+    integral += 0.5 * (value[k] + q1) * (t1 - time[k]);
   }
   return integral / period;
 }
@@ -96,21 +111,50 @@ std::string text(const nlohmann::json& j, const char* key, const std::string& fa
   return v.get<std::string>();
 }
 
-std::vector<double> samples(const nlohmann::json& w, const char* key, const std::string& where) {
+std::vector<double> samples(const nlohmann::json& w, const char* key, const std::string& where,
+                            const char* values) {
   const std::string message =
-      where + ": a table needs number lists \"time\" and \"flow\"";
+      where + ": a table needs number lists \"time\" and \"" + values + "\"";
   if (!w.contains(key) || !w.at(key).is_array()) throw InputError(message);
-  std::vector<double> values;
-  values.reserve(w.at(key).size());
+  std::vector<double> list;
+  list.reserve(w.at(key).size());
   for (const auto& v : w.at(key)) {
     if (!v.is_number()) throw InputError(message);
-    values.push_back(v.get<double>());
+    list.push_back(v.get<double>());
   }
-  return values;
+  return list;
 }
 
 std::string element(const char* key, std::size_t k) {
   return std::string(key) + "[" + std::to_string(k) + "]";
+}
+
+// A waveform's shape and samples; `values` names a table's samples ("flow" or "pressure").
+// Ranges are the caller's: an inlet's flow and a node's pressure accept different values.
+Waveform waveform_from_json(const nlohmann::json& w, const std::string& where, const char* values) {
+  if (!w.is_object()) throw InputError(where + ": must be an object");
+  Waveform wave;
+  wave.period = number(w, "period", where);
+  const bool flows = std::string_view(values) == "flow";
+  const std::string shape = text(w, "shape", "", where, flows ? "\"half_sine\" or \"table\"" : "\"table\"");
+  if (shape == "half_sine" && flows) {
+    wave.shape = Waveform::Shape::half_sine;
+    wave.systole = number(w, "systole", where);
+    wave.mean = number(w, "mean", where);
+  } else if (shape == "table") {
+    wave.shape = Waveform::Shape::table;
+    wave.time = samples(w, "time", where, values);
+    wave.value = samples(w, values, where, values);
+  } else {
+    throw InputError(where + ": \"shape\" must be " + (flows ? "\"half_sine\" or \"table\"" : "\"table\""));
+  }
+  return wave;
+}
+
+nlohmann::json to_json(const Waveform& w, const char* values) {
+  if (w.shape == Waveform::Shape::half_sine)
+    return {{"shape", "half_sine"}, {"period", w.period}, {"systole", w.systole}, {"mean", w.mean}};
+  return {{"shape", "table"}, {"period", w.period}, {"time", w.time}, {values, w.value}};
 }
 
 }  // namespace
@@ -122,7 +166,8 @@ nlohmann::json to_json(const Blood& b) {
           {"alpha", b.alpha},
           {"rheology", to_string(b.rheology)},
           {"newtonian_viscosity", b.newtonian_viscosity},
-          {"pries_max_diameter", b.pries_max_diameter}};
+          {"pries_max_diameter", b.pries_max_diameter},
+          {"mean_cell_volume", b.mean_cell_volume}};
 }
 
 Blood blood_from_json(const nlohmann::json& j) {
@@ -143,20 +188,25 @@ Blood blood_from_json(const nlohmann::json& j) {
       in_range_or(j, "newtonian_viscosity", ranges::viscosity, b.newtonian_viscosity, where);
   b.pries_max_diameter = in_range_or(j, "pries_max_diameter", ranges::pries_max_diameter,
                                      b.pries_max_diameter, where);
+  b.mean_cell_volume =
+      in_range_or(j, "mean_cell_volume", ranges::mean_cell_volume, b.mean_cell_volume, where);
   return b;
 }
 
 nlohmann::json to_json(const Inlet& inlet) {
-  const Waveform& w = inlet.waveform;
-  nlohmann::json wave;
-  if (w.shape == Waveform::Shape::half_sine)
-    wave = {{"shape", "half_sine"}, {"period", w.period}, {"systole", w.systole}, {"mean", w.mean}};
-  else
-    wave = {{"shape", "table"}, {"period", w.period}, {"time", w.time}, {"flow", w.flow}};
-  return {{"vessel", inlet.vessel}, {"type", "flow"}, {"waveform", wave}};
+  return {{"vessel", inlet.vessel}, {"type", "flow"}, {"waveform", to_json(inlet.waveform, "flow")}};
 }
 
-void check_waveform(const Waveform& wave, const std::string& where) {
+namespace {
+
+// A waveform's period, shape and samples in their ranges: `values` names the samples
+// ("flow", "pressure"), `sample` their range and `mean` that of their mean over a period.
+void check_waveform(const Waveform& wave, const std::string& where, const char* values,
+                    const FieldRange& sample, const FieldRange& mean) {
+  if (wave.shape == Waveform::Shape::constant) {
+    if (!sample.contains(wave.mean)) throw InputError(where + ": " + out_of_range(values, sample, wave.mean));
+    return;
+  }
   if (!ranges::period.contains(wave.period))
     throw InputError(where + ": " + out_of_range("period", ranges::period, wave.period));
   if (wave.shape == Waveform::Shape::half_sine) {
@@ -165,26 +215,30 @@ void check_waveform(const Waveform& wave, const std::string& where) {
     if (wave.systole > wave.period)
       throw InputError(where + ": \"systole\" (" + format_number(wave.systole) +
                        " s) exceeds the period (" + format_number(wave.period) + " s)");
-    if (!ranges::mean_flow.contains(wave.mean))
-      throw InputError(where + ": " + out_of_range("mean", ranges::mean_flow, wave.mean));
+    if (!mean.contains(wave.mean)) throw InputError(where + ": " + out_of_range("mean", mean, wave.mean));
     return;
   }
-  if (wave.time.size() < 2 || wave.time.size() != wave.flow.size())
-    throw InputError(where + ": \"time\" and \"flow\" need the same length, at least 2");
-  for (std::size_t k = 0; k < wave.flow.size(); ++k)
-    if (!ranges::flow_sample.contains(wave.flow[k]))
-      throw InputError(where + ": " +
-                       out_of_range(element("flow", k), ranges::flow_sample, wave.flow[k]));
+  if (wave.time.size() < 2 || wave.time.size() != wave.value.size())
+    throw InputError(where + ": \"time\" and \"" + values + "\" need the same length, at least 2");
+  for (std::size_t k = 0; k < wave.value.size(); ++k)
+    if (!sample.contains(wave.value[k]))
+      throw InputError(where + ": " + out_of_range(element(values, k), sample, wave.value[k]));
   for (std::size_t k = 1; k < wave.time.size(); ++k)
     if (!(wave.time[k] > wave.time[k - 1]))
       throw InputError(where + ": times must increase (" + element("time", k) + " = " +
                        format_number(wave.time[k]) + " s)");
   if (wave.time.front() < 0 || !(wave.time.back() < wave.period + wave.time.front()))
     throw InputError(where + ": times must lie within one period, from \"time\"[0] >= 0");
-  const double mean = wave.mean_flow();
-  if (!ranges::mean_flow.contains(mean))
-    throw InputError(where + ": the table's mean flow must lie in " +
-                     describe(ranges::mean_flow) + " (got " + format_number(mean) + ")");
+  const double m = wave.mean_value();
+  if (!mean.contains(m))
+    throw InputError(where + ": the table's mean " + values + " must lie in " + describe(mean) +
+                     " (got " + format_number(m) + ")");
+}
+
+}  // namespace
+
+void check_waveform(const Waveform& wave, const std::string& where) {
+  check_waveform(wave, where, "flow", ranges::flow_sample, ranges::mean_flow);
 }
 
 Inlet inlet_from_json(const nlohmann::json& j) {
@@ -204,24 +258,8 @@ Inlet inlet_from_json(const nlohmann::json& j) {
     throw InputError("inlet: missing \"waveform\"");
   Inlet inlet;
   inlet.vessel = j.at("vessel").get<std::int64_t>();
-  const auto& w = j.at("waveform");
-  const std::string wave_where = "inlet.waveform";
-  Waveform& wave = inlet.waveform;
-  wave.period = number(w, "period", wave_where);
-  const std::string shape =
-      text(w, "shape", "", wave_where, "\"half_sine\" or \"table\"");
-  if (shape == "half_sine") {
-    wave.shape = Waveform::Shape::half_sine;
-    wave.systole = number(w, "systole", wave_where);
-    wave.mean = number(w, "mean", wave_where);
-  } else if (shape == "table") {
-    wave.shape = Waveform::Shape::table;
-    wave.time = samples(w, "time", wave_where);
-    wave.flow = samples(w, "flow", wave_where);
-  } else {
-    throw InputError(wave_where + ": \"shape\" must be \"half_sine\" or \"table\"");
-  }
-  check_waveform(wave, wave_where);
+  inlet.waveform = waveform_from_json(j.at("waveform"), "inlet.waveform", "flow");
+  check_waveform(inlet.waveform, "inlet.waveform");
   return inlet;
 }
 
@@ -262,6 +300,61 @@ Outlet outlet_from_json(const nlohmann::json& j, const std::string& where) {
     throw InputError(where + ": unknown outlet type \"" + type + "\" (RCR, R or reflection)");
   }
   return o;
+}
+
+// ---- boundaries at nodes (format version 2) ------------------------------------------
+
+nlohmann::json to_json(const NodeBoundary& b, std::int64_t node_id) {
+  nlohmann::json j;
+  switch (b.type) {
+    case BoundaryType::flow:
+    case BoundaryType::pressure: {
+      const char* values = b.type == BoundaryType::flow ? "flow" : "pressure";
+      j = {{"type", values}};
+      if (b.waveform.shape == Waveform::Shape::constant) j[values] = b.waveform.mean;
+      else j["waveform"] = to_json(b.waveform, values);
+      break;
+    }
+    case BoundaryType::rcr:
+    case BoundaryType::resistance:
+    case BoundaryType::reflection: j = to_json(b.outlet); break;
+  }
+  j["node"] = node_id;
+  if (!std::isnan(b.hematocrit)) j["hematocrit"] = b.hematocrit;
+  return j;
+}
+
+NodeBoundary boundary_from_json(const nlohmann::json& j, const std::string& where, std::int64_t& node_id) {
+  if (!j.is_object()) throw InputError(where + ": a boundary must be an object");
+  if (!j.contains("node") || !j.at("node").is_number_integer() ||
+      (j.at("node").is_number_unsigned() &&
+       j.at("node").get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())))
+    throw InputError(where + ": \"node\" must be a node id");
+  node_id = j.at("node").get<std::int64_t>();
+  const std::string at = where + " (node " + std::to_string(node_id) + ")";
+  NodeBoundary b;
+  const std::string type = text(j, "type", "", at, "flow, pressure, RCR, R or reflection");
+  if (type == "flow" || type == "pressure") {
+    b.type = type == "flow" ? BoundaryType::flow : BoundaryType::pressure;
+    const char* values = type == "flow" ? "flow" : "pressure";
+    const FieldRange& range = type == "flow" ? ranges::flow_sample : ranges::pressure;
+    if (j.contains(values) == j.contains("waveform"))
+      throw InputError(at + ": a " + type + " boundary needs \"" + values + "\" (constant) or \"waveform\", one of them");
+    if (j.contains(values)) b.waveform = Waveform::constant_value(number(j, values, at));
+    else b.waveform = waveform_from_json(j.at("waveform"), at + ".waveform", values);
+    check_waveform(b.waveform, at, values, range, range);
+  } else if (type == "RCR" || type == "R" || type == "reflection") {
+    b.type = type == "RCR" ? BoundaryType::rcr : type == "R" ? BoundaryType::resistance : BoundaryType::reflection;
+    b.outlet = outlet_from_json(j, at);
+  } else {
+    throw InputError(at + ": \"type\" must be flow, pressure, RCR, R or reflection (got \"" + type + "\")");
+  }
+  if (j.contains("hematocrit")) {
+    if (b.type != BoundaryType::flow && b.type != BoundaryType::pressure)
+      throw InputError(at + ": \"hematocrit\" belongs to flow and pressure boundaries, where blood may enter");
+    b.hematocrit = in_range(j, "hematocrit", ranges::hematocrit, at);
+  }
+  return b;
 }
 
 }  // namespace hemotree

@@ -1,8 +1,10 @@
 // What a network carries for flow computations: blood properties, the inflow at its inlet
-// and the 0D models that stand for the vasculature beyond its outlets. SI units.
+// and the 0D models that stand for the vasculature beyond its outlets (the tree's form,
+// format version 1), and boundary conditions at any node (version 2). SI units.
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string_view>
 #include <string>
@@ -22,21 +24,36 @@ struct Blood {
   Rheology rheology = Rheology::pries;
   double newtonian_viscosity = 3.4e-3;   // [Pa s], the paper's constant-viscosity runs
   double pries_max_diameter = 300e-6;    // [m]; above it the viscosity stays at its value there
+  // Mean red-cell volume [m^3]: the Pries laws were fitted to human blood (92 fl); for
+  // another species the diameters entering them scale by (92 fl / MCV)^(1/3), as in Secomb's
+  // NetFlow (rat: 55 fl).
+  double mean_cell_volume = human_mean_cell_volume;
+  static constexpr double human_mean_cell_volume = 92e-18;
+
+  // The factor on a diameter before it enters the Pries laws.
+  double pries_diameter_scale() const;
 };
 
-// Periodic inflow Q(t) [m^3/s].
+// A periodic boundary value f(t): a volume flow [m^3/s] or a pressure [Pa].
 struct Waveform {
-  enum class Shape { half_sine, table } shape = Shape::half_sine;
+  enum class Shape { half_sine, table, constant } shape = Shape::half_sine;
   double period = 1.0;     // [s]
-  // half_sine: Q = Q_max sin(pi t / systole) during systole, 0 in diastole; Q_max from mean
-  double mean = 0.0;       // [m^3/s]
+  // half_sine (flows): f = f_max sin(pi t / systole) during systole, 0 in diastole, f_max
+  // from the mean; constant: f = mean
+  double mean = 0.0;
   double systole = 0.3;    // [s]
-  // table: (time, flow) samples over one period, linearly interpolated, wrapped periodically
-  std::vector<double> time, flow;
+  // table: (time, value) samples over one period, linearly interpolated, wrapped periodically
+  std::vector<double> time, value;
 
+  static Waveform constant_value(double v) {
+    Waveform w;
+    w.shape = Shape::constant;
+    w.mean = v;
+    return w;
+  }
   double operator()(double t) const;
   double peak() const;
-  double mean_flow() const;  // over one period
+  double mean_value() const;  // over one period
 };
 
 struct Inlet {
@@ -58,7 +75,24 @@ struct Outlet {
   double resistance() const { return type == OutletType::rcr ? r1 + r2 : r; }
 };
 
+// A boundary condition at a node (format version 2): a prescribed flow into the network
+// (negative: out of it), a prescribed pressure, or a 0D outlet model to its outflow
+// pressure. Vessels may meet at the node in any number and orientation.
+enum class BoundaryType { flow, pressure, rcr, resistance, reflection };
+
+struct NodeBoundary {
+  std::int32_t node = -1;  // node index
+  BoundaryType type = BoundaryType::flow;
+  Waveform waveform;       // flow [m^3/s] or pressure [Pa]
+  Outlet outlet;           // rcr, resistance, reflection: its parameters (its vessel unused)
+  // The discharge hematocrit of the blood entering here, NaN: the blood's.
+  double hematocrit = std::numeric_limits<double>::quiet_NaN();
+
+  bool is_outlet() const { return type != BoundaryType::flow && type != BoundaryType::pressure; }
+};
+
 std::string_view to_string(OutletType type);
+std::string_view to_string(BoundaryType type);
 std::string_view to_string(Rheology rheology);
 
 // The JSON forms of docs/network-format.md; the readers throw InputError naming the field.
@@ -71,5 +105,9 @@ Outlet outlet_from_json(const nlohmann::json& j, const std::string& where);
 // Throws InputError (prefixed with where) unless the waveform lies in the accepted ranges
 // (formats/field_ranges.hpp); inlet_from_json calls it, tools that build one may too.
 void check_waveform(const Waveform& wave, const std::string& where);
+// A boundary's JSON form: {"node": ID, "type": ..., ...}; the node is written as the id
+// given and read into NodeBoundary::node as that id (the reader resolves it to an index).
+nlohmann::json to_json(const NodeBoundary& boundary, std::int64_t node_id);
+NodeBoundary boundary_from_json(const nlohmann::json& j, const std::string& where, std::int64_t& node_id);
 
 }  // namespace hemotree

@@ -81,6 +81,11 @@ inline constexpr FieldRange hematocrit{0, 0.9, ""};
 // 1.1 for n = 9; the friction ~ alpha / (alpha - 1) diverges at 1 (a flat profile).
 inline constexpr FieldRange alpha{1.001, 2, ""};
 inline constexpr FieldRange pries_max_diameter{2e-6, 0.5, "m"};  // as the diameters
+// Mammalian red cells: about 20 fl (goat) to 120 fl (elephant), human 92, rat 55-60; birds
+// up to about 160. Diameters enter the Pries laws times (92 fl / MCV)^(1/3): within this
+// range the smallest accepted diameter (2 um) stays above 1.5 um, clear of the laws'
+// singularity at 1.1 um.
+inline constexpr FieldRange mean_cell_volume{15e-18, 200e-18, "m^3"};
 
 // --- the inlet -----------------------------------------------------------------------------
 // Hearts beat from about 1200/min (shrew, 0.05 s) to a few per minute (diving whales);

@@ -1,6 +1,8 @@
 #include "formats/network.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <numbers>
 
 #include "cli/errors.hpp"
@@ -94,7 +96,40 @@ void require_tube_laws(const Network& net, const std::string& source) {
 }
 
 double Network::volume(std::size_t v) const {
-  return std::numbers::pi / 4.0 * diameter[v] * diameter[v] * length[v];
+  if (!is_tapered(v)) return std::numbers::pi / 4.0 * diameter[v] * diameter[v] * length[v];
+  const double d0 = diameter[v], d1 = distal_diameter[v];
+  return std::numbers::pi / 12.0 * (d0 * d0 + d0 * d1 + d1 * d1) * length[v];
+}
+
+std::vector<NodeBoundary> node_boundaries(const Network& net) {
+  std::vector<NodeBoundary> all = net.boundaries;
+  if (net.inlet) {
+    const std::int64_t v = net.index_of(net.inlet->vessel);
+    if (v < 0) throw InputError("inlet: unknown vessel " + std::to_string(net.inlet->vessel));
+    NodeBoundary b;
+    b.node = net.from[static_cast<std::size_t>(v)];
+    b.type = BoundaryType::flow;
+    b.waveform = net.inlet->waveform;
+    all.push_back(b);
+  }
+  for (const Outlet& o : net.outlets) {
+    NodeBoundary b;
+    b.node = net.to[static_cast<std::size_t>(o.vessel)];
+    b.type = o.type == OutletType::rcr          ? BoundaryType::rcr
+             : o.type == OutletType::resistance ? BoundaryType::resistance
+                                                : BoundaryType::reflection;
+    b.outlet = o;
+    b.outlet.vessel = -1;
+    all.push_back(b);
+  }
+  std::stable_sort(all.begin(), all.end(),
+                   [](const NodeBoundary& p, const NodeBoundary& q) { return p.node < q.node; });
+  for (std::size_t k = 1; k < all.size(); ++k)
+    if (all[k].node == all[k - 1].node)
+      throw InputError("node " + std::to_string(net.node_id[static_cast<std::size_t>(all[k].node)]) +
+                       " has two boundary conditions (" + std::string(to_string(all[k - 1].type)) +
+                       " and " + std::string(to_string(all[k].type)) + "): one per node");
+  return all;
 }
 
 }  // namespace hemotree

@@ -37,7 +37,7 @@ struct Network {
   std::vector<std::int64_t> id;
   std::vector<std::int32_t> from, to;
   std::vector<double> length;          // [m]
-  std::vector<double> diameter;        // reference lumen diameter [m]
+  std::vector<double> diameter;        // reference lumen diameter [m] (at `from` if tapered)
   std::vector<double> wall_thickness;  // [m]
   std::vector<double> youngs_modulus;  // [Pa]
   std::vector<std::int32_t> generation;  // root = 0
@@ -46,12 +46,20 @@ struct Network {
   // diameter (benchmark cases): empty when no vessel has one, NaN for a vessel without.
   std::vector<double> beta;                // [Pa/m]
   std::vector<double> reference_pressure;  // [Pa]
+  // Tapered vessels (format version 2): the reference lumen diameter at the `to` end, the
+  // lumen varying linearly from `diameter` at `from`: empty when no vessel tapers, NaN for
+  // a vessel that does not.
+  std::vector<double> distal_diameter;     // [m]
 
-  // For flow computations (vprune adds them): blood, inflow, and the 0D outlets of the
-  // terminal vessels (sparse: one entry per outlet, sorted by vessel index).
+  // For flow computations: blood and the boundary conditions. A tree's (vprune's: format
+  // version 1) are the inflow at its root and the 0D outlets of its terminal vessels
+  // (sparse: one entry per outlet, sorted by vessel index); any network's (version 2) are
+  // conditions at nodes, one per node at most, sorted by node. A file may have both forms;
+  // node_boundaries() gives them as one list.
   std::optional<Blood> blood;
   std::optional<Inlet> inlet;
   std::vector<Outlet> outlets;
+  std::vector<NodeBoundary> boundaries;
 
   // Small metadata kept as JSON: who made the file and how, and top-level members this
   // version does not know, passed through untouched.
@@ -70,7 +78,14 @@ struct Network {
                          double length_m, double diameter_m, double wall_thickness_m,
                          double youngs_modulus_pa, std::int32_t generation_index);
 
-  double volume(std::size_t vessel) const;  // pi D^2 / 4 * l [m^3]
+  bool is_tapered(std::size_t vessel) const {
+    return !distal_diameter.empty() && !(distal_diameter[vessel] != distal_diameter[vessel]);
+  }
+  // The reference lumen diameter at `to` (`diameter` unless the vessel tapers).
+  double diameter_at_to(std::size_t vessel) const {
+    return is_tapered(vessel) ? distal_diameter[vessel] : diameter[vessel];
+  }
+  double volume(std::size_t vessel) const;  // pi/4 l (D0^2 + D0 D1 + D1^2)/3: a cone's frustum [m^3]
   // Vessel index of an id (linear search unless ids equal indices); -1 when absent.
   std::int64_t index_of(std::int64_t vessel_id) const;
 };
@@ -81,5 +96,10 @@ struct Network {
 // before any work. Throws InputError "SOURCE: vessel ID: missing \"wall_thickness\" ..."
 // naming the first vessel without one.
 void require_tube_laws(const Network& net, const std::string& source);
+
+// Every boundary condition of the network at its node, sorted by node: the version 2 node
+// boundaries, the inlet (a flow into its vessel's `from` node) and the outlets (at their
+// vessels' `to` nodes). Throws InputError when two land on one node.
+std::vector<NodeBoundary> node_boundaries(const Network& net);
 
 }  // namespace hemotree

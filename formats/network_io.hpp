@@ -12,7 +12,10 @@
 
 namespace hemotree {
 
-inline constexpr int vnet_version = 1;
+// The newest version this build reads; writers write the oldest that holds the content
+// (version 2: node boundaries, tapered vessels).
+inline constexpr int vnet_version = 2;
+int format_version_needed(const Network& net);
 
 // path "-" reads standard input. Throws InputError naming the position or the vessel at
 // fault, IoError when the file cannot be read.

@@ -116,6 +116,11 @@ class Reader {
         in_.next();
         const Position at = Position::of(in_);
         net_.inlet = from_json(inlet_from_json, at);
+      } else if (key == "boundaries") {
+        in_.next();
+        if (in_.token() != Token::begin_array) in_.fail("\"boundaries\" must be a list");
+        boundaries_at_ = Position::of(in_);
+        boundaries_json_ = in_.read_value();
       } else if (key == "nodes") {
         read_nodes();
         seen_nodes = true;
@@ -133,7 +138,7 @@ class Reader {
     // Required by the format: without it a future reader could not tell version 1 files
     // from later ones.
     if (!seen_version)
-      throw InputError(source_ + ": missing \"version\" (this build reads version " +
+      throw InputError(source_ + ": missing \"version\" (this build reads versions 1 to " +
                        std::to_string(vnet_version) + ")");
     if (!seen_vessels) throw InputError(source_ + ": missing \"vessels\"");
     check_unique_vessel_ids();
@@ -143,8 +148,10 @@ class Reader {
       net_.beta.resize(net_.vessel_count(), unset);
       net_.reference_pressure.resize(net_.vessel_count(), unset);
     }
+    if (!net_.distal_diameter.empty()) net_.distal_diameter.resize(net_.vessel_count(), unset);
     if (net_.inlet && net_.index_of(net_.inlet->vessel) < 0)
       throw InputError(source_ + ": inlet: unknown vessel " + std::to_string(net_.inlet->vessel));
+    read_boundaries();
     return std::move(net_);
   }
 
@@ -163,6 +170,34 @@ class Reader {
       return convert(value);
     } catch (const InputError& e) {
       fail_at(at, e.what());
+    }
+  }
+
+  // Boundaries name nodes by id: read once the nodes are known, sorted by node, and checked
+  // against the tree's inlet and outlets (one condition per node).
+  void read_boundaries() {
+    if (boundaries_json_.is_null()) return;
+    const NodeIndex index(net_.node_id);
+    net_.boundaries.reserve(boundaries_json_.size());
+    for (std::size_t k = 0; k < boundaries_json_.size(); ++k) {
+      std::int64_t node_id = 0;
+      NodeBoundary b;
+      try {
+        b = boundary_from_json(boundaries_json_[k], "boundaries[" + std::to_string(k) + "]", node_id);
+      } catch (const InputError& e) {
+        fail_at(boundaries_at_, e.what());
+      }
+      b.node = index.find(node_id, net_.node_count());
+      if (b.node < 0)
+        throw InputError(source_ + ": boundaries[" + std::to_string(k) + "]: unknown node " + std::to_string(node_id));
+      net_.boundaries.push_back(std::move(b));
+    }
+    std::stable_sort(net_.boundaries.begin(), net_.boundaries.end(),
+                     [](const NodeBoundary& p, const NodeBoundary& q) { return p.node < q.node; });
+    try {
+      node_boundaries(net_);
+    } catch (const InputError& e) {
+      throw InputError(source_ + ": " + e.what());
     }
   }
 
@@ -219,7 +254,7 @@ class Reader {
   void read_vessel(std::size_t n) {
     std::int64_t vid = 0, from = 0, to = 0, generation = 0;
     double length = unset, diameter = unset, wall = unset, modulus = unset;
-    double beta = unset, reference_pressure = unset;
+    double beta = unset, reference_pressure = unset, distal_diameter = unset;
     bool has_id = false, has_from = false, has_to = false, has_class = false;
     bool has_generation = false;
     Position generation_at;
@@ -236,6 +271,8 @@ class Reader {
       else if (key == "to") { to = read_integer(in_, "to", where); has_to = true; }
       else if (key == "length") length = read_number(in_, "length", ranges::length, where);
       else if (key == "diameter") diameter = read_number(in_, "diameter", ranges::diameter, where);
+      else if (key == "distal_diameter")
+        distal_diameter = read_number(in_, "distal_diameter", ranges::diameter, where);
       else if (key == "wall_thickness")
         wall = read_number(in_, "wall_thickness", ranges::wall_thickness, where);
       else if (key == "youngs_modulus")
@@ -293,6 +330,10 @@ class Reader {
       net_.reference_pressure.resize(index, unset);
       net_.beta.push_back(beta);
       net_.reference_pressure.push_back(reference_pressure);
+    }
+    if (!std::isnan(distal_diameter) || !net_.distal_diameter.empty()) {
+      net_.distal_diameter.resize(index, unset);
+      net_.distal_diameter.push_back(distal_diameter);
     }
     if (outlet) {
       try {
@@ -384,6 +425,8 @@ class Reader {
   bool generations_given_ = false;
   std::int64_t deepest_ = -1;  // the largest generation read, and where
   Position deepest_at_;
+  nlohmann::json boundaries_json_;  // read after the nodes
+  Position boundaries_at_;
 };
 
 Network read_with(JsonPull& in, const std::string& source) { return Reader(in, source).read(); }

@@ -64,6 +64,10 @@ void append_vessel(std::string& s, const Network& net, std::size_t v,
   append_real(s, net.length[v]);
   s += ",\"diameter\":";
   append_diameter(s, net.diameter[v]);
+  if (net.is_tapered(v)) {
+    s += ",\"distal_diameter\":";
+    append_real(s, net.distal_diameter[v]);
+  }
   // Optional members a hand-written file may lack (NaN here) are left out again.
   if (!std::isnan(net.wall_thickness[v])) {
     s += ",\"wall_thickness\":";
@@ -122,11 +126,27 @@ void write_lines(OutputStream& out, std::size_t count, AppendLine append_line) {
 
 }  // namespace
 
+int format_version_needed(const Network& net) {
+  bool tapered = false;
+  for (std::size_t v = 0; v < net.distal_diameter.size() && !tapered; ++v) tapered = net.is_tapered(v);
+  return net.boundaries.empty() && !tapered ? 1 : 2;
+}
+
 void write_network(const Network& net, OutputStream& out) {
-  out << "{\n\"format\": \"vnet\",\n\"version\": " << vnet_version << ",\n";
+  // The oldest version that holds the content, so that older readers read what they can.
+  out << "{\n\"format\": \"vnet\",\n\"version\": " << format_version_needed(net) << ",\n";
   out << "\"provenance\": " << net.provenance.dump() << ",\n";
   if (net.blood) out << "\"blood\": " << to_json(*net.blood).dump() << ",\n";
   if (net.inlet) out << "\"inlet\": " << to_json(*net.inlet).dump() << ",\n";
+  if (!net.boundaries.empty()) {
+    out << "\"boundaries\": [\n";
+    for (std::size_t k = 0; k < net.boundaries.size(); ++k) {
+      const NodeBoundary& b = net.boundaries[k];
+      out << to_json(b, net.node_id[static_cast<std::size_t>(b.node)]).dump()
+          << (k + 1 < net.boundaries.size() ? ",\n" : "\n");
+    }
+    out << "],\n";
+  }
   for (const auto& [key, value] : net.extra.items())
     out << nlohmann::json(key).dump() << ": " << value.dump() << ",\n";
   out << "\"nodes\": [\n";

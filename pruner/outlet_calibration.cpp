@@ -39,7 +39,7 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
   std::size_t leaves = 0;
   for (std::size_t v = 0; v < n; ++v) leaves += is_leaf(v);
   report.capillary_resistance = capillary_outlet_resistance(
-      leaves, full.inlet->waveform.mean_flow(), p.capillary_pressure_drop);
+      leaves, full.inlet->waveform.mean_value(), p.capillary_pressure_drop);
 
   // The full tree ends in its capillary outlets.
   Outlet leaf_outlet;
@@ -59,7 +59,7 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
   const std::vector<double> resistance = vessel_resistances(full, blood);
   std::vector<Equivalent> beyond;
   report.steady_inlet_pressure_full =
-      solve_steady_flow(full, resistance, full.inlet->waveform.mean_flow(), &beyond).inlet_pressure;
+      solve_steady_flow(full, resistance, full.inlet->waveform.mean_value(), &beyond).inlet_pressure;
 
   // Compliance beyond each vessel's distal node: dV/dp = 2 l sqrt(A_ref) / beta per vessel.
   std::vector<double> compliance_beyond(n, 0.0);

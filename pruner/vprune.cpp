@@ -62,10 +62,10 @@ Waveform read_inflow_table(const std::string& path, double period) {
       throw InputError(where + ": times must increase (" + t_text + " s follows " +
                        format_rounded(w.time.back()) + " s)");
     w.time.push_back(t);
-    w.flow.push_back(q);
+    w.value.push_back(q);
   }
   if (w.time.size() < 2) throw InputError("--inflow-table " + path + ": needs at least two rows");
-  const double mean = w.mean_flow();
+  const double mean = w.mean_value();
   if (!ranges::mean_flow.contains(mean))
     throw InputError("--inflow-table " + path + ": the mean flow " +
                      format_quantity(mean, "ml/min") + " lies outside the accepted range " +
@@ -349,7 +349,7 @@ int main(int argc, char** argv) {
          " capillary; steady inlet pressure " + format_quantity(pruned_p, "mmHg") +
          " (full tree " + format_quantity(full_p, "mmHg") + ")");
     if (const std::string w = unphysiological_pressure_warning(
-            report, outlets, full.inlet->waveform.mean_flow(), full.diameter[root]);
+            report, outlets, full.inlet->waveform.mean_value(), full.diameter[root]);
         !w.empty())
       warn(w);
 

@@ -78,7 +78,7 @@ void warn_unphysiological(double low, double high, std::int64_t vessel, const Ne
   if (low >= physiological_low * pascal_per_mmhg && high <= physiological_high * pascal_per_mmhg) return;
   warn(std::string(what) + " reach " + format_quantity(high, "mmHg") + " (lowest " + format_quantity(low, "mmHg") +
        ", at vessel " + std::to_string(vessel) + "), outside a physiological 0 to 300 mmHg: the inlet's mean flow (" +
-       format_quantity(net.inlet->waveform.mean_flow(), "ml/min") +
+       format_quantity(net.inlet->waveform.mean_value(), "ml/min") +
        ") is likely wrong for this network's size (vprune --mean-flow sets it)");
 }
 
@@ -402,7 +402,7 @@ int main(int argc, char** argv) {
     // A run is complete only when its numbers say so.
     std::string failure;
     if (status == RunStatus::complete || status == RunStatus::not_periodic) {
-      const double prescribed = net.inlet->waveform.mean_flow();
+      const double prescribed = net.inlet->waveform.mean_value();
       if (!(std::abs(last.conservation_error) < conservation_tolerance))
         failure = "the scheme lost mass: (in - out - stored) / in = " + format_rounded(last.conservation_error) +
                   " over the last cycle, above " + format_rounded(conservation_tolerance);

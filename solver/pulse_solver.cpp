@@ -88,7 +88,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   std::optional<SteadyFlow> steady;
   if (net.inlet) {
     try {
-      steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet->waveform.mean_flow(),
+      steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet->waveform.mean_value(),
                                            &steady_resistance_);
     } catch (const InputError& e) {
       steady_refusal_ = e.what();

@@ -247,7 +247,7 @@ SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resi
 SteadyFlow solve_steady_flow(const Network& net) {
   if (!net.inlet) throw InputError("the network has no inlet");
   const Blood blood = net.blood.value_or(Blood{});
-  return solve_steady_flow(net, vessel_resistances(net, blood), net.inlet->waveform.mean_flow());
+  return solve_steady_flow(net, vessel_resistances(net, blood), net.inlet->waveform.mean_value());
 }
 
 SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const VesselLaw> laws,

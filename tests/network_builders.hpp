@@ -50,7 +50,7 @@ inline Waveform tabulate(const std::function<double(double)>& f, double duration
   for (int k = 0; k < samples; ++k) {
     const double t = duration * k / (samples - 1);
     w.time.push_back(t);
-    w.flow.push_back(f(t));
+    w.value.push_back(f(t));
   }
   return w;
 }

@@ -224,7 +224,7 @@ TEST(NetworkRanges, DuplicateIdsAndAMissingVersionAreRefused) {
   EXPECT_EQ(error_of(replaced(base, "{\"id\":2,\"x\"", "{\"id\":0,\"x\"")),
             "net.json: node id 0 appears twice: nodes[0] and nodes[2]");
   EXPECT_EQ(error_of(replaced(base, "\"version\":1,", "")),
-            "net.json: missing \"version\" (this build reads version 1)");
+            "net.json: missing \"version\" (this build reads versions 1 to 2)");
   EXPECT_EQ(message_of(replaced(base, "\"provenance\":{\"tool\":\"test\"}", "\"provenance\":3")),
             "\"provenance\" must be an object");
 }

@@ -206,7 +206,7 @@ SteadyRun run_to_steady_state(Network& net, double q, double duration, const Sol
   w.shape = Waveform::Shape::table;
   w.period = 1000.0;
   w.time = {0.0, 0.01, 999.0};
-  w.flow = {0.0, q, q};
+  w.value = {0.0, q, q};
   net.inlet = Inlet{0, w};
   SolverOptions o = options;
   o.steady_start = false;

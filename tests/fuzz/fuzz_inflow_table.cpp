@@ -35,9 +35,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!net->inlet) finding("vprune wrote a network without its inlet");
   const Waveform& w = net->inlet->waveform;
   for (std::size_t k = 0; k < w.time.size(); ++k)
-    if (!std::isfinite(w.time[k]) || !std::isfinite(w.flow[k]))
+    if (!std::isfinite(w.time[k]) || !std::isfinite(w.value[k]))
       finding("an accepted inflow table holds a non-finite sample at row " + std::to_string(k));
-  const double mean = w.mean_flow();
+  const double mean = w.mean_value();
   if (!(std::isfinite(mean) && mean > 0))
     finding("an accepted inflow table has a mean flow of " + std::to_string(mean) + " m^3/s");
   return 0;
