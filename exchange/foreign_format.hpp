@@ -1,0 +1,29 @@
+// What every importer of a foreign network format shares: how to fill what the file lacks
+// (wall thickness, Young's modulus) and where to say what was assumed.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "formats/network.hpp"
+
+namespace hemotree {
+
+struct ImportOptions {
+  // A Young's modulus [Pa] for every vessel whose file gives none; unset: the toolkit's E(D)
+  // table (generator/growth_rules.hpp, default_rules().youngs_modulus).
+  std::optional<double> youngs_modulus;
+  // A wall thickness as a fraction of the lumen diameter, h = wall_ratio D, for every vessel
+  // whose file gives none; unset: the toolkit's per-class wall law (default_rules().wall).
+  std::optional<double> wall_ratio;
+  // Receives one line per assumption ("vessel wall thickness from h = 0.1 D for 1130
+  // vessels"); vimport prints them on stderr.
+  std::function<void(const std::string&)> note = [](const std::string&) {};
+};
+
+// Fills wall_thickness and youngs_modulus where they are NaN, from the options or the
+// toolkit's tables, and notes what it did (one line each, with the count of vessels).
+void fill_missing_walls(Network& net, const ImportOptions& options);
+
+}  // namespace hemotree
