@@ -1,6 +1,8 @@
 #include "solver/steady_flow.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <memory>
 #include <cmath>
 #include <numbers>
 #include <numeric>
@@ -9,7 +11,7 @@
 
 #include "cli/errors.hpp"
 #include "formats/topology.hpp"
-#include "network_flow/nodal_system.hpp"
+#include "network_flow/flow_network.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/rheology.hpp"
 
@@ -116,10 +118,34 @@ std::vector<std::int32_t> steady_outlets(const Network& net) {
 
 namespace {
 
-// The steady flow as the nodal system of the network's node pressures (nodal_system.hpp):
-// each vessel an edge of conductance 1/R, each outlet a shunt 1/R to its outflow pressure at
-// its vessel's distal node (b += p_out / R), the inflow injected at the inlet's node. The
-// graph, the outlets and the checks are set once; every solve refactorises (the distended
+// Union-find over nodes (keeping the lower root: short paths on a network numbered from its
+// root): the connected parts of the network.
+class NodeParts {
+ public:
+  explicit NodeParts(const Network& net) : up_(net.node_count()) {
+    std::iota(up_.begin(), up_.end(), 0);
+    for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+      const std::int32_t rf = root(net.from[v]), rt = root(net.to[v]);
+      up_[static_cast<std::size_t>(std::max(rf, rt))] = std::min(rf, rt);
+    }
+  }
+  std::int32_t root(std::int32_t i) {
+    while (up_[static_cast<std::size_t>(i)] != i) {
+      auto& next = up_[static_cast<std::size_t>(i)];
+      next = up_[static_cast<std::size_t>(next)];  // path halving
+      i = next;
+    }
+    return i;
+  }
+
+ private:
+  std::vector<std::int32_t> up_;
+};
+
+// The steady flow as the nodal system of the network's node pressures (flow_network.hpp):
+// each vessel an edge of conductance 1/R, each outlet a shunt 1/R to its outflow pressure
+// (b += p_out / R), flows injected at their nodes, prescribed pressures eliminated. The
+// graph, the boundaries and the checks are set once; every solve refactorises (the distended
 // iteration changes the resistances each sweep).
 class SteadySystem {
  public:
@@ -127,17 +153,67 @@ class SteadySystem {
   SteadyFlow solve(const std::vector<double>& resistance, double inlet_flow);
 
  private:
+  void check_tree_form();
+  void check_node_form(const std::vector<NodeBoundary>& boundaries);
+
   const Network& net_;
-  std::size_t inlet_node_ = 0;
-  NodalSystem system_;
-  std::vector<double> shunt_, outlet_current_;  // per node: the outlets' 1/R and p_out / R
-  std::vector<double> conductance_;             // per vessel
+  std::int64_t inlet_node_ = -1;  // where the tree's inflow (solve's inlet_flow) enters
+  std::vector<double> shunt_, inflow_;      // per node: outlets' 1/R; flows in and p_out / R
+  std::vector<double> pressure_;            // per node: the prescribed ones
+  std::vector<unsigned char> prescribed_;   // per node
+  std::vector<double> conductance_;         // per vessel
+  std::unique_ptr<FlowNetwork> system_;
 };
 
 SteadySystem::SteadySystem(const Network& net) : net_(net) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
-  auto name = [&](std::size_t v) { return "vessel " + std::to_string(net.id[v]); };
   if (n == 0) throw InputError("the network has no vessels");
+  shunt_.assign(nodes, 0.0);
+  inflow_.assign(nodes, 0.0);
+  pressure_.assign(nodes, 0.0);
+  prescribed_.assign(nodes, 0);
+  // A tree's boundaries (an inlet, outlets on its terminal vessels) keep the tree's checks
+  // and messages; boundaries at nodes make any connected graph solvable.
+  std::vector<NodeBoundary> boundaries;
+  if (net.boundaries.empty()) {
+    check_tree_form();
+    boundaries = node_boundaries(net);
+  } else {
+    boundaries = node_boundaries(net);
+    check_node_form(boundaries);
+  }
+  if (net.inlet) inlet_node_ = net.from[static_cast<std::size_t>(net.index_of(net.inlet->vessel))];
+  for (const NodeBoundary& b : boundaries) {
+    const auto i = static_cast<std::size_t>(b.node);
+    switch (b.type) {
+      case BoundaryType::flow:
+        if (static_cast<std::int64_t>(i) != inlet_node_) inflow_[i] += b.waveform.mean_value();
+        break;
+      case BoundaryType::pressure:
+        prescribed_[i] = 1;
+        pressure_[i] = b.waveform.mean_value();
+        break;
+      case BoundaryType::rcr:
+      case BoundaryType::resistance:
+        shunt_[i] += 1 / b.outlet.resistance();
+        inflow_[i] += b.outlet.p_out / b.outlet.resistance();
+        break;
+      case BoundaryType::reflection: break;  // refused by the checks
+    }
+  }
+  // A node that no vessel touches carries nothing: a unit shunt holds it at 0 Pa.
+  std::vector<unsigned char> touched(nodes, 0);
+  for (std::size_t v = 0; v < n; ++v) touched[static_cast<std::size_t>(net.from[v])] = touched[static_cast<std::size_t>(net.to[v])] = 1;
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (!touched[i] && !prescribed_[i]) shunt_[i] = 1;
+  system_ = std::make_unique<FlowNetwork>(nodes, net.from, net.to, prescribed_);
+  conductance_.resize(n);
+}
+
+void SteadySystem::check_tree_form() {
+  const Network& net = net_;
+  const std::size_t n = net.vessel_count(), nodes = net.node_count();
+  auto name = [&](std::size_t v) { return "vessel " + std::to_string(net.id[v]); };
   steady_outlets(net);  // the outlets sit on exactly the terminal vessels, none a reflection
 
   // The inlet: the network's, or else the one vessel that no vessel feeds. Its node is the
@@ -163,56 +239,70 @@ SteadySystem::SteadySystem(const Network& net) : net_(net) {
     }
     if (inlet < 0) throw InputError("no inlet given, and every vessel is fed by another (a closed loop)");
   }
-  inlet_node_ = static_cast<std::size_t>(net.from[static_cast<std::size_t>(inlet)]);
+  const auto inlet_node = static_cast<std::size_t>(net.from[static_cast<std::size_t>(inlet)]);
   for (std::size_t v = 0; v < n; ++v) {
     const auto from = static_cast<std::size_t>(net.from[v]);
-    if (entering[from] < 0 && from != inlet_node_)
+    if (entering[from] < 0 && from != inlet_node)
       throw InputError(name(v) + " is fed by no vessel and does not start at the inlet (vessel " +
                        std::to_string(net.id[static_cast<std::size_t>(inlet)]) + ")");
   }
-
-  shunt_.assign(nodes, 0.0);
-  outlet_current_.assign(nodes, 0.0);
-  for (const Outlet& o : net.outlets) {
-    const auto node = static_cast<std::size_t>(net.to[static_cast<std::size_t>(o.vessel)]);
-    shunt_[node] += 1 / o.resistance();
-    outlet_current_[node] += o.p_out / o.resistance();
-  }
-  // A node that no vessel touches carries nothing: a unit shunt holds it at 0 Pa.
-  std::vector<unsigned char> touched(nodes, 0);
-  for (std::size_t v = 0; v < n; ++v) touched[static_cast<std::size_t>(net.from[v])] = touched[static_cast<std::size_t>(net.to[v])] = 1;
-  std::size_t untouched = 0;
-  for (std::size_t i = 0; i < nodes; ++i)
-    if (!touched[i]) {
-      shunt_[i] = 1;
-      ++untouched;
-    }
-  system_ = NodalSystem(nodes, net.from, net.to);
+  if (!net.inlet) inlet_node_ = static_cast<std::int64_t>(inlet_node);
 
   // Every vessel must hang together with the inlet: a part apart from it would carry no flow
-  // (or, with no outlet, have no solution at all). A forest has nodes - edges components, so a
-  // tree needs no search; otherwise union-find (keeping the lower root: short paths on a
-  // network numbered from its root) names the first vessel apart.
-  if (system_.method() != NodalSystem::Method::tree_elimination || nodes - n != 1 + untouched) {
-    std::vector<std::int32_t> up(nodes);
-    std::iota(up.begin(), up.end(), 0);
-    auto root = [&](std::int32_t i) {
-      while (up[static_cast<std::size_t>(i)] != i) {
-        auto& next = up[static_cast<std::size_t>(i)];
-        next = up[static_cast<std::size_t>(next)];  // path halving
-        i = next;
-      }
-      return i;
-    };
-    for (std::size_t v = 0; v < n; ++v) {
-      const std::int32_t rf = root(net.from[v]), rt = root(net.to[v]);
-      up[static_cast<std::size_t>(std::max(rf, rt))] = std::min(rf, rt);
+  // (or, with no outlet, have no solution at all).
+  NodeParts parts(net);
+  const std::int32_t inlet_part = parts.root(static_cast<std::int32_t>(inlet_node));
+  for (std::size_t v = 0; v < n; ++v)
+    if (parts.root(net.from[v]) != inlet_part) throw InputError(name(v) + " is not connected to the inlet");
+}
+
+void SteadySystem::check_node_form(const std::vector<NodeBoundary>& boundaries) {
+  const Network& net = net_;
+  const std::size_t n = net.vessel_count(), nodes = net.node_count();
+  auto node_name = [&](std::int64_t i) { return "node " + std::to_string(net.node_id[static_cast<std::size_t>(i)]); };
+  std::vector<std::int32_t> degree(nodes, 0), some_vessel(nodes, -1);
+  for (std::size_t v = 0; v < n; ++v)
+    for (const std::int32_t i : {net.from[v], net.to[v]}) {
+      ++degree[static_cast<std::size_t>(i)];
+      some_vessel[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(v);
     }
-    const std::int32_t inlet_part = root(static_cast<std::int32_t>(inlet_node_));
-    for (std::size_t v = 0; v < n; ++v)
-      if (root(net.from[v]) != inlet_part) throw InputError(name(v) + " is not connected to the inlet");
+  std::vector<unsigned char> has_boundary(nodes, 0);
+  for (const NodeBoundary& b : boundaries) {
+    if (degree[static_cast<std::size_t>(b.node)] == 0)
+      throw InputError(node_name(b.node) + " has a " + std::string(to_string(b.type)) +
+                       " boundary but no vessel meets it");
+    if (b.type == BoundaryType::reflection)
+      throw InputError(node_name(b.node) + ": a reflection outlet has no steady resistance (give an R or RCR)");
+    if (b.is_outlet() && !(b.outlet.resistance() > 0))
+      throw InputError(node_name(b.node) + ": its outlet has no resistance");
+    has_boundary[static_cast<std::size_t>(b.node)] = 1;
   }
-  conductance_.resize(n);
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (degree[i] == 1 && !has_boundary[i])
+      throw InputError("vessel " + std::to_string(net.id[static_cast<std::size_t>(some_vessel[i])]) + " ends at " +
+                       node_name(static_cast<std::int64_t>(i)) +
+                       ", which no other vessel meets and which has no boundary condition (a dead end; a "
+                       "closed one is {\"node\": " + std::to_string(net.node_id[i]) + ", \"type\": \"flow\", \"flow\": 0})");
+  // Each connected part needs a pressure to refer to: a prescribed one or an outlet's.
+  NodeParts parts(net);
+  std::vector<unsigned char> part_boundary(nodes, 0), part_reference(nodes, 0);
+  for (const NodeBoundary& b : boundaries) {
+    const auto r = static_cast<std::size_t>(parts.root(b.node));
+    part_boundary[r] = 1;
+    if (b.type != BoundaryType::flow) part_reference[r] = 1;
+  }
+  std::vector<std::size_t> part_vessels(nodes, 0);
+  for (std::size_t v = 0; v < n; ++v) ++part_vessels[static_cast<std::size_t>(parts.root(net.from[v]))];
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto r = static_cast<std::size_t>(parts.root(net.from[v]));
+    if (part_reference[r]) continue;
+    const std::string part = "the part of the network with vessel " + std::to_string(net.id[v]) + " (" +
+                             std::to_string(part_vessels[r]) + (part_vessels[r] == 1 ? " vessel" : " vessels") + ")";
+    if (!part_boundary[r])
+      throw InputError(part + " has no boundary condition: it is cut off from every inflow and outflow");
+    throw InputError(part + " has flow boundaries only: its pressure is undetermined (give a node a pressure or "
+                     "an outlet)");
+  }
 }
 
 SteadyFlow SteadySystem::solve(const std::vector<double>& resistance, double inlet_flow) {
@@ -221,13 +311,20 @@ SteadyFlow SteadySystem::solve(const std::vector<double>& resistance, double inl
     throw std::invalid_argument("solve_steady_flow: " + std::to_string(resistance.size()) + " resistances for " +
                                 std::to_string(n) + " vessels");
   for (std::size_t v = 0; v < n; ++v) conductance_[v] = 1 / resistance[v];
-  // Connected to the inlet, the network is singular only without a single outlet.
-  if (system_.factorize(conductance_, shunt_) >= 0) throw InputError("the network has no outlet for the inflow");
+  const std::int64_t floating = system_->factorize(conductance_, shunt_);
+  if (floating >= 0) {
+    if (net_.boundaries.empty()) throw InputError("the network has no outlet for the inflow");
+    // The checks found a reference in every part: this one's is lost in rounding.
+    throw InputError("node " + std::to_string(net_.node_id[static_cast<std::size_t>(floating)]) +
+                     ": the outlets' resistances of its part are too large against its vessels' to fix its pressure");
+  }
   SteadyFlow s;
-  s.node_pressure = outlet_current_;
-  s.node_pressure[inlet_node_] += inlet_flow;
-  system_.solve(s.node_pressure, s.node_pressure);
-  s.inlet_pressure = s.node_pressure[inlet_node_];
+  s.node_pressure = pressure_;
+  std::vector<double> inflow = inflow_;
+  if (inlet_node_ >= 0) inflow[static_cast<std::size_t>(inlet_node_)] += inlet_flow;
+  system_->solve(inflow, s.node_pressure);
+  s.inlet_pressure = inlet_node_ >= 0 ? s.node_pressure[static_cast<std::size_t>(inlet_node_)]
+                                      : std::numeric_limits<double>::quiet_NaN();
   s.flow.resize(n);
   for (std::size_t v = 0; v < n; ++v)
     s.flow[v] = (s.node_pressure[static_cast<std::size_t>(net_.from[v])] -
@@ -245,9 +342,9 @@ SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resi
 }
 
 SteadyFlow solve_steady_flow(const Network& net) {
-  if (!net.inlet) throw InputError("the network has no inlet");
+  if (!net.inlet && net.boundaries.empty()) throw InputError("the network has no inlet and no boundary conditions");
   const Blood blood = net.blood.value_or(Blood{});
-  return solve_steady_flow(net, vessel_resistances(net, blood), net.inlet->waveform.mean_value());
+  return solve_steady_flow(net, vessel_resistances(net, blood), net.inlet ? net.inlet->waveform.mean_value() : 0.0);
 }
 
 SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const VesselLaw> laws,
