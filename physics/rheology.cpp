@@ -73,8 +73,10 @@ double apparent_viscosity(const Blood& blood, double diameter) {
     case Rheology::pries:
       // Above the threshold the law is frozen at its value there: eta is continuous in D,
       // and the 1D friction of large vessels sees a constant viscosity, as in the paper.
+      // Red cells of another size than the human ones the law was fitted to: the diameter
+      // the cells see scales as their size, (92 fl / MCV)^(1/3) (Secomb's NetFlow).
       return blood.plasma_viscosity *
-             pries_relative_viscosity(std::min(diameter, blood.pries_max_diameter),
+             pries_relative_viscosity(std::min(diameter, blood.pries_max_diameter) * blood.pries_diameter_scale(),
                                       blood.hematocrit);
   }
   throw InputError("unknown rheology");  // unreachable for valid enumerators

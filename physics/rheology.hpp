@@ -13,8 +13,9 @@ namespace hemotree {
 double pries_relative_viscosity(double diameter, double hematocrit);
 
 // The dynamic viscosity mu [Pa s] used in the friction term and in Poiseuille resistances:
-// Pries: plasma viscosity x eta(D, H_d) for D < pries_max_diameter, and the value at that
-// threshold above it (continuous); Newtonian: blood.newtonian_viscosity.
+// Pries: plasma viscosity x eta(s D, H_d) for D < pries_max_diameter, and the value at that
+// threshold above it (continuous), s = (92 fl / MCV)^(1/3) the red cells' size against the
+// human ones (Blood::pries_diameter_scale); Newtonian: blood.newtonian_viscosity.
 double apparent_viscosity(const Blood& blood, double diameter);
 
 }  // namespace hemotree

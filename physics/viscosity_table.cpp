@@ -28,13 +28,15 @@ ViscosityTable::ViscosityTable(const Blood& blood) : blood_(blood) {
   const int octaves = last - first + 1;
   table_.resize(static_cast<std::size_t>(octaves) * intervals * 4);
   std::vector<double> f(intervals + 3);
+  const double scale = blood.pries_diameter_scale();  // as apparent_viscosity
   for (int o = 0; o < octaves; ++o) {
     // Per octave, N + 3 nodes m = 1 + (j - 1) / N, j = 0 .. N + 2 (one before the octave, two
     // after it), the law itself (not clamped at the threshold) so that no stencil straddles
     // a kink.
     for (std::size_t j = 0; j < intervals + 3; ++j) {
       const double m = 1 + (static_cast<double>(j) - 1) / intervals;
-      f[j] = blood.plasma_viscosity * pries_relative_viscosity(diameter_of(std::ldexp(m, first - 1 + o)), blood.hematocrit);
+      f[j] = blood.plasma_viscosity * pries_relative_viscosity(scale * diameter_of(std::ldexp(m, first - 1 + o)),
+                                                                blood.hematocrit);
     }
     // Interval k, t in [0, 1) from node k + 1: the Lagrange weights of nodes k .. k + 3,
     // -t(t-1)(t-2)/6, (t+1)(t-1)(t-2)/2, -(t+1)t(t-2)/2, (t+1)t(t-1)/6, expanded in powers of t.

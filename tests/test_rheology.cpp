@@ -159,6 +159,25 @@ TEST(ApparentViscosity, ContinuousAndConstantAboveThreshold) {
   expect_relative(apparent_viscosity(blood, blood.pries_max_diameter * (1 - 1e-9)), at, 1e-9);
 }
 
+// Rat blood (mean cell volume 55 fl against the human 92): the law sees the diameter times
+// (92/55)^(1/3) = 1.1870664916, as NetFlow does. eta(11.870664916 um, 0.4) = 4.2781233416901330
+// (the script above; eta(10 um, 0.4) = 5.0059805425975064 for human cells): smaller cells pass
+// a 10 um capillary 15 % more easily.
+TEST(ApparentViscosity, MeanCellVolumeScalesTheDiameterTheLawSees) {
+  Blood rat;
+  rat.hematocrit = 0.4;
+  rat.plasma_viscosity = 1.0466e-3;
+  rat.mean_cell_volume = 55e-18;
+  expect_relative(rat.pries_diameter_scale(), 1.1870664916411232, 1e-14);
+  expect_relative(apparent_viscosity(rat, 10 * um), 1.0466e-3 * 4.2781233416901330, 1e-9);
+  Blood human = rat;
+  human.mean_cell_volume = Blood::human_mean_cell_volume;
+  EXPECT_EQ(human.pries_diameter_scale(), 1.0);
+  expect_relative(apparent_viscosity(human, 10 * um), 1.0466e-3 * 5.0059805425975064, 1e-9);
+  // The threshold is the vessel's own diameter: above it the value is frozen as before.
+  EXPECT_EQ(apparent_viscosity(rat, 1e-3), apparent_viscosity(rat, rat.pries_max_diameter));
+}
+
 TEST(ApparentViscosity, NewtonianIgnoresDiameterAndHematocrit) {
   Blood blood;
   blood.rheology = Rheology::newtonian;

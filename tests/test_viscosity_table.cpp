@@ -23,6 +23,23 @@ TEST(ViscosityTable, MatchesThePriesLawEverywhere) {
   }
 }
 
+// Cells of another size (mean cell volume from the goat's 15 fl to 200 fl) scale the diameter
+// the law sees; the table follows it as closely.
+TEST(ViscosityTable, FollowsTheMeanCellVolume) {
+  for (double mcv : {15e-18, 55e-18, 200e-18}) {
+    Blood blood;
+    blood.mean_cell_volume = mcv;
+    const ViscosityTable table(blood);
+    double worst = 0;
+    for (double d = 2e-6; d < 1e-3; d *= 1.0007) {
+      const double area = std::numbers::pi / 4 * d * d;
+      const double exact = apparent_viscosity(blood, d);
+      worst = std::max(worst, std::abs(table(area) - exact) / exact);
+    }
+    EXPECT_LT(worst, 1e-9) << "mean cell volume " << mcv;
+  }
+}
+
 TEST(ViscosityTable, NewtonianIsConstant) {
   Blood blood;
   blood.rheology = Rheology::newtonian;
