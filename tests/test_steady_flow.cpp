@@ -1,4 +1,5 @@
 // The steady Poiseuille-Pries solver against hand calculations.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -220,4 +221,118 @@ TEST(SteadyFlow, RefusesOpenEndsAndPartsApartFromTheInlet) {
   closed.add_vessel(1, 1, 2, 0.01, 1e-3, 1e-4, 2e5, 1);
   closed.add_vessel(2, 2, 1, 0.01, 1e-3, 1e-4, 2e5, 1);
   expect_refusal(closed, "no outlet");
+}
+
+// ---- boundaries at nodes (format version 2): loops, several inlets, prescribed pressures ----
+
+namespace {
+
+NodeBoundary flow_at(std::int32_t node, double q) {
+  NodeBoundary b;
+  b.node = node;
+  b.type = BoundaryType::flow;
+  b.waveform = Waveform::constant_value(q);
+  return b;
+}
+
+NodeBoundary pressure_at(std::int32_t node, double p) {
+  NodeBoundary b;
+  b.node = node;
+  b.type = BoundaryType::pressure;
+  b.waveform = Waveform::constant_value(p);
+  return b;
+}
+
+// A diamond with a bridge: flow Q into node 0, node 3 held at P; vessels 0: 0->1, 1: 0->2,
+// 2: 1->3, 3: 3->2 (written against its flow), 4: 1->2 (the bridge), resistances r, r, r, 2r, r.
+Network bridged_diamond(double q, double p) {
+  Network net;
+  for (int n = 0; n < 4; ++n) net.add_node(n);
+  const int from[] = {0, 0, 1, 3, 1}, to[] = {1, 2, 3, 2, 2};
+  for (int v = 0; v < 5; ++v) net.add_vessel(v, from[v], to[v], 0.01, 1e-3, 1e-4, 2e5, 0);
+  net.boundaries = {flow_at(0, q), pressure_at(3, p)};
+  return net;
+}
+
+}  // namespace
+
+// Kirchhoff by hand (r = 1e9 Pa s/m^3, Q = 1e-9 m^3/s, so pressures above P in Pa):
+// 2 p0 - p1 - p2 = 1, 3 p1 - p0 - p2 = 0, 2.5 p2 - p0 - p1 = 0 give p0 = 13/11, p1 = 7/11,
+// p2 = 8/11; the flows 6/11, 5/11, 7/11, -4/11 (against its from -> to), -1/11.
+TEST(SteadyFlowAtNodes, LoopedNetworkMatchesKirchhoffByHand) {
+  const double r = 1e9, q = 1e-9, p = 1000;
+  const Network net = bridged_diamond(q, p);
+  const SteadyFlow s = solve_steady_flow(net, {r, r, r, 2 * r, r}, 0.0);
+  const double expected_p[] = {13.0 / 11, 7.0 / 11, 8.0 / 11, 0};
+  for (int n = 0; n < 4; ++n) EXPECT_NEAR(s.node_pressure[n], p + expected_p[n], 1e-12 * p) << "node " << n;
+  const double expected_q[] = {6.0 / 11, 5.0 / 11, 7.0 / 11, -4.0 / 11, -1.0 / 11};
+  for (int v = 0; v < 5; ++v) EXPECT_NEAR(s.flow[v], q * expected_q[v], 1e-12 * q) << "vessel " << v;
+  EXPECT_TRUE(std::isnan(s.inlet_pressure));  // no tree inlet
+}
+
+// Several inflows and outflows, one pressure, an R outlet: whatever enters leaves.
+TEST(SteadyFlowAtNodes, SeveralInletsAndOutletsBalance) {
+  // A ladder: rails 0-1-2-3 and 4-5-6-7, rungs i <-> i + 4.
+  Network net;
+  for (int n = 0; n < 8; ++n) net.add_node(n);
+  int id = 0;
+  for (int i = 0; i < 3; ++i) net.add_vessel(id++, i, i + 1, 0.01, 1e-3, 1e-4, 2e5, 0);
+  for (int i = 4; i < 7; ++i) net.add_vessel(id++, i + 1, i, 0.01, 1e-3, 1e-4, 2e5, 0);
+  for (int i = 0; i < 4; ++i) net.add_vessel(id++, i, i + 4, 0.01, 0.8e-3, 1e-4, 2e5, 0);
+  NodeBoundary outlet;
+  outlet.node = 7;
+  outlet.type = BoundaryType::resistance;
+  outlet.outlet = resistance_outlet(-1, 5e8, 200.0);
+  net.boundaries = {flow_at(0, 2e-9), flow_at(3, 1e-9), flow_at(5, -0.5e-9), pressure_at(4, 100.0), outlet};
+  std::sort(net.boundaries.begin(), net.boundaries.end(),
+            [](const NodeBoundary& a, const NodeBoundary& b) { return a.node < b.node; });
+  std::vector<double> r(net.vessel_count());
+  for (std::size_t v = 0; v < r.size(); ++v) r[v] = 1e9 * (1 + 0.1 * static_cast<double>(v));
+  const SteadyFlow s = solve_steady_flow(net, r, 0.0);
+  // Net flow out of every node into its vessels.
+  std::vector<double> out(8, 0.0);
+  for (std::size_t v = 0; v < r.size(); ++v) {
+    out[net.from[v]] += s.flow[v];
+    out[net.to[v]] -= s.flow[v];
+  }
+  const double scale = 1e-9, tol = 1e-12 * scale;
+  EXPECT_NEAR(out[0], 2e-9, tol);
+  EXPECT_NEAR(out[3], 1e-9, tol);
+  EXPECT_NEAR(out[5], -0.5e-9, tol);
+  for (int n : {1, 2, 6}) EXPECT_NEAR(out[n], 0.0, tol) << "node " << n;
+  EXPECT_DOUBLE_EQ(s.node_pressure[4], 100.0);
+  EXPECT_NEAR(-out[7], (s.node_pressure[7] - 200.0) / 5e8, tol);  // the outlet's law
+  EXPECT_NEAR(out[4] + out[7], -(2e-9 + 1e-9 - 0.5e-9), tol);    // the rest leaves at 4 and 7
+}
+
+TEST(SteadyFlowAtNodes, RefusesNetworksWithoutAPressureReference) {
+  auto expect_refusal = [&](const Network& net, const std::string& fragment) {
+    try {
+      solve_steady_flow(net, std::vector<double>(net.vessel_count(), 1e9), 0.0);
+      ADD_FAILURE() << "no refusal, expected: " << fragment;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  Network flows_only = bridged_diamond(1e-9, 0);
+  flows_only.boundaries[1] = flow_at(3, -1e-9);
+  expect_refusal(flows_only, "the part of the network with vessel 0 (5 vessels) has flow boundaries only");
+  // A second part, 4 -> 5 -> 6 -> 4, with no boundary at all.
+  Network apart = bridged_diamond(1e-9, 0);
+  for (int n = 4; n < 7; ++n) apart.add_node(n);
+  apart.add_vessel(5, 4, 5, 0.01, 1e-3, 1e-4, 2e5, 0);
+  apart.add_vessel(6, 5, 6, 0.01, 1e-3, 1e-4, 2e5, 0);
+  apart.add_vessel(7, 6, 4, 0.01, 1e-3, 1e-4, 2e5, 0);
+  expect_refusal(apart, "the part of the network with vessel 5 (3 vessels) has no boundary condition");
+  // A dead end: 2 -> 4 with nothing at node 4.
+  Network dead = bridged_diamond(1e-9, 0);
+  dead.add_node(4);
+  dead.add_vessel(5, 2, 4, 0.01, 1e-3, 1e-4, 2e5, 0);
+  expect_refusal(dead, "vessel 5 ends at node 4, which no other vessel meets and which has no boundary condition");
+  dead.boundaries.push_back(flow_at(4, 0.0));  // closed: accepted, and it carries nothing
+  const SteadyFlow closed = solve_steady_flow(dead, std::vector<double>(6, 1e9), 0.0);
+  EXPECT_NEAR(closed.flow[5], 0.0, 1e-24);
+  Network reflecting = bridged_diamond(1e-9, 0);
+  reflecting.boundaries[1].type = BoundaryType::reflection;
+  expect_refusal(reflecting, "node 3: a reflection outlet has no steady resistance");
 }
