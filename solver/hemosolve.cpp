@@ -25,6 +25,7 @@
 #include "solver/pulse_solver.hpp"
 #include "solver/run_estimate.hpp"
 #include "solver/run_report.hpp"
+#include "solver/steady_run.hpp"
 
 using namespace hemotree;
 
@@ -93,7 +94,7 @@ int main(int argc, char** argv) {
   int cycles = 1, max_cycles = 50, frames = 0, checkpoint_every = 0;
   double periodic_tol = 0;
   std::vector<std::string> probe_texts;
-  bool quiet = false, vtk = false, balance = true, force = false;
+  bool quiet = false, vtk = false, balance = true, force = false, steady = false;
   SolverOptions options;
   const int cores = omp_get_num_procs();
   app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
@@ -183,8 +184,16 @@ int main(int argc, char** argv) {
   app.add_flag("--force", force,
                "run even with a --dt or --cfl above the stability limit, an estimated wall time above a day, or "
                "over the checkpoint a killed run left in OUT.partial");
+  auto* steady_flag = app.add_flag(
+      "--steady", steady,
+      "the steady state alone, vessels at their file diameters (what NetFlow computes): flows, pressures and wall "
+      "shear stress in the same files as a run; any connected network with boundaries at nodes");
   app.add_flag("--quiet", quiet, "no progress lines or notes (warnings and errors still)");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
+
+  for (const char* pulsatile_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
+                                     "--probe", "--frames", "--dt", "--start"})
+    steady_flag->excludes(app.get_option(pulsatile_only));
 
   return run_tool(app, argc, argv, [&] {
     // ---- every flag, before any work -------------------------------------------------
@@ -261,6 +270,17 @@ int main(int argc, char** argv) {
     }
     if ((vtk || frames > 0) && net.x.empty())
       throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
+    if (steady) {
+      SteadyRunRequest request;
+      request.input = input;
+      request.out_dir = out_dir;
+      request.rheology_override = options.rheology_override;
+      request.vtk = vtk;
+      request.vtk_keep = vtk_keep;
+      request.quiet = quiet;
+      run_steady(net, request);
+      return 0;
+    }
     if (!net.inlet) throw InputError("the network has no \"inlet\": hemosolve needs one (vprune adds it)");
     const double period = net.inlet->waveform.period;
     check_range(sample_interval, {0, period, true, false}, "--sample-interval", "s");

@@ -32,25 +32,20 @@ WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_
   return t;
 }
 
-VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle, double frequency) {
-  const double omega = 2 * std::numbers::pi * frequency;
+VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vector<std::uint8_t> model,
+                        std::vector<std::string> model_labels, std::vector<std::int64_t> degree) {
   const std::size_t n = cycle.vessels.size();
   VesselTable table(n);
-  std::vector<std::int64_t> degree(n);
-  std::vector<std::uint8_t> vessel_class(n), model(n);
+  std::vector<std::uint8_t> vessel_class(n);
   std::vector<std::string> class_names;
   for (int k = 0; k <= static_cast<int>(VesselClass::capillary); ++k)
     class_names.emplace_back(to_string(static_cast<VesselClass>(k)));
-  for (std::size_t v = 0; v < n; ++v) {
-    degree[v] = solver.is_lumped(v) ? VesselTable::null_integer : solver.degree(v);
-    vessel_class[v] = static_cast<std::uint8_t>(net.vessel_class[v]);
-    model[v] = solver.is_lumped(v) ? 1 : 0;
-  }
+  for (std::size_t v = 0; v < n; ++v) vessel_class[v] = static_cast<std::uint8_t>(net.vessel_class[v]);
   table.add_integer("id", net.id);
   table.add_number("diameter", net.diameter);
   table.add_number("length", net.length);
   table.add_text("class", std::move(vessel_class), std::move(class_names));
-  table.add_text("model", std::move(model), {"1d", "0d"});
+  table.add_text("model", std::move(model), std::move(model_labels));
   table.add_integer("degree", std::move(degree));
   auto column = [&](const char* name, auto value) {
     std::vector<double> x(n);
@@ -68,6 +63,19 @@ VesselTable vessel_results(const Network& net, const PulseSolver& solver, const 
   column("reynolds", [](const VesselCycle& c) { return c.reynolds; });
   column("pwv_pressure", [](const VesselCycle& c) { return c.pwv_pressure; });
   column("pwv_velocity", [](const VesselCycle& c) { return c.pwv_velocity; });
+  return table;
+}
+
+VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle, double frequency) {
+  const double omega = 2 * std::numbers::pi * frequency;
+  const std::size_t n = cycle.vessels.size();
+  std::vector<std::int64_t> degree(n);
+  std::vector<std::uint8_t> model(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    degree[v] = solver.is_lumped(v) ? VesselTable::null_integer : solver.degree(v);
+    model[v] = solver.is_lumped(v) ? 1 : 0;
+  }
+  VesselTable table = cycle_table(net, cycle, std::move(model), {"1d", "0d"}, std::move(degree));
   std::vector<double> womersley(n), elastic(n), theory(n);
   for (std::size_t v = 0; v < n; ++v) {
     const WaveTheory t = wave_theory(solver, net, v, omega);

@@ -3,7 +3,9 @@
 // snapshots of the solution as frames of a ParaView time series.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -32,7 +34,14 @@ struct WaveTheory {
 };
 WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_t vessel, double omega);
 
-// The per-vessel results, one row per vessel in the network's order.
+// The columns every run reports, one row per vessel in the network's order: id, geometry,
+// class, the vessel's model (a label per vessel: model_labels[model[v]]) and degree (null
+// where none), and the cycle's statistics.
+VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vector<std::uint8_t> model,
+                        std::vector<std::string> model_labels, std::vector<std::int64_t> degree);
+
+// The per-vessel results, one row per vessel in the network's order: cycle_table's, and the
+// linear wave theory's Womersley number and wave speeds.
 VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
                            double analysis_frequency);
 

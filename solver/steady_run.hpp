@@ -1,0 +1,46 @@
+// hemosolve --steady: the steady state alone (what Secomb's NetFlow computes for a measured
+// network), reported in the same files and fields as a pulsatile run: each cycle value is the
+// steady one (systolic = diastolic = mean pressure, pulsatility 0, peak = least = mean flow),
+// and what only waves have (wave speeds, Womersley numbers) is null.
+#pragma once
+
+#include <filesystem>
+#include <span>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "formats/network.hpp"
+#include "solver/cycle_statistics.hpp"
+#include "solver/steady_flow.hpp"
+#include "solver/vessel_table.hpp"
+
+namespace hemotree {
+
+// Per vessel its flow (signed: positive from `from` to `to`), the pressure at its middle
+// (the mean of its ends': Poiseuille's profile is linear), the wall shear stress and Reynolds
+// number of its mean velocity in its reference lumen; per run the flows in and out through
+// the boundaries (their balance is the solve's round-off).
+CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFlow& steady);
+
+// Every boundary node's condition and what the solve gives there: {"node", "type", "flow"
+// (into the network, m^3/s), "pressure" (Pa)}, by node.
+nlohmann::json boundary_results(const Network& net, const SteadyFlow& steady);
+
+// cycle_table's columns with the model "steady" and no degree, and null wave columns.
+VesselTable steady_results(const Network& net, const CycleSummary& cycle);
+
+struct SteadyRunRequest {
+  std::string input;               // as given, for summary.json
+  std::filesystem::path out_dir;
+  int rheology_override = -1;      // -1: the file's; else static_cast<int>(Rheology)
+  bool vtk = false;
+  std::span<const std::uint8_t> vtk_keep;
+  bool quiet = false;
+};
+
+// Solves and writes OUT/summary.json, OUT/vessels.csv (and OUT/results.vtp with vtk) through
+// OutputFolder (never a half-written folder). InputError for a network it cannot solve.
+void run_steady(const Network& net, const SteadyRunRequest& request);
+
+}  // namespace hemotree

@@ -1,0 +1,76 @@
+# hemosolve --steady on a network with boundaries at nodes (format version 2): a loop, a
+# vessel written against its flow, a pressure and a flow boundary; the same summary.json and
+# vessels.csv fields as a pulsatile run; the refusals of networks without a pressure reference.
+source "$(dirname "$0")/lib.sh"
+HEMOSOLVE=$BUILD/solver/hemosolve
+PY=/usr/bin/python3
+
+# The bridged diamond of tests/test_steady_flow.cpp, Newtonian blood (3.4 mPa s), vessels of
+# 1 mm and 1 cm with alpha 4/3: r = 128 mu l / (pi D^4) each (vessel 3 twice as long).
+cat >"$WORK/diamond.json" <<'JSON'
+{"format": "vnet", "version": 2,
+ "blood": {"rheology": "newtonian", "newtonian_viscosity": 0.0034},
+ "boundaries": [{"node": 10, "type": "flow", "flow": 1e-6, "hematocrit": 0.4},
+                {"node": 13, "type": "pressure", "pressure": 1000}],
+ "vessels": [
+  {"id": 0, "from": 10, "to": 11, "length": 0.01, "diameter": 0.001},
+  {"id": 1, "from": 10, "to": 12, "length": 0.01, "diameter": 0.001},
+  {"id": 2, "from": 11, "to": 13, "length": 0.01, "diameter": 0.001},
+  {"id": 3, "from": 13, "to": 12, "length": 0.02, "diameter": 0.001},
+  {"id": 4, "from": 11, "to": 12, "length": 0.01, "diameter": 0.001}]}
+JSON
+"$HEMOSOLVE" "$WORK/diamond.json" --steady --out "$WORK/run" 2>"$WORK/err" \
+  && pass "--steady on a looped network" || fail "--steady: $(cat "$WORK/err")"
+"$PY" - "$WORK/run/summary.json" "$WORK/run/vessels.csv" <<'PY' && pass "summary.json: steady values, signed flows, boundaries" || fail "summary.json"
+import csv, json, math, sys
+s = json.load(open(sys.argv[1]))
+assert s["status"] == "complete" and s["mode"] == "steady", s["status"]
+r = 128 * 0.0034 * 0.01 / (math.pi * 0.001 ** 4)
+q = 1e-6
+# Kirchhoff by hand (tests/test_steady_flow.cpp): node pressures above 1000 Pa in units of q r.
+p = {10: 13 / 11, 11: 7 / 11, 12: 8 / 11, 13: 0}
+flows = {0: 6 / 11, 1: 5 / 11, 2: 7 / 11, 3: -4 / 11, 4: -1 / 11}
+ends = {0: (10, 11), 1: (10, 12), 2: (11, 13), 3: (13, 12), 4: (11, 12)}
+rows = {v["id"]: v for v in s["vessels"]}
+for v, f in flows.items():
+    row = rows[v]
+    assert abs(row["mean_flow"] - f * q) < 1e-9 * q, (v, row["mean_flow"])
+    a, b = ends[v]
+    mid = 1000 + q * r * (p[a] + p[b]) / 2
+    assert abs(row["mean_pressure"] - mid) < 1e-9 * mid, (v, row["mean_pressure"], mid)
+    assert row["systolic_pressure"] == row["diastolic_pressure"] == row["mean_pressure"]
+    assert row["pulsatility_index"] == 0 and row["peak_flow"] == row["least_flow"] == row["mean_flow"]
+    # Poiseuille: tau = 4 mu u / R, signed with the flow
+    u = row["mean_flow"] / (math.pi * 0.0005 ** 2)
+    assert abs(row["mean_wss"] - 4 * 0.0034 * u / 0.0005) < 1e-9 * abs(row["mean_wss"]), v
+    assert row["model"] == "steady" and row["degree"] is None and row["pwv_pressure"] is None
+assert abs(s["inlet_mean_flow"] - q) < 1e-12 * q and abs(s["outlets_mean_flow"] - q) < 1e-12 * q
+assert abs(s["mass_balance"]) < 1e-12
+b = {x["node"]: x for x in s["boundaries"]}
+assert b[10]["type"] == "flow" and abs(b[10]["flow"] - q) < 1e-12 * q
+assert b[13]["type"] == "pressure" and b[13]["pressure"] == 1000 and abs(b[13]["flow"] + q) < 1e-12 * q
+header = next(csv.reader(open(sys.argv[2])))
+assert header[:6] == ["id", "diameter", "length", "class", "model", "degree"], header
+PY
+
+# ---- refusals: one line, exit 2, nothing written -----------------------------------------
+"$PY" - "$WORK/diamond.json" "$WORK" <<'PY'
+import json, sys
+net = json.load(open(sys.argv[1]))
+flows = json.loads(json.dumps(net)); flows["boundaries"][1] = {"node": 13, "type": "flow", "flow": -1e-6}
+json.dump(flows, open(sys.argv[2] + "/flows.json", "w"))
+dead = json.loads(json.dumps(net)); dead["vessels"].append({"id": 5, "from": 12, "to": 14, "length": 0.01, "diameter": 0.001})
+json.dump(dead, open(sys.argv[2] + "/dead.json", "w"))
+twice = json.loads(json.dumps(net)); twice["boundaries"].append({"node": 13, "type": "R", "R": 1e9})
+json.dump(twice, open(sys.argv[2] + "/twice.json", "w"))
+PY
+expect_error "flows only" 2 "has flow boundaries only: its pressure is undetermined" -- \
+  "$HEMOSOLVE" "$WORK/flows.json" --steady --out "$WORK/flows"
+[ ! -e "$WORK/flows" ] && pass "nothing written for a refused network" || fail "$WORK/flows exists"
+expect_error "dead end" 2 "vessel 5 ends at node 14, which no other vessel meets and which has no boundary condition" -- \
+  "$HEMOSOLVE" "$WORK/dead.json" --steady --out "$WORK/dead"
+expect_error "two conditions at a node" 2 "node 13 has two boundary conditions" -- \
+  "$HEMOSOLVE" "$WORK/twice.json" --steady --out "$WORK/twice"
+expect_error "--steady with --cycles" 2 "--cycles excludes --steady" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --steady --cycles 3 --out "$WORK/x"
+finish
