@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <filesystem>
@@ -282,6 +284,13 @@ VesselModel read_vessel(const Source& source, const YAML::Node& node, std::size_
   return v;
 }
 
+// Three significant digits, for a figure a note reports.
+std::string three_digits(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return format_number(std::strtod(text, nullptr));
+}
+
 // --- the inlet table -----------------------------------------------------------------------
 
 // openBF's inlet file: two columns, t [s] and Q [m^3/s], over one cardiac cycle whose period is
@@ -374,8 +383,8 @@ Waveform read_inlet_table(const std::string& path, const std::string& named_by, 
     for (const Row& r : rows)
       if (r.t < period) deviation = std::max(deviation, std::abs(w(r.t) - openbf_flow(rows, r.t)));
     options.note("inlet table " + path + ": rows " + lines + " go back in time and are left out; the flow then " +
-                 "differs from openBF's reading by at most " + format_number(deviation) + " m^3/s (" +
-                 format_number(std::round(1e4 * deviation / w.peak()) / 100) + " % of the peak)");
+                 "differs from openBF's reading by at most " + three_digits(deviation) + " m^3/s (" +
+                 three_digits(100 * deviation / w.peak()) + " % of the peak)");
   }
   if (last != w.value.front())
     options.note("inlet table " + path + ": its flow at the period (" + format_number(last) +
@@ -827,9 +836,26 @@ void write_openbf(const Network& net, OutputStream& out, const std::string& inle
                                          net.provenance["labels"].size() == nv
                                      ? &net.provenance["labels"]
                                      : nullptr;
-  const double pext = net.provenance.contains("external_pressure") && net.provenance["external_pressure"].is_number()
-                          ? net.provenance["external_pressure"].get<double>()
-                          : 0.0;
+  // openBF's one external pressure: the reference pressure of the vessels whose tube law is
+  // given by beta, else what an import from openBF recorded, else 0.
+  const auto has_beta = [&](std::size_t v) { return !net.beta.empty() && !std::isnan(net.beta[v]); };
+  double pext = net.provenance.contains("external_pressure") && net.provenance["external_pressure"].is_number()
+                    ? net.provenance["external_pressure"].get<double>()
+                    : 0.0;
+  std::optional<std::size_t> first_beta;
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!has_beta(v)) continue;
+    if (!first_beta) first_beta = v, pext = net.reference_pressure[v];
+    if (net.reference_pressure[v] != pext)
+      throw InputError(vessel_name(v) + ": reference_pressure " + format_number(net.reference_pressure[v]) +
+                       " Pa differs from " + vessel_name(*first_beta) + "'s " + format_number(pext) +
+                       " Pa; openBF's Pext is one for the network");
+  }
+  if (first_beta)
+    for (std::size_t v = 0; v < nv; ++v)
+      if (!has_beta(v) && pext != 0)
+        throw InputError(vessel_name(v) + ": no beta, where " + vessel_name(*first_beta) + "'s reference_pressure " +
+                         format_number(pext) + " Pa would become openBF's Pext for every vessel");
 
   // The YAML names the inlet file relative to its own folder (openBF looks there).
   std::string inlet_name = inlet_path;
@@ -841,7 +867,7 @@ void write_openbf(const Network& net, OutputStream& out, const std::string& inle
   std::string y;
   y += "# openBF model written by hemotree";
   if (net.provenance.contains("source") && net.provenance["source"].is_string())
-    y += " from " + net.provenance["source"].get<std::string>();
+    for (const char c : " from " + net.provenance["source"].get<std::string>()) y += c == '\n' || c == '\r' ? ' ' : c;
   y += "\n";
   if (blood.rheology != Rheology::newtonian)
     y += "# hemotree's blood was " + std::string(to_string(blood.rheology)) +
@@ -855,21 +881,30 @@ void write_openbf(const Network& net, OutputStream& out, const std::string& inle
   out << y;
 
   for (std::size_t v = 0; v < nv; ++v) {
-    if (!net.beta.empty() && !std::isnan(net.beta[v]))
-      throw InputError(vessel_name(v) + ": a tube law given by beta; openBF takes E and h0");
-    if (std::isnan(net.youngs_modulus[v]))
+    // A tube law given by beta is openBF's thin wall with E h0 = 3 beta A0 / (4 sqrt(pi)): h0
+    // is the vessel's (or openBF's law), E follows, exact where the vessel does not taper.
+    double youngs_modulus = net.youngs_modulus[v], wall = net.wall_thickness[v];
+    if (has_beta(v)) {
+      if (net.is_tapered(v))
+        throw InputError(vessel_name(v) + ": a tapered vessel whose tube law is given by beta; openBF derives a "
+                         "tapered vessel's from E and h0");
+      const double r = net.diameter[v] / 2;
+      if (std::isnan(wall)) wall = avolio_wall_thickness(r);
+      youngs_modulus = 3 * net.beta[v] * std::numbers::pi * r * r / (4 * std::sqrt(std::numbers::pi) * wall);
+    }
+    if (std::isnan(youngs_modulus))
       throw InputError(vessel_name(v) + ": no Young's modulus; openBF needs E for every vessel");
     const bool own_label = labels && (*labels)[v].is_string() && !(*labels)[v].get<std::string>().empty();
     y = "  - label: " + yaml_string(own_label ? (*labels)[v].get<std::string>() : "v" + std::to_string(net.id[v])) + "\n";
     y += "    sn: " + std::to_string(number[static_cast<std::size_t>(net.from[v])]) + "\n";
     y += "    tn: " + std::to_string(number[static_cast<std::size_t>(net.to[v])]) + "\n";
     y += "    L: " + yaml_real(net.length[v]) + "\n";
-    y += "    E: " + yaml_real(net.youngs_modulus[v]) + "\n";
+    y += "    E: " + yaml_real(youngs_modulus) + "\n";
     if (net.is_tapered(v))
       y += "    Rp: " + yaml_real(net.diameter[v] / 2) + "\n    Rd: " + yaml_real(net.distal_diameter[v] / 2) + "\n";
     else
       y += "    R0: " + yaml_real(net.diameter[v] / 2) + "\n";
-    if (!std::isnan(net.wall_thickness[v])) y += "    h0: " + yaml_real(net.wall_thickness[v]) + "\n";
+    if (!std::isnan(wall)) y += "    h0: " + yaml_real(wall) + "\n";
     if (pext != 0) y += "    Pext: " + yaml_real(pext) + "\n";
     y += "    gamma_profile: " + std::to_string(static_cast<long long>(whole)) + "\n";
     if (const Outlet* o = outlet_of[v]) {
