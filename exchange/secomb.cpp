@@ -569,8 +569,12 @@ void check_writable(const Network& net, const std::vector<NodeBoundary>& boundar
       throw InputError(vessel_name(net, v) + " tapers, and network.dat holds one diameter a segment");
     const auto f = static_cast<std::size_t>(net.from[v]), t = static_cast<std::size_t>(net.to[v]);
     const double distance = std::hypot(net.x[t] - net.x[f], net.y[t] - net.y[f], net.z[t] - net.z[f]);
-    // Beyond the rounding of coordinates written to 9 digits: a curved vessel.
-    if (!(std::abs(distance - net.length[v]) <= 1e-5 * net.length[v]))
+    // Beyond the rounding of lengths and coordinates to 9 significant digits (vnet files):
+    // a curved vessel. A coordinate far from the origin rounds by more than a short vessel's
+    // length would, hence the term in the coordinates' size.
+    const double size = std::max({std::abs(net.x[f]), std::abs(net.y[f]), std::abs(net.z[f]), std::abs(net.x[t]),
+                                  std::abs(net.y[t]), std::abs(net.z[t])});
+    if (!(std::abs(distance - net.length[v]) <= 1e-5 * net.length[v] + 2e-8 * size))
       throw InputError(vessel_name(net, v) + ": length " + format_number(net.length[v] / metre_per_um) +
                        " um differs from the distance between its nodes (" + format_number(distance / metre_per_um) +
                        " um), and NetFlow takes lengths from the coordinates");

@@ -1,0 +1,69 @@
+// vexport: writes a vnet network in another program's format: Secomb's network.dat (NetFlow)
+// or openBF's YAML model with its inlet table (docs/import.md).
+#include <filesystem>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/errors.hpp"
+#include "cli/tool.hpp"
+#include "cli/units.hpp"
+#include "exchange/openbf.hpp"
+#include "exchange/secomb.hpp"
+#include "formats/network_io.hpp"
+
+using namespace hemotree;
+
+namespace {
+
+// openBF names its inflow file in the YAML: it goes beside it, OUT's stem + "_inlet.dat".
+std::string inlet_path_for(const std::string& output) {
+  const std::filesystem::path out(output);
+  return (out.parent_path() / (out.stem().string() + "_inlet.dat")).string();
+}
+
+// What network.dat leaves out of a network that has it, said once each.
+void note_what_secomb_drops(const Network& net) {
+  note("note: network.dat holds segments, node coordinates and steady boundary pressures and flows; not written: "
+       "wall thickness and Young's modulus (NetFlow's flow is steady)" +
+       std::string(net.beta.empty() ? "" : ", the tube laws' beta"));
+  if (net.blood)
+    note("note: blood not written: NetFlow takes it from its RheolParams.dat (here plasma viscosity " +
+         format_quantity(net.blood->plasma_viscosity, "cP") + ", mean cell volume " +
+         format_rounded(net.blood->mean_cell_volume * 1e18) + " fl)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Writes a vnet network in another program's format.", "vexport"};
+  std::string format, input = "-", output = "-";
+  app.add_option("FORMAT", format, "secomb (NetFlow's network.dat) or openbf (YAML, with an inlet table beside it)")
+      ->required();
+  app.add_option("NET", input, "network file (vnet JSON); - reads standard input")->capture_default_str();
+  app.add_option("-o,--output", output,
+                 "output file; - for standard output (secomb only: openbf writes its inlet table beside the YAML, "
+                 "as OUT's name + _inlet.dat)")
+      ->capture_default_str();
+  app.set_version_flag("--version", std::string("vexport ") + HEMOTREE_VERSION);
+
+  return run_tool(app, argc, argv, [&] {
+    if (format != "secomb" && format != "openbf")
+      throw InputError("FORMAT must be secomb or openbf (got '" + format + "')");
+    if (format == "openbf" && (output.empty() || output == "-"))
+      throw InputError("vexport openbf needs -o FILE.yaml: its inlet table is written beside it");
+
+    const Network net = read_network(input);
+    OutputStream out(output);
+    if (format == "secomb") {
+      write_secomb(net, out);
+      note_what_secomb_drops(net);
+    } else {
+      const std::string inlet = inlet_path_for(output);
+      write_openbf(net, out, inlet);
+      note("note: inlet table written to " + inlet);
+    }
+    out.commit();
+    return 0;
+  });
+}
