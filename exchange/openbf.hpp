@@ -13,8 +13,12 @@ namespace hemotree {
 // Throws InputError "FILE:LINE: what is wrong" for a malformed model or one using a feature
 // hemotree does not model; IoError when the file or its inlet file cannot be read.
 Network read_openbf(const std::string& path, const ImportOptions& options);
-// Writes an openBF YAML model; the inlet's table goes to inlet_path (two columns t, Q),
-// named in the YAML relative to the YAML's folder.
+// Writes an openBF YAML model into out (the caller commits it); the inlet's table goes to
+// inlet_path (two columns t, Q, from 0 to the period; written and committed here), named in
+// the YAML relative to the YAML's folder. Throws InputError "node ID: ..." or "vessel ID: ..."
+// for what openBF cannot express: pressure boundaries, a second inflow, an inflow hematocrit,
+// resistance outlets, RCR outlets with R1 or R2 = 0, a terminal vessel without an outlet, a
+// tapered vessel whose tube law is given by beta, a velocity profile that is not a whole gamma.
 void write_openbf(const Network& net, OutputStream& out, const std::string& inlet_path);
 
 }  // namespace hemotree
