@@ -146,4 +146,12 @@ TubeLaw tube_law(const WallProperties& wall, double external_pressure, double th
              : thick_wall_tube_law(wall, external_pressure, poisson_ratio);
 }
 
+double thin_wall_tapered_compliance(double length, double d0, double d1, double wall_thickness,
+                                    double youngs_modulus, double poisson_ratio) {
+  const double r0 = d0 / 2, r1 = d1 / 2;
+  const double cubes = r0 * r0 * r0 + r0 * r0 * r1 + r0 * r1 * r1 + r1 * r1 * r1;
+  return 2 * std::numbers::pi * (1 - poisson_ratio * poisson_ratio) / (youngs_modulus * wall_thickness) * length *
+         cubes / 4;
+}
+
 }  // namespace hemotree

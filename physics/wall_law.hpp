@@ -49,4 +49,11 @@ TubeLaw tube_law(const WallProperties& wall, double external_pressure,
                  double thick_ratio = default_thick_wall_ratio,
                  double poisson_ratio = default_poisson_ratio);
 
+// Compliance at the reference lumen, int_0^L dA/dp dx [m^3/Pa], of a thin-walled vessel whose
+// radius is linear from d0/2 to d1/2 with E and h constant along it (as openBF's tapered
+// vessels): dA/dp = 2 sqrt(A) / beta = 2 pi (1 - nu^2) R^3 / (E h), and int R^3 dx =
+// L (R0^3 + R0^2 R1 + R0 R1^2 + R1^3) / 4.
+double thin_wall_tapered_compliance(double length, double d0, double d1, double wall_thickness,
+                                    double youngs_modulus, double poisson_ratio = default_poisson_ratio);
+
 }  // namespace hemotree
