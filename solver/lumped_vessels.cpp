@@ -3,15 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "cli/errors.hpp"
+#include "physics/poiseuille.hpp"
 #include "solver/solution_breakdown.hpp"
 
 namespace hemotree {
 
 LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws, const ViscosityTable& viscosity,
-                             const Blood& blood, const std::vector<bool>& zero_d)
+                             const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of,
+                             std::span<const VesselTaper> tapers)
     : density_(blood.density), friction_k_(friction_coefficient(blood.alpha)), viscosity_(&viscosity) {
   const std::size_t n = net.vessel_count();
   node_of_.assign(net.node_count(), -1);
@@ -35,7 +38,13 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
     edge_length_.push_back(net.length[v]);
     edge_root_slope_.push_back(1 / law.beta);
     edge_root_intercept_.push_back(std::sqrt(law.reference_area) - law.reference_pressure / law.beta);
+    if (!taper_of.empty() && taper_of[v] >= 0) {
+      if (taper_edge_.empty()) taper_edge_.assign(n, -1);  // sized for every vessel; shrunk below
+      taper_edge_[vessels_.size() - 1] = static_cast<std::int32_t>(tapered_.size());
+      tapered_.push_back(describe_taper(tapers[static_cast<std::size_t>(taper_of[v])], blood.alpha));
+    }
   }
+  if (!taper_edge_.empty()) taper_edge_.resize(vessels_.size());
   if (vessels_.empty()) return;
   network_nodes_ = network_node_.size();
   nodes_ = network_nodes_;
@@ -83,6 +92,13 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
     const double w = edge_length_[e] / 2, c = edge_root_intercept_[e], d = edge_root_slope_[e];
     for (const std::int32_t k : {a_[e], b_[e]}) {
       const auto i = static_cast<std::size_t>(k);
+      if (tapered(e)) {  // int A(p, x) dx, half at each node
+        const TaperedEdge& t = tapered_[static_cast<std::size_t>(taper_edge_[e])];
+        volume_a_[i] += t.volume_a / 2;
+        volume_b_[i] += t.volume_b / 2;
+        volume_c_[i] += t.volume_c / 2;
+        continue;
+      }
       volume_a_[i] += w * d * d;
       volume_b_[i] += 2 * w * c * d;
       volume_c_[i] += w * c * c;
@@ -120,6 +136,86 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
   block_outflow_.assign((nodes_ + block - 1) / block, 0.0);
 }
 
+LumpedVessels::TaperedEdge LumpedVessels::describe_taper(const VesselTaper& taper, double alpha) {
+  // sqrt(A) = c(x) + d(x) p with c = sqrt(A_ref) - p_ref / beta, d = 1 / beta, so
+  // int A dx = p^2 int d^2 dx + 2 p int c d dx + int c^2 dx: eight Gauss points along it.
+  TaperedEdge t;
+  t.taper = taper;
+  auto root = [&](double x, double& c, double& d) {
+    const VesselLaw law = taper.at(x);
+    d = 1 / law.beta;
+    c = std::sqrt(law.reference_area) - law.reference_pressure * d;
+  };
+  for (std::size_t i = 0; i < taper_rule_nodes.size(); ++i) {
+    double c, d;
+    root(taper_rule_nodes[i], c, d);
+    const double w = taper_rule_weights[i] * taper.length;
+    t.volume_a += w * d * d;
+    t.volume_b += 2 * w * c * d;
+    t.volume_c += w * c * c;
+    // The rule's points in u, the fraction of the rigid taper's resistance, where its
+    // pressure profile puts p = pa - (pa - pb) u.
+    const double diameter = tapered_resistance_diameter(taper.d0, taper.d1, taper_rule_nodes[i]);
+    const double x = taper.d1 != taper.d0 ? (diameter - taper.d0) / (taper.d1 - taper.d0) : taper_rule_nodes[i];
+    root(x, t.root_c[i], t.root_d[i]);
+    t.rigid_area[i] = std::numbers::pi / 4 * diameter * diameter;
+  }
+  t.unit_resistance = tapered_poiseuille_resistance(1.0, taper.length, taper.d0, taper.d1, alpha);
+  return t;
+}
+
+double LumpedVessels::tapered_resistance(std::int32_t index, double pa, double pb) const {
+  // R = int k mu(A) / A^2 dx = R_1 int_0^1 mu(A) (A_rigid / A)^2 du (physics/poiseuille.hpp's
+  // substitution), A at the rigid taper's pressure p(u) = pa - (pa - pb) u: exact for a rigid
+  // taper, and it follows the distension along the vessel as the uniform vessels' Simpson rule does.
+  const TaperedEdge& t = tapered_[static_cast<std::size_t>(taper_edge_[static_cast<std::size_t>(index)])];
+  double sum = 0;
+  for (std::size_t i = 0; i < taper_rule_nodes.size(); ++i) {
+    const double root = t.root_c[i] + t.root_d[i] * (pa - (pa - pb) * taper_rule_nodes[i]);
+    const double area = root * root, ratio = t.rigid_area[i] / area;
+    sum += taper_rule_weights[i] * (*viscosity_)(area) * ratio * ratio;
+  }
+  return t.unit_resistance * sum;
+}
+
+double LumpedVessels::tapered_inertance(std::int32_t index, double pa, double pb) const {
+  // rho int dx / A with the lumen at the mean pressure, as a uniform vessel's: on the
+  // resistance's points u, dx = (R_1 / k) A_rigid^2 du, so int dx / A = (R_1 / k) int
+  // A_rigid^2 / A du, a smooth integrand (about A_rigid).
+  const TaperedEdge& t = tapered_[static_cast<std::size_t>(taper_edge_[static_cast<std::size_t>(index)])];
+  const double p = 0.5 * (pa + pb);
+  double sum = 0;
+  for (std::size_t i = 0; i < taper_rule_nodes.size(); ++i) {
+    const double root = t.root_c[i] + t.root_d[i] * p;
+    sum += taper_rule_weights[i] * t.rigid_area[i] * t.rigid_area[i] / (root * root);
+  }
+  return density_ * t.unit_resistance / friction_k_ * sum;
+}
+
+double LumpedVessels::tapered_compliance(std::int32_t index, double p) const {
+  const TaperedEdge& t = tapered_[static_cast<std::size_t>(taper_edge_[static_cast<std::size_t>(index)])];
+  return 2 * t.volume_a * p + t.volume_b;
+}
+
+double LumpedVessels::tapered_volume(std::int32_t index) const {
+  const auto e = static_cast<std::size_t>(index);
+  const TaperedEdge& t = tapered_[static_cast<std::size_t>(taper_edge_[e])];
+  double v = 0;
+  for (const std::int32_t k : {a_[e], b_[e]}) {
+    const double p = pressure_[static_cast<std::size_t>(k)];
+    v += 0.5 * ((t.volume_a * p + t.volume_b) * p + t.volume_c);
+  }
+  return v;
+}
+
+double LumpedVessels::resistance_fraction(std::size_t e, double x) const {
+  const VesselTaper& taper = tapered_[static_cast<std::size_t>(taper_edge_[e])].taper;
+  if (taper.d1 == taper.d0) return x;
+  const double d = taper.diameter(x);
+  const double inverse_cube0 = 1 / (taper.d0 * taper.d0 * taper.d0), inverse_cube1 = 1 / (taper.d1 * taper.d1 * taper.d1);
+  return (inverse_cube0 - 1 / (d * d * d)) / (inverse_cube0 - inverse_cube1);
+}
+
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
   coupling_nodes_ = std::move(nodes);
   held_inflow_.assign(coupling_nodes_.size(), 0.0);
@@ -151,6 +247,10 @@ void LumpedVessels::update_resistances() {
 }
 
 double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const {
+  if (tapered(e)) {  // its interior profile is the rigid taper's (pressure_at): no capacities
+    capacity_a = capacity_b = 0;
+    return tapered_resistance(static_cast<std::int32_t>(e), pa, pb);
+  }
   const double c = edge_root_intercept_[e], d = edge_root_slope_[e];
   const double sa = c + d * pa, sb = c + d * pb, sm = c + d * 0.5 * (pa + pb);
   const double aa = sa * sa, ab = sb * sb, am = sm * sm;
@@ -172,7 +272,7 @@ void LumpedVessels::update_dynamic_pressures() {
     double weighted = 0, weight = 0;
     for (auto i = coupling_edge_offset_[j]; i < coupling_edge_offset_[j + 1]; ++i) {
       const auto e = static_cast<std::size_t>(coupling_edge_[static_cast<std::size_t>(i)]);
-      const double s = lumen_root(e, pressure_[k]);
+      const double s = lumen_root(e, pressure_[k], a_[e] == static_cast<std::int32_t>(k) ? 0.0 : 1.0);
       const double q = std::abs(flow_[e]), u = q / (s * s);
       weighted += q * u;
       weight += q;
@@ -225,7 +325,10 @@ void LumpedVessels::start_at_rest(std::span<const VesselLaw> laws) {
   std::vector<double> sum(network_nodes_, 0.0), count(network_nodes_, 0.0);
   for (std::size_t e = 0; e < vessels_.size(); ++e)
     for (const std::int32_t k : {a_[e], b_[e]}) {
-      sum[static_cast<std::size_t>(k)] += laws[static_cast<std::size_t>(vessels_[e])].reference_pressure;
+      const VesselLaw& law = laws[static_cast<std::size_t>(vessels_[e])];
+      // A tapered vessel rests at its measured lumen (vessel_equations.hpp), at that pressure.
+      sum[static_cast<std::size_t>(k)] += tapered(e) ? law.pressure(tapered_[static_cast<std::size_t>(taper_edge_[e])].taper.rest_area(0))
+                                                     : law.reference_pressure;
       count[static_cast<std::size_t>(k)] += 1;
     }
   for (std::size_t k = 0; k < network_nodes_; ++k) pressure_[k] = sum[k] / count[k];
@@ -256,6 +359,7 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
   // error of O(dt^2) in the coefficients keeps BDF2 second order with one solve; the
   // resistance is extrapolated itself, no viscosity to evaluate, within a factor of two of
   // today's), or a Picard pass's last solution.
+  const bool has_tapers = !tapered_.empty();
   auto at = [&](std::int32_t k) {
     const auto i = static_cast<std::size_t>(k);
     return extrapolated ? 2 * pressure_[i] - previous_pressure_[i] : predicted_[i];
@@ -276,7 +380,8 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
         r = resistance(e, pa, pb, capacity_a, capacity_b);
       }
       const double s = edge_root_intercept_[e] + edge_root_slope_[e] * 0.5 * (pa + pb);
-      const double inertance = density_ * edge_length_[e] / (s * s);
+      const double inertance = has_tapers && tapered(e) ? tapered_inertance(static_cast<std::int32_t>(e), pa, pb)
+                                                        : density_ * edge_length_[e] / (s * s);
       conductance_[e] = 1 / (r + 1.5 * inertance / dt);
       history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
     }
@@ -395,6 +500,7 @@ double LumpedVessels::pressure_at(std::int32_t index, double x) const {
   const double drop = pa - pb;
   if (drop == 0 || x <= 0) return pa;
   if (x >= 1) return pb;
+  if (tapered(e)) return pa - drop * resistance_fraction(e, x);  // the rigid taper's profile
   // With G = A^2 / (k mu) linear in p between G_a and G_b, int_p^pa G dp = x int_pb^pa G dp
   // is a quadratic in d = pa - p: G_a d - g d^2 / 2 = x F, g = (G_a - G_b) / (pa - pb).
   const double ga = capacity_a_[e], gb = capacity_b_[e];
@@ -411,7 +517,7 @@ void LumpedVessels::sample(double x, std::span<double> area, std::span<double> f
     const auto e = static_cast<std::size_t>(i);
     const auto v = static_cast<std::size_t>(vessels_[e]);
     const double p = pressure_at(static_cast<std::int32_t>(i), x);
-    const double s = lumen_root(e, p);
+    const double s = lumen_root(e, p, x);
     area[v] = s * s;
     flow[v] = flow_[e];
     if (!pressure.empty()) pressure[v] = p;
@@ -445,8 +551,8 @@ void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std
 
 void LumpedVessels::check(double time) const {
   for (std::size_t e = 0; e < vessels_.size(); ++e) {
-    const double s_a = lumen_root(e, pressure_[static_cast<std::size_t>(a_[e])]);
-    const double s_b = lumen_root(e, pressure_[static_cast<std::size_t>(b_[e])]);
+    const double s_a = lumen_root(e, pressure_[static_cast<std::size_t>(a_[e])], 0.0);
+    const double s_b = lumen_root(e, pressure_[static_cast<std::size_t>(b_[e])], 1.0);
     if (!(s_a > 0) || !(s_b > 0) || !std::isfinite(flow_[e]) || !std::isfinite(s_a * s_b))
       throw SolutionBreakdown(vessel_ids_[e], time);
   }

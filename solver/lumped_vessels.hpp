@@ -28,6 +28,8 @@
 // 1D scheme let through that end (docs/solver.md §10).
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -45,8 +47,13 @@ class LumpedVessels {
   LumpedVessels() = default;  // none
   // zero_d: per vessel, whether it is 0D. Throws InputError for a reflection outlet on a 0D
   // vessel (it needs the waves of a 1D one).
+  // taper_of: per vessel, its index in tapers or -1 (empty: no vessel tapers). A tapered 0D
+  // vessel (docs/solver.md §10) holds int A(p, x) dx, still a quadratic in p; its resistance
+  // is int k mu(A) / A^2 dx along the rigid taper's pressure profile, its inertance
+  // rho int dx / A.
   LumpedVessels(const Network& net, std::span<const VesselLaw> laws, const ViscosityTable& viscosity,
-                const Blood& blood, const std::vector<bool>& zero_d);
+                const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of = {},
+                std::span<const VesselTaper> tapers = {});
   // Solves a step takes (1: the extrapolated linearisation alone), and the threads of its
   // loops over vessels and nodes and of the elimination's subtrees.
   void set_passes(int passes) { passes_ = passes; }
@@ -124,14 +131,22 @@ class LumpedVessels {
       s.pressure_in = pressure_at(static_cast<std::int32_t>(i), 0.0);
       s.pressure_centre = pressure_at(static_cast<std::int32_t>(i), 0.5);
       s.pressure_out = pressure_at(static_cast<std::int32_t>(i), 1.0);
-      const double root_in = lumen_root(e, s.pressure_in), root_centre = lumen_root(e, s.pressure_centre),
-                   root_out = lumen_root(e, s.pressure_out);
+      const double root_in = lumen_root(e, s.pressure_in, 0.0), root_centre = lumen_root(e, s.pressure_centre, 0.5),
+                   root_out = lumen_root(e, s.pressure_out, 1.0);
       s.area_in = root_in * root_in;
       s.area_centre = root_centre * root_centre;
       s.area_out = root_out * root_out;
       f(static_cast<std::size_t>(vessels_[e]), s);
     }
   }
+  // A tapered 0D vessel's volume, half at each of its nodes' pressures as the nodes hold it [m^3].
+  double tapered_volume(std::int32_t index) const;
+  // The parts of a tapered 0D vessel at its node pressures pa, pb (tests: against quadrature):
+  // resistance [Pa s/m^3], inertance [Pa s^2/m^3], and compliance int dA/dp dx at a uniform
+  // pressure p [m^3/Pa].
+  double tapered_resistance(std::int32_t index, double pa, double pb) const;
+  double tapered_inertance(std::int32_t index, double pa, double pb) const;
+  double tapered_compliance(std::int32_t index, double p) const;
   // The volume the 0D vessels hold now (what BDF2 conserves: (3 V^n - V^(n-1)) / 2, which
   // is V at a steady state), capacitors not included [m^3].
   double stored_volume() const;
@@ -158,6 +173,28 @@ class LumpedVessels {
   double node_excess(std::size_t k, double p) const { return (volume_a_[k] * p + volume_b_[k]) * p; }
   // sqrt(A) of 0D vessel e at pressure p: the tube law's root, linear in p.
   double lumen_root(std::size_t e, double p) const { return edge_root_intercept_[e] + edge_root_slope_[e] * p; }
+  // The same at fraction x along it (a tapered vessel's law changes along it).
+  double lumen_root(std::size_t e, double p, double x) const {
+    if (taper_edge_.empty() || taper_edge_[e] < 0) return lumen_root(e, p);
+    const VesselLaw law = tapered_[static_cast<std::size_t>(taper_edge_[e])].taper.at(x);
+    return std::sqrt(law.reference_area) + (p - law.reference_pressure) / law.beta;
+  }
+  // A tapered 0D vessel: its law along it, its volume V(p) = a p^2 + b p + c at a uniform p,
+  // and at the rule's points u_i of the rigid taper's resistance (physics/poiseuille.hpp)
+  // the lumen's root c_i + d_i p and the reference lumen; unit_resistance is the rigid
+  // taper's at unit viscosity.
+  struct TaperedEdge {
+    VesselTaper taper;
+    double volume_a = 0, volume_b = 0, volume_c = 0;
+    std::array<double, 8> root_c{}, root_d{}, rigid_area{};
+    double unit_resistance = 0;
+  };
+  std::vector<TaperedEdge> tapered_;
+  std::vector<std::int32_t> taper_edge_;  // per 0D vessel (empty without tapers)
+  bool tapered(std::size_t e) const { return !taper_edge_.empty() && taper_edge_[e] >= 0; }
+  static TaperedEdge describe_taper(const VesselTaper& taper, double alpha);
+  // Fraction of the rigid taper's resistance built by fraction x of its length.
+  double resistance_fraction(std::size_t e, double x) const;
   double node_compliance(std::size_t k, double p) const { return 2 * volume_a_[k] * p + volume_b_[k]; }
   double pressure_from_excess(std::size_t node, double excess) const;
   // The resistance of 0D vessel e between end pressures pa and pb: L over Simpson's mean of

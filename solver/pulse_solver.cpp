@@ -76,10 +76,33 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
       law.reference_area = t.reference_area;
       law.reference_pressure = t.reference_pressure;
     }
+    if (net.is_tapered(v)) {
+      // The law along the vessel (vessel_equations.hpp): the wall's h and E, or the given
+      // beta at the proximal diameter, with the proximal diameter's wall model.
+      VesselTaper taper;
+      taper.d0 = net.diameter[v];
+      taper.d1 = net.distal_diameter[v];
+      taper.length = net.length[v];
+      taper.density = blood_.density;
+      taper.alpha = blood_.alpha;
+      taper.given_beta = !net.beta.empty() && !std::isnan(net.beta[v]);
+      taper.beta0 = law.beta;
+      taper.reference_pressure = law.reference_pressure;
+      if (!taper.given_beta) {
+        taper.wall = {net.diameter[v], net.wall_thickness[v], net.youngs_modulus[v]};
+        taper.model = choose_wall_model(taper.wall, options.thick_wall_ratio);
+        taper.external_pressure = options.external_pressure;
+      }
+      if (taper_of_.empty()) taper_of_.assign(n, -1);
+      taper_of_[v] = static_cast<std::int32_t>(tapers_.size());
+      tapers_.push_back(taper);
+      law = taper.at(0);
+      distal_laws_.push_back(taper.at(1));
+    }
   }
 
   choose_models(options);
-  lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_);
+  lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_);
   lumped_.set_passes(options.lumped_passes);
   lumped_.set_threads(threads_);
 
@@ -131,6 +154,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   flux_q_.resize(rows, points);
   source_q_.resize(rows, points);
 
+  compute_rest_correction();
   started_from_steady_ = options.steady_start && steady;
   if (started_from_steady_) start_from_steady_flow(*steady);
   else start_at_rest();
@@ -185,9 +209,22 @@ void PulseSolver::choose_models(const SolverOptions& options) {
   for (std::size_t v = 0; v < n; ++v) {
     const VesselLaw& law = laws_[v];
     const double area = law.reference_area, length = net_.length[v];
-    const double transit = length / law.wave_speed(area);
-    const double compliance = length * 2 * std::sqrt(area) / law.beta;
-    const double resistance = friction_k_ * viscosity_(area) * length / (area * area);
+    double transit = length / law.wave_speed(area);
+    double compliance = length * 2 * std::sqrt(area) / law.beta;
+    double resistance = friction_k_ * viscosity_(area) * length / (area * area);
+    if (is_tapered(v)) {
+      // The same integrals along the vessel: int dx / c, int dA/dp dx, int k mu / A^2 dx.
+      const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
+      transit = compliance = 0;
+      for (std::size_t i = 0; i < taper_rule_nodes.size(); ++i) {
+        const VesselLaw at = taper.at(taper_rule_nodes[i]);
+        const double a = taper.rest_area(taper_rule_nodes[i]);
+        transit += taper_rule_weights[i] * length / at.wave_speed(a);
+        compliance += taper_rule_weights[i] * length * 2 * std::sqrt(a) / at.beta;
+      }
+      resistance = tapered_poiseuille_resistance(
+          [&](double d) { return viscosity_(std::numbers::pi / 4 * d * d); }, length, taper.d0, taper.d1, blood_.alpha);
+    }
     zero_d_[v] = !reflecting[v] && transit < options.lumped_transit * period &&
                  omega * resistance * compliance < options.lumped_rc;
   }
@@ -199,9 +236,12 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
   elements_per_vessel_ = e;
   if (options.degree == SolverOptions::automatic) {
     std::vector<double> transit(n), linear_error;
-    for (std::size_t v = 0; v < n; ++v)
+    for (std::size_t v = 0; v < n; ++v) {
       transit[v] = zero_d_[v] ? std::numeric_limits<double>::infinity()  // no step limit of its own
                               : net_.length[v] / e / laws_[v].wave_speed(laws_[v].reference_area);
+      if (!zero_d_[v] && is_tapered(v))  // the faster end sets it
+        transit[v] = std::min(transit[v], net_.length[v] / e / end_law(v, true).wave_speed(end_law(v, true).reference_area));
+    }
     if (steady) {
       // Over one element of the vessel: its share of the drop.
       linear_error.resize(n);
@@ -218,9 +258,13 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
     vessel_degree_.assign(n, options.degree);
   }
   std::size_t one_d = 0;
-  for (std::size_t v = 0; v < n; ++v)
+  for (std::size_t v = 0; v < n; ++v) {
     if (zero_d_[v]) vessel_degree_[v] = -1;
     else ++one_d;
+    // A tapered vessel's rest lumen pi D(x)^2 / 4 is quadratic in x: degree 2 holds it
+    // exactly, and with it the rest state (well-balanced, docs/solver.md §1a).
+    if (!zero_d_[v] && is_tapered(v)) vessel_degree_[v] = std::max(vessel_degree_[v], 2);
+  }
   const int top = std::max(0, n == 0 ? 0 : *std::max_element(vessel_degree_.begin(), vessel_degree_.end()));
   bases_.assign(static_cast<std::size_t>(top) + 1, ModalBasis{});
   first_element_.assign(n, -1);
@@ -246,20 +290,128 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
     bases_[static_cast<std::size_t>(p)] = modal_basis(p, options.quadrature_points);
     blocks_.push_back({p, first, next - first});
   }
+  build_taper_tables();
+}
+
+void PulseSolver::build_taper_tables() {
+  taper_row_.clear();
+  tapered_elements_.clear();
+  taper_right_law_.clear();
+  if (tapers_.empty()) return;
+  const auto elements = static_cast<Eigen::Index>(element_vessel_.size());
+  taper_row_.assign(element_vessel_.size(), -1);
+  for (Eigen::Index el = 0; el < elements; ++el)
+    if (is_tapered(static_cast<std::size_t>(element_vessel_[static_cast<std::size_t>(el)]))) {
+      taper_row_[static_cast<std::size_t>(el)] = static_cast<std::int32_t>(tapered_elements_.size());
+      tapered_elements_.push_back(static_cast<std::int32_t>(el));
+    }
+  Eigen::Index points = 1;
+  for (const DegreeBlock& b : blocks_) points = std::max<Eigen::Index>(points, bases_[static_cast<std::size_t>(b.degree)].points);
+  const auto rows = static_cast<Eigen::Index>(tapered_elements_.size());
+  taper_beta_.setZero(rows, points);
+  taper_g1_.setZero(rows, points);
+  taper_g0_.setZero(rows, points);
+  taper_rest_.setZero(rows, max_degree() + 1);
+  const int e = elements_per_vessel_;
+  for (Eigen::Index row = 0; row < rows; ++row) {
+    const auto el = tapered_elements_[static_cast<std::size_t>(row)];
+    const auto v = static_cast<std::size_t>(element_vessel_[static_cast<std::size_t>(el)]);
+    const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
+    const ModalBasis& basis = bases_[static_cast<std::size_t>(vessel_degree_[v])];
+    const int k = el - first_element_[v];
+    for (Eigen::Index q = 0; q < basis.points; ++q) {
+      const double s = (k + 0.5 * (basis.rule.nodes(q) + 1)) / e;
+      taper_beta_(row, q) = taper.at(s).beta;
+      taper.source_coefficients(s, taper_g1_(row, q), taper_g0_(row, q));
+    }
+    taper_right_law_.push_back(taper.at(static_cast<double>(k + 1) / e));
+  }
+}
+
+VesselLaw PulseSolver::law_at(std::size_t vessel, double x) const {
+  if (!is_tapered(vessel)) return laws_[vessel];
+  return tapers_[static_cast<std::size_t>(taper_of_[vessel])].at(std::clamp(x, 0.0, 1.0));
 }
 
 // ---- initial states --------------------------------------------------------------------
 
 void PulseSolver::start_at_rest() {
   // Every vessel at its reference area and no flow: p = p_ref.
-  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    if (is_tapered(v) && !zero_d_[v]) {
+      // A tapered vessel rests at its measured lumen pi D(x)^2 / 4, where the pressure is the
+      // same all along (vessel_equations.hpp): quadratic in x, projected exactly at degree 2.
+      const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
+      project_along(v, [&](double x) { return taper.rest_area(x); }, state_.area);
+      continue;
+    }
     for (auto el = first_element_[v]; el < end_element(v); ++el)
       state_.area(el, 0) = laws_[v].reference_area;
+  }
   lumped_.start_at_rest(laws_);
   for (auto& o : boundaries_.outlets) {
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) = o.outlet.p_out;
-    o.rest_area = laws_[static_cast<std::size_t>(o.end.vessel)].reference_area;
+    const auto v = static_cast<std::size_t>(o.end.vessel);
+    o.rest_area = is_tapered(v) ? tapers_[static_cast<std::size_t>(taper_of_[v])].rest_area(1) : laws_[v].reference_area;
     o.rest_flow = 0;
+  }
+}
+
+template <class F>
+void PulseSolver::project_along(std::size_t v, const F& f, Eigen::MatrixXd& coefficients) const {
+  const ModalBasis& basis = bases_[static_cast<std::size_t>(vessel_degree_[v])];
+  const auto e = elements_per_vessel_;
+  Eigen::VectorXd values(basis.points);
+  for (auto k = 0; k < e; ++k) {
+    for (Eigen::Index q = 0; q < basis.points; ++q) values(q) = f((k + 0.5 * (basis.rule.nodes(q) + 1)) / e);
+    coefficients.row(first_element_[v] + k).head(basis.degree + 1) = (basis.projection * values).transpose();
+  }
+}
+
+void PulseSolver::compute_rest_correction() {
+  // The discrete right-hand side of the rest state (Q = 0, A = pi D(x)^2 / 4) in every tapered
+  // element, with each element's end fluxes F at its own traces (what the upwind flux and the
+  // nodes return there at rest). In exact arithmetic and with exact integrals it vanishes; what
+  // remains is the quadrature's error on the non-polynomial flux and source, and the finite
+  // differences' in beta' and c'. Subtracting it in every evaluation makes the rest state
+  // exact to round-off (the well-balanced property) and changes nothing else beyond that
+  // error, which vanishes spectrally as the mesh is refined.
+  if (tapered_elements_.empty()) return;
+  PulseState rest;
+  rest.set_zero_like(state_);
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
+    if (is_tapered(v) && !zero_d_[v]) {
+      const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
+      project_along(v, [&](double x) { return taper.rest_area(x); }, rest.area);
+    }
+  taper_rest_.setZero();
+  const double rho = blood_.density;
+  const int e = elements_per_vessel_;
+  for (std::size_t row = 0; row < tapered_elements_.size(); ++row) {
+    const auto el = tapered_elements_[row];
+    const auto v = static_cast<std::size_t>(element_vessel_[static_cast<std::size_t>(el)]);
+    const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
+    const ModalBasis& basis = bases_[static_cast<std::size_t>(vessel_degree_[v])];
+    const Eigen::Index modes = basis.degree + 1;
+    const Eigen::VectorXd a = rest.area.row(el).head(modes).transpose();
+    const Eigen::VectorXd a_q = basis.at_points * a;
+    Eigen::VectorXd flux(basis.points), source(basis.points);
+    const auto r = static_cast<Eigen::Index>(row);
+    for (Eigen::Index q = 0; q < basis.points; ++q) {
+      const double root = std::sqrt(a_q(q));
+      flux(q) = taper_beta_(r, q) * a_q(q) * root / (3 * rho);
+      source(q) = a_q(q) * (taper_g1_(r, q) * root + taper_g0_(r, q));
+    }
+    const int k = el - first_element_[v];
+    const VesselLaw left = taper.at(static_cast<double>(k) / e), right = taper.at(static_cast<double>(k + 1) / e);
+    const double flux_left = left.flux_flow((basis.left * a).value(), 0.0);
+    const double flux_right = right.flux_flow((basis.right * a).value(), 0.0);
+    Eigen::VectorXd rate = basis.weak_derivative * flux -
+                           basis.inverse_mass.cwiseProduct(basis.right).transpose() * flux_right +
+                           basis.inverse_mass.cwiseProduct(basis.left).transpose() * flux_left;
+    rate /= half_length_(el);
+    rate += basis.projection * source;
+    taper_rest_.row(r).head(modes) = rate.transpose();
   }
 }
 
@@ -272,6 +424,13 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
     const Eigen::Index points = basis.points;
     const double p0 = s.node_pressure[net.from[v]], p1 = s.node_pressure[net.to[v]];
     const auto e = elements_per_vessel_;
+    if (is_tapered(v)) {
+      // Pressure linear along the vessel as below, each point's area from the law there.
+      const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
+      project_along(v, [&](double x) { return taper.at(x).area(p0 + (p1 - p0) * x); }, state_.area);
+      for (auto k = 0; k < e; ++k) state_.flow(first_element_[v] + k, 0) = s.flow[v];
+      continue;
+    }
     for (auto k = 0; k < e; ++k) {
       // Pressure falls linearly along the vessel; project A(p(x)) onto the modes.
       Eigen::VectorXd a(points);
@@ -288,7 +447,7 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
     const auto v = static_cast<std::size_t>(o.end.vessel);
     const double q = s.flow[v], p = s.node_pressure[net.to[v]];  // 1D vessels only
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) = p - o.outlet.r1 * q;
-    o.rest_area = laws_[v].area(p);
+    o.rest_area = end_law(v, true).area(p);
     o.rest_flow = q;
   }
 }
@@ -312,7 +471,24 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
     const auto el = first_element_[v];
     const double a = state_.area(el, 0), q = state_.flow(el, 0);
     const double h = 2 * half_length_(el);
-    const double lambda = std::max(std::abs(law.lambda_forward(a, q)), std::abs(law.lambda_backward(a, q)));
+    double lambda = std::max(std::abs(law.lambda_forward(a, q)), std::abs(law.lambda_backward(a, q)));
+    if (is_tapered(v)) {
+      // The speeds change along the vessel: the largest at the ends of its elements.
+      const int degree = vessel_degree_[v];
+      for (auto k = first_element_[v]; k < end_element(v); ++k) {
+        const int j = k - first_element_[v];
+        for (const int side : {0, 1}) {
+          const VesselLaw at = law_at(v, static_cast<double>(j + side) / elements_per_vessel_);
+          double ak = 0, qk = 0;
+          for (int m = 0; m <= degree; ++m) {
+            const double sign = side == 0 && m % 2 == 1 ? -1.0 : 1.0;  // P_m(-1) = (-1)^m
+            ak += sign * state_.area(k, m);
+            qk += sign * state_.flow(k, m);
+          }
+          lambda = std::max({lambda, std::abs(at.lambda_forward(ak, qk)), std::abs(at.lambda_backward(ak, qk))});
+        }
+      }
+    }
     const double dt_wave = courant[static_cast<std::size_t>(vessel_degree_[v])] * h / lambda;
     if (dt_wave < wave) {
       wave = dt_wave;
@@ -513,6 +689,16 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
   flux_q.array() = alpha * flow_q.array().square() / area_q.array() +
                    (element_beta_.segment(first, count).array() / (3 * rho)).replicate(1, area_q.cols()) *
                        area_q.array() * area_q.array().sqrt();
+  // Tapered elements: beta varies between the points.
+  const auto tapered_begin = std::lower_bound(tapered_elements_.begin(), tapered_elements_.end(), first);
+  const auto tapered_end = std::lower_bound(tapered_begin, tapered_elements_.end(), first + count);
+  for (auto it = tapered_begin; it != tapered_end; ++it) {
+    const Eigen::Index el = *it - first, row = it - tapered_elements_.begin();
+    for (Eigen::Index q = 0; q < points; ++q) {
+      const double a = area_q(el, q), u = flow_q(el, q);
+      flux_q(el, q) = alpha * u * u / a + taper_beta_(row, q) / (3 * rho) * a * std::sqrt(a);
+    }
+  }
   rate.area.block(first, 0, count, modes).noalias() = flow_q.lazyProduct(basis.weak_derivative.transpose());
   rate.flow.block(first, 0, count, modes).noalias() = flux_q.lazyProduct(basis.weak_derivative.transpose());
 
@@ -527,6 +713,15 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
   // integrates -r Q exactly and leaves only the variation of r within the element explicit.
   friction_rate_.segment(first, count).noalias() = source_q.lazyProduct(basis.rule.weights) / 2;
   source_q.array() *= -flow_q.array();
+  // Tapered elements: the part of the pressure force that the flux does not hold,
+  // A (g1 sqrt(A) + g0) (vessel_equations.hpp, docs/solver.md §1a).
+  for (auto it = tapered_begin; it != tapered_end; ++it) {
+    const Eigen::Index el = *it - first, row = it - tapered_elements_.begin();
+    for (Eigen::Index q = 0; q < points; ++q) {
+      const double a = area_q(el, q);
+      source_q(el, q) += a * (taper_g1_(row, q) * std::sqrt(a) + taper_g0_(row, q));
+    }
+  }
 
   // Traces at both ends of every element.
   area_left_.segment(first, count).noalias() = area.lazyProduct(basis.left.transpose());
@@ -573,8 +768,11 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
       const std::int32_t v = element_vessel_[static_cast<std::size_t>(el)];
       if (element_vessel_[static_cast<std::size_t>(el) + 1] != v) continue;
       double fa, fq;
-      upwind_flux(laws_[static_cast<std::size_t>(v)], area_right_(el), flow_right_(el), area_left_(el + 1),
-                  flow_left_(el + 1), fa, fq);
+      // In a tapered vessel, the law at the interface itself.
+      const VesselLaw& law = taper_row_.empty() || taper_row_[static_cast<std::size_t>(el)] < 0
+                                 ? laws_[static_cast<std::size_t>(v)]
+                                 : taper_right_law_[static_cast<std::size_t>(taper_row_[static_cast<std::size_t>(el)])];
+      upwind_flux(law, area_right_(el), flow_right_(el), area_left_(el + 1), flow_left_(el + 1), fa, fq);
       flux_a_right_(el) = flux_a_left_(el + 1) = fa;
       flux_q_right_(el) = flux_q_left_(el + 1) = fq;
     }
@@ -582,7 +780,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
 
   // Vessel ends: the node supplies U*, the flux is F(U*).
   auto set_end_flux = [&](const VesselEnd& end, const EndState& u) {
-    const VesselLaw& law = laws_[static_cast<std::size_t>(end.vessel)];
+    const VesselLaw& law = end_law(static_cast<std::size_t>(end.vessel), end.distal);
     const double fa = u.flow, fq = law.flux_flow(u.area, u.flow);
     if (end.distal) {
       flux_a_right_(end.element) = fa;
@@ -615,7 +813,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     const double s = dt_ > 0 ? std::clamp((t - step_start_) / dt_, 0.0, 1.0) : 0.0;
     const std::int32_t node = coupled_node_[k];
     const double r = 1.5 * lumped_.impedance(node);
-    const EndState u = pressure_state(laws_[static_cast<std::size_t>(c.end.vessel)], a, q,
+    const EndState u = pressure_state(end_law(static_cast<std::size_t>(c.end.vessel), c.end.distal), a, q,
                                       lumped_.pressure_during_step(node, s) + lumped_.dynamic_pressure(node) -
                                           r * held_end_flow_[k],
                                       c.end.distal, r);
@@ -628,7 +826,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     const auto& o = boundaries_.outlets[static_cast<std::size_t>(k)];
     double a, q;
     trace(o.end, a, q);
-    const VesselLaw& law = laws_[static_cast<std::size_t>(o.end.vessel)];
+    const VesselLaw& law = end_law(static_cast<std::size_t>(o.end.vessel), true);
     EndState u;
     switch (o.outlet.type) {
       case OutletType::resistance:
@@ -674,7 +872,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     const auto count = static_cast<std::size_t>(last - first);
     for (std::size_t i = 0; i < count; ++i) {
       const VesselEnd& end = boundaries_.junction_ends[static_cast<std::size_t>(first) + i];
-      laws[i] = &laws_[static_cast<std::size_t>(end.vessel)];
+      laws[i] = &end_law(static_cast<std::size_t>(end.vessel), end.distal);
       trace(end, ja[i], jq[i]);
       sign[i] = end.distal ? 1 : -1;
       out[i] = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
@@ -716,6 +914,9 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
       rq.noalias() += source_q_.block(first, 0, count, basis.points).lazyProduct(basis.projection.transpose());
     }
   }
+  // Tapered elements: less the rest state's residual (compute_rest_correction).
+  for (std::size_t row = 0; row < tapered_elements_.size(); ++row)
+    rate.flow.row(tapered_elements_[row]) -= taper_rest_.row(static_cast<Eigen::Index>(row));
 }
 
 // ---- evaluation --------------------------------------------------------------------------
@@ -736,7 +937,7 @@ double PulseSolver::evaluate_modes(const Eigen::MatrixXd& c, std::size_t element
 }
 
 double PulseSolver::area_at(std::size_t vessel, double x) const {
-  if (zero_d_[vessel]) return laws_[vessel].area(pressure_at(vessel, x));
+  if (zero_d_[vessel]) return law_at(vessel, x).area(pressure_at(vessel, x));
   std::size_t el;
   double xi;
   locate(vessel, x, el, xi);
@@ -753,7 +954,7 @@ double PulseSolver::flow_at(std::size_t vessel, double x) const {
 
 double PulseSolver::pressure_at(std::size_t vessel, double x) const {
   if (zero_d_[vessel]) return lumped_.pressure_at(lumped_.vessel_index(vessel), std::clamp(x, 0.0, 1.0));
-  return laws_[vessel].pressure(area_at(vessel, x));
+  return law_at(vessel, x).pressure(area_at(vessel, x));
 }
 
 double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
@@ -789,7 +990,7 @@ void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<do
     }
     area[v] = a;
     flow[v] = q;
-    if (pressure) (*pressure)[v] = laws_[v].pressure(a);
+    if (pressure) (*pressure)[v] = is_tapered(v) ? law_at(v, x).pressure(a) : laws_[v].pressure(a);
   }
 }
 
@@ -822,7 +1023,8 @@ std::vector<double> PulseSolver::vessel_volumes() const {
   for (std::size_t v = 0; v < volume.size(); ++v) {
     if (zero_d_[v]) {  // half at each node's pressure, as the 0D scheme holds it
       const std::int32_t e = lumped_.vessel_index(v);
-      volume[v] = net_.length[v] * 0.5 * (laws_[v].area(lumped_.pressure_at(e, 0)) + laws_[v].area(lumped_.pressure_at(e, 1)));
+      volume[v] = is_tapered(v) ? lumped_.tapered_volume(e)
+                                : net_.length[v] * 0.5 * (laws_[v].area(lumped_.pressure_at(e, 0)) + laws_[v].area(lumped_.pressure_at(e, 1)));
     }
     for (auto el = first_element_[v]; el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
   }
@@ -839,6 +1041,14 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   if (mean_pressure)
     for (std::size_t v = 0; v < n; ++v) {
       const double area = laws_[v].area((*mean_pressure)[v]);
+      if (is_tapered(v)) {
+        const double area_to = end_law(v, true).area((*mean_pressure)[v]);
+        if (area > 0 && area_to > 0)
+          resistance[v] = tapered_poiseuille_resistance(
+              [&](double d) { return viscosity_(std::numbers::pi / 4 * d * d); }, net_.length[v],
+              std::sqrt(4 / std::numbers::pi * area), std::sqrt(4 / std::numbers::pi * area_to), blood_.alpha);
+        continue;
+      }
       if (area > 0)
         resistance[v] = poiseuille_resistance(viscosity_(area), net_.length[v], std::sqrt(4 / std::numbers::pi * area), blood_.alpha);
     }
@@ -846,6 +1056,31 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   const std::vector<double> volume = vessel_volumes();
   std::vector<double> area_per_pressure(n);
   for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = 2 * std::sqrt(volume[v] / net_.length[v]) / laws_[v].beta;
+  // A tapered vessel's dA/dp changes along it: each element's at its mean area and centre
+  // (a 0D one's, the mean of its ends'), and the vessel's the mean of those.
+  std::vector<double> element_area_per_pressure;
+  if (!tapers_.empty()) {
+    element_area_per_pressure.assign(static_cast<std::size_t>(state_.area.rows()), 0.0);
+    for (std::size_t v = 0; v < n; ++v) {
+      if (!is_tapered(v)) continue;
+      double sum = 0;
+      if (zero_d_[v]) {
+        const std::int32_t e = lumped_.vessel_index(v);
+        for (const double x : {0.0, 1.0}) {
+          const VesselLaw at = law_at(v, x);
+          sum += std::sqrt(std::max(at.area(lumped_.pressure_at(e, x)), 0.0)) / at.beta;  // 2 sqrt(A) / beta, halved
+        }
+      } else {
+        for (auto el = first_element_[v]; el < end_element(v); ++el) {
+          const double x = (el - first_element_[v] + 0.5) / elements_per_vessel_;
+          const double c = 2 * std::sqrt(state_.area(el, 0)) / law_at(v, x).beta;
+          element_area_per_pressure[static_cast<std::size_t>(el)] = c;
+          sum += c / elements_per_vessel_;
+        }
+      }
+      area_per_pressure[v] = sum;
+    }
+  }
   const std::vector<double> capacitor_now = capacitor_pressures();
   if (cycle_volume_.empty()) {
     cycle_volume_ = volume;
@@ -909,8 +1144,9 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
     const double y0 = move.node[static_cast<std::size_t>(net_.from[v])], y1 = move.node[static_cast<std::size_t>(net_.to[v])];
     for (int k = 0; k < e; ++k) {
       const auto el = first_element_[v] + k;
-      state_.area(el, 0) += area_per_pressure[v] * (y0 + (y1 - y0) * (k + 0.5) / e);
-      if (state_.area.cols() > 1 && vessel_degree_[v] >= 1) state_.area(el, 1) += area_per_pressure[v] * (y1 - y0) / (2 * e);
+      const double c = is_tapered(v) ? element_area_per_pressure[static_cast<std::size_t>(el)] : area_per_pressure[v];
+      state_.area(el, 0) += c * (y0 + (y1 - y0) * (k + 0.5) / e);
+      if (state_.area.cols() > 1 && vessel_degree_[v] >= 1) state_.area(el, 1) += c * (y1 - y0) / (2 * e);
     }
   }
   for (const auto& o : boundaries_.outlets)

@@ -112,7 +112,15 @@ class PulseSolver {
   const std::vector<std::int32_t>& one_d_vessels() const { return one_d_vessels_; }
   int threads() const { return threads_; }
 
+  // A vessel's tube law: at its `from` end (the whole vessel's unless it tapers), at one of
+  // its ends, and at fraction x along it.
   const VesselLaw& law(std::size_t vessel) const { return laws_[vessel]; }
+  const VesselLaw& end_law(std::size_t vessel, bool distal) const {
+    return distal && !taper_of_.empty() && taper_of_[vessel] >= 0 ? distal_laws_[static_cast<std::size_t>(taper_of_[vessel])]
+                                                                  : laws_[vessel];
+  }
+  VesselLaw law_at(std::size_t vessel, double x) const;
+  bool is_tapered(std::size_t vessel) const { return !taper_of_.empty() && taper_of_[vessel] >= 0; }
   const Blood& blood() const { return blood_; }
   int degree(std::size_t vessel) const { return vessel_degree_[vessel]; }  // -1: 0D
   int max_degree() const { return static_cast<int>(bases_.size()) - 1; }
@@ -176,7 +184,25 @@ class PulseSolver {
   const Network& net_;
   Blood blood_;
   ViscosityTable viscosity_;
-  std::vector<VesselLaw> laws_;            // per vessel
+  std::vector<VesselLaw> laws_;            // per vessel (a tapered one's at its `from` end)
+  // Tapered vessels (none in most networks: then taper_of_ is empty and nothing below is
+  // touched): per vessel its taper's index or -1; per taper its description and distal law.
+  std::vector<std::int32_t> taper_of_;
+  std::vector<VesselTaper> tapers_;
+  std::vector<VesselLaw> distal_laws_;
+  // Per element of a tapered vessel (a row): beta and the source coefficients g1, g0 at its
+  // quadrature points, the law at its right interface, and the rest-state correction of the
+  // flow's rate (modes); taper_row_ per element (-1: untapered; empty without tapers).
+  std::vector<std::int32_t> taper_row_, tapered_elements_;
+  Eigen::MatrixXd taper_beta_, taper_g1_, taper_g0_, taper_rest_;
+  std::vector<VesselLaw> taper_right_law_;
+  void build_taper_tables();
+  // The tapered elements' rates at the rest state: what the discrete operator leaves of an
+  // exact balance (quadrature, differences), subtracted in every evaluation.
+  void compute_rest_correction();
+  // L2 projection of f(x), x in [0, 1] along 1D vessel v, onto its elements' rows of coefficients.
+  template <class F>
+  void project_along(std::size_t v, const F& f, Eigen::MatrixXd& coefficients) const;
   // Elements are numbered by degree, so that each degree is one block of rows that the
   // basis of that degree acts on at once; rows have the columns of the highest degree
   // (unused modes stay zero).
