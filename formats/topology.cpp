@@ -1,5 +1,6 @@
 #include "formats/topology.hpp"
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -20,15 +21,71 @@ NetworkGraph make_graph(const Network& net) {
                       bundles.begin(), net.node_count());
 }
 
-std::vector<std::int32_t> generations_from_inlets(const Network& net) {
+namespace {
+
+// What no directed path from an inlet node reaches (a measured network's vessels written
+// against the flow, a closed loop): breadth first over the undirected graph, from every node
+// reached so far, then from the lowest node of each part still unreached. A vessel's
+// generation is its nearer end's + 1, so every vessel has one, and a tree's are unchanged.
+void reach_the_rest(const Network& net, std::vector<boost::default_color_type>& colour,
+                    std::vector<std::int32_t>& node_generation, std::vector<std::int32_t>& generation) {
+  const std::size_t nodes = net.node_count(), n = net.vessel_count();
+  if (std::find(generation.begin(), generation.end(), -1) == generation.end()) return;
+  std::vector<std::int64_t> offset(nodes + 1, 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    ++offset[static_cast<std::size_t>(net.from[v]) + 1];
+    ++offset[static_cast<std::size_t>(net.to[v]) + 1];
+  }
+  for (std::size_t i = 0; i < nodes; ++i) offset[i + 1] += offset[i];
+  std::vector<std::int32_t> incident(static_cast<std::size_t>(offset[nodes]));
+  std::vector<std::int64_t> fill(offset.begin(), offset.end() - 1);
+  for (std::size_t v = 0; v < n; ++v) {
+    incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(net.from[v])]++)] = static_cast<std::int32_t>(v);
+    incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(net.to[v])]++)] = static_cast<std::int32_t>(v);
+  }
+  std::vector<std::int32_t> queue;
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (colour[i] != boost::white_color) queue.push_back(static_cast<std::int32_t>(i));
+  auto sweep = [&] {
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const auto i = static_cast<std::size_t>(queue[head]);
+      for (auto k = offset[i]; k < offset[i + 1]; ++k) {
+        const auto v = static_cast<std::size_t>(incident[static_cast<std::size_t>(k)]);
+        if (generation[v] < 0) generation[v] = node_generation[i] + 1;
+        const auto other = static_cast<std::size_t>(net.from[v]) == i ? static_cast<std::size_t>(net.to[v])
+                                                                       : static_cast<std::size_t>(net.from[v]);
+        if (colour[other] == boost::white_color) {
+          colour[other] = boost::black_color;
+          node_generation[other] = node_generation[i] + 1;
+          queue.push_back(static_cast<std::int32_t>(other));
+        }
+      }
+    }
+    queue.clear();
+  };
+  sweep();
+  for (std::size_t v = 0; v < n; ++v) {
+    if (generation[v] >= 0) continue;
+    const auto root = static_cast<std::size_t>(std::min(net.from[v], net.to[v]));
+    colour[root] = boost::black_color;
+    node_generation[root] = -1;
+    queue.push_back(static_cast<std::int32_t>(root));
+    sweep();
+  }
+}
+
+// Generations along the vessels' direction from the nodes no vessel enters; -1 for vessels
+// no such path reaches. colour and node_generation: per node, reached or not, and the
+// generation of the vessel that reached it (-1 at inlet nodes).
+std::vector<std::int32_t> directed_generations(const Network& net, std::vector<boost::default_color_type>& colour,
+                                               std::vector<std::int32_t>& node_generation) {
   const NetworkGraph g = make_graph(net);
   std::vector<std::int32_t> in_degree(net.node_count(), 0);
   for (std::size_t v = 0; v < net.vessel_count(); ++v) ++in_degree[net.to[v]];
 
-  // Generation of the vessel entering each node; -1 at inlet nodes.
-  std::vector<std::int32_t> node_generation(net.node_count(), -1);
+  node_generation.assign(net.node_count(), -1);
   std::vector<std::int32_t> generation(net.vessel_count(), -1);
-  std::vector<boost::default_color_type> colour(net.node_count(), boost::white_color);
+  colour.assign(net.node_count(), boost::white_color);
   auto colours = boost::make_iterator_property_map(colour.begin(), get(boost::vertex_index, g));
 
   struct Visitor : boost::default_bfs_visitor {
@@ -56,6 +113,16 @@ std::vector<std::int32_t> generations_from_inlets(const Network& net) {
   return generation;
 }
 
+}  // namespace
+
+std::vector<std::int32_t> generations_from_inlets(const Network& net) {
+  std::vector<boost::default_color_type> colour;
+  std::vector<std::int32_t> node_generation;
+  std::vector<std::int32_t> generation = directed_generations(net, colour, node_generation);
+  reach_the_rest(net, colour, node_generation, generation);
+  return generation;
+}
+
 std::size_t check_rooted_tree(const Network& net) {
   auto name = [&](std::size_t v) { return "vessel " + std::to_string(net.id[v]); };
   if (net.vessel_count() == 0) throw InputError("the network has no vessels");
@@ -76,7 +143,9 @@ std::size_t check_rooted_tree(const Network& net) {
     root = static_cast<std::int64_t>(v);
   }
   if (root < 0) throw InputError("not a tree: every vessel is fed by another (a closed loop)");
-  const auto generation = generations_from_inlets(net);
+  std::vector<boost::default_color_type> colour;
+  std::vector<std::int32_t> node_generation;
+  const auto generation = directed_generations(net, colour, node_generation);
   for (std::size_t v = 0; v < net.vessel_count(); ++v)
     if (generation[v] < 0)
       throw InputError("not a tree: " + name(v) +

@@ -22,7 +22,9 @@ NetworkGraph make_graph(const Network& net);
 
 // Generation of every vessel: vessels leaving a node that no vessel enters are generation
 // 0; each vessel downstream is one more than the vessel that feeds it (breadth-first).
-// Vessels not reached from such a node (a closed loop) get -1.
+// Vessels no such path reaches (written against the flow, or in a closed loop) count from
+// the nearest reached node in either direction, or else from their part's lowest node: every
+// vessel gets a generation >= 0.
 std::vector<std::int32_t> generations_from_inlets(const Network& net);
 
 // Checks that the network is one rooted tree: a single inlet vessel, every node entered by

@@ -1,6 +1,7 @@
 // The vnet format: round trips, streaming through files, and clear refusals.
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -277,4 +278,98 @@ TEST(OutputStream, AnUncommittedFileIsRemovedAndFullDisksAreReported) {
         },
         IoError);
   }
+}
+
+// ---- version 2: boundaries at nodes, tapered vessels, the mean cell volume ---------------
+
+namespace {
+
+// A loop 10 -> 11 -> 12 -> 10 written partly against its flow, fed at 13, drained at 14.
+const char* looped = R"({"format": "vnet", "version": 2,
+ "blood": {"mean_cell_volume": 55e-18, "plasma_viscosity": 1.0466e-3},
+ "boundaries": [
+  {"node": 14, "type": "pressure", "pressure": 1333.22},
+  {"node": 13, "type": "flow", "flow": 1e-12, "hematocrit": 0.45},
+  {"node": 15, "type": "RCR", "R1": 1e9, "C": 1e-12, "R2": 4e9, "p_out": 500},
+  {"node": 16, "type": "flow", "waveform": {"shape": "table", "period": 1, "time": [0, 0.5], "flow": [2e-12, -1e-12]}}],
+ "vessels": [
+  {"id": 1, "from": 13, "to": 10, "length": 1e-3, "diameter": 20e-6, "distal_diameter": 15e-6},
+  {"id": 2, "from": 11, "to": 10, "length": 1e-3, "diameter": 20e-6},
+  {"id": 3, "from": 11, "to": 12, "length": 1e-3, "diameter": 20e-6},
+  {"id": 4, "from": 12, "to": 10, "length": 1e-3, "diameter": 20e-6},
+  {"id": 5, "from": 12, "to": 14, "length": 1e-3, "diameter": 20e-6},
+  {"id": 6, "from": 11, "to": 15, "length": 1e-3, "diameter": 20e-6},
+  {"id": 7, "from": 16, "to": 11, "length": 1e-3, "diameter": 20e-6}]})";
+
+}  // namespace
+
+TEST(NetworkFormatVersion2, BoundariesAtNodesTaperAndCellVolumeRoundTrip) {
+  const Network net = parse_network(looped);
+  ASSERT_EQ(net.boundaries.size(), 4u);
+  // Sorted by node (index): 13, 14, 15, 16 are nodes 4..7 in order of first appearance? The
+  // reader makes nodes from the vessels' ids, sorted: 10..16 are indices 0..6.
+  EXPECT_EQ(net.node_id[static_cast<std::size_t>(net.boundaries[0].node)], 13);
+  EXPECT_EQ(net.boundaries[0].type, BoundaryType::flow);
+  EXPECT_EQ(net.boundaries[0].waveform.shape, Waveform::Shape::constant);
+  EXPECT_EQ(net.boundaries[0].waveform.mean_value(), 1e-12);
+  EXPECT_EQ(net.boundaries[0].hematocrit, 0.45);
+  EXPECT_EQ(net.boundaries[1].type, BoundaryType::pressure);
+  EXPECT_EQ(net.boundaries[1].waveform(0.3), 1333.22);
+  EXPECT_TRUE(std::isnan(net.boundaries[1].hematocrit));
+  EXPECT_EQ(net.boundaries[2].type, BoundaryType::rcr);
+  EXPECT_EQ(net.boundaries[2].outlet.r2, 4e9);
+  EXPECT_EQ(net.boundaries[3].waveform.shape, Waveform::Shape::table);
+  EXPECT_DOUBLE_EQ(net.boundaries[3].waveform(0.25), 0.5e-12);
+  EXPECT_DOUBLE_EQ(net.boundaries[3].waveform.mean_value(), 0.5e-12);
+  EXPECT_EQ(net.blood->mean_cell_volume, 55e-18);
+  ASSERT_EQ(net.distal_diameter.size(), 7u);
+  EXPECT_EQ(net.diameter_at_to(0), 15e-6);
+  EXPECT_FALSE(net.is_tapered(1));
+  EXPECT_NEAR(net.volume(0), std::numbers::pi / 12 * (400 + 300 + 225) * 1e-12 * 1e-3, 1e-24);
+  // Every vessel has a generation, against its flow or not.
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) EXPECT_GE(net.generation[v], 0) << "vessel " << net.id[v];
+
+  const std::string text = write_to_string(net, "v2.json");
+  EXPECT_NE(text.find("\"version\": 2"), std::string::npos);
+  EXPECT_NE(text.find("\"distal_diameter\":1.5e-05"), std::string::npos) << text;
+  const Network back = parse_network(text);
+  ASSERT_EQ(back.boundaries.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(back.boundaries[k].node, net.boundaries[k].node);
+    EXPECT_EQ(back.boundaries[k].type, net.boundaries[k].type);
+    EXPECT_EQ(back.boundaries[k].waveform.mean_value(), net.boundaries[k].waveform.mean_value());
+  }
+  EXPECT_EQ(back.generation, net.generation);
+  EXPECT_EQ(write_to_string(back, "v2b.json"), text);
+}
+
+// Writers write the oldest version that holds the content: a tree without node boundaries or
+// tapers stays version 1, which older readers read.
+TEST(NetworkFormatVersion2, AVersionOneNetworkIsWrittenAsVersionOne) {
+  const std::string text = write_to_string(parse_network(minimal), "v1.json");
+  EXPECT_NE(text.find("\"version\": 1"), std::string::npos);
+  EXPECT_EQ(text.find("boundaries"), std::string::npos);
+}
+
+TEST(NetworkFormatVersion2, BoundaryErrorsNameTheNodeAndTheField) {
+  auto with_boundary = [](const std::string& boundary) {
+    std::string text = looped;
+    const auto at = text.find("\"boundaries\": [") + 15;
+    return text.insert(at, boundary + ",\n");
+  };
+  expect_refusal(with_boundary(R"({"node": 99, "type": "flow", "flow": 1e-12})"), "boundaries[0]: unknown node 99");
+  expect_refusal(with_boundary(R"({"node": 10, "type": "suction"})"),
+                 "\"type\" must be flow, pressure, RCR, R or reflection (got \"suction\")");
+  expect_refusal(with_boundary(R"({"node": 10, "type": "flow"})"),
+                 "a flow boundary needs \"flow\" (constant) or \"waveform\", one of them");
+  expect_refusal(with_boundary(R"({"node": 10, "type": "pressure", "pressure": 1e9})"),
+                 "(node 10): \"pressure\" must lie in [-1e5, 1e5] Pa (got 1e9)");
+  expect_refusal(with_boundary(R"({"node": 10, "type": "R", "R": 1e9, "hematocrit": 0.4})"),
+                 "\"hematocrit\" belongs to flow and pressure boundaries");
+  expect_refusal(with_boundary(R"({"node": 13, "type": "R", "R": 1e9})"),
+                 "node 13 has two boundary conditions (R and flow): one per node");
+  expect_refusal(with_boundary(R"({"node": "13", "type": "R", "R": 1e9})"), "\"node\" must be a node id");
+  std::string cells = looped;
+  cells.replace(cells.find("55e-18"), 6, "5e-18");
+  expect_refusal(cells, "\"mean_cell_volume\" must lie in [1.5e-17, 2e-16] m^3 (got 5e-18)");
 }
