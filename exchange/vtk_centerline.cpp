@@ -445,7 +445,8 @@ Centerlines read_xml(const std::string& path, std::string text, const Centerline
   const ptree* radius = point_data ? named_array(*point_data, options.radius_array) : nullptr;
   if (!radius)
     f.fail(at + "/PointData", "no DataArray Name=\"" + options.radius_array + "\" (point data arrays: " +
-                                  join(c.point_arrays) + "; cell data arrays: " + join(c.cell_arrays) + ")");
+                                  join(c.point_arrays) + "; cell data arrays: " + join(c.cell_arrays) +
+                                  "); vimport --radius-array names another");
   c.radius = read_data_array(f, *radius, at + "/PointData/DataArray[Name=" + options.radius_array + "]", points, 1);
   if (const ptree* groups = cell_data ? named_array(*cell_data, "GroupIds") : nullptr)
     c.group_ids = read_data_array(f, *groups, at + "/CellData/DataArray[Name=GroupIds]", lines, 1);
@@ -555,7 +556,7 @@ class LegacyReader {
         fail_file("LINES: point id " + std::to_string(id) + " outside [0, " + std::to_string(c.point_count()) + ")");
     if (!have_radius)
       fail_file("no point data array \"" + options.radius_array + "\" (point data arrays: " + join(c.point_arrays) +
-           "; cell data arrays: " + join(c.cell_arrays) + ")");
+           "; cell data arrays: " + join(c.cell_arrays) + "); vimport --radius-array names another");
     return c;
   }
 

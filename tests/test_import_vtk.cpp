@@ -375,12 +375,12 @@ TEST_F(ImportVtk, RefusesSideBySideCenterlines) {
 TEST_F(ImportVtk, MissingRadiusNamesTheArrays) {
   EXPECT_EQ(message("noradius.vtp", VtpWriter({Mode::ascii}).file(y_shape(), "Float64", "Radius")),
             ": PolyData/Piece/PointData: no DataArray Name=\"MaximumInscribedSphereRadius\" (point data arrays: "
-            "Radius; cell data arrays: CenterlineIds)");
+            "Radius; cell data arrays: CenterlineIds); vimport --radius-array names another");
   std::string legacy = legacy_classic(y_shape());
   legacy.replace(legacy.find("SCALARS Max"), 36, "SCALARS Radius");
   EXPECT_EQ(message("noradius.vtk", legacy),
             ": no point data array \"MaximumInscribedSphereRadius\" (point data arrays: FrenetNormal, Radius; "
-            "cell data arrays: CenterlineIds)");
+            "cell data arrays: CenterlineIds); vimport --radius-array names another");
 }
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
@@ -467,6 +467,18 @@ TEST_F(ImportVtk, RefusesNonPositiveRadius) {
   g.radius[3] = 0;
   EXPECT_EQ(message("zero.vtp", VtpWriter({Mode::ascii}).file(g)),
             ": point 3 (3, 0, 9): radius (MaximumInscribedSphereRadius) 0 is not a positive number");
+}
+
+TEST_F(ImportVtk, EveryTruncationIsAnInputError) {
+  // A file cut anywhere (a partial download) fails with InputError, never otherwise.
+  for (Mode mode : {Mode::ascii, Mode::binary, Mode::binary_zlib, Mode::appended_raw, Mode::appended_base64_zlib}) {
+    const std::string whole = VtpWriter({mode, true}).file(y_shape());
+    const std::string path = write("cut.vtp", "");
+    for (std::size_t size = 0; size + 20 < whole.size(); size += 7) {
+      std::ofstream(path, std::ios::binary | std::ios::trunc) << whole.substr(0, size);
+      EXPECT_THROW(read_vtk_centerline(path, ImportOptions{}), InputError) << "cut at " << size;
+    }
+  }
 }
 
 TEST_F(ImportVtk, UnreadableFileIsIoError) {
