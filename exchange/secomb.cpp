@@ -173,16 +173,16 @@ struct BoundaryNode {
 // is refused at its first odd line instead of at a segment that is not one.
 void read_header(Lines& lines) {
   lines.expect("the box dimensions [um]");
-  for (std::size_t k = 0; k < 3; ++k) lines.real(k, "the box dimensions (line 2: three numbers [um])");
+  for (std::size_t k = 0; k < 3; ++k) lines.real(k, "the box dimensions (three numbers [um])");
   lines.expect("the numbers of tissue points in x, y, z");
   for (std::size_t k = 0; k < 3; ++k)
-    lines.integer(k, "the numbers of tissue points (line 3: three integers)");
+    lines.integer(k, "the numbers of tissue points (three integers)");
   lines.expect("the outer bound distance [um]");
-  lines.real(0, "the outer bound distance (line 4)");
+  lines.real(0, "the outer bound distance [um]");
   lines.expect("the maximum segment length [um]");
-  lines.real(0, "the maximum segment length (line 5)");
+  lines.real(0, "the maximum segment length [um]");
   lines.expect("the maximum number of segments per node");
-  lines.integer(0, "the maximum number of segments per node (line 6)");
+  lines.integer(0, "the maximum number of segments per node");
 }
 
 // A line of seven or more numbers where a count belongs is a segment the count left out.
@@ -192,6 +192,10 @@ void refuse_segment_as_count(const Lines& lines, int count_line, std::int64_t se
     lines.fail("a segment line where the number of nodes should be: line " + std::to_string(count_line) +
                " announced " + std::to_string(segments) + " segments, the file has more");
 }
+
+// Room for a section's announced count, but no more than a million lines ahead: a corrupt
+// count must not allocate gigabytes before the file shows it wrong.
+std::size_t expected(std::int64_t count) { return static_cast<std::size_t>(std::min<std::int64_t>(count, 1 << 20)); }
 
 std::string range_message(const std::string& what, double got, double min, double max, const char* unit) {
   return what + " must lie in [" + format_number(min) + ", " + format_number(max) + "] " + unit + " (got " +
@@ -204,7 +208,7 @@ std::vector<Segment> read_segments(Lines& lines, std::size_t& nonzero_results, i
   const std::int64_t count = lines.count("total number of segments");
   lines.column_names("segments", "SegName Type StartNode EndNode Diam Flow Hd");
   std::vector<Segment> segments;
-  segments.reserve(static_cast<std::size_t>(count));
+  segments.reserve(expected(count));
   std::unordered_map<std::int64_t, int> seen;
   const FieldRange& d = ranges::diameter;
   for (std::int64_t k = 0; k < count; ++k) {
@@ -245,7 +249,7 @@ std::vector<Node> read_nodes(Lines& lines, std::int64_t segment_count, int segme
   const std::int64_t count = lines.count("number of nodes");
   lines.column_names("nodes", "Name x y z");
   std::vector<Node> nodes;
-  nodes.reserve(static_cast<std::size_t>(count));
+  nodes.reserve(expected(count));
   std::unordered_map<std::int64_t, int> seen;
   const double limit = ranges::coordinate.max / metre_per_um;
   for (std::int64_t k = 0; k < count; ++k) {
@@ -276,7 +280,7 @@ std::vector<BoundaryNode> read_boundary_nodes(Lines& lines, std::size_t& solute_
   const std::int64_t count = lines.count("total number of boundary nodes");
   lines.column_names("boundary nodes", "Node Bctype Press/Flow HD");
   std::vector<BoundaryNode> boundaries;
-  boundaries.reserve(static_cast<std::size_t>(count));
+  boundaries.reserve(expected(count));
   std::unordered_map<std::int64_t, int> seen;
   for (std::int64_t k = 0; k < count; ++k) {
     if (!lines.next())

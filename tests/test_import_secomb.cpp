@@ -267,7 +267,10 @@ TEST(ImportSecomb, Refusals) {
                  "13: expected the nodes' column names (Name x y z) after the count, found numbers; NetFlow skips this "
                  "line unread");
   expect_refusal("Test network\n1000. 1000. box dimensions\n",
-                 "2: the box dimensions (line 2: three numbers [um]) must be a number (got 'box')");
+                 "2: the box dimensions (three numbers [um]) must be a number (got 'box')");
+  // A corrupt count is found wrong at the end of the file, without reserving room for it.
+  expect_refusal(header(2147483647) + segments_3,
+                 "11: the file ends after 3 of the 2147483647 segments announced on line 7");
   expect_refusal("Test network\n1000. 1000. 100.\n10 10 1\n100.\n150.\n4\nmany\n",
                  "7: the total number of segments must be a decimal integer (got 'many')");
 }
