@@ -397,34 +397,6 @@ std::optional<std::vector<std::int64_t>> ids_from_keys(const std::vector<std::st
   return ids;
 }
 
-// Generations breadth first from the nodes no vessel enters; vessels on a loop that no such
-// node reaches are counted from their part's first vessel, in either direction.
-std::size_t set_generations(Network& net) {
-  net.generation = generations_from_inlets(net);
-  std::vector<std::vector<std::int32_t>> at(net.node_count());
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    at[static_cast<std::size_t>(net.from[v])].push_back(static_cast<std::int32_t>(v));
-    at[static_cast<std::size_t>(net.to[v])].push_back(static_cast<std::int32_t>(v));
-  }
-  std::size_t rootless = 0;
-  for (std::size_t start = 0; start < net.vessel_count(); ++start) {
-    if (net.generation[start] >= 0) continue;
-    ++rootless;
-    net.generation[start] = 0;
-    std::vector<std::int32_t> queue{static_cast<std::int32_t>(start)};
-    for (std::size_t q = 0; q < queue.size(); ++q) {
-      const auto v = static_cast<std::size_t>(queue[q]);
-      for (std::int32_t node : {net.from[v], net.to[v]})
-        for (std::int32_t w : at[static_cast<std::size_t>(node)])
-          if (net.generation[static_cast<std::size_t>(w)] < 0) {
-            net.generation[static_cast<std::size_t>(w)] = net.generation[v] + 1;
-            queue.push_back(w);
-          }
-    }
-  }
-  return rootless;
-}
-
 void check_range(const RawGraph& g, const std::string& where, const char* field, const FieldRange& range,
                  double value, const std::string& hint) {
   if (!range.contains(value)) g.fail(where, out_of_range(field, range, value) + hint);
@@ -584,7 +556,7 @@ Network build_network(RawGraph& g, const ImportOptions& options, const GraphOpti
     vessel_how = "numbered in the file's order";
   }
 
-  const std::size_t rootless = generations ? 0 : set_generations(net);
+  if (!generations) net.generation = generations_from_inlets(net);  // breadth first from the inlets
   net.provenance["tool"] = "vimport";
   net.provenance["format"] = g.format;
   net.provenance["source"] = g.path;
@@ -604,9 +576,6 @@ Network build_network(RawGraph& g, const ImportOptions& options, const GraphOpti
   if (!g.ignored_graph.empty()) options.note("graph attributes not imported: " + some(g.ignored_graph));
   if (!g.ignored_node.empty()) options.note("node attributes not imported: " + some(g.ignored_node));
   if (!g.ignored_edge.empty()) options.note("edge attributes not imported: " + some(g.ignored_edge));
-  if (rootless > 0)
-    options.note(plural(rootless, "part", "parts") + " with loops and no node that only starts vessels: generations "
-                 "counted from the part's first vessel");
   fill_missing_walls(net, options);
   return net;
 }

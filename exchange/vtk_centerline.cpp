@@ -752,34 +752,6 @@ std::string point_text(const Centerlines& c, std::size_t p) {
          ", " + format_number(c.xyz[3 * p + 2]) + ")";
 }
 
-// Generations breadth first from the nodes no vessel enters; vessels on a loop that no such
-// node reaches are counted from their part's first vessel, in either direction.
-std::size_t set_generations(Network& net) {
-  net.generation = generations_from_inlets(net);
-  std::vector<std::vector<std::int32_t>> at(net.node_count());
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    at[static_cast<std::size_t>(net.from[v])].push_back(static_cast<std::int32_t>(v));
-    at[static_cast<std::size_t>(net.to[v])].push_back(static_cast<std::int32_t>(v));
-  }
-  std::size_t rootless = 0;
-  for (std::size_t start = 0; start < net.vessel_count(); ++start) {
-    if (net.generation[start] >= 0) continue;
-    ++rootless;
-    net.generation[start] = 0;
-    std::vector<std::int32_t> queue{static_cast<std::int32_t>(start)};
-    for (std::size_t q = 0; q < queue.size(); ++q) {
-      const auto v = static_cast<std::size_t>(queue[q]);
-      for (std::int32_t node : {net.from[v], net.to[v]})
-        for (std::int32_t w : at[static_cast<std::size_t>(node)])
-          if (net.generation[static_cast<std::size_t>(w)] < 0) {
-            net.generation[static_cast<std::size_t>(w)] = net.generation[v] + 1;
-            queue.push_back(w);
-          }
-    }
-  }
-  return rootless;
-}
-
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
@@ -951,7 +923,7 @@ Network build_network(const std::string& path, const Centerlines& c, const Impor
     net.add_vessel(static_cast<std::int64_t>(k), node_of[p.front()], node_of[p.back()], u * length, diameter,
                    std::nan(""), std::nan(""), 0);
   }
-  const std::size_t rootless = set_generations(net);
+  net.generation = generations_from_inlets(net);  // breadth first from the nodes no vessel enters
 
   // How many separate pieces: polylines that share no point with the rest.
   UnionFind parts(net.node_count());
@@ -983,9 +955,6 @@ Network build_network(const std::string& path, const Centerlines& c, const Impor
   if (!other_point_arrays.empty()) options.note("point data not imported: " + join(other_point_arrays));
   if (!c.cell_arrays.empty()) options.note("cell data not imported: " + join(c.cell_arrays));
   if (pieces > 1) options.note("the centerlines form " + std::to_string(pieces) + " separate pieces that share no point");
-  if (rootless > 0)
-    options.note(plural(rootless, "part", "parts") + " with loops and no node that only starts vessels: generations "
-                 "counted from the part's first vessel");
   fill_missing_walls(net, options);
   return net;
 }
