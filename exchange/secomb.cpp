@@ -529,7 +529,7 @@ Network read_secomb(const std::string& path, const ImportOptions& options) {
                  std::to_string(trailing_from) + ")");
   options.note("generations counted breadth first from the " +
                std::string(inflows.empty() ? "boundary nodes" : "inflow boundary nodes") +
-               " along vessels in either direction (network.dat has none; the network has loops)");
+               " along vessels in either direction (network.dat has none, and its networks may loop)");
   if (rootless > 0)
     options.note(plural(rootless, "part", "parts") + " of the network joined to no boundary node " +
                  "(NetFlow cannot compute flow there), counted from " + (rootless == 1 ? "its" : "their") +
