@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <numeric>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -138,6 +139,29 @@ NetworkStats compute_stats(const Network& net) {
   for (std::size_t node = 0; node < net.node_count(); ++node)
     if (ending[node] >= 1 && beginning[node] >= 2) ++stats.bifurcations;
 
+  // Degrees, parts (union-find), loops: the graph as it is, directions aside.
+  std::vector<std::int32_t> up(net.node_count());
+  std::iota(up.begin(), up.end(), 0);
+  auto root = [&](std::int32_t i) {
+    while (up[static_cast<std::size_t>(i)] != i) i = up[static_cast<std::size_t>(i)] = up[static_cast<std::size_t>(up[static_cast<std::size_t>(i)])];
+    return i;
+  };
+  for (std::size_t v = 0; v < n; ++v) {
+    const std::int32_t a = root(net.from[v]), b = root(net.to[v]);
+    up[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+  }
+  std::size_t touched = 0;
+  for (std::size_t node = 0; node < net.node_count(); ++node) {
+    const std::size_t degree = ending[node] + beginning[node];
+    if (degree == 0) continue;
+    ++touched;
+    if (stats.nodes_by_degree.size() <= degree) stats.nodes_by_degree.resize(degree + 1, 0);
+    ++stats.nodes_by_degree[degree];
+    if (root(static_cast<std::int32_t>(node)) == static_cast<std::int32_t>(node)) ++stats.parts;
+  }
+  stats.loops = n + stats.parts - touched;
+  for (const NodeBoundary& b : node_boundaries(net)) ++stats.boundaries_by_type[static_cast<std::size_t>(b.type)];
+
   int max_generation = -1;
   for (std::size_t v = 0; v < n; ++v) {
     if (beginning[static_cast<std::size_t>(net.to[v])] == 0) ++stats.terminals;
@@ -191,6 +215,16 @@ nlohmann::json to_json(const NetworkStats& stats) {
   out["vessels"] = stats.vessels;
   out["bifurcations"] = stats.bifurcations;
   out["terminals"] = stats.terminals;
+  nlohmann::json degrees = nlohmann::json::object();
+  for (std::size_t d = 1; d < stats.nodes_by_degree.size(); ++d)
+    if (stats.nodes_by_degree[d] > 0) degrees[std::to_string(d)] = stats.nodes_by_degree[d];
+  out["nodes_by_degree"] = std::move(degrees);
+  out["parts"] = stats.parts;
+  out["loops"] = stats.loops;
+  nlohmann::json boundaries = nlohmann::json::object();
+  for (std::size_t t = 0; t < stats.boundaries_by_type.size(); ++t)
+    boundaries[std::string(to_string(static_cast<BoundaryType>(t)))] = stats.boundaries_by_type[t];
+  out["boundary_nodes"] = std::move(boundaries);
   out["total_length"] = stats.total_length;
   out["total_volume"] = stats.total_volume;
   out["classes"] = class_counts_json(stats.by_class);
@@ -230,6 +264,21 @@ void print_table(const NetworkStats& stats, std::ostream& out) {
   out << format("%-22s %12zu\n", "vessels", stats.vessels)
       << format("%-22s %12zu\n", "bifurcations", stats.bifurcations)
       << format("%-22s %12zu\n", "terminals", stats.terminals)
+      << format("%-22s %12zu\n", "parts", stats.parts)
+      << format("%-22s %12zu\n", "loops", stats.loops);
+  for (std::size_t d = 1; d < stats.nodes_by_degree.size(); ++d)
+    if (stats.nodes_by_degree[d] > 0)
+      out << format("%-22s %12zu\n", ("nodes of degree " + std::to_string(d)).c_str(), stats.nodes_by_degree[d]);
+  std::size_t boundary_nodes = 0;
+  std::string by_type;
+  for (std::size_t t = 0; t < stats.boundaries_by_type.size(); ++t) {
+    boundary_nodes += stats.boundaries_by_type[t];
+    if (stats.boundaries_by_type[t] > 0)
+      by_type += (by_type.empty() ? "" : ", ") + std::to_string(stats.boundaries_by_type[t]) + " " +
+                 std::string(to_string(static_cast<BoundaryType>(t)));
+  }
+  out << format("%-22s %12zu", "boundary nodes", boundary_nodes) << (by_type.empty() ? "" : "  (" + by_type + ")")
+      << "\n"
       << format("%-22s %12.6g m\n", "total length", stats.total_length)
       << format("%-22s %12.6g m^3  (%.6g ml)\n", "total volume", stats.total_volume,
                 stats.total_volume / m3_per_ml);

@@ -26,8 +26,16 @@ struct GenerationStats {
 
 struct NetworkStats {
   std::size_t vessels = 0;
-  std::size_t bifurcations = 0;  // nodes where one vessel ends and two or more begin
-  std::size_t terminals = 0;     // vessels whose distal node starts no vessel
+  std::size_t bifurcations = 0;  // nodes where one vessel ends and two or more begin (trees)
+  std::size_t terminals = 0;     // vessels whose distal node starts no vessel (trees)
+  // Any graph, whatever the vessels' directions: nodes by how many vessels meet there
+  // (index = degree; 1: ends, 2: vessel continues, 3: bifurcations and confluences, ...),
+  // connected parts, independent loops (vessels - nodes + parts, the cycle rank; 0 for a
+  // tree), and boundary conditions by type (flow, pressure, RCR, R, reflection).
+  std::vector<std::size_t> nodes_by_degree;
+  std::size_t parts = 0;
+  std::size_t loops = 0;
+  std::array<std::size_t, 5> boundaries_by_type{};
   double total_length = 0;       // [m]
   double total_volume = 0;       // [m^3]
   std::array<std::size_t, vessel_class_count> by_class{};

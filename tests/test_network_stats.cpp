@@ -252,9 +252,13 @@ TEST(NetworkStats, JsonKeysAndValues) {
   const nlohmann::json j = to_json(compute_stats(net));
 
   const std::set<std::string> classes = {"artery", "small_artery", "arteriole", "capillary"};
-  EXPECT_EQ(keys(j), (std::set<std::string>{"vessels", "bifurcations", "terminals",
-                                            "total_length", "total_volume", "classes",
+  EXPECT_EQ(keys(j), (std::set<std::string>{"vessels", "bifurcations", "terminals", "nodes_by_degree", "parts",
+                                            "loops", "boundary_nodes", "total_length", "total_volume", "classes",
                                             "capillary_generations", "generations"}));
+  EXPECT_EQ(j["nodes_by_degree"], (nlohmann::json{{"1", 3}, {"3", 1}}));
+  EXPECT_EQ(j["parts"], 1);
+  EXPECT_EQ(j["loops"], 0);
+  EXPECT_EQ(j["boundary_nodes"]["flow"], 0);
   EXPECT_EQ(keys(j["classes"]), classes);
   EXPECT_TRUE(j["capillary_generations"].is_null());
   EXPECT_EQ(j["vessels"], 3);
@@ -275,6 +279,34 @@ TEST(NetworkStats, JsonKeysAndValues) {
   EXPECT_EQ(g1["classes"]["arteriole"], 2);
   EXPECT_DOUBLE_EQ(g1["diameter"]["median"].get<double>(), um(30));  // metres
   EXPECT_DOUBLE_EQ(g1["diameter"]["max"].get<double>(), um(40));
+}
+
+// A measured network: a loop written partly against its flow, a second part, boundaries at
+// nodes. Loops are the cycle rank, vessels - nodes + parts, whatever the directions.
+TEST(NetworkStats, LoopsPartsDegreesAndBoundaryNodes) {
+  Network net = with_nodes(8);
+  add(net, 0, 1, mm(1), um(20), 0);
+  add(net, 2, 1, mm(1), um(20), 1);  // against the flow
+  add(net, 1, 3, mm(1), um(20), 1);
+  add(net, 3, 2, mm(1), um(20), 2);
+  add(net, 2, 4, mm(1), um(20), 2);
+  add(net, 4, 3, mm(1), um(20), 3);  // a second loop
+  add(net, 5, 6, mm(1), um(20), 0);  // a part of its own, and node 7 alone (no vessel)
+  NodeBoundary in, out;
+  in.node = 0;
+  in.type = BoundaryType::flow;
+  out.node = 6;
+  out.type = BoundaryType::pressure;
+  net.boundaries = {in, out};
+  const NetworkStats s = compute_stats(net);
+  EXPECT_EQ(s.parts, 2u);
+  EXPECT_EQ(s.loops, 2u);  // 7 vessels - 7 nodes touched + 2 parts
+  EXPECT_EQ(s.nodes_by_degree, (std::vector<std::size_t>{0, 3, 1, 3}));  // ends 0, 5, 6; node 4 joins two
+  EXPECT_EQ(s.boundaries_by_type[static_cast<std::size_t>(BoundaryType::flow)], 1u);
+  EXPECT_EQ(s.boundaries_by_type[static_cast<std::size_t>(BoundaryType::pressure)], 1u);
+  std::ostringstream table;
+  print_table(s, table);
+  EXPECT_NE(table.str().find("boundary nodes                    2  (1 flow, 1 pressure)"), std::string::npos) << table.str();
 }
 
 TEST(NetworkStats, EmptyNetwork) {
