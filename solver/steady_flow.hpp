@@ -21,7 +21,8 @@ struct SteadyFlow {
 };
 
 // Poiseuille resistance of every vessel [Pa s/m^3] with the blood's apparent viscosity at
-// its reference diameter and its velocity profile (alpha).
+// its reference diameter and its velocity profile (alpha); a tapered vessel's integrated
+// along it (physics/poiseuille.hpp).
 std::vector<double> vessel_resistances(const Network& net, const Blood& blood);
 
 // Thevenin equivalent of what lies beyond a vessel's distal node: the flow into it is

@@ -336,3 +336,18 @@ TEST(SteadyFlowAtNodes, RefusesNetworksWithoutAPressureReference) {
   reflecting.boundaries[1].type = BoundaryType::reflection;
   expect_refusal(reflecting, "node 3: a reflection outlet has no steady resistance");
 }
+
+// A tapered vessel resists as the integral of Poiseuille's law along it: for Newtonian
+// blood and a radius linear from r0 to r1, R = 8 mu L (r0^2 + r0 r1 + r1^2) / (3 pi r0^3 r1^3).
+TEST(SteadyFlow, TaperedVesselResistsAsTheIntegralAlongIt) {
+  Network net;
+  net.add_node(0);
+  net.add_node(1);
+  net.add_vessel(0, 0, 1, 0.02, 4e-3, 4e-4, 4e5, 0);
+  net.distal_diameter = {2e-3};
+  Blood blood;
+  blood.rheology = Rheology::newtonian;
+  const double r0 = 2e-3, r1 = 1e-3, mu = blood.newtonian_viscosity;
+  const double expected = 8 * mu * 0.02 * (r0 * r0 + r0 * r1 + r1 * r1) / (3 * std::numbers::pi * std::pow(r0 * r1, 3));
+  EXPECT_NEAR(vessel_resistances(net, blood)[0], expected, 1e-12 * expected);
+}
