@@ -55,13 +55,18 @@ int main(int argc, char** argv) {
 
     const Network net = read_network(input);
     OutputStream out(output);
-    if (format == "secomb") {
-      write_secomb(net, out);
-      note_what_secomb_drops(net);
-    } else {
-      const std::string inlet = inlet_path_for(output);
-      write_openbf(net, out, inlet);
-      note("note: inlet table written to " + inlet);
+    // The writers name the vessel or node the format cannot hold; the network's file goes first.
+    try {
+      if (format == "secomb") {
+        write_secomb(net, out);
+        note_what_secomb_drops(net);
+      } else {
+        const std::string inlet = inlet_path_for(output);
+        write_openbf(net, out, inlet);
+        note("note: inlet table written to " + inlet);
+      }
+    } catch (const InputError& e) {
+      throw InputError((input == "-" ? std::string("standard input") : input) + ": " + e.what());
     }
     out.commit();
     return 0;

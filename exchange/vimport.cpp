@@ -59,7 +59,7 @@ void make_provenance_writable(nlohmann::json& provenance) {
 int main(int argc, char** argv) {
   CLI::App app{"Reads a network in another program's format and writes it as vnet JSON.", "vimport"};
   std::string format, input, output = "-";
-  std::string youngs_text, wall_ratio_text, mcv_text, plasma_text, hematocrit_text, radius_array;
+  std::string youngs_text, wall_ratio_text, mcv_text, plasma_text, hematocrit_text, radius_array, unit_text;
   app.add_option("FORMAT", format,
                  "secomb (network.dat), openbf (YAML), vtk (centerlines, .vtp or legacy .vtk), graphml, "
                  "networkx (node-link JSON)")
@@ -83,6 +83,9 @@ int main(int argc, char** argv) {
       ->group("Blood");
   app.add_option("--radius-array", radius_array,
                  "vtk: the point array of radii (default " + CenterlineOptions{}.radius_array + ")");
+  app.add_option("--unit", unit_text,
+                 "vtk, graphml, networkx: the length unit of the file's coordinates, lengths and radii (m, cm, mm, "
+                 "um; VMTK models are usually in mm; default m, or a graph's own \"unit\" attribute)");
   app.set_version_flag("--version", std::string("vimport ") + HEMOTREE_VERSION);
 
   return run_tool(app, argc, argv, [&] {
@@ -90,6 +93,8 @@ int main(int argc, char** argv) {
     if (format != "secomb" && format != "openbf" && format != "vtk" && format != "graphml" && format != "networkx")
       throw InputError("FORMAT must be secomb, openbf, vtk, graphml or networkx (got '" + format + "')");
     if (!radius_array.empty() && format != "vtk") throw InputError("--radius-array applies to FORMAT vtk only");
+    if (!unit_text.empty() && (format == "secomb" || format == "openbf"))
+      throw InputError("--unit applies to FORMAT vtk, graphml and networkx only (" + format + " files have their units)");
 
     ImportOptions options;
     options.note = [](const std::string& line) { note("note: " + line); };
@@ -111,6 +116,20 @@ int main(int argc, char** argv) {
     if (!hematocrit_text.empty())
       hematocrit = parse_number(hematocrit_text, "--hematocrit", accepted(ranges::hematocrit));
     CenterlineOptions centerline;
+    GraphOptions graph;
+    if (!unit_text.empty()) {
+      double metres = 0;
+      try {
+        metres = parse_quantity("1" + unit_text, Dimension::length, "--unit");
+      } catch (const InputError&) {
+        metres = 0;
+      }
+      if (!(metres >= 1e-9 && metres <= 1))
+        throw InputError("--unit must be a length unit: m, cm, mm, um or nm (got '" + unit_text + "')");
+      centerline.length_unit = metres;
+      graph.length_unit = metres;
+      parameters["unit"] = unit_text;
+    }
     if (!radius_array.empty()) {
       centerline.radius_array = radius_array;
       parameters["radius_array"] = radius_array;
@@ -120,8 +139,8 @@ int main(int argc, char** argv) {
     Network net = format == "secomb"   ? read_secomb(input, options)
                   : format == "openbf" ? read_openbf(input, options)
                   : format == "vtk"    ? read_vtk_centerline(input, options, centerline)
-                  : format == "graphml" ? read_graphml(input, options)
-                                        : read_node_link_json(input, options);
+                  : format == "graphml" ? read_graphml(input, options, graph)
+                                        : read_node_link_json(input, options, graph);
 
     // ---- blood: the file's, with what the flags set --------------------------------------
     if (mean_cell_volume || plasma_viscosity || hematocrit) {
