@@ -17,6 +17,7 @@
 #include "generator/size_estimate.hpp"
 #include "generator/tree_growth.hpp"
 #include "generator/tree_layout.hpp"
+#include "generator/venous_mirror.hpp"
 
 using namespace hemotree;
 
@@ -51,8 +52,9 @@ int main(int argc, char** argv) {
                "length law) and write it in the vnet network format.",
                "vgen"};
   std::string root_text = "1mm", min_text = "7um", rules_path, output = "-", format_name = "json";
-  std::string seed_text = "1";
-  bool print_rules = false, force = false;
+  std::string seed_text = "1", mean_flow_text = "1.74ml/min", venous_pressure_text = "10mmHg",
+              venous_ratio_text = "1";
+  bool print_rules = false, force = false, venous = false;
   app.add_option("--root-diameter", root_text,
                  "diameter of the root vessel, SI metres or with a unit (1mm); in [3um, 2.6cm) "
                  "with the default rules (their largest diameter), above --min-diameter")
@@ -75,6 +77,21 @@ int main(int argc, char** argv) {
   app.add_flag("--force", force,
                "grow even when the estimated size exceeds available memory (never beyond the "
                "2147483646 vessels a network holds)");
+  app.add_flag("--venous", venous,
+               "add the tree's venous mirror: each vessel a venous twin carrying its flow back, the capillaries "
+               "joining the two trees (arterio-venous loops), a flow boundary at the arterial root and a "
+               "pressure boundary at the venous root (format version 2; hemosolve --steady runs it)")
+      ->group("Venous mirror");
+  app.add_option("--mean-flow", mean_flow_text, "with --venous: the inflow at the arterial root")
+      ->capture_default_str()
+      ->group("Venous mirror");
+  app.add_option("--venous-pressure", venous_pressure_text, "with --venous: the pressure at the venous root")
+      ->capture_default_str()
+      ->group("Venous mirror");
+  app.add_option("--venous-diameter-ratio", venous_ratio_text,
+                 "with --venous: a venous twin's diameter (and wall) over its artery's, in [0.5, 4]")
+      ->capture_default_str()
+      ->group("Venous mirror");
   app.set_version_flag("--version", std::string("vgen ") + HEMOTREE_VERSION);
 
   const int status = run_tool(app, argc, argv, [&] {
@@ -122,6 +139,23 @@ int main(int argc, char** argv) {
     progress.finish();
     check_fields(net);
     lay_out_tree(net);
+    nlohmann::json venous_parameters;
+    if (venous) {
+      VenousMirror mirror;
+      mirror.mean_flow = parse_quantity(mean_flow_text, Dimension::flow, "--mean-flow",
+                                        Interval{ranges::mean_flow.min, ranges::mean_flow.max}, "ml/min");
+      mirror.venous_pressure = parse_quantity(venous_pressure_text, Dimension::pressure, "--venous-pressure",
+                                              Interval{ranges::pressure.min, ranges::pressure.max}, "mmHg");
+      mirror.diameter_ratio = parse_number(venous_ratio_text, "--venous-diameter-ratio", Interval{0.5, 4});
+      mirror.offset = 2 * p.root_diameter;
+      add_venous_mirror(net, mirror);
+      check_fields(net);
+      venous_parameters = {{"mean_flow", mirror.mean_flow},
+                           {"venous_pressure", mirror.venous_pressure},
+                           {"diameter_ratio", mirror.diameter_ratio}};
+    } else if (app.count("--mean-flow") + app.count("--venous-pressure") + app.count("--venous-diameter-ratio") > 0) {
+      throw InputError("--mean-flow, --venous-pressure and --venous-diameter-ratio apply with --venous only");
+    }
     net.provenance = {{"tool", "vgen"},
                       {"version", HEMOTREE_VERSION},
                       {"seed", p.seed},
@@ -129,6 +163,7 @@ int main(int argc, char** argv) {
                        {{"root_diameter", p.root_diameter},
                         {"min_diameter", p.min_diameter},
                         {"rules", to_json(rules)}}}};
+    if (venous) net.provenance["parameters"]["venous"] = venous_parameters;
 
     OutputStream out(output);
     write_network_as(net, *format, out);
