@@ -31,6 +31,7 @@ CycleStatistics::CycleStatistics(const Network& net, double analysis_frequency)
 
 void CycleStatistics::begin(const PulseSolver& solver) {
   exchanged_start_ = solver.state().exchanged;
+  boundary_start_ = solver.state().boundary;
   volume_start_ = solver.network_volume();
 }
 
@@ -107,6 +108,8 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   const Eigen::Vector2d exchanged = solver.state().exchanged - exchanged_start_;
   summary.inlet_mean_flow = exchanged(0) / duration_;
   summary.outlets_mean_flow = exchanged(1) / duration_;
+  const Eigen::VectorXd through = solver.state().boundary - boundary_start_;
+  for (Eigen::Index i = 0; i < through.size(); ++i) summary.boundary_mean_flow.push_back(through(i) / duration_);
   summary.volume_change = solver.network_volume() - volume_start_;
   summary.conservation_error = (exchanged(0) - exchanged(1) - summary.volume_change) / exchanged(0);
   if (duration_ > 0) record_ends(solver, last_);  // the state of the cycle's last sample

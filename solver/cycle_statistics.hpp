@@ -40,9 +40,13 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 
 struct CycleSummary {
   std::vector<VesselCycle> vessels;
-  // Mean flow in at the inlet and out through all outlets, from the volume fluxes the solver
-  // exchanged there: over a periodic cycle the compliances store nothing, and they agree.
+  // Mean flow in through the boundaries that count as entering (the inlet; flows into the
+  // network, pressures whose steady flow enters) and out through the others (outlets,
+  // prescribed outflows), from the volume fluxes the solver exchanged there: over a periodic
+  // cycle the compliances store nothing, and they agree.
   double inlet_mean_flow = 0, outlets_mean_flow = 0;
+  // Per boundary (PulseSolver::boundary_list), the mean flow in through it [m^3/s].
+  std::vector<double> boundary_mean_flow;
   // The change of the blood volume in the vessels over the cycle [m^3], and the scheme's
   // mass balance: (in - out - change) / in, round-off and the junctions' tolerance.
   double volume_change = 0, conservation_error = 0;
@@ -64,6 +68,7 @@ class CycleStatistics {
   const Network& net_;
   double omega_;
   Eigen::Vector2d exchanged_start_ = Eigen::Vector2d::Zero();  // at begin()
+  Eigen::VectorXd boundary_start_;                               // at begin()
   double volume_start_ = 0;
   std::vector<double> flow_, pressure_, p_min_, p_max_, q_min_, q_max_, wss_, reynolds_;
   // Fourier sums at the ends, and each signal's first and last sample of the cycle: a

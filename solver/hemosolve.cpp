@@ -54,6 +54,8 @@ std::uint64_t network_fingerprint(const Network& net) {
   if (net.blood) f.add(to_json(*net.blood).dump());
   if (net.inlet) f.add(to_json(*net.inlet).dump());
   for (const Outlet& o : net.outlets) f.add(to_json(o).dump() + std::to_string(o.vessel));
+  for (const NodeBoundary& b : net.boundaries) f.add(to_json(b, net.node_id[static_cast<std::size_t>(b.node)]).dump());
+  f.add(net.distal_diameter);
   return f.value();
 }
 
@@ -78,9 +80,10 @@ void warn_unphysiological(double low, double high, std::int64_t vessel, const Ne
   if (!std::isfinite(low) || !std::isfinite(high)) return;
   if (low >= physiological_low * pascal_per_mmhg && high <= physiological_high * pascal_per_mmhg) return;
   warn(std::string(what) + " reach " + format_quantity(high, "mmHg") + " (lowest " + format_quantity(low, "mmHg") +
-       ", at vessel " + std::to_string(vessel) + "), outside a physiological 0 to 300 mmHg: the inlet's mean flow (" +
-       format_quantity(net.inlet->waveform.mean_value(), "ml/min") +
-       ") is likely wrong for this network's size (vprune --mean-flow sets it)");
+       ", at vessel " + std::to_string(vessel) + "), outside a physiological 0 to 300 mmHg: " +
+       (net.inlet ? "the inlet's mean flow (" + format_quantity(net.inlet->waveform.mean_value(), "ml/min") +
+                        ") is likely wrong for this network's size (vprune --mean-flow sets it)"
+                  : std::string("the boundary flows and pressures are likely wrong for this network")));
 }
 
 }  // namespace
@@ -281,8 +284,11 @@ int main(int argc, char** argv) {
       run_steady(net, request);
       return 0;
     }
-    if (!net.inlet) throw InputError("the network has no \"inlet\": hemosolve needs one (vprune adds it)");
-    const double period = net.inlet->waveform.period;
+    if (!net.inlet && net.boundaries.empty())
+      throw InputError("the network has no \"inlet\": hemosolve needs one (vprune adds it), or \"boundaries\"");
+    // The common period of the time-varying boundary conditions (1 s where all are constant).
+    const Waveform driving = driving_waveform(net);
+    const double period = driving.period;
     check_range(sample_interval, {0, period, true, false}, "--sample-interval", "s");
     std::vector<Probe> probe_list;
     for (const auto& t : probe_texts) probe_list.push_back(parse_probe(t, net));
@@ -422,14 +428,22 @@ int main(int argc, char** argv) {
     // A run is complete only when its numbers say so.
     std::string failure;
     if (status == RunStatus::complete || status == RunStatus::not_periodic) {
-      const double prescribed = net.inlet->waveform.mean_value();
       if (!(std::abs(last.conservation_error) < conservation_tolerance))
         failure = "the scheme lost mass: (in - out - stored) / in = " + format_rounded(last.conservation_error) +
                   " over the last cycle, above " + format_rounded(conservation_tolerance);
-      else if (!(std::abs(last.inlet_mean_flow - prescribed) <= 1e-2 * std::abs(prescribed)))
-        failure = "the inlet's mean flow over the last cycle is " + format_quantity(last.inlet_mean_flow, "ml/min") +
-                  " where the waveform prescribes " + format_quantity(prescribed, "ml/min") +
-                  ": the time step cannot follow the pulse";
+      // Each prescribed flow's mean against what went through it (a zero mean within 1e-6
+      // of the flow in).
+      const std::vector<NodeBoundary>& list = run.boundary_list();
+      for (std::size_t i = 0; i < list.size() && failure.empty() && i < last.boundary_mean_flow.size(); ++i) {
+        if (list[i].type != BoundaryType::flow) continue;
+        const double prescribed = list[i].waveform.mean_value(), got = last.boundary_mean_flow[i];
+        if (std::abs(got - prescribed) <= 1e-2 * std::abs(prescribed) + 1e-6 * std::abs(last.inlet_mean_flow)) continue;
+        const bool inlet = net.inlet && net.boundaries.empty();
+        failure = (inlet ? std::string("the inlet's mean flow")
+                         : "the mean flow into node " + std::to_string(net.node_id[static_cast<std::size_t>(list[i].node)])) +
+                  " over the last cycle is " + format_quantity(got, "ml/min") + " where the waveform prescribes " +
+                  format_quantity(prescribed, "ml/min") + ": the time step cannot follow the pulse";
+      }
     }
 
     nlohmann::json run_info = {{"tool", "hemosolve"}, {"version", HEMOTREE_VERSION},
@@ -447,8 +461,8 @@ int main(int argc, char** argv) {
                                {"start_requested", start},
                                {"balance_compliances", balance && steady_start},
                                {"period", period},
-                               {"pulse_frequency", pulse_frequency(net.inlet->waveform)},
-                               {"analysis_frequency", analysis_frequency(net.inlet->waveform)},
+                               {"pulse_frequency", pulse_frequency(driving)},
+                               {"analysis_frequency", analysis_frequency(driving)},
                                {"time_step", dt}, {"time_step_limit", dt_reason},
                                {"steps_per_cycle", steps_per_cycle},
                                {"status", failure.empty() ? to_string(status) : "failed"},
@@ -463,6 +477,16 @@ int main(int argc, char** argv) {
       run_info["slowest_vessel"] = net.id[pulsatile.change().vessel];
     }
     if (!failure.empty()) run_info["error"] = failure;
+    if (!last.boundary_mean_flow.empty()) {
+      // Each boundary's mean flow into the network over the last cycle (as --steady reports).
+      run_info["boundaries"] = nlohmann::json::array();
+      for (std::size_t i = 0; i < run.boundary_list().size(); ++i) {
+        const NodeBoundary& b = run.boundary_list()[i];
+        run_info["boundaries"].push_back({{"node", net.node_id[static_cast<std::size_t>(b.node)]},
+                                          {"type", to_string(b.type)},
+                                          {"flow", last.boundary_mean_flow[i]}});
+      }
+    }
     if (status == RunStatus::broken_down) run_info["error"] = pulsatile.breakdown();
     if (status == RunStatus::interrupted)
       run_info["error"] = std::string("interrupted by ") + InterruptRequests::name(pulsatile.signal()) +
@@ -486,7 +510,7 @@ int main(int argc, char** argv) {
     if (status == RunStatus::interrupted || checkpoint_every > 0) pulsatile.write_checkpoint();
     pulsatile.probes().write(dir / "probes.csv");
     const VesselTable results =
-        last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(net.inlet->waveform));
+        last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(driving));
     if (!last.vessels.empty()) run_info["statistics"] = group_statistics(net, results);
     write_summary(dir / "summary.json", run_info, results, last);
     write_vessel_table(dir / "vessels.csv", results);

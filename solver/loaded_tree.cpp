@@ -1,10 +1,12 @@
 #include "solver/loaded_tree.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
 #include "cli/errors.hpp"
 #include "network_flow/nodal_system.hpp"
+#include "solver/network_boundaries.hpp"
 #include "solver/steady_flow.hpp"
 
 namespace hemotree {
@@ -12,29 +14,69 @@ namespace hemotree {
 TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& resistance, const TreeLoads& loads) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   if (n == 0) throw InputError("the network has no vessels");
+  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
+  const std::vector<Outlet> outlets = run_outlets(boundaries);
   if (resistance.size() != n || loads.node_shunt.size() != nodes || loads.node_current.size() != nodes ||
-      loads.capacitor_shunt.size() != net.outlets.size() || loads.capacitor_current.size() != net.outlets.size())
+      loads.capacitor_shunt.size() != outlets.size() || loads.capacitor_current.size() != outlets.size())
     throw std::invalid_argument("solve_loaded_tree: resistances or loads not sized to the network");
-  steady_outlets(net);  // the outlets sit on exactly the terminal vessels, none a reflection
+  if (net.boundaries.empty()) steady_outlets(net);  // the outlets sit on exactly the terminal vessels, none a reflection
+  for (const NodeBoundary& bc : boundaries)
+    if (bc.type == BoundaryType::reflection)
+      throw InputError("node " + std::to_string(net.node_id[static_cast<std::size_t>(bc.node)]) +
+                       ": a reflection outlet has no resistance for the network's response");
+  // Each outlet's node (the tree form's: its vessel's `to`), and the nodes a prescribed
+  // pressure holds: their disturbance is 0.
+  std::vector<std::int32_t> outlet_node;
+  std::vector<unsigned char> held(nodes, 0);
+  for (const NodeBoundary& bc : boundaries) {
+    if (bc.is_outlet()) outlet_node.push_back(bc.node);
+    if (bc.type == BoundaryType::pressure) held[static_cast<std::size_t>(bc.node)] = 1;
+  }
 
   // The system's nodes: the network's, then a capacitor node per RCR outlet that has one
   // apart from both ends (R1 and R2 both positive). With R1 = 0 the capacitor sits on the
   // vessel's distal node; with R2 = 0 it is grounded (its potential 0, its loads shorted).
-  std::vector<std::int32_t> capacitor_node(net.outlets.size(), -1);
+  std::vector<std::int32_t> capacitor_node(outlets.size(), -1);
   std::vector<std::int32_t> a(net.from), b(net.to);
   std::vector<double> conductance(n), shunt(loads.node_shunt), current(loads.node_current);
   for (std::size_t v = 0; v < n; ++v) conductance[v] = 1 / resistance[v];
+  if (std::find(held.begin(), held.end(), 1) != held.end()) {
+    // A held node is eliminated exactly: a vessel to it is a shunt at its other node (both
+    // ends held: nothing), and the node itself stands apart, at 0 (a unit shunt, no current).
+    std::vector<std::int32_t> kept_a, kept_b;
+    std::vector<double> kept;
+    for (std::size_t v = 0; v < n; ++v) {
+      const auto i = static_cast<std::size_t>(a[v]), j = static_cast<std::size_t>(b[v]);
+      if (held[i] && held[j]) continue;
+      if (held[i] || held[j]) {
+        shunt[held[i] ? j : i] += conductance[v];
+        continue;
+      }
+      kept_a.push_back(a[v]);
+      kept_b.push_back(b[v]);
+      kept.push_back(conductance[v]);
+    }
+    a = std::move(kept_a);
+    b = std::move(kept_b);
+    conductance = std::move(kept);
+    for (std::size_t i = 0; i < nodes; ++i)
+      if (held[i]) {
+        shunt[i] = 1;
+        current[i] = 0;
+      }
+  }
   // A node that no vessel touches is no part of the tree: held at 0 (a unit shunt, no current).
   std::vector<unsigned char> touched(nodes, 0);
-  for (std::size_t v = 0; v < n; ++v) touched[static_cast<std::size_t>(a[v])] = touched[static_cast<std::size_t>(b[v])] = 1;
+  for (std::size_t v = 0; v < n; ++v)
+    touched[static_cast<std::size_t>(net.from[v])] = touched[static_cast<std::size_t>(net.to[v])] = 1;
   for (std::size_t i = 0; i < nodes; ++i)
     if (!touched[i]) {
       shunt[i] = 1;
       current[i] = 0;
     }
-  for (std::size_t k = 0; k < net.outlets.size(); ++k) {
-    const Outlet& o = net.outlets[k];
-    const std::int32_t distal = net.to[static_cast<std::size_t>(o.vessel)];
+  for (std::size_t k = 0; k < outlets.size(); ++k) {
+    const Outlet& o = outlets[k];
+    const std::int32_t distal = outlet_node[k];
     const auto d = static_cast<std::size_t>(distal);
     if (o.type != OutletType::rcr) {
       shunt[d] += 1 / o.r;
@@ -66,11 +108,11 @@ TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& 
 
   TreePotentials p;
   p.node.assign(current.begin(), current.begin() + static_cast<std::ptrdiff_t>(nodes));
-  p.capacitor.assign(net.outlets.size(), 0.0);
-  for (std::size_t k = 0; k < net.outlets.size(); ++k) {
-    const Outlet& o = net.outlets[k];
+  p.capacitor.assign(outlets.size(), 0.0);
+  for (std::size_t k = 0; k < outlets.size(); ++k) {
+    const Outlet& o = outlets[k];
     if (capacitor_node[k] >= 0) p.capacitor[k] = current[static_cast<std::size_t>(capacitor_node[k])];
-    else if (o.type == OutletType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(net.to[static_cast<std::size_t>(o.vessel)])];
+    else if (o.type == OutletType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(outlet_node[k])];
   }
   return p;
 }

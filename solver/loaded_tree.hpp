@@ -1,7 +1,8 @@
 // A linear resistive network with loads (a tree, as a rule): the network's vessels
 // (Poiseuille resistances) and outlets (R to ground; RCR as R1 to a capacitor node and R2 to
-// ground), the inlet open, and at every node and every capacitor node a conductance to ground
-// and an injected current.
+// ground, at the outlet's node), prescribed flows open (the inlet), prescribed pressures
+// held (potential 0), and at every node and every capacitor node a conductance to ground
+// and an injected current. The boundaries are solver/network_boundaries.hpp's run_boundaries.
 // Its potentials are what the slow drift of the network's compliances towards the periodic
 // state needs (PulseSolver::balance_compliances): pressure shifts in Pa for volume rates in
 // m^3/s. Outflow pressures are zero: the tree is the network's response to disturbances.
@@ -15,20 +16,21 @@ namespace hemotree {
 
 struct TreeLoads {
   std::vector<double> node_shunt, node_current;            // per node [m^3/(s Pa)], [m^3/s]
-  std::vector<double> capacitor_shunt, capacitor_current;  // per outlet (used for RCR only)
+  std::vector<double> capacitor_shunt, capacitor_current;  // per run outlet (RCR only; a tree's: net.outlets)
 };
 
 struct TreePotentials {
   std::vector<double> node;       // per node [Pa]
-  std::vector<double> capacitor;  // per outlet: the capacitor node's (RCR), else 0 [Pa]
+  std::vector<double> capacitor;  // per run outlet: the capacitor node's (RCR), else 0 [Pa]
 };
 
 // The nodal system (network_flow/nodal_system.hpp) of the network's nodes and the RCR outlets'
 // capacitor nodes (node -R1- capacitor node -R2- ground): on a tree the elimination from the
 // leaves up, O(vessels); the network may have loops too (a sparse Cholesky factorisation
-// then). Throws InputError where steady_outlets does (a terminal vessel without an outlet, an
-// outlet on a vessel that is not terminal, a reflection outlet), and where a part of the
-// network has no path to ground.
+// then). A held node is eliminated exactly (its vessels become shunts at their other nodes).
+// Throws InputError for a tree form's outlets where steady_outlets does (a terminal vessel
+// without an outlet, an outlet on a vessel that is not terminal), for a reflection outlet,
+// and where a part of the network has no path to ground.
 TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& resistance, const TreeLoads& loads);
 
 }  // namespace hemotree

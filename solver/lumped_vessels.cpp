@@ -4,10 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 
 #include "cli/errors.hpp"
 #include "physics/poiseuille.hpp"
+#include "solver/network_boundaries.hpp"
 #include "solver/solution_breakdown.hpp"
 
 namespace hemotree {
@@ -52,21 +54,59 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
   shunt_pressure_.assign(network_nodes_, 0.0);
   volume_b_.assign(network_nodes_, 0.0);
 
-  // Outlets on 0D vessels: shunts, or R1 to a capacitor node with R2 and C.
-  capacitor_of_outlet_.assign(net.outlets.size(), -1);
-  for (std::size_t k = 0; k < net.outlets.size(); ++k) {
-    const Outlet& o = net.outlets[k];
-    const auto v = static_cast<std::size_t>(o.vessel);
-    if (!zero_d[v]) continue;
-    const auto at = static_cast<std::size_t>(node_of_[static_cast<std::size_t>(net.to[v])]);
+  // Boundary conditions at nodes of 0D vessels (solver/network_boundaries.hpp's order):
+  // outlets are shunts, or R1 to a capacitor node with R2 and C; flows are currents into
+  // their nodes; a pressure holds its node through a shunt far stiffer than the node's
+  // vessel (predict() sizes it), a Dirichlet condition to 1e-10 of the vessel's drop.
+  std::vector<std::int32_t> vessel_at(net.node_count(), -1), end_sign(net.node_count(), 0);
+  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+    const auto v = static_cast<std::size_t>(vessels_[e]);
+    vessel_at[static_cast<std::size_t>(net.from[v])] = static_cast<std::int32_t>(v);
+    end_sign[static_cast<std::size_t>(net.from[v])] = -1;  // flow along it leaves the node
+    vessel_at[static_cast<std::size_t>(net.to[v])] = static_cast<std::int32_t>(v);
+    end_sign[static_cast<std::size_t>(net.to[v])] = 1;
+  }
+  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
+  std::size_t outlet_count = 0;
+  for (const NodeBoundary& b : boundaries) outlet_count += b.is_outlet() ? 1 : 0;
+  capacitor_of_outlet_.assign(outlet_count, -1);
+  std::int32_t k = -1;  // outlet index
+  for (std::size_t i = 0; i < boundaries.size(); ++i) {
+    const NodeBoundary& bc = boundaries[i];
+    if (bc.is_outlet()) ++k;
+    const auto network_node = static_cast<std::size_t>(bc.node);
+    if (node_of_[network_node] < 0) continue;
+    const auto at = static_cast<std::size_t>(node_of_[network_node]);
+    const auto v = static_cast<std::size_t>(vessel_at[network_node]);
+    const auto boundary = static_cast<std::int32_t>(i);
+    if (bc.type == BoundaryType::flow) {
+      inflow_node_.push_back(static_cast<std::int32_t>(at));
+      inflow_boundary_.push_back(boundary);
+      inflow_entering_.push_back(bc.waveform.mean_value() >= 0);
+      continue;
+    }
+    if (bc.type == BoundaryType::pressure) {
+      held_node_.push_back(static_cast<std::int32_t>(at));
+      held_boundary_.push_back(boundary);
+      held_entering_.push_back(1);
+      const VesselLaw& law = laws[v];
+      held_reference_conductance_.push_back(law.reference_area * law.reference_area /
+                                            (friction_k_ * viscosity(law.reference_area) * net.length[v]));
+      shunt_pressure_[at] = bc.waveform.mean_value();
+      continue;
+    }
+    const Outlet& o = bc.outlet;
     if (o.type == OutletType::reflection)
       throw InputError("vessel " + std::to_string(net.id[v]) +
                        ": a reflection outlet needs a 1D vessel (--model 1d, or auto, keeps it 1D)");
+    outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(at), -1});
     if (o.type == OutletType::rcr && o.c > 0) {
-      capacitor_of_outlet_[k] = static_cast<std::int32_t>(outlet_of_capacitor_.size());
+      capacitor_of_outlet_[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(outlet_of_capacitor_.size());
       const auto c = static_cast<std::int32_t>(nodes_++);
-      outlet_of_capacitor_.push_back(static_cast<std::int32_t>(k));
+      outlet_boundary_.back().r1_edge = static_cast<std::int32_t>(vessels_.size() + outlet_of_capacitor_.size());
+      outlet_of_capacitor_.push_back(k);
       capacitor_vessel_edge_.push_back(index_of_vessel_[v]);
+      capacitor_edge_sign_.push_back(end_sign[network_node]);
       a_.push_back(static_cast<std::int32_t>(at));
       b_.push_back(c);
       edge_fixed_resistance_.push_back(o.r1);
@@ -78,10 +118,9 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
       shunt_pressure_[at] = o.p_out;
     }
   }
-  if (net.inlet) {
-    const std::int64_t inlet = net.index_of(net.inlet->vessel);
-    if (inlet >= 0 && zero_d[static_cast<std::size_t>(inlet)])
-      inlet_node_ = node_of_[static_cast<std::size_t>(net.from[static_cast<std::size_t>(inlet)])];
+  if (!held_node_.empty()) {
+    held_.assign(nodes_, 0);
+    for (const std::int32_t h : held_node_) held_[static_cast<std::size_t>(h)] = 1;
   }
 
   // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes:
@@ -307,7 +346,7 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
   for (std::size_t j = 0; j < outlet_of_capacitor_.size(); ++j) {
     // R1 edges follow the vessels: edge vessels_.size() + j joins the vessel's end to capacitor j.
     const std::size_t e = vessels_.size() + j;
-    const double q = flow_[static_cast<std::size_t>(capacitor_vessel_edge_[j])];
+    const double q = capacitor_edge_sign_[j] * flow_[static_cast<std::size_t>(capacitor_vessel_edge_[j])];
     const double pc = pressure_[static_cast<std::size_t>(a_[e])] - edge_fixed_resistance_[j] * q;
     pressure_[static_cast<std::size_t>(b_[e])] = pc;
     flow_[e] = q;
@@ -401,13 +440,29 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
       rhs_[k] = rhs;
     }
   }
-  for_each_source(coupled_inflow, inlet_flow_, [&](std::size_t k, double inflow) { rhs_[k] += inflow; });
+  for_each_source(coupled_inflow, 1.0, [&](std::size_t k, double inflow) { rhs_[k] += inflow; });
 }
 
 void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, double inlet_flow) {
+  predict(dt, coupled_inflow, inflow_node_.empty() ? std::span<const double>() : std::span<const double>(&inlet_flow, 1), {});
+}
+
+void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
+                            std::span<const double> held_pressure) {
   if (empty()) return;
+  if (inflow.size() != inflow_node_.size() || held_pressure.size() != held_node_.size())
+    throw std::invalid_argument("LumpedVessels::predict: one value per boundary flow and pressure");
   dt_ = dt;
-  inlet_flow_ = inlet_flow;
+  inflow_.assign(inflow.begin(), inflow.end());
+  // A held node's shunt: 1e10 times what else reaches it (its vessel's conductance at rest and
+  // its compliance's C / dt), so that its pressure departs from the held one by 1e-10 of its
+  // vessel's drop; the flow through the shunt is what the boundary lets in or out.
+  for (std::size_t j = 0; j < held_node_.size(); ++j) {
+    const auto k = static_cast<std::size_t>(held_node_[j]);
+    shunt_[k] = 1e10 * (held_reference_conductance_[j] + 1.5 * node_compliance(k, pressure_[k]) / dt);
+    shunt_pressure_[k] = held_pressure[j];
+    shunt_current_[k] = shunt_[k] * held_pressure[j];
+  }
   for (int pass = 0; pass < passes_; ++pass) {
     // Each further (Picard) pass takes the coefficients again at the last solution.
     linearise(pass == 0, coupled_inflow);
@@ -429,7 +484,8 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, d
     impedance_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_scratch_[j];
 }
 
-void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out) {
+void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
+                             std::span<double> boundary_volume) {
   if (empty()) return;
   const double dt = dt_;
   // The departure of the 1D ends' mean inflows from those held, into the forward half.
@@ -460,7 +516,8 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
       double outflow = 0;
       for (std::size_t k = first; k < last; ++k) {
         const double shunted = shunt_[k] * predicted_[k] - shunt_current_[k];
-        if (k < network_nodes_) outflow += shunted;  // a capacitor's R2 is not the network's
+        // A capacitor's R2 is not the network's; a held pressure's flow is counted below.
+        if (k < network_nodes_ && (held_.empty() || !held_[k])) outflow += shunted;
         double inflow = -shunted;
         for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
           const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
@@ -475,7 +532,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   }
   volume_.swap(previous_volume_);
   pressure_.swap(previous_pressure_);
-  for_each_source(coupled_volume, dt * inlet_flow_, [&](std::size_t k, double volume) {
+  for_each_source(coupled_volume, dt, [&](std::size_t k, double volume) {
     volume_[k] += 2 * volume / 3;
     pressure_[k] = pressure_from_excess(k, volume_[k]);
   });
@@ -484,12 +541,36 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   previous_resistance_.swap(resistance_);
   update_resistances();
   update_dynamic_pressures();
-  // Across the network's boundary: the inlet, outlet shunts, and the R1 of RCR outlets.
-  if (inlet_node_ >= 0) exchanged_in += dt * inlet_flow_;
+  // Across the network's boundary: flows, outlet shunts and the R1 of RCR outlets, held
+  // pressures' shunts; each to "in" or "out" as its boundary counts (set_entering).
+  for (std::size_t j = 0; j < inflow_node_.size(); ++j) {
+    if (inflow_entering_[j]) exchanged_in += dt * inflow_[j];
+    else exchanged_out -= dt * inflow_[j];
+  }
   double outflow = 0;
   for (const double b : block_outflow_) outflow += b;
   for (std::size_t e = vessels_.size(); e < a_.size(); ++e) outflow += flow_[e];
   exchanged_out += dt * outflow;
+  for (std::size_t j = 0; j < held_node_.size(); ++j) {
+    const double out = held_outflow(j);
+    if (held_entering_[j]) exchanged_in -= dt * out;
+    else exchanged_out += dt * out;
+  }
+  if (boundary_volume.empty()) return;
+  for (std::size_t j = 0; j < inflow_node_.size(); ++j)
+    boundary_volume[static_cast<std::size_t>(inflow_boundary_[j])] += dt * inflow_[j];
+  for (std::size_t j = 0; j < held_node_.size(); ++j)
+    boundary_volume[static_cast<std::size_t>(held_boundary_[j])] -= dt * held_outflow(j);
+  for (const OutletNode& o : outlet_boundary_) {
+    const auto k = static_cast<std::size_t>(o.node);
+    const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * predicted_[k] - shunt_current_[k];
+    boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * out;
+  }
+}
+
+void LumpedVessels::set_entering(std::span<const unsigned char> entering) {
+  for (std::size_t j = 0; j < inflow_node_.size(); ++j) inflow_entering_[j] = entering[static_cast<std::size_t>(inflow_boundary_[j])];
+  for (std::size_t j = 0; j < held_node_.size(); ++j) held_entering_[j] = entering[static_cast<std::size_t>(held_boundary_[j])];
 }
 
 // ---- what the rest of the solver reads -------------------------------------------------------

@@ -22,8 +22,9 @@
 // sums its edges by a gather, in one order whatever the threads: the loops are bound by
 // memory bandwidth, so each is written to read a node's or a vessel's row once.
 //
-// Outlets on 0D vessels are part of the system (R: a shunt to p_out; RCR: R1 to a
-// capacitor node, R2 from there to p_out). A 1D vessel end at a node of 0D vessels is a
+// Boundary conditions at nodes of 0D vessels are part of the system (an outlet R: a shunt
+// to p_out; RCR: R1 to a capacitor node, R2 from there to p_out; a flow: a current into the
+// node; a pressure: a shunt stiff enough to hold the node there). A 1D vessel end at a node of 0D vessels is a
 // coupling end: the 1D vessel sees the node's pressure, and the node receives the volume the
 // 1D scheme let through that end (docs/solver.md §10).
 #pragma once
@@ -67,7 +68,13 @@ class LumpedVessels {
   std::size_t node_count() const { return nodes_; }  // network nodes of 0D vessels, then capacitors
   // Its node for a network node, or -1 where no 0D vessel ends.
   std::int32_t node_of(std::int64_t network_node) const { return node_of_[static_cast<std::size_t>(network_node)]; }
-  bool feeds_inlet() const { return inlet_node_ >= 0; }
+  // The boundary flows and pressures at its nodes, by their places in run_boundaries(net)
+  // (solver/network_boundaries.hpp): predict() takes their values in these orders.
+  const std::vector<std::int32_t>& inflow_boundaries() const { return inflow_boundary_; }
+  const std::vector<std::int32_t>& held_boundaries() const { return held_boundary_; }
+  // Per boundary of run_boundaries: whether its flow counts as "in" (else "out") in
+  // complete()'s exchanged volumes. By default a flow by the sign of its mean, a pressure in.
+  void set_entering(std::span<const unsigned char> entering);
 
   // Initial states: every node at the given pressure of its network node (steady: the steady
   // solution; rest: reference pressures), vessels at the given flows; capacitors at
@@ -86,7 +93,11 @@ class LumpedVessels {
   // at coupled_inflow (per coupling node, in set_coupling_nodes' order: their flows at t0),
   // and each one's response to a change of it: the impedance dp(t1)/dQ_in, the diagonal of
   // the system's inverse there.
-  // inlet_flow: the prescribed inflow at t1 where the inlet vessel is 0D.
+  // inflow: the boundary flows into 0D nodes at t1 (inflow_boundaries' order), held_pressure
+  // the boundary pressures there (held_boundaries').
+  void predict(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
+               std::span<const double> held_pressure);
+  // The tree form's: inlet_flow at the inlet where the inlet vessel is 0D (else unused).
   void predict(double dt, std::span<const double> coupled_inflow, double inlet_flow);
   // The pressure of a node at a fraction s in [0, 1] of the step being taken (linear
   // between the start and the prediction), and its impedance: a coupled end whose inflow
@@ -100,9 +111,11 @@ class LumpedVessels {
   // (coupled_volume, in set_coupling_nodes' order): the pressures at t1 with the departure
   // from the predicted inflows (the same factorisation: its forward half along the coupling
   // nodes' paths, then one backward half for every node), the flows, then the node volumes
-  // from them and the pressures from the tube laws. Adds what crossed the network's boundary (inlet,
-  // outlets) to exchanged (in, out) [m^3].
-  void complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out);
+  // from them and the pressures from the tube laws. Adds what crossed the network's boundary
+  // (flows, pressures, outlets) to exchanged (in, out) [m^3], and, where boundary_volume is
+  // given (per boundary of run_boundaries), what went in through each.
+  void complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
+                std::span<double> boundary_volume = {});
 
   // The state a vessel's samples come from.
   double node_pressure(std::int32_t node) const { return pressure_[static_cast<std::size_t>(node)]; }
@@ -206,12 +219,18 @@ class LumpedVessels {
   // right-hand sides (with the coupled inflows and the inlet's), at the state extrapolated to
   // the step's end (extrapolated) or at the pressures predicted_ (a Picard pass).
   void linearise(bool extrapolated, std::span<const double> coupled_inflow);
-  // Calls f(node, value) for the coupling nodes' values (per coupling node) and the inlet's.
+  // Calls f(node, value) for the coupling nodes' values (per coupling node) and the boundary
+  // inflows' (scale times each).
   template <class F>
-  void for_each_source(std::span<const double> coupled, double inlet, F&& f) const {
+  void for_each_source(std::span<const double> coupled, double scale, F&& f) const {
     for (std::size_t j = 0; j < coupling_nodes_.size() && !coupled.empty(); ++j)
       f(static_cast<std::size_t>(coupling_nodes_[j]), coupled[j]);
-    if (inlet_node_ >= 0) f(static_cast<std::size_t>(inlet_node_), inlet);
+    for (std::size_t j = 0; j < inflow_node_.size(); ++j) f(static_cast<std::size_t>(inflow_node_[j]), scale * inflow_[j]);
+  }
+  // The flow out of the network through held node j's shunt in the step just completed.
+  double held_outflow(std::size_t j) const {
+    const auto k = static_cast<std::size_t>(held_node_[j]);
+    return shunt_[k] * predicted_[k] - shunt_current_[k];
   }
   void restart_history();
   void update_dynamic_pressures();
@@ -223,7 +242,15 @@ class LumpedVessels {
   std::vector<std::int32_t> index_of_vessel_;  // per network vessel
   std::vector<std::int32_t> vessels_;          // per 0D vessel: its network index
   std::vector<std::int64_t> vessel_ids_;       // and its id, for messages
-  std::int32_t inlet_node_ = -1;
+  // Boundary flows (currents into their nodes) and held pressures: node, place in
+  // run_boundaries, whether "in"; a held node's conductance scale (its vessel's at rest).
+  std::vector<std::int32_t> inflow_node_, inflow_boundary_, held_node_, held_boundary_;
+  std::vector<unsigned char> inflow_entering_, held_entering_, held_;  // held_: per node (empty: none)
+  std::vector<double> inflow_, held_reference_conductance_;
+  struct OutletNode {
+    std::int32_t boundary, node, r1_edge;  // r1_edge: an RCR's R1 edge, or -1 (a shunt at node)
+  };
+  std::vector<OutletNode> outlet_boundary_;
 
   // Edges: the 0D vessels (first), then the R1 of every RCR outlet on them.
   std::vector<std::int32_t> a_, b_;
@@ -232,13 +259,14 @@ class LumpedVessels {
   double density_ = 0, friction_k_ = 0;
   const ViscosityTable* viscosity_ = nullptr;
   std::vector<std::int32_t> capacitor_vessel_edge_;  // per R1 edge: the 0D vessel ending at it
+  std::vector<int> capacitor_edge_sign_;             // and +1 if it ends there at `to`, -1 at `from`
 
   // Node volume V(p) = a p^2 + b p + c (half of each 0D vessel, capacitors).
   std::vector<double> volume_a_, volume_b_, volume_c_;  // c: only to report V
   // Shunts to ground: conductance and the pressure behind it (outlets, R2).
   std::vector<double> shunt_, shunt_pressure_, shunt_current_;  // current: shunt x pressure
   std::vector<std::int32_t> outlet_of_capacitor_;  // per capacitor node
-  std::vector<std::int32_t> capacitor_of_outlet_;  // per network outlet, -1 if none here
+  std::vector<std::int32_t> capacitor_of_outlet_;  // per run outlet (run_outlets), -1 if none here
 
   NodalSystem system_;
   // State: node volumes (W, above c) and pressures, edge flows, and the last step's (BDF2 history and
@@ -263,7 +291,7 @@ class LumpedVessels {
   std::vector<std::int32_t> incident_offset_, incident_edge_;
   static constexpr std::size_t block = 4096;
   std::vector<double> block_outflow_;  // per block of nodes: the outlets' outflow (a fixed-order sum)
-  double dt_ = 0, inlet_flow_ = 0;
+  double dt_ = 0;
   int passes_ = 1, threads_ = 1;
 };
 

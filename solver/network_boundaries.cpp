@@ -1,19 +1,88 @@
 #include "solver/network_boundaries.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "cli/errors.hpp"
 
 namespace hemotree {
 
+std::vector<NodeBoundary> run_boundaries(const Network& net) {
+  node_boundaries(net);  // refuses two conditions at one node, and an inlet of no vessel
+  std::vector<NodeBoundary> list;
+  list.reserve(net.outlets.size() + 1 + net.boundaries.size());
+  for (const Outlet& o : net.outlets) {
+    NodeBoundary b;
+    b.node = net.to[static_cast<std::size_t>(o.vessel)];
+    b.type = o.type == OutletType::rcr ? BoundaryType::rcr
+             : o.type == OutletType::resistance ? BoundaryType::resistance
+                                                : BoundaryType::reflection;
+    b.outlet = o;
+    list.push_back(b);
+  }
+  if (net.inlet) {
+    NodeBoundary b;
+    b.node = net.from[static_cast<std::size_t>(net.index_of(net.inlet->vessel))];
+    b.type = BoundaryType::flow;
+    b.waveform = net.inlet->waveform;
+    list.push_back(b);
+  }
+  list.insert(list.end(), net.boundaries.begin(), net.boundaries.end());
+  return list;
+}
+
+std::vector<Outlet> run_outlets(const std::vector<NodeBoundary>& boundaries) {
+  std::vector<Outlet> outlets;
+  for (const NodeBoundary& b : boundaries)
+    if (b.is_outlet()) outlets.push_back(b.outlet);
+  return outlets;
+}
+
+Waveform driving_waveform(const Network& net) {
+  const std::vector<NodeBoundary> list = run_boundaries(net);
+  const NodeBoundary* first = nullptr;
+  for (const NodeBoundary& b : list) {
+    if (b.is_outlet() || b.waveform.shape == Waveform::Shape::constant) continue;
+    if (!first) {
+      first = &b;
+    } else if (std::abs(b.waveform.period - first->waveform.period) > 1e-9 * first->waveform.period) {
+      auto name = [&](const NodeBoundary& x) { return "node " + std::to_string(net.node_id[static_cast<std::size_t>(x.node)]); };
+      throw InputError("the boundary waveforms at " + name(*first) + " and " + name(b) + " have different periods (" +
+                       std::to_string(first->waveform.period) + " s and " + std::to_string(b.waveform.period) +
+                       " s): a pulsatile run needs one period for all");
+    }
+  }
+  if (first) return first->waveform;
+  if (net.inlet) return net.inlet->waveform;
+  return Waveform::constant_value(0.0);  // period 1 s
+}
+
 NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element,
                                    int elements_per_vessel, const std::vector<bool>& zero_d) {
   auto name = [&](std::size_t v) { return "vessel " + std::to_string(net.id[v]); };
+  auto node_name = [&](std::size_t node) { return "node " + std::to_string(net.node_id[node]); };
   const std::size_t n = net.vessel_count();
   if (n == 0) throw InputError("the network has no vessels");
-  if (!net.inlet) throw InputError("the network has no inlet (vprune adds one; see docs/network-format.md)");
-  const std::int64_t inlet = net.index_of(net.inlet->vessel);
-  if (inlet < 0) throw InputError("inlet: unknown vessel " + std::to_string(net.inlet->vessel));
+  if (!net.inlet && net.boundaries.empty())
+    throw InputError("the network has no inlet (vprune adds one; see docs/network-format.md)");
+
+  NetworkBoundaries b;
+  b.list = run_boundaries(net);
+  b.end_state.resize(2 * n);
+  const bool tree_form = net.boundaries.empty();
+  // Where each entry of the list came from: the tree's outlets, its inlet, or net.boundaries.
+  const std::size_t tree_inlet = net.inlet ? net.outlets.size() : static_cast<std::size_t>(-1);
+  std::vector<std::int32_t> boundary_at(net.node_count(), -1), outlet_index(b.list.size(), -1);
+  std::int32_t outlets = 0;
+  for (std::size_t i = 0; i < b.list.size(); ++i) {
+    const NodeBoundary& c = b.list[i];
+    boundary_at[static_cast<std::size_t>(c.node)] = static_cast<std::int32_t>(i);
+    if (c.is_outlet()) outlet_index[i] = outlets++;
+    b.entering.push_back(c.type == BoundaryType::flow ? c.waveform.mean_value() >= 0 : c.type == BoundaryType::pressure);
+    if (!c.is_outlet() && c.waveform.shape != Waveform::Shape::constant && !(c.waveform.period > 0))
+      throw InputError((i == tree_inlet ? std::string("inlet") : node_name(static_cast<std::size_t>(c.node))) +
+                       ": the waveform needs a positive period");
+  }
 
   // Ends meeting at each node.
   std::vector<std::vector<VesselEnd>> at_node(net.node_count());
@@ -21,65 +90,66 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
     at_node[net.from[v]].push_back({static_cast<std::int32_t>(v), first_element[v], false});
     at_node[net.to[v]].push_back({static_cast<std::int32_t>(v), first_element[v] + elements_per_vessel - 1, true});
   }
-  std::vector<std::int32_t> outlet_of(n, -1);
-  for (std::size_t k = 0; k < net.outlets.size(); ++k) outlet_of[net.outlets[k].vessel] = static_cast<std::int32_t>(k);
-
-  NetworkBoundaries b;
-  b.end_state.resize(2 * n);
-  b.inlet.vessel = -1;
-  b.inflow = net.inlet->waveform;
+  // A boundary where other than one vessel ends: the tree form's messages for its inlet and
+  // outlets, the general one for node boundaries.
+  auto refuse_degree = [&](std::size_t node, std::size_t i) {
+    const auto& ends = at_node[node];
+    if (i == tree_inlet && !ends.empty())
+      throw InputError("inlet: " + name(static_cast<std::size_t>(net.index_of(net.inlet->vessel))) +
+                       " does not start at a free node (other vessels meet there)");
+    if (i < net.outlets.size() && !ends.empty())
+      throw InputError(name(static_cast<std::size_t>(net.outlets[i].vessel)) +
+                       " has an outlet but other vessels continue from its end");
+    throw InputError("hemosolve's pulsatile run takes boundary conditions where one vessel ends; " + node_name(node) +
+                     " joins " + std::to_string(ends.size()) + " vessels; --steady takes any");
+  };
   for (std::size_t node = 0; node < at_node.size(); ++node) {
     const auto& ends = at_node[node];
-    if (ends.empty()) continue;
-    const auto v0 = static_cast<std::size_t>(ends[0].vessel);
+    const std::int32_t bi = boundary_at[node];
+    if (ends.size() != 1) {
+      if (bi >= 0) refuse_degree(node, static_cast<std::size_t>(bi));
+      if (ends.empty()) continue;
+    }
     const bool lumped = std::any_of(ends.begin(), ends.end(), [&](const VesselEnd& e) { return zero_d[e.vessel]; });
     if (ends.size() == 1) {
-      if (lumped) {  // the 0D vessel's inlet or outlet: solver/lumped_vessels
-        if (!ends[0].distal && static_cast<std::int64_t>(v0) != inlet)
-          throw InputError(name(v0) + " starts at node " + std::to_string(net.node_id[node]) +
-                           ", which no vessel feeds and which is not the inlet");
-        if (ends[0].distal && outlet_of[v0] < 0) throw InputError(name(v0) + " is terminal but has no outlet");
-        continue;
-      }
       const VesselEnd e = ends[0];
-      if (!e.distal) {
-        if (static_cast<std::int64_t>(v0) != inlet)
-          throw InputError(name(v0) + " starts at node " + std::to_string(net.node_id[node]) +
-                           ", which no vessel feeds and which is not the inlet");
-        b.inlet = e;
+      const auto v = static_cast<std::size_t>(e.vessel);
+      if (bi < 0) {
+        if (!tree_form)
+          throw InputError(node_name(node) + ": only " + name(v) +
+                           " ends there, and the node has no boundary condition (a flow, a pressure or an outlet)");
+        if (e.distal) throw InputError(name(v) + " is terminal but has no outlet");
+        throw InputError(name(v) + " starts at " + node_name(node) + ", which no vessel feeds and which is not the inlet");
+      }
+      if (lumped) continue;  // the 0D vessel's boundary: solver/lumped_vessels
+      const NodeBoundary& c = b.list[static_cast<std::size_t>(bi)];
+      if (c.type == BoundaryType::flow) {
+        b.flows.push_back({e, bi});
+      } else if (c.type == BoundaryType::pressure) {
+        b.pressures.push_back({e, bi});
       } else {
-        if (outlet_of[v0] < 0)
-          throw InputError(name(v0) + " is terminal but has no outlet");
         NetworkBoundaries::OutletEnd o;
         o.end = e;
-        o.index = outlet_of[v0];
-        o.outlet = net.outlets[static_cast<std::size_t>(o.index)];
+        o.index = outlet_index[static_cast<std::size_t>(bi)];
+        o.boundary = bi;
+        o.outlet = c.outlet;
+        o.outlet.vessel = static_cast<std::int32_t>(v);
         if (o.outlet.type == OutletType::rcr && o.outlet.c > 0)
           o.capacitor = static_cast<std::int32_t>(b.capacitors++);
         b.outlets.push_back(o);
       }
       continue;
     }
-    for (const VesselEnd& e : ends) {
-      if (!e.distal && static_cast<std::int64_t>(e.vessel) == inlet)
-        throw InputError("inlet: " + name(static_cast<std::size_t>(inlet)) +
-                         " does not start at a free node (other vessels meet there)");
-      if (e.distal && outlet_of[e.vessel] >= 0)
-        throw InputError(name(static_cast<std::size_t>(e.vessel)) +
-                         " has an outlet but other vessels continue from its end");
-    }
     if (lumped) {
       for (const VesselEnd& e : ends)
         if (!zero_d[e.vessel]) b.coupled.push_back({e, static_cast<std::int64_t>(node)});
       continue;
     }
-    if (ends.size() > 16)
-      throw InputError("node " + std::to_string(net.node_id[node]) + " joins more than 16 vessels");
+    if (ends.size() > 16) throw InputError(node_name(node) + " joins more than 16 vessels");
     b.junction_ends.insert(b.junction_ends.end(), ends.begin(), ends.end());
     b.junction_offset.push_back(static_cast<std::int64_t>(b.junction_ends.size()));
     b.junction_node.push_back(net.node_id[node]);
   }
-  if (b.inflow.period <= 0) throw InputError("inlet: the waveform needs a positive period");
   return b;
 }
 

@@ -1,6 +1,11 @@
-// Where the 1D vessels' ends meet: junctions, the inlet, the outlets, and the nodes of 0D
-// vessels (coupling ends), in flat lists the solver sweeps every stage. Built once from the
-// network; refuses, naming the vessel, a network it cannot run.
+// Where the 1D vessels' ends meet: junctions, the boundary conditions at vessel ends (flows,
+// pressures, outlets), and the nodes of 0D vessels (coupling ends), in flat lists the solver
+// sweeps every stage. Built once from the network; refuses, naming the vessel or node, a
+// network it cannot run.
+//
+// Boundary conditions sit at nodes where exactly one vessel ends, at either of its ends: the
+// 1D equations are symmetric under x -> -x, Q -> -Q, so a condition written for one end
+// (solver/riemann.hpp) acts at the other on the mirrored trace (A, -Q), its flow negated.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +18,19 @@
 
 namespace hemotree {
 
+// The network's boundary conditions as the pulsatile run takes them, in one fixed order: the
+// tree form's outlets (in net.outlets' order), its inlet, then net.boundaries. "Outlet k"
+// everywhere in the run (capacitors, TreeLoads) is the k-th outlet of this list: for a tree,
+// net.outlets[k]. Throws InputError where node_boundaries does (two at one node).
+std::vector<NodeBoundary> run_boundaries(const Network& net);
+// The outlets of run_boundaries, in its order.
+std::vector<Outlet> run_outlets(const std::vector<NodeBoundary>& boundaries);
+
+// The waveform that sets the run's period and pulse: the tree form's inlet, else the first
+// time-varying flow or pressure of run_boundaries, else a constant of period 1 s. Throws
+// InputError (naming both nodes) where two time-varying boundaries have different periods.
+Waveform driving_waveform(const Network& net);
+
 // One end of a vessel: its distal end (the `to` node, right trace of its last element) or
 // its proximal end (`from` node, left trace of its first element).
 struct VesselEnd {
@@ -24,11 +42,21 @@ struct VesselEnd {
 struct NetworkBoundaries {
   // Junctions: ends of junction j are ends[offset[j] .. offset[j+1]).
   std::vector<std::int64_t> junction_offset{0};
-  std::vector<VesselEnd> junction_ends;
   std::vector<std::int64_t> junction_node;  // node id, for messages
+  std::vector<VesselEnd> junction_ends;
 
-  VesselEnd inlet;  // vessel -1: the inlet vessel is 0D
-  Waveform inflow;
+  // The run's boundary conditions (run_boundaries), and per boundary whether its flow counts
+  // as entering the network (the cycle's "in") or leaving it ("out"): a flow by the sign of
+  // its mean, a pressure by its steady flow (PulseSolver sets it), an outlet always out.
+  std::vector<NodeBoundary> list;
+  std::vector<unsigned char> entering;
+
+  // Prescribed flows and pressures at 1D ends (index: the boundary's place in list).
+  struct GivenEnd {
+    VesselEnd end;
+    std::int32_t index = -1;
+  };
+  std::vector<GivenEnd> flows, pressures;
 
   // 1D vessel ends at a node where 0D vessels end: the node's pressure is given to them.
   struct CoupledEnd {
@@ -40,9 +68,11 @@ struct NetworkBoundaries {
   struct OutletEnd {
     VesselEnd end;
     Outlet outlet;
-    std::int32_t index = -1;      // its position in the network's outlets
+    std::int32_t index = -1;      // its place among the run's outlets (run_outlets)
+    std::int32_t boundary = -1;   // its place in list
     std::int32_t capacitor = -1;  // index of its RCR state, or -1
-    double rest_area = 0, rest_flow = 0;  // for the reflection coefficient
+    // For the reflection coefficient: the rest area and the flow along the vessel there.
+    double rest_area = 0, rest_flow = 0;
   };
   std::vector<OutletEnd> outlets;
   std::size_t capacitors = 0;
@@ -52,7 +82,8 @@ struct NetworkBoundaries {
 };
 
 // Vessel v's elements are first_element[v] .. first_element[v] + elements_per_vessel - 1;
-// zero_d[v]: vessel v is 0D (no elements: its ends belong to solver/lumped_vessels).
+// zero_d[v]: vessel v is 0D (no elements: its ends, and boundaries there, belong to
+// solver/lumped_vessels).
 NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element,
                                    int elements_per_vessel, const std::vector<bool>& zero_d);
 

@@ -36,6 +36,7 @@ void put_summary(CheckpointWriter& out, const CycleSummary& c) {
     values.insert(values.end(), {v.mean_flow, v.mean_pressure, v.systolic_pressure, v.diastolic_pressure,
                                  v.peak_flow, v.least_flow, v.mean_wss, v.reynolds, v.pwv_pressure, v.pwv_velocity});
   out.put(values);
+  out.put(c.boundary_mean_flow);
 }
 
 CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
@@ -46,6 +47,7 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
   c.outlets_mean_flow = values[1];
   c.volume_change = values[2];
   c.conservation_error = values[3];
+  c.boundary_mean_flow = in.get_vector();
   for (std::size_t k = 4; k < values.size(); k += vessel_fields) {
     const double* f = &values[k];
     c.vessels.push_back({f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], f[9]});
@@ -57,7 +59,7 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
 PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<Probe> probes, RunPlan plan,
                            std::filesystem::path folder)
     : net_(net), solver_(solver), plan_(std::move(plan)), folder_(std::move(folder)),
-      stats_(net, analysis_frequency(net.inlet->waveform)), probes_(std::move(probes)) {}
+      stats_(net, analysis_frequency(driving_waveform(net))), probes_(std::move(probes)) {}
 
 void PulsatileRun::snapshot() {
   CheckpointWriter out;
@@ -108,7 +110,7 @@ void PulsatileRun::progress(std::size_t k, double started) {
 }
 
 RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
-  const double period = net_.inlet->waveform.period;
+  const double period = solver_.period();
   const int planned = plan_.until_periodic ? plan_.max_cycles : plan_.cycles;
   // Statistics every 1e-4 of a period (or every step if that is longer): means and extrema
   // of the smooth pulse are then exact to ~1e-7, at a few per cent of the run's time. With

@@ -26,6 +26,7 @@ void PulseState::set_zero_like(const PulseState& other) {
   capacitor.setZero(other.capacitor.size());
   exchanged.setZero();
   coupled.setZero(other.coupled.size());
+  boundary.setZero(other.boundary.size());
 }
 
 void PulseState::add_scaled(double factor, const PulseState& other) {
@@ -34,6 +35,7 @@ void PulseState::add_scaled(double factor, const PulseState& other) {
   capacitor += factor * other.capacitor;
   exchanged += factor * other.exchanged;
   coupled += factor * other.coupled;
+  boundary += factor * other.boundary;
 }
 
 namespace {
@@ -42,7 +44,6 @@ Blood effective_blood(const Network& net, const SolverOptions& options) {
   if (options.rheology_override >= 0) blood.rheology = static_cast<Rheology>(options.rheology_override);
   return blood;
 }
-double period_of(const Network& net) { return net.inlet ? net.inlet->waveform.period : 1.0; }
 }  // namespace
 
 PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
@@ -101,6 +102,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     }
   }
 
+  period_ = driving_waveform(net).period;
+  run_outlets_ = run_outlets(run_boundaries(net));
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_);
   lumped_.set_passes(options.lumped_passes);
@@ -109,13 +112,12 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   // The steady Poiseuille solution, where the network has one (not with reflection outlets):
   // the degrees follow its pressure profiles, and the run starts from it.
   std::optional<SteadyFlow> steady;
-  if (net.inlet) {
-    try {
-      steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet->waveform.mean_value(),
-                                           &steady_resistance_);
-    } catch (const InputError& e) {
-      steady_refusal_ = e.what();
-    }
+  // (A network with node boundaries takes their means; a tree, its inlet's.)
+  try {
+    steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet ? net.inlet->waveform.mean_value() : 0.0,
+                                         &steady_resistance_);
+  } catch (const InputError& e) {
+    steady_refusal_ = e.what();
   }
   if (steady) {
     const auto [low, high] = std::minmax_element(steady->node_pressure.begin(), steady->node_pressure.end());
@@ -128,6 +130,20 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   }
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
   boundaries_ = build_boundaries(net, first_element_, elements_per_vessel_, zero_d_);
+  if (steady) {
+    // A pressure boundary counts as "in" or "out" by its steady flow.
+    std::vector<double> inflow(net.node_count(), 0.0);
+    for (std::size_t v = 0; v < n; ++v) {
+      inflow[static_cast<std::size_t>(net.from[v])] += steady->flow[v];
+      inflow[static_cast<std::size_t>(net.to[v])] -= steady->flow[v];
+    }
+    for (std::size_t i = 0; i < boundaries_.list.size(); ++i)
+      if (boundaries_.list[i].type == BoundaryType::pressure)
+        boundaries_.entering[i] = inflow[static_cast<std::size_t>(boundaries_.list[i].node)] >= 0;
+  }
+  lumped_.set_entering(boundaries_.entering);
+  lumped_inflow_.assign(lumped_.inflow_boundaries().size(), 0.0);
+  lumped_held_.assign(lumped_.held_boundaries().size(), 0.0);
   for (const auto& c : boundaries_.coupled) coupled_node_.push_back(lumped_.node_of(c.node));
   {
     std::vector<std::int32_t> nodes = coupled_node_;
@@ -149,6 +165,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   state_.flow.setZero(rows, modes);
   state_.capacitor.setZero(static_cast<Eigen::Index>(boundaries_.capacitors));
   state_.coupled.setZero(static_cast<Eigen::Index>(boundaries_.coupled.size()));
+  state_.boundary.setZero(static_cast<Eigen::Index>(boundaries_.list.size()));
   area_q_.resize(rows, points);
   flow_q_.resize(rows, points);
   flux_q_.resize(rows, points);
@@ -165,7 +182,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   if (!lumped_.empty()) {
     // The 0D step follows the pulse (it has no stability limit); the 1D vessels take as
     // many substeps of at most their own limit as fit in it.
-    const double target = options.lumped_step * period_of(net);
+    const double target = options.lumped_step * period_;
     const double substeps = std::isfinite(stable_1d_) ? std::max(1.0, std::floor(target / stable_1d_)) : 1.0;
     dt_ = std::isfinite(stable_1d_) ? std::min(target, substeps * stable_1d_) : target;
     std::ostringstream why;
@@ -202,10 +219,12 @@ void PulseSolver::choose_models(const SolverOptions& options) {
   // --lumped-transit of the period; where it dominates (capillaries), w R C, the pressure's
   // diffusion along the vessel, bounded at the fundamental by --lumped-rc (docs/solver.md §10
   // gives the measurements behind both).
-  std::vector<bool> reflecting(n, false);
-  for (const Outlet& o : net_.outlets)
-    if (o.type == OutletType::reflection) reflecting[static_cast<std::size_t>(o.vessel)] = true;
-  const double period = period_of(net_), omega = 2 * std::numbers::pi / period;
+  std::vector<bool> reflecting(n, false), reflecting_node(net_.node_count(), false);
+  for (const NodeBoundary& b : run_boundaries(net_))
+    if (b.type == BoundaryType::reflection) reflecting_node[static_cast<std::size_t>(b.node)] = true;
+  for (std::size_t v = 0; v < n; ++v)
+    reflecting[v] = reflecting_node[static_cast<std::size_t>(net_.from[v])] || reflecting_node[static_cast<std::size_t>(net_.to[v])];
+  const double period = period_, omega = 2 * std::numbers::pi / period;
   for (std::size_t v = 0; v < n; ++v) {
     const VesselLaw& law = laws_[v];
     const double area = law.reference_area, length = net_.length[v];
@@ -250,7 +269,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
         linear_error[v] = linear_profile_error(laws_[v], viscosity_, p_in, p_in + (p_out - p_in) / e);
       }
     }
-    const double period = net_.inlet ? net_.inlet->waveform.period : 1.0;
+    const double period = period_;
     vessel_degree_ = choose_degrees(transit, linear_error, period, options.degree_rule,
                                     scheme_ == TimeScheme::runge_kutta4 ? TimeScheme::runge_kutta4
                                                                         : TimeScheme::adams_bashforth2);
@@ -352,7 +371,8 @@ void PulseSolver::start_at_rest() {
   for (auto& o : boundaries_.outlets) {
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) = o.outlet.p_out;
     const auto v = static_cast<std::size_t>(o.end.vessel);
-    o.rest_area = is_tapered(v) ? tapers_[static_cast<std::size_t>(taper_of_[v])].rest_area(1) : laws_[v].reference_area;
+    o.rest_area = is_tapered(v) ? tapers_[static_cast<std::size_t>(taper_of_[v])].rest_area(o.end.distal ? 1 : 0)
+                                : laws_[v].reference_area;
     o.rest_flow = 0;
   }
 }
@@ -445,10 +465,11 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
   }
   for (auto& o : boundaries_.outlets) {
     const auto v = static_cast<std::size_t>(o.end.vessel);
-    const double q = s.flow[v], p = s.node_pressure[net.to[v]];  // 1D vessels only
+    // Its outflow, and the pressure at its node (1D vessels only).
+    const double q = (o.end.distal ? 1.0 : -1.0) * s.flow[v], p = s.node_pressure[o.end.distal ? net.to[v] : net.from[v]];
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) = p - o.outlet.r1 * q;
-    o.rest_area = end_law(v, true).area(p);
-    o.rest_flow = q;
+    o.rest_area = end_law(v, o.end.distal).area(p);
+    o.rest_flow = s.flow[v];
   }
 }
 
@@ -578,6 +599,7 @@ void PulseSolver::step_exponential(double h) {
   state_.capacitor += h * (1.5 * rate_.capacitor - 0.5 * previous_rate_.capacitor);
   state_.exchanged += h * (1.5 * rate_.exchanged - 0.5 * previous_rate_.exchanged);
   state_.coupled += h * (1.5 * rate_.coupled - 0.5 * previous_rate_.coupled);
+  state_.boundary += h * (1.5 * rate_.boundary - 0.5 * previous_rate_.boundary);
   std::swap(previous_rate_, rate_);
 }
 
@@ -607,7 +629,12 @@ void PulseSolver::step_coupled() {
   }
   step_start_ = time_;
   const double t1 = time_ + dt_;
-  lumped_.predict(dt_, coupled_inflow_, lumped_.feeds_inlet() ? boundaries_.inflow(t1) : 0.0);
+  // The boundary flows and pressures at the 0D vessels' nodes, at the step's end.
+  for (std::size_t j = 0; j < lumped_inflow_.size(); ++j)
+    lumped_inflow_[j] = boundaries_.list[static_cast<std::size_t>(lumped_.inflow_boundaries()[j])].waveform(t1);
+  for (std::size_t j = 0; j < lumped_held_.size(); ++j)
+    lumped_held_[j] = boundaries_.list[static_cast<std::size_t>(lumped_.held_boundaries()[j])].waveform(t1);
+  lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
   if (element_count() > 0) {
     const Eigen::VectorXd before = state_.coupled;
@@ -622,7 +649,8 @@ void PulseSolver::step_coupled() {
           state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
   }
   // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
-  lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1));
+  lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1),
+                   std::span<double>(state_.boundary.data(), static_cast<std::size_t>(state_.boundary.size())));
   time_ = t1;
 }
 
@@ -736,7 +764,8 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Every used mode of every rate is written below; the padding columns of lower degrees
   // must stay zero, so the storage is cleared only when it is (re)allocated.
   if (rate.area.rows() != elements || rate.area.cols() != s.area.cols() ||
-      rate.capacitor.size() != s.capacitor.size() || rate.coupled.size() != s.coupled.size())
+      rate.capacitor.size() != s.capacitor.size() || rate.coupled.size() != s.coupled.size() ||
+      rate.boundary.size() != s.boundary.size())
     rate.set_zero_like(s);
   friction_rate_.resize(elements);
   for (Eigen::VectorXd* v : {&area_left_, &area_right_, &flow_left_, &flow_right_, &flux_a_left_,
@@ -796,11 +825,27 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     q = end.distal ? flow_right_(end.element) : flow_left_(end.element);
   };
 
-  if (boundaries_.inlet.vessel >= 0) {
+  // Prescribed flows into the network: at a distal end on the mirrored trace (A, -Q).
+  for (const auto& f : boundaries_.flows) {
     double a, q;
-    const VesselEnd& end = boundaries_.inlet;
-    trace(end, a, q);
-    set_end_flux(end, inflow_state(laws_[static_cast<std::size_t>(end.vessel)], a, q, boundaries_.inflow(t)));
+    trace(f.end, a, q);
+    const double q_in = boundaries_.list[static_cast<std::size_t>(f.index)].waveform(t);
+    const VesselLaw& law = end_law(static_cast<std::size_t>(f.end.vessel), f.end.distal);
+    EndState u;
+    if (!f.end.distal) {
+      u = inflow_state(law, a, q, q_in);
+    } else {
+      u = inflow_state(law, a, -q, q_in);
+      u.flow = -u.flow;
+    }
+    set_end_flux(f.end, u);
+  }
+  // Prescribed pressures: the end's total pressure is the node's.
+  for (const auto& g : boundaries_.pressures) {
+    double a, q;
+    trace(g.end, a, q);
+    const double p = boundaries_.list[static_cast<std::size_t>(g.index)].waveform(t);
+    set_end_flux(g.end, pressure_state(end_law(static_cast<std::size_t>(g.end.vessel), g.end.distal), a, q, p, g.end.distal));
   }
   // Ends at nodes of 0D vessels: the node's pressure, moving through the 0D step.
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
@@ -826,7 +871,11 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     const auto& o = boundaries_.outlets[static_cast<std::size_t>(k)];
     double a, q;
     trace(o.end, a, q);
-    const VesselLaw& law = end_law(static_cast<std::size_t>(o.end.vessel), true);
+    const VesselLaw& law = end_law(static_cast<std::size_t>(o.end.vessel), o.end.distal);
+    // The distal end's conditions; at a proximal end on the mirrored state, the flow negated
+    // back after (sign: along the vessel, out of the network).
+    const double sign = o.end.distal ? 1.0 : -1.0;
+    q *= sign;
     EndState u;
     switch (o.outlet.type) {
       case OutletType::resistance:
@@ -843,9 +892,10 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
         }
         break;
       case OutletType::reflection:
-        u = reflection_state(law, a, q, o.rest_area, o.rest_flow, o.outlet.reflection);
+        u = reflection_state(law, a, q, o.rest_area, sign * o.rest_flow, o.outlet.reflection);
         break;
     }
+    u.flow *= sign;
     set_end_flux(o.end, u);
   }
   // The volume fluxes the boundaries exchange, summed in a fixed order (the same bits
@@ -854,9 +904,18 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     const double q = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)].flow;
     return end.distal ? q : -q;
   };
-  rate.exchanged(0) = boundaries_.inlet.vessel >= 0 ? -leaving(boundaries_.inlet) : 0.0;
-  rate.exchanged(1) = 0;
-  for (const auto& o : boundaries_.outlets) rate.exchanged(1) += leaving(o.end);
+  rate.exchanged.setZero();
+  for (const auto* given : {&boundaries_.flows, &boundaries_.pressures})
+    for (const auto& g : *given) {
+      const double in = -leaving(g.end);
+      rate.boundary(g.index) = in;
+      if (boundaries_.entering[static_cast<std::size_t>(g.index)]) rate.exchanged(0) += in;
+      else rate.exchanged(1) -= in;
+    }
+  for (const auto& o : boundaries_.outlets) {
+    rate.exchanged(1) += leaving(o.end);
+    rate.boundary(o.boundary) = -leaving(o.end);
+  }
   // Junctions are independent: each writes only its own ends' fluxes.
   const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
   std::int64_t failed_junction = -1;
@@ -1010,7 +1069,7 @@ double PulseSolver::network_volume() const {
 }
 
 std::vector<double> PulseSolver::capacitor_pressures() const {
-  std::vector<double> p(net_.outlets.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> p(run_outlets_.size(), std::numeric_limits<double>::quiet_NaN());
   for (const auto& o : boundaries_.outlets)
     if (o.capacitor >= 0) p[static_cast<std::size_t>(o.index)] = state_.capacitor(o.capacitor);
   for (std::size_t k = 0; k < p.size(); ++k)
@@ -1091,9 +1150,9 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   TreeLoads loads;
   loads.node_shunt.assign(net_.node_count(), 0.0);
   loads.node_current.assign(net_.node_count(), 0.0);
-  loads.capacitor_shunt.assign(net_.outlets.size(), 0.0);
-  loads.capacitor_current.assign(net_.outlets.size(), 0.0);
-  std::vector<double> node_compliance(net_.node_count(), 0.0), capacitor_compliance(net_.outlets.size(), 0.0);
+  loads.capacitor_shunt.assign(run_outlets_.size(), 0.0);
+  loads.capacitor_current.assign(run_outlets_.size(), 0.0);
+  std::vector<double> node_compliance(net_.node_count(), 0.0), capacitor_compliance(run_outlets_.size(), 0.0);
   for (std::size_t v = 0; v < n; ++v) {
     const double rate = (volume[v] - cycle_volume_[v]) / period, compliance = area_per_pressure[v] * net_.length[v];
     for (const auto node : {net_.from[v], net_.to[v]}) {
@@ -1101,10 +1160,10 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       node_compliance[static_cast<std::size_t>(node)] += compliance / 2;
     }
   }
-  for (std::size_t k = 0; k < net_.outlets.size(); ++k) {
+  for (std::size_t k = 0; k < run_outlets_.size(); ++k) {
     if (std::isnan(capacitor_now[k])) continue;
-    capacitor_compliance[k] = net_.outlets[k].c;
-    loads.capacitor_current[k] = net_.outlets[k].c * (capacitor_now[k] - cycle_capacitor_[k]) / period;
+    capacitor_compliance[k] = run_outlets_[k].c;
+    loads.capacitor_current[k] = run_outlets_[k].c * (capacitor_now[k] - cycle_capacitor_[k]) / period;
   }
   // delta = K^-1 I: the shifts that cancel the rates in the linear network (K its conductance).
   const TreePotentials delta = solve_loaded_tree(net_, resistance, loads);
@@ -1182,6 +1241,7 @@ void PulseSolver::save(CheckpointWriter& out) const {
     out.put(s->exchanged(0));
     out.put(s->exchanged(1));
     out.put(s->coupled);
+    out.put(s->boundary);
   }
   out.put(previous_flow_);
   out.put(cycle_volume_);
@@ -1218,6 +1278,7 @@ void PulseSolver::restore(CheckpointReader& in) {
   state_.exchanged(0) = in.get_double();
   state_.exchanged(1) = in.get_double();
   in.get_into(state_.coupled, "coupled ends");
+  in.get_into(state_.boundary, "boundary volumes");
   // The multistep history: empty until a multistep scheme has taken a step.
   previous_rate_.area = in.get_matrix();
   previous_rate_.flow = in.get_matrix();
@@ -1225,6 +1286,7 @@ void PulseSolver::restore(CheckpointReader& in) {
   previous_rate_.exchanged(0) = in.get_double();
   previous_rate_.exchanged(1) = in.get_double();
   previous_rate_.coupled = in.get_eigen_vector();
+  previous_rate_.boundary = in.get_eigen_vector();
   if (previous_rate_.area.size() != 0 &&
       (previous_rate_.area.rows() != state_.area.rows() || previous_rate_.area.cols() != state_.area.cols() ||
        previous_rate_.flow.rows() != state_.flow.rows() || previous_rate_.capacitor.size() != state_.capacitor.size()))

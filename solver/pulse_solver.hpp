@@ -65,8 +65,11 @@ struct SolverOptions {
 struct PulseState {
   Eigen::MatrixXd area, flow;  // elements x modes
   Eigen::VectorXd capacitor;   // one per RCR outlet [Pa]
-  Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();  // in at the inlet, out at the outlets [m^3]
+  // In through the boundaries that count as entering (flows, pressures: NetworkBoundaries::
+  // entering), out through the others and the outlets [m^3].
+  Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();
   Eigen::VectorXd coupled;     // per 1D end at a 0D node: the volume it let into the node [m^3]
+  Eigen::VectorXd boundary;    // per boundary (run_boundaries' order): the volume in through it [m^3]
 
   void set_zero_like(const PulseState& other);
   void add_scaled(double factor, const PulseState& other);  // this += factor * other
@@ -108,6 +111,11 @@ class PulseSolver {
   void sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
                   std::vector<double>* pressure = nullptr, bool zero_d = true) const;
   const LumpedVessels& lumped() const { return lumped_; }
+  // The run's boundary conditions (solver/network_boundaries.hpp: run_boundaries), and per
+  // boundary whether its flow counts as "in"; the period of its waveforms.
+  const std::vector<NodeBoundary>& boundary_list() const { return boundaries_.list; }
+  const std::vector<unsigned char>& boundary_entering() const { return boundaries_.entering; }
+  double period() const { return period_; }
   // The 1D vessels (indices), in the order of their elements.
   const std::vector<std::int32_t>& one_d_vessels() const { return one_d_vessels_; }
   int threads() const { return threads_; }
@@ -177,11 +185,14 @@ class PulseSolver {
   std::int32_t end_element(std::size_t vessel) const {
     return zero_d_[vessel] ? first_element_[vessel] : first_element_[vessel] + elements_per_vessel_;
   }
-  std::vector<double> capacitor_pressures() const;  // per network outlet (NaN: none)
+  std::vector<double> capacitor_pressures() const;  // per run outlet (NaN: none)
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
   double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;
 
   const Network& net_;
+  double period_ = 1;                      // driving_waveform(net)'s
+  std::vector<Outlet> run_outlets_;        // run_outlets(run_boundaries(net))
+  std::vector<double> lumped_inflow_, lumped_held_;  // the 0D nodes' boundary values at a step's end
   Blood blood_;
   ViscosityTable viscosity_;
   std::vector<VesselLaw> laws_;            // per vessel (a tapered one's at its `from` end)
