@@ -277,7 +277,19 @@ int main(int argc, char** argv) {
 
     // ---- the tree and its pruning --------------------------------------------------------
     Network full = read_network(input);
-    const std::size_t root = check_rooted_tree(full);
+    std::size_t root = 0;
+    try {
+      root = check_rooted_tree(full);
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()) + ": vprune cuts trees (hemosolve --steady solves any network whole)");
+    }
+    // vprune sets the tree's boundaries itself: an inflow at its root and calibrated outlets.
+    if (!full.boundaries.empty() || full.inlet || !full.outlets.empty()) {
+      note("note: the file's boundary conditions (" + std::to_string(node_boundaries(full).size()) +
+           ") are replaced by the inflow at the root and the calibrated outlets");
+      full.boundaries.clear();
+      full.outlets.clear();
+    }
     Inlet inlet;
     inlet.vessel = full.id[root];
     inlet.waveform = wave;

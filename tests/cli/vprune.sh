@@ -72,4 +72,9 @@ JSON
 expect_error "several roots" 2 "several roots" -- "$VPRUNE" --budget 1 "$WORK/roots.json"
 "$VPRUNE" --budget 0 "$WORK/full.json" -o "$WORK/none.json" 2>/dev/null
 [ -e "$WORK/none.json" ] && fail "refused run left a file" || pass "refused run leaves no file"
+
+# A looped network (format version 2) is not vprune's: one line saying what to use instead.
+"$VGEN" --root-diameter 60um --min-diameter 8.5um --venous --mean-flow 1e-3ml/min -o "$WORK/venous.json"
+expect_error "looped network" 2 "vprune cuts trees (hemosolve --steady solves any network whole)" -- \
+  "$VPRUNE" --budget 5 "$WORK/venous.json"
 finish
