@@ -120,7 +120,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
   }
   if (!held_node_.empty()) {
     held_.assign(nodes_, 0);
-    for (const std::int32_t h : held_node_) held_[static_cast<std::size_t>(h)] = 1;
+    for (std::size_t j = 0; j < held_node_.size(); ++j) held_[static_cast<std::size_t>(held_node_[j])] = static_cast<std::int32_t>(j + 1);
+    held_out_.assign(held_node_.size(), 0.0);
   }
 
   // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes:
@@ -454,9 +455,10 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
     throw std::invalid_argument("LumpedVessels::predict: one value per boundary flow and pressure");
   dt_ = dt;
   inflow_.assign(inflow.begin(), inflow.end());
-  // A held node's shunt: 1e10 times what else reaches it (its vessel's conductance at rest and
-  // its compliance's C / dt), so that its pressure departs from the held one by 1e-10 of its
-  // vessel's drop; the flow through the shunt is what the boundary lets in or out.
+  // A held node's shunt in the solve: 1e10 times what else reaches it (its vessel's
+  // conductance at rest and its compliance's C / dt), so that the pressure its neighbour sees
+  // departs from the held one by 1e-10 of its vessel's drop. complete() then puts the node
+  // at the held pressure exactly.
   for (std::size_t j = 0; j < held_node_.size(); ++j) {
     const auto k = static_cast<std::size_t>(held_node_[j]);
     shunt_[k] = 1e10 * (held_reference_conductance_[j] + 1.5 * node_compliance(k, pressure_[k]) / dt);
@@ -522,6 +524,17 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
         for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
           const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
           inflow += e >= 0 ? -next_flow_[static_cast<std::size_t>(e)] : next_flow_[static_cast<std::size_t>(~e)];
+        }
+        if (!held_.empty() && held_[k]) {
+          // Dirichlet: the node sits at the held pressure, and the boundary lets in what its
+          // volume and its vessel take (the stiff shunt's own flow, G (p - p_held), is
+          // round-off times G: not taken).
+          const double next_volume = node_excess(k, shunt_pressure_[k]);
+          const auto j = static_cast<std::size_t>(held_[k] - 1);
+          held_out_[j] = inflow + shunted - (3 * next_volume - 4 * volume_[k] + previous_volume_[k]) / (2 * dt);
+          previous_volume_[k] = next_volume;
+          previous_pressure_[k] = shunt_pressure_[k];
+          continue;
         }
         const double next = (4 * volume_[k] - previous_volume_[k] + 2 * dt * inflow) / 3;
         previous_volume_[k] = next;

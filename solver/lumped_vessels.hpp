@@ -227,11 +227,8 @@ class LumpedVessels {
       f(static_cast<std::size_t>(coupling_nodes_[j]), coupled[j]);
     for (std::size_t j = 0; j < inflow_node_.size(); ++j) f(static_cast<std::size_t>(inflow_node_[j]), scale * inflow_[j]);
   }
-  // The flow out of the network through held node j's shunt in the step just completed.
-  double held_outflow(std::size_t j) const {
-    const auto k = static_cast<std::size_t>(held_node_[j]);
-    return shunt_[k] * predicted_[k] - shunt_current_[k];
-  }
+  // The flow out of the network through held node j in the step just completed.
+  double held_outflow(std::size_t j) const { return held_out_[j]; }
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R
@@ -245,8 +242,9 @@ class LumpedVessels {
   // Boundary flows (currents into their nodes) and held pressures: node, place in
   // run_boundaries, whether "in"; a held node's conductance scale (its vessel's at rest).
   std::vector<std::int32_t> inflow_node_, inflow_boundary_, held_node_, held_boundary_;
-  std::vector<unsigned char> inflow_entering_, held_entering_, held_;  // held_: per node (empty: none)
-  std::vector<double> inflow_, held_reference_conductance_;
+  std::vector<unsigned char> inflow_entering_, held_entering_;
+  std::vector<std::int32_t> held_;  // per node: 1 + its place in held_node_, or 0 (empty: none held)
+  std::vector<double> inflow_, held_reference_conductance_, held_out_;
   struct OutletNode {
     std::int32_t boundary, node, r1_edge;  // r1_edge: an RCR's R1 edge, or -1 (a shunt at node)
   };
