@@ -95,6 +95,9 @@ boost::dynamic_properties network_properties(const Network& net, const Graph& g)
                              [&net, vessel](Edge e) { return net.length[vessel(e)]; });
   add_property<Edge, double>(dp, "diameter",
                              [&net, vessel](Edge e) { return net.diameter[vessel(e)]; });
+  if (!net.distal_diameter.empty())
+    add_property<Edge, double>(dp, "distal_diameter",
+                               [&net, vessel](Edge e) { return net.diameter_at_to(vessel(e)); });
   add_property<Edge, double>(dp, "wall_thickness",
                              [&net, vessel](Edge e) { return net.wall_thickness[vessel(e)]; });
   add_property<Edge, double>(dp, "youngs_modulus",

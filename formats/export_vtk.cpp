@@ -107,12 +107,25 @@ void write_vtk(const Network& net, OutputStream& out, const std::vector<CellFiel
                    [&](std::size_t v) { out << static_cast<long long>(2 * (v + 1)); });
   out << "      </Lines>\n";
 
+  // Boundary conditions at nodes (measured networks): a code per point, -1 where none.
+  const std::vector<NodeBoundary> boundaries = node_boundaries(net);
+  if (!boundaries.empty()) {
+    std::vector<int> code(net.node_count(), -1);
+    for (const NodeBoundary& b : boundaries) code[static_cast<std::size_t>(b.node)] = static_cast<int>(b.type);
+    out << "      <PointData>\n";
+    write_data_array(out, "Int8", "boundary", 1, nodes, [&](std::size_t k) { out << code[node(k)]; });
+    out << "      </PointData>\n";
+  }
+
   out << "      <CellData Scalars=\"diameter\">\n";
   auto cells_of = [&](std::string_view type, std::string_view name, const auto& values) {
     write_data_array(out, type, name, 1, vessels, [&](std::size_t i) { out << values[vessel(i)]; });
   };
   cells_of("Int64", "id", net.id);
   cells_of("Float64", "diameter", net.diameter);
+  if (!net.distal_diameter.empty())
+    write_data_array(out, "Float64", "distal_diameter", 1, vessels,
+                     [&](std::size_t i) { out << net.diameter_at_to(vessel(i)); });
   cells_of("Float64", "length", net.length);
   cells_of("Float64", "wall_thickness", net.wall_thickness);
   cells_of("Float64", "youngs_modulus", net.youngs_modulus);

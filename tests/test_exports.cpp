@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -158,6 +159,39 @@ TEST(ExportVtk, IsWellFormedPolyDataWithTheNetworksNumbers) {
     for (std::size_t v = 0; v < values.size(); ++v)
       expect_close(expected[i].values[v], values[v], expected[i].name);
   }
+}
+
+// A measured network's boundary nodes as point data, a tapered vessel's distal diameter as
+// cell data (every vessel: its diameter at `to`).
+TEST(ExportVtk, BoundaryNodesAndTapersAreWrittenWhereTheNetworkHasThem) {
+  Network net = sample_network();
+  net.distal_diameter = {1.0e-3, std::numeric_limits<double>::quiet_NaN(), 4.0e-5,
+                         std::numeric_limits<double>::quiet_NaN()};
+  NodeBoundary in, out_pressure;
+  in.node = 2;  // the root's node (id 12)
+  in.type = BoundaryType::flow;
+  out_pressure.node = 4;  // node 14
+  out_pressure.type = BoundaryType::pressure;
+  net.boundaries = {in, out_pressure};
+  const std::string text = export_text("boundaries.vtp", [&](OutputStream& out) { write_vtk(net, out); });
+  const XmlElement file = XmlParser(text).document();
+  const XmlElement& piece = file.child("PolyData").child("Piece");
+  const XmlElement& points = piece.child("PointData");
+  ASSERT_EQ(points.children.size(), 1u);
+  EXPECT_EQ(points.children[0].attributes.at("Name"), "boundary");
+  EXPECT_EQ(numbers(points.children[0].text), (std::vector<double>{-1, -1, 0, -1, 1}));
+  const XmlElement& cells = piece.child("CellData");
+  bool found = false;
+  for (const XmlElement& array : cells.children)
+    if (array.attributes.at("Name") == "distal_diameter") {
+      found = true;
+      const auto values = numbers(array.text);
+      ASSERT_EQ(values.size(), 4u);
+      expect_close(1.0e-3, values[0], "tapered");
+      expect_close(net.diameter[1], values[1], "untapered: its diameter");
+      expect_close(4.0e-5, values[2], "tapered");
+    }
+  EXPECT_TRUE(found);
 }
 
 TEST(ExportVtk, WithoutCoordinatesIsAnInputErrorAndLeavesNoFile) {
