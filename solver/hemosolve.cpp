@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
       "run until every vessel's mean pressure changes less than this (relative, in (0, 1)) from one cycle to the next");
   app.add_option("--max-cycles", max_cycles, "upper bound for --until-periodic, in [1, 100000]")->capture_default_str();
   app.add_option("--probe", probe_texts, "record p, Q, A, u at vessel ID, fraction x in [0, 1] along it (ID[:x], x 0.5 by default)");
-  app.add_option("--sample-interval", sample_text, "time between probe samples, in (0, the inlet's period]")
+  app.add_option("--sample-interval", sample_text, "time between probe samples, in (0, the period]")
       ->capture_default_str();
   app.add_option("--degree", degree_text,
                  "polynomial degree p in [0, 30] in every vessel, or auto: per vessel, --low-degree in vessels "
