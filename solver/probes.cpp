@@ -38,7 +38,8 @@ void ProbeRecorder::sample(const PulseSolver& solver) {
   rows_ << number(solver.time());
   for (const Probe& p : probes_) {
     const double a = solver.area_at(p.vessel, p.x), q = solver.flow_at(p.vessel, p.x);
-    rows_ << ',' << number(solver.law(p.vessel).pressure(a)) << ',' << number(q) << ',' << number(a) << ','
+    // The law where the probe is: a tapered vessel's reference lumen changes along it.
+    rows_ << ',' << number(solver.law_at(p.vessel, p.x).pressure(a)) << ',' << number(q) << ',' << number(a) << ','
           << number(q / a);
   }
   rows_ << '\n';

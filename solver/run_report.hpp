@@ -28,7 +28,8 @@ double analysis_frequency(const Waveform& w);
 
 // Linear theory for a vessel at angular frequency omega: the Womersley number of its
 // reference lumen (viscosity at that diameter), the elastic wave speed c0 of its reference
-// state, and the Womersley phase velocity at that c0 and W (the paper's eq. wavespeedWomersley).
+// state, and the Womersley phase velocity at that c0 and W (the paper's eq. wavespeedWomersley);
+// a tapered vessel's at its middle.
 struct WaveTheory {
   double womersley = 0, pwv_elastic = 0, pwv_theory = 0;
 };

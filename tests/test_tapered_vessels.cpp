@@ -19,6 +19,8 @@
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -28,6 +30,7 @@
 #include "physics/wall_law.hpp"
 #include "solver/legendre_basis.hpp"
 #include "solver/lumped_vessels.hpp"
+#include "solver/probes.hpp"
 #include "solver/pulse_solver.hpp"
 #include "solver/vessel_equations.hpp"
 #include "tests/network_builders.hpp"
@@ -143,6 +146,20 @@ TEST(TaperedVessels, RestStateStaysAtRestThroughAJunctionWithWallLaws) {
     EXPECT_LT(d.flow, 1e-13);
     for (std::size_t v = 0; v < 3; ++v)
       for (const double x : {0.0, 0.5, 1.0}) EXPECT_NEAR(s.pressure_at(v, x), 10 * 133.322, 1e-9);
+    // A probe reads the pressure with the law where it sits: at rest, p_ext all along the taper
+    // (the proximal law at the narrower lumen downstream would read far below it).
+    ProbeRecorder probes({Probe{0, 0, 0.5}, Probe{0, 0, 1.0}});
+    probes.sample(s);
+    std::istringstream row(probes.rows());
+    std::string t, p_mid, q_mid, a_mid, u_mid, p_end;
+    std::getline(row, t, ',');
+    std::getline(row, p_mid, ',');
+    std::getline(row, q_mid, ',');
+    std::getline(row, a_mid, ',');
+    std::getline(row, u_mid, ',');
+    std::getline(row, p_end, ',');
+    EXPECT_NEAR(std::stod(p_mid), 10 * 133.322, 1e-6);
+    EXPECT_NEAR(std::stod(p_end), 10 * 133.322, 1e-6);
   }
 }
 
