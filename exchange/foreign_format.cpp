@@ -1,12 +1,26 @@
 #include "exchange/foreign_format.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
 #include <string>
 
+#include "cli/errors.hpp"
 #include "formats/field_ranges.hpp"
 #include "generator/growth_rules.hpp"
 
 namespace hemotree {
+
+std::string read_whole_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError("cannot open " + path + ": " + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw IoError("cannot read " + path);
+  return std::move(text).str();
+}
 
 void fill_missing_walls(Network& net, const ImportOptions& options) {
   const GrowthRules rules = default_rules();

@@ -22,6 +22,10 @@ struct ImportOptions {
   std::function<void(const std::string&)> note = [](const std::string&) {};
 };
 
+// The whole file as bytes (formats read whole: centerlines, graphs); IoError naming it when it
+// cannot be opened or read.
+std::string read_whole_file(const std::string& path);
+
 // Fills wall_thickness and youngs_modulus where they are NaN, from the options or the
 // toolkit's tables, and notes what it did (one line each, with the count of vessels).
 void fill_missing_walls(Network& net, const ImportOptions& options);

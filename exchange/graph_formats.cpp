@@ -154,15 +154,6 @@ struct RawGraph {
   }
 };
 
-std::string read_whole_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot open " + path + ": " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw IoError("cannot read " + path);
-  return std::move(text).str();
-}
-
 // --- GraphML ---------------------------------------------------------------------------------
 
 using boost::property_tree::ptree;

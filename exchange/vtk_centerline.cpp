@@ -47,15 +47,6 @@ struct Centerlines {
   std::size_t cell_count() const { return offsets.size() - 1; }
 };
 
-std::string read_whole_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot open " + path + ": " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw IoError("cannot read " + path);
-  return std::move(text).str();
-}
-
 std::string join(const std::vector<std::string>& names) {
   if (names.empty()) return "none";
   std::string s;
