@@ -101,27 +101,30 @@ double Network::volume(std::size_t v) const {
   return std::numbers::pi / 12.0 * (d0 * d0 + d0 * d1 + d1 * d1) * length[v];
 }
 
+NodeBoundary as_node_boundary(const Network& net, const Outlet& outlet) {
+  NodeBoundary b;
+  b.node = net.to[static_cast<std::size_t>(outlet.vessel)];
+  b.type = outlet.type == OutletType::rcr          ? BoundaryType::rcr
+           : outlet.type == OutletType::resistance ? BoundaryType::resistance
+                                                   : BoundaryType::reflection;
+  b.outlet = outlet;
+  return b;
+}
+
+NodeBoundary as_node_boundary(const Network& net, const Inlet& inlet) {
+  const std::int64_t v = net.index_of(inlet.vessel);
+  if (v < 0) throw InputError("inlet: unknown vessel " + std::to_string(inlet.vessel));
+  NodeBoundary b;
+  b.node = net.from[static_cast<std::size_t>(v)];
+  b.type = BoundaryType::flow;
+  b.waveform = inlet.waveform;
+  return b;
+}
+
 std::vector<NodeBoundary> node_boundaries(const Network& net) {
   std::vector<NodeBoundary> all = net.boundaries;
-  if (net.inlet) {
-    const std::int64_t v = net.index_of(net.inlet->vessel);
-    if (v < 0) throw InputError("inlet: unknown vessel " + std::to_string(net.inlet->vessel));
-    NodeBoundary b;
-    b.node = net.from[static_cast<std::size_t>(v)];
-    b.type = BoundaryType::flow;
-    b.waveform = net.inlet->waveform;
-    all.push_back(b);
-  }
-  for (const Outlet& o : net.outlets) {
-    NodeBoundary b;
-    b.node = net.to[static_cast<std::size_t>(o.vessel)];
-    b.type = o.type == OutletType::rcr          ? BoundaryType::rcr
-             : o.type == OutletType::resistance ? BoundaryType::resistance
-                                                : BoundaryType::reflection;
-    b.outlet = o;
-    b.outlet.vessel = -1;
-    all.push_back(b);
-  }
+  if (net.inlet) all.push_back(as_node_boundary(net, *net.inlet));
+  for (const Outlet& o : net.outlets) all.push_back(as_node_boundary(net, o));
   std::stable_sort(all.begin(), all.end(),
                    [](const NodeBoundary& p, const NodeBoundary& q) { return p.node < q.node; });
   for (std::size_t k = 1; k < all.size(); ++k)

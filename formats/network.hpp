@@ -97,6 +97,12 @@ struct Network {
 // naming the first vessel without one.
 void require_tube_laws(const Network& net, const std::string& source);
 
+// The tree form's conditions as conditions at nodes: an outlet at its vessel's `to` node
+// (its vessel kept in outlet.vessel), the inlet as a flow into its vessel's `from` node
+// (InputError for an inlet of no vessel).
+NodeBoundary as_node_boundary(const Network& net, const Outlet& outlet);
+NodeBoundary as_node_boundary(const Network& net, const Inlet& inlet);
+
 // Every boundary condition of the network at its node, sorted by node: the version 2 node
 // boundaries, the inlet (a flow into its vessel's `from` node) and the outlets (at their
 // vessels' `to` nodes). Throws InputError when two land on one node.

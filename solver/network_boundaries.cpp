@@ -11,22 +11,8 @@ std::vector<NodeBoundary> run_boundaries(const Network& net) {
   node_boundaries(net);  // refuses two conditions at one node, and an inlet of no vessel
   std::vector<NodeBoundary> list;
   list.reserve(net.outlets.size() + 1 + net.boundaries.size());
-  for (const Outlet& o : net.outlets) {
-    NodeBoundary b;
-    b.node = net.to[static_cast<std::size_t>(o.vessel)];
-    b.type = o.type == OutletType::rcr ? BoundaryType::rcr
-             : o.type == OutletType::resistance ? BoundaryType::resistance
-                                                : BoundaryType::reflection;
-    b.outlet = o;
-    list.push_back(b);
-  }
-  if (net.inlet) {
-    NodeBoundary b;
-    b.node = net.from[static_cast<std::size_t>(net.index_of(net.inlet->vessel))];
-    b.type = BoundaryType::flow;
-    b.waveform = net.inlet->waveform;
-    list.push_back(b);
-  }
+  for (const Outlet& o : net.outlets) list.push_back(as_node_boundary(net, o));
+  if (net.inlet) list.push_back(as_node_boundary(net, *net.inlet));
   list.insert(list.end(), net.boundaries.begin(), net.boundaries.end());
   return list;
 }
