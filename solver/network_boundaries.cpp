@@ -131,7 +131,6 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
         if (!zero_d[e.vessel]) b.coupled.push_back({e, static_cast<std::int64_t>(node)});
       continue;
     }
-    if (ends.size() > 16) throw InputError(node_name(node) + " joins more than 16 vessels");
     b.junction_ends.insert(b.junction_ends.end(), ends.begin(), ends.end());
     b.junction_offset.push_back(static_cast<std::int64_t>(b.junction_ends.size()));
     b.junction_node.push_back(net.node_id[node]);

@@ -923,12 +923,34 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   for (std::int64_t jj = 0; jj < junctions; ++jj) {
     const auto j = static_cast<std::size_t>(jj);
     // Left uninitialised: only the first `count` entries are used (zeroing all 16 was 5 % of a step).
-    std::array<const VesselLaw*, 16> laws;
-    std::array<double, 16> ja, jq;
-    std::array<int, 16> sign;
-    std::array<EndState, 16> out;
+    // A node of more than 16 vessels (measured networks) takes its scratch from the heap.
+    constexpr std::size_t on_stack = 16;
+    std::array<const VesselLaw*, on_stack> laws_stack;
+    std::array<double, on_stack> ja_stack, jq_stack;
+    std::array<int, on_stack> sign_stack;
+    std::array<EndState, on_stack> out_stack;
     const auto first = boundaries_.junction_offset[j], last = boundaries_.junction_offset[j + 1];
     const auto count = static_cast<std::size_t>(last - first);
+    std::vector<const VesselLaw*> laws_heap;
+    std::vector<double> ja_heap, jq_heap;
+    std::vector<int> sign_heap;
+    std::vector<EndState> out_heap;
+    const VesselLaw** laws = laws_stack.data();
+    double *ja = ja_stack.data(), *jq = jq_stack.data();
+    int* sign = sign_stack.data();
+    EndState* out = out_stack.data();
+    if (count > on_stack) {
+      laws_heap.resize(count);
+      ja_heap.resize(count);
+      jq_heap.resize(count);
+      sign_heap.resize(count);
+      out_heap.resize(count);
+      laws = laws_heap.data();
+      ja = ja_heap.data();
+      jq = jq_heap.data();
+      sign = sign_heap.data();
+      out = out_heap.data();
+    }
     for (std::size_t i = 0; i < count; ++i) {
       const VesselEnd& end = boundaries_.junction_ends[static_cast<std::size_t>(first) + i];
       laws[i] = &end_law(static_cast<std::size_t>(end.vessel), end.distal);
@@ -936,8 +958,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
       sign[i] = end.distal ? 1 : -1;
       out[i] = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
     }
-    if (!junction_state({laws.data(), count}, {ja.data(), count}, {jq.data(), count},
-                        {sign.data(), count}, {out.data(), count})) {
+    if (!junction_state({laws, count}, {ja, count}, {jq, count}, {sign, count}, {out, count})) {
 #pragma omp critical
       failed_junction = failed_junction < 0 ? jj : std::min(failed_junction, jj);
       continue;

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -85,9 +86,16 @@ bool junction_state(std::span<const VesselLaw* const> laws, std::span<const doub
                     std::span<const double> q, std::span<const int> sign,
                     std::span<EndState> out) {
   const std::size_t n = laws.size();
-  constexpr std::size_t max_ends = 16;
-  if (n > max_ends || n < 2) return false;
-  std::array<double, max_ends> mu, x, f, dpt, root_reference;  // the first n entries are used
+  if (n < 2) return false;
+  // Scratch on the stack for up to 16 ends (every branching and most measured confluences),
+  // on the heap beyond: a node may join any number of vessels.
+  constexpr std::size_t on_stack = 16;
+  std::array<double, 5 * on_stack> stack;  // the first 5 n entries are used
+  std::vector<double> heap;
+  if (n > on_stack) heap.resize(5 * n);
+  double* const scratch = n > on_stack ? heap.data() : stack.data();
+  double *const mu = scratch, *const x = scratch + n, *const f = scratch + 2 * n, *const dpt = scratch + 3 * n,
+                *const root_reference = scratch + 4 * n;
   for (std::size_t i = 0; i < n; ++i) {
     mu[i] = incoming_speed(*laws[i], a[i], q[i], sign[i] > 0);
     x[i] = out[i].area > 0 ? out[i].area : a[i];
