@@ -83,4 +83,32 @@ inline Outlet rcr_outlet(std::int32_t vessel, double r1, double c, double r2, do
   return o;
 }
 
+// Boundary conditions at nodes (format version 2).
+inline NodeBoundary flow_boundary(std::int32_t node, const Waveform& w) {
+  NodeBoundary b;
+  b.node = node;
+  b.type = BoundaryType::flow;
+  b.waveform = w;
+  return b;
+}
+
+inline NodeBoundary flow_boundary(std::int32_t node, double q) { return flow_boundary(node, Waveform::constant_value(q)); }
+
+inline NodeBoundary pressure_boundary(std::int32_t node, double p) {
+  NodeBoundary b;
+  b.node = node;
+  b.type = BoundaryType::pressure;
+  b.waveform = Waveform::constant_value(p);
+  return b;
+}
+
+inline NodeBoundary outlet_boundary(std::int32_t node, const Outlet& o) {
+  NodeBoundary b;
+  b.node = node;
+  b.type = o.type == OutletType::rcr ? BoundaryType::rcr
+           : o.type == OutletType::resistance ? BoundaryType::resistance : BoundaryType::reflection;
+  b.outlet = o;
+  return b;
+}
+
 }  // namespace hemotree::test_networks

@@ -31,30 +31,6 @@ namespace {
 
 constexpr double pi = std::numbers::pi;
 
-NodeBoundary flow_at(std::int32_t node, const Waveform& w) {
-  NodeBoundary b;
-  b.node = node;
-  b.type = BoundaryType::flow;
-  b.waveform = w;
-  return b;
-}
-
-NodeBoundary pressure_at(std::int32_t node, double p) {
-  NodeBoundary b;
-  b.node = node;
-  b.type = BoundaryType::pressure;
-  b.waveform = Waveform::constant_value(p);
-  return b;
-}
-
-NodeBoundary outlet_at(std::int32_t node, const Outlet& o) {
-  NodeBoundary b;
-  b.node = node;
-  b.type = o.type == OutletType::rcr ? BoundaryType::rcr : BoundaryType::resistance;
-  b.outlet = o;
-  return b;
-}
-
 void sort_boundaries(Network& net) {
   std::sort(net.boundaries.begin(), net.boundaries.end(),
             [](const NodeBoundary& a, const NodeBoundary& b) { return a.node < b.node; });
@@ -128,7 +104,7 @@ TEST(NetworkGraphsPulsatile, ConstantBoundariesSettleOnTheSteadySolution) {
   for (const bool reversed : {false, true})
     for (const ModelChoice model : {ModelChoice::one_d, ModelChoice::zero_d, ModelChoice::automatic}) {
       Network net = looped(reversed, p_out);
-      net.boundaries = {flow_at(4, Waveform::constant_value(q)), pressure_at(5, p_out)};
+      net.boundaries = {flow_boundary(4, Waveform::constant_value(q)), pressure_boundary(5, p_out)};
       sort_boundaries(net);
       const SteadyFlow steady = solve_steady_flow(net, vessel_resistances(net, *net.blood), 0.0);
       SolverOptions options = options_for(model);
@@ -179,7 +155,7 @@ TEST(NetworkGraphsPulsatile, ReversedBoundaryVesselsGiveTheMirrorImage) {
     std::vector<Network> nets;
     for (const bool reversed : {false, true}) {
       Network net = looped(reversed, 1333.0);
-      net.boundaries = {flow_at(4, pulse), outlet_at(5, rcr_outlet(-1, 2e9, 2e-13, 8e9, 1333.0))};
+      net.boundaries = {flow_boundary(4, pulse), outlet_boundary(5, rcr_outlet(-1, 2e9, 2e-13, 8e9, 1333.0))};
       sort_boundaries(net);
       nets.push_back(net);
     }
@@ -235,9 +211,9 @@ TEST(NetworkGraphsPulsatile, SeveralPulsatileInflowsBalanceOverAPeriodicCycle) {
                     period);
   };
   const Waveform a = table(3e-9, 0.0), b = table(1e-9, 0.3);
-  net.boundaries = {flow_at(6, a), flow_at(7, b), pressure_at(8, 1333.0),
-                    flow_at(9, Waveform::constant_value(-0.5e-9)),
-                    outlet_at(10, resistance_outlet(-1, 2e9, 1333.0))};
+  net.boundaries = {flow_boundary(6, a), flow_boundary(7, b), pressure_boundary(8, 1333.0),
+                    flow_boundary(9, Waveform::constant_value(-0.5e-9)),
+                    outlet_boundary(10, resistance_outlet(-1, 2e9, 1333.0))};
   sort_boundaries(net);
   for (const ModelChoice model : {ModelChoice::one_d, ModelChoice::automatic}) {
     SCOPED_TRACE(std::string("--model ") + name(model));
@@ -288,7 +264,7 @@ TEST(NetworkGraphsPulsatile, RefusesWhatItCannotRun) {
   {
     // The bridged diamond without its stubs: the boundaries sit where two vessels meet.
     Network net = vessels({{0, 1, 0.01}, {0, 2, 0.01}, {1, 3, 0.01}, {3, 2, 0.01}, {1, 2, 0.01}}, 4, 1333.0);
-    net.boundaries = {flow_at(0, Waveform::constant_value(1e-9)), pressure_at(3, 1333.0)};
+    net.boundaries = {flow_boundary(0, Waveform::constant_value(1e-9)), pressure_boundary(3, 1333.0)};
     EXPECT_EQ(message(net), "hemosolve's pulsatile run takes boundary conditions where one vessel ends; node 0 joins 2 "
                             "vessels; --steady takes any");
     EXPECT_EQ(message(net, ModelChoice::zero_d), message(net));
@@ -301,7 +277,7 @@ TEST(NetworkGraphsPulsatile, RefusesWhatItCannotRun) {
     fast.mean = 1e-9;
     Waveform slow = fast;
     slow.period = 1.0;
-    net.boundaries = {flow_at(4, fast), flow_at(5, slow)};
+    net.boundaries = {flow_boundary(4, fast), flow_boundary(5, slow)};
     const std::string m = message(net);
     EXPECT_NE(m.find("different periods"), std::string::npos) << m;
     EXPECT_NE(m.find("node 4"), std::string::npos) << m;
@@ -309,7 +285,7 @@ TEST(NetworkGraphsPulsatile, RefusesWhatItCannotRun) {
   {
     // A free end without a condition, named by its node.
     Network net = looped(false, 1333.0);
-    net.boundaries = {flow_at(4, Waveform::constant_value(1e-9))};
+    net.boundaries = {flow_boundary(4, Waveform::constant_value(1e-9))};
     const std::string m = message(net);
     EXPECT_NE(m.find("node 5"), std::string::npos) << m;
     EXPECT_NE(m.find("no boundary condition"), std::string::npos) << m;
@@ -321,7 +297,7 @@ TEST(NetworkGraphsPulsatile, RefusesWhatItCannotRun) {
     reflect.node = 5;
     reflect.type = BoundaryType::reflection;
     reflect.outlet = reflection_outlet(-1, 0.0);
-    net.boundaries = {flow_at(4, Waveform::constant_value(1e-9)), reflect};
+    net.boundaries = {flow_boundary(4, Waveform::constant_value(1e-9)), reflect};
     const std::string m = message(net, ModelChoice::zero_d);
     EXPECT_NE(m.find("reflection outlet needs a 1D vessel"), std::string::npos) << m;
     EXPECT_EQ(message(net, ModelChoice::one_d), "");

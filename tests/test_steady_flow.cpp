@@ -15,6 +15,8 @@
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;
+using test_networks::flow_boundary;
+using test_networks::pressure_boundary;
 using test_networks::resistance_outlet;
 
 namespace {
@@ -227,22 +229,6 @@ TEST(SteadyFlow, RefusesOpenEndsAndPartsApartFromTheInlet) {
 
 namespace {
 
-NodeBoundary flow_at(std::int32_t node, double q) {
-  NodeBoundary b;
-  b.node = node;
-  b.type = BoundaryType::flow;
-  b.waveform = Waveform::constant_value(q);
-  return b;
-}
-
-NodeBoundary pressure_at(std::int32_t node, double p) {
-  NodeBoundary b;
-  b.node = node;
-  b.type = BoundaryType::pressure;
-  b.waveform = Waveform::constant_value(p);
-  return b;
-}
-
 // A diamond with a bridge: flow Q into node 0, node 3 held at P; vessels 0: 0->1, 1: 0->2,
 // 2: 1->3, 3: 3->2 (written against its flow), 4: 1->2 (the bridge), resistances r, r, r, 2r, r.
 Network bridged_diamond(double q, double p) {
@@ -250,7 +236,7 @@ Network bridged_diamond(double q, double p) {
   for (int n = 0; n < 4; ++n) net.add_node(n);
   const int from[] = {0, 0, 1, 3, 1}, to[] = {1, 2, 3, 2, 2};
   for (int v = 0; v < 5; ++v) net.add_vessel(v, from[v], to[v], 0.01, 1e-3, 1e-4, 2e5, 0);
-  net.boundaries = {flow_at(0, q), pressure_at(3, p)};
+  net.boundaries = {flow_boundary(0, q), pressure_boundary(3, p)};
   return net;
 }
 
@@ -283,7 +269,7 @@ TEST(SteadyFlowAtNodes, SeveralInletsAndOutletsBalance) {
   outlet.node = 7;
   outlet.type = BoundaryType::resistance;
   outlet.outlet = resistance_outlet(-1, 5e8, 200.0);
-  net.boundaries = {flow_at(0, 2e-9), flow_at(3, 1e-9), flow_at(5, -0.5e-9), pressure_at(4, 100.0), outlet};
+  net.boundaries = {flow_boundary(0, 2e-9), flow_boundary(3, 1e-9), flow_boundary(5, -0.5e-9), pressure_boundary(4, 100.0), outlet};
   std::sort(net.boundaries.begin(), net.boundaries.end(),
             [](const NodeBoundary& a, const NodeBoundary& b) { return a.node < b.node; });
   std::vector<double> r(net.vessel_count());
@@ -315,7 +301,7 @@ TEST(SteadyFlowAtNodes, RefusesNetworksWithoutAPressureReference) {
     }
   };
   Network flows_only = bridged_diamond(1e-9, 0);
-  flows_only.boundaries[1] = flow_at(3, -1e-9);
+  flows_only.boundaries[1] = flow_boundary(3, -1e-9);
   expect_refusal(flows_only, "the part of the network with vessel 0 (5 vessels) has flow boundaries only");
   // A second part, 4 -> 5 -> 6 -> 4, with no boundary at all.
   Network apart = bridged_diamond(1e-9, 0);
@@ -329,7 +315,7 @@ TEST(SteadyFlowAtNodes, RefusesNetworksWithoutAPressureReference) {
   dead.add_node(4);
   dead.add_vessel(5, 2, 4, 0.01, 1e-3, 1e-4, 2e5, 0);
   expect_refusal(dead, "vessel 5 ends at node 4, which no other vessel meets and which has no boundary condition");
-  dead.boundaries.push_back(flow_at(4, 0.0));  // closed: accepted, and it carries nothing
+  dead.boundaries.push_back(flow_boundary(4, 0.0));  // closed: accepted, and it carries nothing
   const SteadyFlow closed = solve_steady_flow(dead, std::vector<double>(6, 1e9), 0.0);
   EXPECT_NEAR(closed.flow[5], 0.0, 1e-24);
   Network reflecting = bridged_diamond(1e-9, 0);
