@@ -4,6 +4,7 @@
 #include "physics/phase_separation.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <sstream>
 #include <string_view>
 
@@ -99,6 +100,27 @@ DaughterHematocrits daughter_hematocrits(const Bifurcation& bifurcation) {
   daughters.first = fqb > 0 ? fqe * feed / fqb : 0;
   daughters.second = fqb < 1 ? (1 - fqe) * feed / (1 - fqb) : 0;
   return daughters;
+}
+
+double mixed_hematocrit(std::span<const double> inflows, std::span<const double> hematocrits) {
+  constexpr std::string_view law = "hematocrit mixing";
+  if (inflows.size() != hematocrits.size()) {
+    std::ostringstream message;
+    message << law << ": " << inflows.size() << " inflows but " << hematocrits.size()
+            << " hematocrits";
+    throw InputError(message.str());
+  }
+  double blood = 0;
+  double cells = 0;
+  for (std::size_t i = 0; i < inflows.size(); ++i) {
+    if (!(inflows[i] >= 0) || !std::isfinite(inflows[i]))
+      refuse(law, "inflow [m^3/s]", inflows[i], "[0, inf)");
+    require_hematocrit(law, "inflow discharge hematocrit", hematocrits[i]);
+    blood += inflows[i];
+    cells += inflows[i] * hematocrits[i];
+  }
+  // No blood in, none out: the outflows' hematocrit carries no red cells whatever it is.
+  return blood > 0 ? cells / blood : 0;
 }
 
 double tube_hematocrit(double discharge_hematocrit, double diameter, double diameter_scale) {

@@ -7,6 +7,8 @@
 // 263:H1770. Formulas, edge cases and test values: docs/physics.md.
 #pragma once
 
+#include <span>
+
 namespace hemotree {
 
 // One feeding vessel dividing into two daughters. Diameters in metres; the law itself reads
@@ -53,6 +55,13 @@ struct DaughterHematocrits {
   double second = 0;
 };
 DaughterHematocrits daughter_hematocrits(const Bifurcation& bifurcation);
+
+// The discharge hematocrit of blood mixed at a node, H = sum Q_i H_i / sum Q_i, over its
+// inflows (Q_i >= 0 [m^3/s], H_i in [0, 1)): what a converging node sends on, and NetFlow's
+// dishem.cpp rule for every outflow of a node where one vessel feeds more than two (no
+// separation there). 0 when no blood flows in. Throws InputError for spans of different
+// lengths, a negative or non-finite flow, or a hematocrit outside [0, 1).
+double mixed_hematocrit(std::span<const double> inflows, std::span<const double> hematocrits);
 
 // Tube hematocrit H_T (the red-cell volume fraction inside the vessel) from the discharge
 // hematocrit H_D (that of the blood leaving it), the Fahraeus effect, Pries et al. 1992 eq. 7:

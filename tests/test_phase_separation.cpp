@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "cli/errors.hpp"
 #include "physics/phase_separation.hpp"
@@ -196,6 +197,28 @@ TEST(PhaseSeparation, RefusesInputsOutsideTheDomain) {
               std::string::npos)
         << error.what();
   }
+}
+
+// 2 nl/min at 0.45 and 1 nl/min at 0.30 mix to (0.9 + 0.3) / 3 = 0.4; red-cell flux is kept.
+TEST(HematocritMixing, FlowWeightedMean) {
+  const std::vector<double> flows{2.0 / 6e13, 1.0 / 6e13};
+  const std::vector<double> hematocrits{0.45, 0.30};
+  EXPECT_NEAR(mixed_hematocrit(flows, hematocrits), 0.4, 1e-15);
+  EXPECT_NEAR(mixed_hematocrit(std::vector<double>{1.0}, std::vector<double>{0.3}), 0.3, 0);
+  // A stagnant inflow adds nothing; no inflow at all gives 0.
+  EXPECT_NEAR(mixed_hematocrit(std::vector<double>{0.0, 1e-12}, std::vector<double>{0.9, 0.2}),
+              0.2, 1e-15);
+  EXPECT_EQ(mixed_hematocrit(std::vector<double>{0.0, 0.0}, std::vector<double>{0.4, 0.2}), 0.0);
+  EXPECT_EQ(mixed_hematocrit(std::vector<double>{}, std::vector<double>{}), 0.0);
+}
+
+TEST(HematocritMixing, RefusesInputsOutsideTheDomain) {
+  const std::vector<double> one_flow{1e-12};
+  EXPECT_THROW(mixed_hematocrit(one_flow, std::vector<double>{0.4, 0.4}), InputError);
+  for (double q : {-1e-12, inf, not_a_number})
+    EXPECT_THROW(mixed_hematocrit(std::vector<double>{q}, std::vector<double>{0.4}), InputError);
+  for (double h : {1.0, -0.1, not_a_number})
+    EXPECT_THROW(mixed_hematocrit(one_flow, std::vector<double>{h}), InputError);
 }
 
 // Fahraeus, H_T = H_D (H_D + (1 - H_D) X), X = 1 + 1.7 e^(-0.415 D) - 0.6 e^(-0.011 D),
