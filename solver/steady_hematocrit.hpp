@@ -56,6 +56,9 @@ struct SteadyHematocritResult {
 // hematocrits before the last relaxation, and `hematocrit` is recomputed from them, so the
 // result obeys the hematocrit rules exactly and the flow equations to within `change`.
 // converged says whether the tolerance was met; an unconverged result is returned as such.
+// Relaxation: the rat mesentery (1130 vessels) oscillates at 1 (no convergence in 2000 passes)
+// and converges to 1e-10 in 59 passes at 0.5, 144 at 0.2; its flows and hematocrits then
+// agree with NetFlow's own solution to the 6 digits NetFlow writes (median 4e-7 relative).
 // The inflow at a tree inlet is its mean. Throws InputError for max_iterations < 1, tolerance
 // <= 0, relaxation outside (0, 1], and where solve_steady_flow or distribute_hematocrit does.
 SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, const Blood& blood,

@@ -105,6 +105,33 @@ TEST(DistributeHematocrit, ConvergingNodeMixesByFlux) {
   EXPECT_EQ(h[3], 0.0);
 }
 
+// No separation where the law does not apply (NetFlow's dishem.cpp): two inflows feeding two
+// vessels, a boundary at a dividing node, one vessel feeding three: every outflow takes the mix.
+TEST(DistributeHematocrit, MixesWhereTheLawDoesNotApply) {
+  Network two_in;
+  add_vessels(two_in, 5, {{0, 2}, {1, 2}, {2, 3}, {2, 4}}, {10e-6, 10e-6, 12e-6, 6e-6});
+  two_in.boundaries = {with_hematocrit(flow_boundary(0, 1e-12), 0.5), with_hematocrit(flow_boundary(1, 1e-12), 0.3),
+                       pressure_boundary(3, 0), pressure_boundary(4, 0)};
+  auto h = distribute_hematocrit(two_in, std::vector<double>{1e-12, 1e-12, 1.8e-12, 0.2e-12}, 0.45, 1);
+  EXPECT_NEAR(h[2], 0.4, 1e-15);
+  EXPECT_NEAR(h[3], 0.4, 1e-15);
+
+  Network fed_node;  // 0 -> 1 -> {2, 3}, and 1 also receives 1e-12 at 0.2 through a boundary
+  add_vessels(fed_node, 4, {{0, 1}, {1, 2}, {1, 3}}, {10e-6, 12e-6, 6e-6});
+  fed_node.boundaries = {with_hematocrit(flow_boundary(0, 1e-12), 0.5), with_hematocrit(flow_boundary(1, 1e-12), 0.2),
+                         pressure_boundary(2, 0), pressure_boundary(3, 0)};
+  h = distribute_hematocrit(fed_node, std::vector<double>{1e-12, 1.8e-12, 0.2e-12}, 0.45, 1);
+  EXPECT_NEAR(h[1], 0.35, 1e-15);
+  EXPECT_NEAR(h[2], 0.35, 1e-15);
+
+  Network three;
+  add_vessels(three, 5, {{0, 1}, {1, 2}, {1, 3}, {1, 4}}, {10e-6, 8e-6, 6e-6, 4e-6});
+  three.boundaries = {with_hematocrit(flow_boundary(0, 1e-12), 0.45), pressure_boundary(2, 0), pressure_boundary(3, 0),
+                      pressure_boundary(4, 0)};
+  h = distribute_hematocrit(three, std::vector<double>{1e-12, 0.7e-12, 0.2e-12, 0.1e-12}, 0.45, 1);
+  for (int v : {1, 2, 3}) EXPECT_DOUBLE_EQ(h[v], 0.45) << "vessel " << v;
+}
+
 // The ladder of test_steady_flow (rails 0-1-2-3 and 4-5-6-7, rungs) fed at nodes 0 and 3 and
 // possibly 4 (a pressure) at three hematocrits: red cells balance at every node.
 TEST(DistributeHematocrit, ConservesRedCellsOnALoopedNetwork) {
@@ -248,4 +275,19 @@ TEST(SteadyWithPhaseSeparation, RatMesenteryConverges) {
     EXPECT_GE(h, 0.0);
     EXPECT_LT(h, 1.0);
   }
+  // Red cells balance at every node, boundaries included (the file's hematocrits, else 0.4).
+  std::vector<double> boundary_h(net.node_count(), 0.0);
+  std::vector<char> has_boundary(net.node_count(), 0);
+  for (const NodeBoundary& b : node_boundaries(net)) {
+    has_boundary[b.node] = 1;
+    boundary_h[b.node] = std::isnan(b.hematocrit) ? 0.4 : b.hematocrit;
+  }
+  double flux = 0;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    flux = std::max(flux, std::abs(res.flow.flow[v]) * res.hematocrit[v]);
+  for (std::size_t n = 0; n < net.node_count(); ++n)
+    EXPECT_NEAR(red_cell_imbalance(net, res.flow.flow, res.hematocrit, static_cast<int>(n), boundary_h[n],
+                                   has_boundary[n]),
+                0.0, 1e-12 * flux)
+        << "node " << net.node_id[n];
 }
