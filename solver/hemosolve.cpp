@@ -191,6 +191,12 @@ int main(int argc, char** argv) {
       "--steady", steady,
       "the steady state alone, vessels at their file diameters (what NetFlow computes): flows, pressures and wall "
       "shear stress in the same files as a run; any connected network with boundaries at nodes");
+  std::string red_cells = "fixed";
+  app.add_option("--red-cells", red_cells,
+                 "fixed (the blood's hematocrit in every vessel) or transport: with --steady, red cells split by "
+                 "the Pries-Secomb law at diverging bifurcations, each vessel's viscosity at its own hematocrit "
+                 "(what NetFlow computes); the pulsatile transport is to come")
+      ->capture_default_str();
   app.add_flag("--quiet", quiet, "no progress lines or notes (warnings and errors still)");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
@@ -273,6 +279,10 @@ int main(int argc, char** argv) {
     }
     if ((vtk || frames > 0) && net.x.empty())
       throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
+    if (red_cells != "fixed" && red_cells != "transport")
+      throw InputError("--red-cells must be fixed or transport (got '" + red_cells + "')");
+    if (red_cells == "transport" && !steady)
+      throw InputError("--red-cells transport runs with --steady for now: the pulsatile transport is not built yet");
     if (steady) {
       SteadyRunRequest request;
       request.input = input;
@@ -281,6 +291,7 @@ int main(int argc, char** argv) {
       request.vtk = vtk;
       request.vtk_keep = vtk_keep;
       request.quiet = quiet;
+      request.phase_separation = red_cells == "transport";
       run_steady(net, request);
       return 0;
     }

@@ -5,15 +5,23 @@
 #include <limits>
 #include <numbers>
 
+#include "cli/errors.hpp"
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "physics/rheology.hpp"
 #include "solver/output_folder.hpp"
+#include "physics/phase_separation.hpp"
 #include "solver/run_report.hpp"
+#include "solver/steady_hematocrit.hpp"
 
 namespace hemotree {
 
 namespace {
+
+// The coupled flow-hematocrit iteration: passes and the change (hematocrit, and flow relative
+// to the largest) below which it has converged.
+constexpr int red_cell_iterations = 1000;
+constexpr double red_cell_tolerance = 1e-9;
 
 // Flow into the network at every node through its boundary: what leaves the node by its
 // vessels.
@@ -28,13 +36,16 @@ std::vector<double> boundary_inflow(const Network& net, const SteadyFlow& steady
 
 }  // namespace
 
-CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFlow& steady) {
+CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFlow& steady,
+                          const std::vector<double>* hematocrit) {
   CycleSummary cycle;
   cycle.vessels.resize(net.vessel_count());
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
     VesselCycle& c = cycle.vessels[v];
     const double radius = net.diameter[v] / 2, area = std::numbers::pi * radius * radius;
-    const double mu = apparent_viscosity(blood, net.diameter[v]);
+    Blood own = blood;  // the vessel's own hematocrit where red cells separate
+    if (hematocrit) own.hematocrit = (*hematocrit)[v];
+    const double mu = apparent_viscosity(own, net.diameter[v]);
     const double u = steady.flow[v] / area;
     c.mean_flow = c.peak_flow = c.least_flow = steady.flow[v];
     c.mean_pressure = c.systolic_pressure = c.diastolic_pressure =
@@ -81,11 +92,26 @@ void run_steady(const Network& net, const SteadyRunRequest& request) {
   if (request.rheology_override >= 0) blood.rheology = static_cast<Rheology>(request.rheology_override);
   OutputFolder folder(request.out_dir);
   const auto started = std::chrono::steady_clock::now();
-  const SteadyFlow steady = solve_steady_flow(net, vessel_resistances(net, blood),
-                                              net.inlet ? net.inlet->waveform.mean_value() : 0.0);
-  const CycleSummary cycle = steady_cycle(net, blood, steady);
+  SteadyFlow steady;
+  SteadyHematocritResult separated;
+  if (request.phase_separation) {
+    // Under-relaxed by half: undamped, the rat mesentery's split oscillates (Gardner et al.
+    // 2010 on such networks); 59 passes to 1e-10 there.
+    separated = solve_steady_with_phase_separation(net, blood, red_cell_iterations, red_cell_tolerance, 0.5);
+    steady = separated.flow;
+  } else {
+    steady = solve_steady_flow(net, vessel_resistances(net, blood), net.inlet ? net.inlet->waveform.mean_value() : 0.0);
+  }
+  const CycleSummary cycle = steady_cycle(net, blood, steady, request.phase_separation ? &separated.hematocrit : nullptr);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  const VesselTable results = steady_results(net, cycle);
+  VesselTable results = steady_results(net, cycle);
+  if (request.phase_separation) {
+    std::vector<double> tube(net.vessel_count());
+    for (std::size_t v = 0; v < tube.size(); ++v)
+      tube[v] = tube_hematocrit(separated.hematocrit[v], net.diameter[v], blood.pries_diameter_scale());
+    results.add_number("discharge_hematocrit", separated.hematocrit);
+    results.add_number("tube_hematocrit", std::move(tube));
+  }
   nlohmann::json run_info = {{"tool", "hemosolve"},
                              {"version", HEMOTREE_VERSION},
                              {"network", request.input},
@@ -95,10 +121,16 @@ void run_steady(const Network& net, const SteadyRunRequest& request) {
                              {"vessels_0d", 0},
                              {"rheology", to_string(blood.rheology)},
                              {"mean_cell_volume", blood.mean_cell_volume},
-                             {"status", "complete"},
+                             {"red_cells", request.phase_separation ? "phase_separation" : "fixed"},
+                             {"status", !request.phase_separation || separated.converged ? "complete" : "not converged"},
                              {"cycles", 0},
                              {"wall_time", wall}};
   run_info["boundaries"] = boundary_results(net, steady);
+  if (request.phase_separation)
+    run_info["red_cell_iterations"] = {{"passes", separated.iterations},
+                                       {"change", separated.change},
+                                       {"tolerance", red_cell_tolerance},
+                                       {"relaxation", 0.5}};
   run_info["statistics"] = group_statistics(net, results);
   folder.open();
   const std::filesystem::path dir = folder.staging();
@@ -106,6 +138,11 @@ void run_steady(const Network& net, const SteadyRunRequest& request) {
   write_vessel_table(dir / "vessels.csv", results);
   if (request.vtk) write_results_vtk(dir / "results.vtp", net, results, request.vtk_keep);
   folder.publish();
+  if (request.phase_separation && !separated.converged)
+    throw InputError("the flows and hematocrits did not converge in " + std::to_string(separated.iterations) +
+                     " passes (last change " + format_rounded(separated.change) +
+                     "): phase separation may have no steady state here, or several; " +
+                     request.out_dir.string() + " holds the last pass, marked \"not converged\"");
   if (!request.quiet)
     note("steady state of " + std::to_string(net.vessel_count()) + " vessels in " + format_quantity(wall, "s") +
          ": " + format_quantity(cycle.inlet_mean_flow, "nl/min") + " in through the boundaries; results in " +

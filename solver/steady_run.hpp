@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -21,7 +22,9 @@ namespace hemotree {
 // (the mean of its ends': Poiseuille's profile is linear), the wall shear stress and Reynolds
 // number of its mean velocity in its reference lumen; per run the flows in and out through
 // the boundaries (their balance is the solve's round-off).
-CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFlow& steady);
+// hematocrit: each vessel's discharge hematocrit for its viscosity, or null: the blood's.
+CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFlow& steady,
+                          const std::vector<double>* hematocrit = nullptr);
 
 // Every boundary node's condition and what the solve gives there: {"node", "type", "flow"
 // (into the network, m^3/s), "pressure" (Pa)}, by node.
@@ -37,10 +40,15 @@ struct SteadyRunRequest {
   bool vtk = false;
   std::span<const std::uint8_t> vtk_keep;
   bool quiet = false;
+  // Red cells: fixed (the blood's hematocrit everywhere) or phase separation at diverging
+  // bifurcations, the flows and hematocrits solved together (solver/steady_hematocrit.hpp).
+  bool phase_separation = false;
 };
 
 // Solves and writes OUT/summary.json, OUT/vessels.csv (and OUT/results.vtp with vtk) through
-// OutputFolder (never a half-written folder). InputError for a network it cannot solve.
+// OutputFolder (never a half-written folder). InputError for a network it cannot solve. With
+// phase separation each vessel's discharge and tube hematocrit are reported too; an iteration
+// that does not converge writes its last state marked "not converged" and is InputError.
 void run_steady(const Network& net, const SteadyRunRequest& request);
 
 }  // namespace hemotree

@@ -73,4 +73,40 @@ expect_error "two conditions at a node" 2 "node 13 has two boundary conditions" 
   "$HEMOSOLVE" "$WORK/twice.json" --steady --out "$WORK/twice"
 expect_error "--steady with --cycles" 2 "--cycles excludes --steady" -- \
   "$HEMOSOLVE" "$WORK/diamond.json" --steady --cycles 3 --out "$WORK/x"
+
+# ---- red cells: phase separation in steady flow (the rat mesentery, where it is shared) ----
+expect_error "--red-cells unknown" 2 "--red-cells must be fixed or transport (got 'sludge')" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --steady --red-cells sludge --out "$WORK/x"
+expect_error "--red-cells transport without --steady" 2 "--red-cells transport runs with --steady for now" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --out "$WORK/x"
+DAT=$(dirname "$0")/../../../shared/networks/mesentery-rat/network.dat
+if [ -s "$DAT" ]; then
+  "$BUILD/exchange/vimport" secomb "$DAT" --mean-cell-volume 55 --plasma-viscosity 1.0466cP -o "$WORK/mes.json" 2>/dev/null
+  "$HEMOSOLVE" "$WORK/mes.json" --steady --red-cells transport --out "$WORK/rbc" --quiet \
+    && pass "--steady --red-cells transport on the mesentery" || fail "--red-cells transport"
+  "$PY" - "$WORK/mes.json" "$WORK/rbc/summary.json" <<'PY' && pass "red cells balance at every node; hematocrits in range" || fail "red-cell balance"
+import json, sys
+net, s = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert s["status"] == "complete" and s["red_cells"] == "phase_separation", s["status"]
+assert s["red_cell_iterations"]["change"] < 1e-9
+rows = {v["id"]: v for v in s["vessels"]}
+boundary = {b["node"] for b in net["boundaries"]}
+cells = {}  # net red-cell flux out of each node through its vessels
+scale = 0
+for v in net["vessels"]:
+    r = rows[v["id"]]
+    assert 0 <= r["discharge_hematocrit"] < 1 and 0 <= r["tube_hematocrit"] < 1, r["id"]
+    f = r["mean_flow"] * r["discharge_hematocrit"]
+    scale = max(scale, abs(f))
+    cells[v["from"]] = cells.get(v["from"], 0) + f
+    cells[v["to"]] = cells.get(v["to"], 0) - f
+worst = max(abs(x) for n, x in cells.items() if n not in boundary)
+assert worst < 1e-12 * scale, worst / scale
+# The first segment carries the largest inflow (node 830: 362.56 nl/min at Hd 0.4338, given).
+first = rows[1]
+assert abs(first["mean_flow"] * 60e12 - 362.56) < 1e-3 and abs(first["discharge_hematocrit"] - 0.4338) < 1e-12
+PY
+else
+  echo "skip: no $DAT (the shared public networks)"
+fi
 finish
