@@ -18,13 +18,19 @@
 namespace hemotree {
 
 std::vector<double> vessel_resistances(const Network& net, const Blood& blood) {
+  return vessel_resistances(net, blood, {});
+}
+
+std::vector<double> vessel_resistances(const Network& net, Blood blood, std::span<const double> hematocrit) {
   std::vector<double> r(net.vessel_count());
-  for (std::size_t v = 0; v < r.size(); ++v)
+  for (std::size_t v = 0; v < r.size(); ++v) {
+    if (!hematocrit.empty()) blood.hematocrit = hematocrit[v];
     r[v] = net.is_tapered(v)
                ? tapered_poiseuille_resistance([&](double d) { return apparent_viscosity(blood, d); },
                                                net.length[v], net.diameter[v], net.distal_diameter[v], blood.alpha)
                : poiseuille_resistance(apparent_viscosity(blood, net.diameter[v]), net.length[v],
                                        net.diameter[v], blood.alpha);
+  }
   return r;
 }
 

@@ -165,24 +165,6 @@ std::vector<double> distribute_hematocrit(const Network& net, std::span<const do
   return h;
 }
 
-namespace {
-
-// Poiseuille resistances with every vessel's apparent viscosity at its own hematocrit.
-std::vector<double> resistances_at(const Network& net, Blood blood, const std::vector<double>& hematocrit) {
-  std::vector<double> r(net.vessel_count());
-  for (std::size_t v = 0; v < r.size(); ++v) {
-    blood.hematocrit = hematocrit[v];
-    r[v] = net.is_tapered(v)
-               ? tapered_poiseuille_resistance([&](double d) { return apparent_viscosity(blood, d); },
-                                               net.length[v], net.diameter[v], net.distal_diameter[v], blood.alpha)
-               : poiseuille_resistance(apparent_viscosity(blood, net.diameter[v]), net.length[v],
-                                       net.diameter[v], blood.alpha);
-  }
-  return r;
-}
-
-}  // namespace
-
 SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, const Blood& blood,
                                                           int max_iterations, double tolerance,
                                                           double relaxation) {
@@ -197,7 +179,7 @@ SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, co
   std::vector<double> previous_flow;
   SteadyHematocritResult result;
   for (int it = 1; it <= max_iterations; ++it) {
-    SteadyFlow s = solve_steady_flow(net, resistances_at(net, blood, h), inlet_flow);
+    SteadyFlow s = solve_steady_flow(net, vessel_resistances(net, blood, h), inlet_flow);
     std::vector<double> target = distribute_hematocrit(net, s.flow, blood.hematocrit, 1.0);
     double q_scale = 0;
     for (const double q : s.flow) q_scale = std::max(q_scale, std::abs(q));

@@ -192,7 +192,7 @@ TEST(NetworkGraphsPulsatile, ReversedBoundaryVesselsGiveTheMirrorImage) {
 // every cycle) what enters leaves.
 TEST(NetworkGraphsPulsatile, SeveralPulsatileInflowsBalanceOverAPeriodicCycle) {
   const double period = 0.8;
-  // A ladder of two rails (0-1-2, 3-4-5) and three rungs, stubs to the boundary nodes 6..10.
+  // A ladder of two rails (0-1-2, 3-4-5) and three rungs, lead vessels to the boundary nodes 6..10.
   Network net = vessels({{0, 1, 0.02},
                          {1, 2, 0.01},
                          {3, 4, 0.01},
@@ -201,7 +201,7 @@ TEST(NetworkGraphsPulsatile, SeveralPulsatileInflowsBalanceOverAPeriodicCycle) {
                          {1, 4, 0.01},
                          {5, 2, 0.01},
                          {6, 0, 0.01},    // inflow A
-                         {3, 7, 0.01},    // inflow B, at the stub's `to` end
+                         {3, 7, 0.01},    // inflow B, at its lead vessel's `to` end
                          {2, 8, 0.01},    // the pressure
                          {9, 5, 0.01},    // the prescribed outflow, at a `from` end
                          {4, 10, 0.01}},  // the R outlet
@@ -262,7 +262,7 @@ TEST(NetworkGraphsPulsatile, RefusesWhatItCannotRun) {
     return std::string();
   };
   {
-    // The bridged diamond without its stubs: the boundaries sit where two vessels meet.
+    // The bridged diamond without its lead vessels: the boundaries sit where two vessels meet.
     Network net = vessels({{0, 1, 0.01}, {0, 2, 0.01}, {1, 3, 0.01}, {3, 2, 0.01}, {1, 2, 0.01}}, 4, 1333.0);
     net.boundaries = {flow_boundary(0, Waveform::constant_value(1e-9)), pressure_boundary(3, 1333.0)};
     EXPECT_EQ(message(net), "hemosolve's pulsatile run takes boundary conditions where one vessel ends; node 0 joins 2 "

@@ -10,7 +10,7 @@ VIMPORT=$BUILD/exchange/vimport
 PY=/usr/bin/python3
 
 # The bridged diamond of tests/test_steady_flow.cpp (nodes 10..13, vessel 3 written against
-# its flow) with a stub to each boundary node: vessel 5 written 10 -> 14 (the inflow at its
+# its flow) with a lead vessel to each boundary node: vessel 5 written 10 -> 14 (the inflow at its
 # `to` end) and vessel 6 written 15 -> 13 (the pressure at its `from` end). Vessels of 1 mm
 # and 1 cm; the pressure at the walls' reference (10 mmHg), so that they barely distend.
 vessels='
@@ -47,7 +47,7 @@ for v in run["vessels"]:
     s = rows[v["id"]]
     assert abs(v["mean_flow"] - s["mean_flow"]) < 1e-3 * q, (v["id"], v["mean_flow"], s["mean_flow"])
     assert abs(v["mean_pressure"] - s["mean_pressure"]) < 1e-2 * drop, (v["id"], v["mean_pressure"], s["mean_pressure"])
-# The reversed stubs carry the flow against their from -> to.
+# The reversed lead vessels carry the flow against their from -> to.
 assert rows[5]["mean_flow"] < 0 and rows[6]["mean_flow"] < 0
 bounds = {b["node"]: b for b in run["boundaries"]}
 assert abs(bounds[14]["flow"] - q) < 1e-9 * q and abs(bounds[15]["flow"] + q) < 1e-4 * q, bounds
@@ -84,7 +84,7 @@ assert abs(sum(b.values())) < 1e-4 * 2.5e-8, b
 assert abs(s["mass_balance"]) < 1e-4 and abs(s["conservation_error"]) < 1e-9, (s["mass_balance"], s["conservation_error"])
 PY
 
-# Refusals: a boundary where two vessels meet (the diamond without its stubs), and two
+# Refusals: a boundary where two vessels meet (the diamond without its lead vessels), and two
 # pulsatile boundaries of different periods.
 "$PY" - "$WORK/loop.json" "$WORK/junction.json" <<'PY'
 import json, sys
