@@ -62,6 +62,8 @@ TEST(VenousMirror, TwinsCarryTheirArteriesFlowAndCapillariesSitMidway) {
     const std::size_t twin = 2 * arteries - 1 - k;  // appended in reverse order
     EXPECT_NEAR(s.flow[twin], s.flow[k], 1e-9 * mirror.mean_flow) << "vessel " << net.id[k];
     const auto end = static_cast<std::size_t>(net.to[k]);
-    if (leaves[end]) EXPECT_NEAR(s.node_pressure[end], midway, 1e-9 * inflow_pressure) << "node " << net.node_id[end];
+    if (leaves[end]) {
+      EXPECT_NEAR(s.node_pressure[end], midway, 1e-9 * inflow_pressure) << "node " << net.node_id[end];
+    }
   }
 }
