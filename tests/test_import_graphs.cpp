@@ -13,6 +13,7 @@
 #include "exchange/graph_formats.hpp"
 #include "formats/exports.hpp"
 #include "formats/output_stream.hpp"
+#include "scratch_path.hpp"
 
 namespace hemotree {
 namespace {
@@ -20,7 +21,7 @@ namespace {
 class ImportGraphs : public ::testing::Test {
  protected:
   std::string write(const std::string& name, const std::string& text) {
-    const auto path = (std::filesystem::path(::testing::TempDir()) / name).string();
+    const auto path = scratch_path(name).string();
     std::ofstream(path, std::ios::binary) << text;
     return path;
   }
@@ -198,7 +199,7 @@ TEST_F(ImportGraphs, HemotreeGraphmlRoundTrip) {
   original.add_vessel(30, 0, 1, 1e-3, 1.23456789e-4, 1.5e-5, 1.1e6, 0);
   original.add_vessel(31, 1, 2, 1.41421356e-3, 8.7654321e-5, 1.2e-5, 1.2e6, 1);
   original.add_vessel(32, 1, 3, 1.5e-3, 6e-6, 1e-6, 3e5, 1);
-  const std::string path = (std::filesystem::path(::testing::TempDir()) / "roundtrip.graphml").string();
+  const std::string path = scratch_path("roundtrip.graphml").string();
   {
     OutputStream out(path);
     write_graphml(original, out);

@@ -17,6 +17,7 @@
 
 #include "cli/errors.hpp"
 #include "exchange/vtk_centerline.hpp"
+#include "scratch_path.hpp"
 
 namespace hemotree {
 namespace {
@@ -229,7 +230,7 @@ std::string legacy_51(const Geometry& g) {
 class ImportVtk : public ::testing::Test {
  protected:
   std::string write(const std::string& name, const std::string& text) {
-    const auto path = (std::filesystem::path(::testing::TempDir()) / name).string();
+    const auto path = scratch_path(name).string();
     std::ofstream(path, std::ios::binary) << text;
     return path;
   }
@@ -246,7 +247,7 @@ class ImportVtk : public ::testing::Test {
       read(name, text);
     } catch (const InputError& e) {
       const std::string m = e.what();
-      const std::string path = (std::filesystem::path(::testing::TempDir()) / name).string();
+      const std::string path = scratch_path(name).string();
       return m.rfind(path, 0) == 0 ? m.substr(path.size()) : m;  // without the file's name
     }
     return "no error";
