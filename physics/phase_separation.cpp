@@ -123,16 +123,21 @@ double mixed_hematocrit(std::span<const double> inflows, std::span<const double>
   return blood > 0 ? cells / blood : 0;
 }
 
-double tube_hematocrit(double discharge_hematocrit, double diameter, double diameter_scale) {
+double fahraeus_parameter(double diameter, double diameter_scale) {
   constexpr std::string_view law = "Fahraeus law";
-  require_hematocrit(law, "discharge hematocrit", discharge_hematocrit);
   require_positive(law, "diameter [m]", diameter);
   require_positive(law, "diameter scale", diameter_scale);
   const double d = diameter * diameter_scale * metres_to_micrometres;
+  // The ratio of the red cells' mean velocity to the blood's, inverted, in the dilute limit:
+  // cells crowd the fast core, so they spend less time in the tube than the plasma and fill
+  // less of it.
+  return 1 + 1.7 * std::exp(-0.415 * d) - 0.6 * std::exp(-0.011 * d);
+}
+
+double tube_hematocrit(double discharge_hematocrit, double diameter, double diameter_scale) {
+  require_hematocrit("Fahraeus law", "discharge hematocrit", discharge_hematocrit);
+  const double x = fahraeus_parameter(diameter, diameter_scale);
   const double h = discharge_hematocrit;
-  // The ratio of the red cells' mean velocity to the blood's, inverted: cells crowd the
-  // fast core, so they spend less time in the tube than the plasma and fill less of it.
-  const double x = 1 + 1.7 * std::exp(-0.415 * d) - 0.6 * std::exp(-0.011 * d);
   return h * (h + (1 - h) * x);
 }
 

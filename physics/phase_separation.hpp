@@ -70,5 +70,9 @@ double mixed_hematocrit(std::span<const double> inflows, std::span<const double>
 // vessels. Throws InputError for H_D outside [0, 1) and a non-finite or non-positive diameter
 // or scale.
 double tube_hematocrit(double discharge_hematocrit, double diameter, double diameter_scale = 1);
+// The law's diameter term k = 1 + 1.7 exp(-0.415 D) - 0.6 exp(-0.011 D) (D in um, scaled), so
+// that H_T = H_D (k + (1 - k) H_D): the limit of H_T / H_D as H_D -> 0. Throws InputError for
+// a non-finite or non-positive diameter or scale.
+double fahraeus_parameter(double diameter, double diameter_scale = 1);
 
 }  // namespace hemotree

@@ -1,0 +1,212 @@
+#include "transport/red_cell_transport.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "cli/errors.hpp"
+#include "physics/phase_separation.hpp"
+
+namespace hemotree {
+
+namespace {
+
+// The Gauss-Seidel sweeps over cells on a directed cycle of the flow: each sweep is a
+// contraction (every cell's update is a convex combination with a weight V / (V + Q_in) on
+// what it held), so a few dozen reach round-off unless the cycle holds no volume at all.
+constexpr int max_cycle_sweeps = 10000;
+constexpr double cycle_tolerance = 1e-15;
+
+}  // namespace
+
+RedCellTransport::RedCellTransport(TransportGrid grid, std::vector<double> volume, double hematocrit,
+                                   RedCellOptions options)
+    : grid_(std::move(grid)), faces_(grid_), options_(options), volume_(std::move(volume)) {
+  const std::size_t cells = grid_.cell_count();
+  if (volume_.size() != cells || grid_.fahraeus.size() != cells || grid_.b.size() != grid_.face_count() ||
+      grid_.vessel.size() != grid_.face_count() || grid_.diameter.size() != grid_.face_count())
+    throw InputError("red-cell transport: the grid's arrays and the " + std::to_string(volume_.size()) +
+                     " cell volumes do not match its " + std::to_string(cells) + " cells");
+  for (std::size_t c = 0; c < cells; ++c)
+    if (!(volume_[c] >= 0) || !std::isfinite(volume_[c]))
+      throw InputError("red-cell transport: cell " + std::to_string(c) + " has volume " + std::to_string(volume_[c]));
+  if (!(hematocrit >= 0 && hematocrit < 1))
+    throw InputError("red-cell transport: hematocrit " + std::to_string(hematocrit) + " is outside [0, 1)");
+  discharge_.assign(cells, hematocrit);
+  next_volume_.assign(cells, 0.0);
+  share_.assign(grid_.face_count(), 1.0);
+  last_outflow_.assign(grid_.boundaries, hematocrit);
+  for (CarrierStep* c : {&cells_, &plasma_, &blood_}) {
+    c->face.assign(grid_.face_count(), 0.0);
+    c->before.assign(cells, 0.0);
+    c->after.assign(cells, 0.0);
+  }
+}
+
+void RedCellTransport::set_hematocrit(std::span<const double> discharge) {
+  if (discharge.size() != discharge_.size())
+    throw InputError("red-cell transport: " + std::to_string(discharge.size()) + " hematocrits for " +
+                     std::to_string(discharge_.size()) + " cells");
+  for (std::size_t c = 0; c < discharge.size(); ++c) {
+    if (!(discharge[c] >= 0 && discharge[c] < 1))
+      throw InputError("red-cell transport: hematocrit " + std::to_string(discharge[c]) + " of cell " +
+                       std::to_string(c) + " is outside [0, 1)");
+    discharge_[c] = discharge[c];
+  }
+}
+
+void RedCellTransport::set_volumes(std::span<const double> volume) {
+  for (std::size_t c = 0; c < volume_.size(); ++c) {
+    const double h = tube(c, discharge_[c]);
+    adjusted_ += (volume[c] - volume_[c]) * h;
+    volume_[c] = volume[c];
+  }
+}
+
+double RedCellTransport::red_cells() const {
+  double sum = 0;
+  for (std::size_t c = 0; c < volume_.size(); ++c) sum += volume_[c] * tube(c, discharge_[c]);
+  return sum;
+}
+
+void RedCellTransport::split_at_nodes(std::span<const double> face_volume) {
+  std::fill(share_.begin(), share_.end(), 1.0);
+  separating_ = 0;
+  if (!options_.phase_separation) return;
+  for (std::size_t c = 0; c < grid_.cell_count(); ++c) {
+    if (grid_.node[c] < 0 || faces_.start[c + 1] - faces_.start[c] != 3) continue;
+    std::int32_t feed = -1, first = -1, second = -1;
+    bool eligible = true;
+    for (auto i = faces_.start[c]; i < faces_.start[c + 1] && eligible; ++i) {
+      const std::int32_t f = faces_.face[static_cast<std::size_t>(i)];
+      const auto fi = static_cast<std::size_t>(f);
+      if (grid_.b[fi] < 0 || grid_.vessel[fi] < 0 || face_volume[fi] == 0) {
+        eligible = false;
+        break;
+      }
+      // Out of this cell when the volume runs from its side a to b.
+      const bool out = (static_cast<std::size_t>(grid_.a[fi]) == c) == (face_volume[fi] > 0);
+      if (!out) {
+        if (feed >= 0) eligible = false;
+        feed = f;
+      } else if (first < 0) {
+        first = f;
+      } else {
+        second = f;
+      }
+    }
+    if (!eligible || feed < 0 || second < 0) continue;
+    const auto fe = static_cast<std::size_t>(feed), f1 = static_cast<std::size_t>(first),
+               f2 = static_cast<std::size_t>(second);
+    Bifurcation bif;
+    bif.feed_diameter = grid_.diameter[fe];
+    bif.first_diameter = grid_.diameter[f1];
+    bif.second_diameter = grid_.diameter[f2];
+    const double q1 = std::abs(face_volume[f1]), q2 = std::abs(face_volume[f2]);
+    bif.flow_fraction = q1 / (q1 + q2);
+    bif.feed_hematocrit = discharge_[c];
+    bif.diameter_scale = options_.diameter_scale;
+    // The law has no split where X0 >= 1/2 (a feed under 1.93 (1 - H) um): mixed there.
+    if (!(0.964 * (1 - bif.feed_hematocrit) / (bif.feed_diameter * bif.diameter_scale * 1e6) < 0.5)) continue;
+    const double fqe = red_cell_fraction(bif);
+    share_[f1] = fqe / bif.flow_fraction;
+    share_[f2] = (1 - fqe) / (1 - bif.flow_fraction);
+    ++separating_;
+  }
+}
+
+double RedCellTransport::face_hematocrit(std::size_t f, std::span<const double> face_volume,
+                                         std::span<const double> inflow_hematocrit) const {
+  if (face_volume[f] > 0) return share_[f] * discharge_[static_cast<std::size_t>(grid_.a[f])];
+  const std::int32_t b = grid_.b[f];
+  if (b >= 0) return share_[f] * discharge_[static_cast<std::size_t>(b)];
+  const auto boundary = static_cast<std::size_t>(-1 - b);
+  const double given = inflow_hematocrit[boundary];
+  return std::isnan(given) ? last_outflow_[boundary] : given;
+}
+
+double RedCellTransport::solve_cell(std::size_t c, std::span<const double> face_volume,
+                                    std::span<const double> inflow_hematocrit) {
+  double rhs = cells_.before[c], out = 0;
+  for (auto i = faces_.start[c]; i < faces_.start[c + 1]; ++i) {
+    const auto f = static_cast<std::size_t>(faces_.face[static_cast<std::size_t>(i)]);
+    const double q = face_volume[f];
+    if (q == 0) continue;
+    if ((static_cast<std::size_t>(grid_.a[f]) == c) == (q > 0)) out += std::abs(q);
+    else rhs += std::abs(q) * face_hematocrit(f, face_volume, inflow_hematocrit);
+  }
+  // W H_T(H) + out H = rhs with H_T = H (k + (1 - k) H): a H^2 + b H = rhs, the root that
+  // vanishes with rhs (written to keep its digits whatever the sign of a).
+  const double w = std::max(next_volume_[c], 0.0), k = grid_.fahraeus[c];
+  const double a = (1 - k) * w, b = k * w + out;
+  if (!(b > 0)) return discharge_[c];  // nothing here and nothing through: it keeps its value
+  const double disc = std::max(b * b + 4 * a * rhs, 0.0);
+  return 2 * rhs / (b + std::sqrt(disc));
+}
+
+void RedCellTransport::step(std::span<const double> face_volume, std::span<const double> inflow_hematocrit) {
+  const std::size_t cells = grid_.cell_count(), faces = grid_.face_count();
+  if (face_volume.size() != faces || inflow_hematocrit.size() != grid_.boundaries)
+    throw InputError("red-cell transport: a step needs " + std::to_string(faces) + " face volumes and " +
+                     std::to_string(grid_.boundaries) + " boundary hematocrits");
+  // The blood: each cell's volume after the step from what its faces passed.
+  next_volume_ = volume_;
+  for (std::size_t f = 0; f < faces; ++f) {
+    next_volume_[static_cast<std::size_t>(grid_.a[f])] -= face_volume[f];
+    if (grid_.b[f] >= 0) next_volume_[static_cast<std::size_t>(grid_.b[f])] += face_volume[f];
+  }
+  for (std::size_t c = 0; c < cells; ++c) cells_.before[c] = volume_[c] * tube(c, discharge_[c]);
+  split_at_nodes(face_volume);
+  order_.update(grid_, faces_, face_volume);
+
+  const std::size_t ordered = cells - order_.cyclic;
+  for (std::size_t k = 0; k < ordered; ++k) {
+    const auto c = static_cast<std::size_t>(order_.cells[k]);
+    discharge_[c] = solve_cell(c, face_volume, inflow_hematocrit);
+  }
+  if (order_.cyclic > 0) {
+    double change = std::numeric_limits<double>::infinity();
+    int sweep = 0;
+    for (; sweep < max_cycle_sweeps && change > cycle_tolerance; ++sweep) {
+      change = 0;
+      for (std::size_t k = ordered; k < cells; ++k) {
+        const auto c = static_cast<std::size_t>(order_.cells[k]);
+        const double next = solve_cell(c, face_volume, inflow_hematocrit);
+        change = std::max(change, std::abs(next - discharge_[c]));
+        discharge_[c] = next;
+      }
+    }
+    if (change > cycle_tolerance)
+      throw InputError("red-cell transport: the hematocrit on a circulation of the flow through network node " +
+                       std::to_string(grid_.node[static_cast<std::size_t>(order_.cells[ordered])]) +
+                       " did not settle in " + std::to_string(max_cycle_sweeps) + " sweeps");
+  }
+
+  // What moved: red cells per face at the new upwind values, and the boundaries' balance.
+  for (std::size_t f = 0; f < faces; ++f) {
+    const double q = face_volume[f];
+    const double cells_through = q == 0 ? 0.0 : q * face_hematocrit(f, face_volume, inflow_hematocrit);
+    cells_.face[f] = cells_through;
+    plasma_.face[f] = q - cells_through;
+    blood_.face[f] = q;
+    if (grid_.b[f] >= 0 || q == 0) continue;
+    const auto boundary = static_cast<std::size_t>(-1 - grid_.b[f]);
+    if (q > 0) {
+      left_ += cells_through;
+      last_outflow_[boundary] = cells_through / q;
+    } else {
+      entered_ -= cells_through;
+    }
+  }
+  for (std::size_t c = 0; c < cells; ++c) {
+    cells_.after[c] = next_volume_[c] * tube(c, discharge_[c]);
+    plasma_.before[c] = volume_[c] - cells_.before[c];
+    plasma_.after[c] = next_volume_[c] - cells_.after[c];
+    blood_.before[c] = volume_[c];
+    blood_.after[c] = next_volume_[c];
+  }
+  volume_.swap(next_volume_);
+}
+
+}  // namespace hemotree

@@ -1,0 +1,102 @@
+// Red cells carried by the pulsatile flow: the discharge hematocrit H_D of every cell of a
+// TransportGrid, advanced by implicit upwind finite volumes (docs/transport.md).
+//
+// A cell holds red cells V H_T, its tube hematocrit (the Fahraeus effect: H_T = H_D (k +
+// (1 - k) H_D), k of its lumen); blood leaving it carries them at H_D, the red cells' mean
+// velocity being faster than the blood's by H_D / H_T. Per step, for each cell in flow order,
+//   V+ H_T(H_D+) + Q_out H_D+ = V H_T(H_D) + sum_in Q_f s_f H_D,upwind(f)
+// with Q the blood volumes the faces passed, V+ = V + Q_in - Q_out, and s_f the share of the
+// red cells a diverging node sends into face f over that face's share of the blood (Pries &
+// Secomb 2005: FQE / FQB; 1 elsewhere). The left side increases in H_D+, so each cell is one
+// quadratic; the right side is a convex combination of values in [0, 1) (with V >= 0 and
+// s_f H <= 1), so 0 <= H_D+ < 1 whatever the step: no CFL limit, no new extrema but those the
+// phase separation makes, and every red cell that leaves a cell enters the next: the content
+// sum V H_T changes by what the boundaries let in and out, to round-off.
+//
+// Phase separation is applied at a node cell with no boundary where this step's flow enters
+// through one vessel and leaves through two (the law's own case, with the feed's hematocrit
+// of the step before); blood is mixed by flux everywhere else, and at a node of more than
+// three vessels too (NetFlow's dishem.cpp rule; solver/steady_hematocrit.hpp does the same).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "transport/transport_grid.hpp"
+
+namespace hemotree {
+
+struct RedCellOptions {
+  bool phase_separation = true;
+  double diameter_scale = 1;  // what the phase separation law multiplies diameters by
+};
+
+// What a step moved of one carrier (red cells, plasma or whole blood): the volume of it each
+// face passed (signed as the blood's), and each cell's content before and after the step.
+// Its balance closes per cell: after + out = before + in. Tracers ride on it.
+struct CarrierStep {
+  std::vector<double> face, before, after;
+};
+
+class RedCellTransport {
+ public:
+  // volume: per cell [m^3] (junctions 0); hematocrit: the discharge hematocrit everywhere at
+  // the start. Throws InputError for sizes that do not match the grid, a negative volume or
+  // a hematocrit outside [0, 1).
+  RedCellTransport(TransportGrid grid, std::vector<double> volume, double hematocrit, RedCellOptions options = {});
+
+  // Advances one step. face_volume: the blood each face passed [m^3]; inflow_hematocrit: per
+  // boundary, the discharge hematocrit of blood it lets in (NaN: what last left through it,
+  // the starting hematocrit until something has).
+  void step(std::span<const double> face_volume, std::span<const double> inflow_hematocrit);
+
+  // Replaces the cells' volumes (the flow solver's moved them: its compliance balance),
+  // keeping their hematocrits; the red cells that adds or removes are kept in adjusted().
+  void set_volumes(std::span<const double> volume);
+  void set_hematocrit(std::span<const double> discharge);
+
+  const TransportGrid& grid() const { return grid_; }
+  const CellFaces& faces() const { return faces_; }
+  const FlowOrder& order() const { return order_; }
+  std::span<const double> discharge_hematocrit() const { return discharge_; }
+  std::span<const double> volume() const { return volume_; }
+  double tube_hematocrit(std::size_t cell) const { return tube(cell, discharge_[cell]); }
+  // Red cells in the network now, sum V H_T [m^3]; through the boundaries since the start
+  // (in, out) [m^3]; added by set_volumes.
+  double red_cells() const;
+  double entered() const { return entered_; }
+  double left() const { return left_; }
+  double adjusted() const { return adjusted_; }
+  // The last step's red cells per face (signed as the blood's) [m^3], and the carriers.
+  const CarrierStep& cells_step() const { return cells_; }
+  const CarrierStep& plasma_step() const { return plasma_; }
+  const CarrierStep& blood_step() const { return blood_; }
+  // Cells where the phase separation law split the red cells in the last step.
+  std::size_t separating_nodes() const { return separating_; }
+
+ private:
+  double tube(std::size_t cell, double discharge) const {
+    const double k = grid_.fahraeus[cell];
+    return discharge * (k + (1 - k) * discharge);
+  }
+  // The phase separation shares s_f of this step's faces (1 where blood is mixed).
+  void split_at_nodes(std::span<const double> face_volume);
+  // The new H_D of a cell from its neighbours' values now; returns it.
+  double solve_cell(std::size_t cell, std::span<const double> face_volume, std::span<const double> inflow_hematocrit);
+  double face_hematocrit(std::size_t face, std::span<const double> face_volume,
+                         std::span<const double> inflow_hematocrit) const;
+
+  TransportGrid grid_;
+  CellFaces faces_;
+  FlowOrder order_;
+  RedCellOptions options_;
+  std::vector<double> volume_, next_volume_, discharge_, next_discharge_;
+  std::vector<double> share_;            // per face: s_f of this step
+  std::vector<double> last_outflow_;     // per boundary: the hematocrit that last left there
+  CarrierStep cells_, plasma_, blood_;
+  double entered_ = 0, left_ = 0, adjusted_ = 0;
+  std::size_t separating_ = 0;
+};
+
+}  // namespace hemotree

@@ -1,0 +1,70 @@
+// The finite volumes that red cells and tracers move through, and the order a step visits
+// them in.
+//
+// A cell is a slice of a 1D vessel, a node of 0D vessels (it holds half of each, as the 0D
+// model's node volumes do), or a junction of 1D vessels (no volume: what flows in flows out).
+// A face joins two cells, or a cell and a boundary of the network. A step hands the volume
+// of blood each face passed (signed: positive from its cell `a` to `b`); the cells' volumes
+// follow from them (V+ = V + in - out), so the scheme's own volumes close exactly and the
+// flow solver's volumes are met where its fluxes are conservative (docs/transport.md).
+//
+// The schemes are implicit upwind (backward Euler): a cell's new value depends on the new
+// values upstream, so cells are visited in flow order, found each step by Kahn's algorithm on
+// the faces' signs. Cells on a directed cycle of the flow (an instant of circulation in a
+// loop) are left for a Gauss-Seidel iteration.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace hemotree {
+
+struct TransportGrid {
+  // Per cell: the network node it is (node cells and junctions), or -1 for a vessel's slice;
+  // and the Fahraeus parameter k of its lumen (physics/phase_separation.hpp:
+  // H_T = H_D (k + (1 - k) H_D); 1 where the effect is off).
+  std::vector<std::int64_t> node;
+  std::vector<double> fahraeus;
+  // Per face: its two sides. b < 0 is boundary -1 - b (a place in the run's boundary list).
+  std::vector<std::int32_t> a, b;
+  // Per face: the vessel whose lumen it lies in (-1: none, a boundary's own face), and that
+  // lumen's diameter there [m] (the phase separation law reads it).
+  std::vector<std::int32_t> vessel;
+  std::vector<double> diameter;
+  std::size_t boundaries = 0;
+
+  std::size_t cell_count() const { return node.size(); }
+  std::size_t face_count() const { return a.size(); }
+  void add_cell(std::int64_t network_node, double fahraeus_k) {
+    node.push_back(network_node);
+    fahraeus.push_back(fahraeus_k);
+  }
+  void add_face(std::int32_t from_cell, std::int32_t to_cell, std::int32_t in_vessel, double lumen_diameter) {
+    a.push_back(from_cell);
+    b.push_back(to_cell);
+    vessel.push_back(in_vessel);
+    diameter.push_back(lumen_diameter);
+  }
+  static std::int32_t boundary_side(std::size_t boundary) { return -1 - static_cast<std::int32_t>(boundary); }
+};
+
+// Each cell's faces (compressed rows): the faces of cell c are face[start[c] .. start[c + 1]).
+struct CellFaces {
+  std::vector<std::int64_t> start;
+  std::vector<std::int32_t> face;
+  explicit CellFaces(const TransportGrid& grid);
+};
+
+// The cells in an order in which every cell comes after the cells its inflows come from (the
+// blood passed through each face this step: volume[f]), as far as the flow has one; the
+// cells on or below a directed cycle come last (`cyclic` of them).
+struct FlowOrder {
+  std::vector<std::int32_t> cells;
+  std::size_t cyclic = 0;
+  // Scratch kept between steps: inflowing faces not yet visited, per cell.
+  std::vector<std::int32_t> pending;
+  void update(const TransportGrid& grid, const CellFaces& faces, std::span<const double> volume);
+};
+
+}  // namespace hemotree
