@@ -14,7 +14,7 @@ namespace hemotree {
 
 namespace {
 constexpr std::string_view magic = "hemotree checkpoint\n";
-constexpr std::uint64_t format_version = 3;  // 2: the 0D vessels keep their previous pressures; 3: their volumes above c
+constexpr std::uint64_t format_version = 4;  // 2: the 0D vessels keep their previous pressures; 3: their volumes above c; 4: face volumes
 }  // namespace
 
 CheckpointWriter::CheckpointWriter() {

@@ -49,7 +49,7 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
   // At the centre: means, extrema, wall shear stress, Reynolds number.
   auto centre = [&](std::size_t v, double a, double q, double p, double mean_q) {
     const double u = q / a;
-    const double mu = solver.viscosity(a);
+    const double mu = solver.viscosity(v, a);
     const double radius = std::sqrt(a / std::numbers::pi);
     flow_[v] += weight * mean_q;
     pressure_[v] += weight * p;

@@ -26,6 +26,7 @@
 #include "solver/run_estimate.hpp"
 #include "solver/run_report.hpp"
 #include "solver/steady_run.hpp"
+#include "physics/phase_separation.hpp"
 
 using namespace hemotree;
 
@@ -193,15 +194,21 @@ int main(int argc, char** argv) {
       "shear stress in the same files as a run; any connected network with boundaries at nodes");
   std::string red_cells = "fixed";
   app.add_option("--red-cells", red_cells,
-                 "fixed (the blood's hematocrit in every vessel) or transport: with --steady, red cells split by "
-                 "the Pries-Secomb law at diverging bifurcations, each vessel's viscosity at its own hematocrit "
-                 "(what NetFlow computes); the pulsatile transport is to come")
+                 "fixed (the blood's hematocrit in every vessel) or transport: red cells split by the "
+                 "Pries-Secomb law at diverging bifurcations and mixed where blood meets; with --steady each "
+                 "vessel's viscosity at its own hematocrit (what NetFlow computes), in a pulsatile run carried "
+                 "by the flow with the Fahraeus effect (docs/transport.md)")
+      ->capture_default_str();
+  double transport_step = 2e-3;
+  app.add_option("--transport-step", transport_step,
+                 "the red-cell transport's step as a fraction of the period (implicit: any length is stable; "
+                 "shorter fronts spread less), at least the flow's step")
       ->capture_default_str();
   app.add_flag("--quiet", quiet, "no progress lines or notes (warnings and errors still)");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
   for (const char* pulsatile_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
-                                     "--probe", "--frames", "--dt", "--start"})
+                                     "--probe", "--frames", "--dt", "--start", "--transport-step"})
     steady_flag->excludes(app.get_option(pulsatile_only));
 
   return run_tool(app, argc, argv, [&] {
@@ -281,8 +288,8 @@ int main(int argc, char** argv) {
       throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
     if (red_cells != "fixed" && red_cells != "transport")
       throw InputError("--red-cells must be fixed or transport (got '" + red_cells + "')");
-    if (red_cells == "transport" && !steady)
-      throw InputError("--red-cells transport runs with --steady for now: the pulsatile transport is not built yet");
+    if (!(transport_step > 0 && transport_step <= 0.5))
+      throw InputError("--transport-step " + format_rounded(transport_step) + ": accepted range (0, 0.5] of the period");
     if (steady) {
       SteadyRunRequest request;
       request.input = input;
@@ -402,6 +409,8 @@ int main(int argc, char** argv) {
             << options.external_pressure << " Pa, thick wall ratio " << options.thick_wall_ratio
             << ", balance " << (balance ? "on" : "off") << ", sample interval " << sample_interval << " s, probes";
     for (const auto& t : probe_texts) shaping << ' ' << t;
+    shaping << ", red cells " << red_cells;
+    if (red_cells == "transport") shaping << " every " << transport_step << " of the period";
     RunPlan plan;
     plan.cycles = cycles;
     plan.until_periodic = until_periodic;
@@ -418,7 +427,16 @@ int main(int argc, char** argv) {
     plan.live_progress = !quiet && stderr_is_terminal();
     plan.log_progress = !quiet && !stderr_is_terminal();
     plan.longest_cycle = force ? 0 : one_day;
-    PulsatileRun pulsatile(net, run, std::move(probe_list), plan, folder.staging());
+    std::optional<FlowTransport> transport;
+    if (red_cells == "transport") {
+      transport.emplace(net, run);
+      plan.transport_every = std::max<std::size_t>(
+          1, static_cast<std::size_t>(std::llround(transport_step * static_cast<double>(steps_per_cycle))));
+      if (!quiet)
+        note("red cells carried on " + plural(transport->cell_count(), "cell") + ", a transport step every " +
+             plural(plan.transport_every, "flow step"));
+    }
+    PulsatileRun pulsatile(net, run, std::move(probe_list), plan, folder.staging(), transport ? &*transport : nullptr);
     if (!checkpoint_bytes.empty()) {
       pulsatile.resume(checkpoint_bytes, checkpoint_source);
       if (!quiet)
@@ -468,6 +486,7 @@ int main(int argc, char** argv) {
                                {"substeps", run.substeps()},
                                {"threads", options.threads},
                                {"rheology", to_string(run.blood().rheology)},
+                               {"red_cells", red_cells},
                                {"start", steady_start ? "steady" : "rest"},
                                {"start_requested", start},
                                {"balance_compliances", balance && steady_start},
@@ -520,8 +539,30 @@ int main(int argc, char** argv) {
     const std::filesystem::path dir = folder.staging();
     if (status == RunStatus::interrupted || checkpoint_every > 0) pulsatile.write_checkpoint();
     pulsatile.probes().write(dir / "probes.csv");
-    const VesselTable results =
+    VesselTable results =
         last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(driving));
+    const RedCellCycle& cells = pulsatile.last_red_cells();
+    if (transport && !last.vessels.empty() && !cells.discharge.empty()) {
+      std::vector<double> tube(net.vessel_count());
+      const double scale = run.blood().pries_diameter_scale();
+      for (std::size_t v = 0; v < tube.size(); ++v)
+        tube[v] = tube_hematocrit(cells.discharge[v], 0.5 * (net.diameter[v] + net.diameter_at_to(v)), scale);
+      results.add_number("discharge_hematocrit", cells.discharge);
+      results.add_number("tube_hematocrit", std::move(tube));
+      results.add_number("discharge_hematocrit_min", cells.lowest);
+      results.add_number("discharge_hematocrit_max", cells.highest);
+      nlohmann::json r = {{"cells", transport->cell_count()},
+                          {"steps", transport->advances()},
+                          {"step", plan.transport_every * dt},
+                          {"red_cells", cells.red_cells},
+                          {"entered", cells.entered},
+                          {"left", cells.left},
+                          {"balance_error", cells.balance_error},
+                          {"separating_nodes", cells.separating_nodes}};
+      r["cycle_change"] = std::isnan(pulsatile.red_cell_change()) ? nlohmann::json(nullptr)
+                                                                   : nlohmann::json(pulsatile.red_cell_change());
+      run_info["red_cell_transport"] = r;
+    }
     if (!last.vessels.empty()) run_info["statistics"] = group_statistics(net, results);
     write_summary(dir / "summary.json", run_info, results, last);
     write_vessel_table(dir / "vessels.csv", results);

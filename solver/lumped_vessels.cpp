@@ -289,7 +289,7 @@ void LumpedVessels::update_resistances() {
 double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const {
   if (tapered(e)) {  // its interior profile is the rigid taper's (pressure_at): no capacities
     capacity_a = capacity_b = 0;
-    return tapered_resistance(static_cast<std::int32_t>(e), pa, pb);
+    return (viscosity_factor_.empty() ? 1.0 : viscosity_factor_[e]) * tapered_resistance(static_cast<std::int32_t>(e), pa, pb);
   }
   const double c = edge_root_intercept_[e], d = edge_root_slope_[e];
   const double sa = c + d * pa, sb = c + d * pb, sm = c + d * 0.5 * (pa + pb);
@@ -301,9 +301,29 @@ double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& ca
   // capillary).
   const double product = friction_k_ * mu_a * mu_b * mu_m, sum = ga + gb + 4 * gm;
   const double inverse_d = 1 / (product * sum), inverse = sum * inverse_d;
-  capacity_a = ga * inverse;
-  capacity_b = gb * inverse;
-  return 6 * edge_length_[e] * product * product * inverse_d;
+  // The vessel's own hematocrit scales mu along all of it: R by f, the capacities by 1 / f.
+  const double f = viscosity_factor_.empty() ? 1.0 : viscosity_factor_[e];
+  capacity_a = ga * inverse / f;
+  capacity_b = gb * inverse / f;
+  return f * 6 * edge_length_[e] * product * product * inverse_d;
+}
+
+void LumpedVessels::set_viscosity_factors(std::span<const double> per_vessel) {
+  if (per_vessel.empty() && viscosity_factor_.empty()) return;
+  if (viscosity_factor_.empty()) viscosity_factor_.assign(vessels_.size(), 1.0);
+  const bool started = !resistance_.empty() && !previous_pressure_.empty();
+  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+    const double f = per_vessel.empty() ? 1.0 : per_vessel[static_cast<std::size_t>(vessels_[e])];
+    if (f == viscosity_factor_[e]) continue;
+    viscosity_factor_[e] = f;
+    if (!started) continue;
+    // What restore() computes from the pressures: a run resumed from a checkpoint has the
+    // same resistances, whenever the factors changed.
+    double capacity_a, capacity_b;
+    const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
+    previous_resistance_[e] = resistance(e, previous_pressure_[a], previous_pressure_[b], capacity_a, capacity_b);
+    resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
+  }
 }
 
 void LumpedVessels::update_dynamic_pressures() {
@@ -551,6 +571,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   });
   previous_flow_.swap(flow_);
   flow_.swap(next_flow_);
+  for (std::size_t e = 0; e < passed_.size(); ++e) passed_[e] += dt * flow_[e];
   previous_resistance_.swap(resistance_);
   update_resistances();
   update_dynamic_pressures();

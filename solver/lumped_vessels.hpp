@@ -29,6 +29,7 @@
 // 1D scheme let through that end (docs/solver.md §10).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -163,6 +164,25 @@ class LumpedVessels {
   // The volume the 0D vessels hold now (what BDF2 conserves: (3 V^n - V^(n-1)) / 2, which
   // is V at a steady state), capacitors not included [m^3].
   double stored_volume() const;
+  // The same at one node of a network node (below network_node_count()): a step changes it
+  // by exactly dt times the flows into the node at the step's end, plus the coupled ends'
+  // volumes: the volume a transport scheme's cell at this node holds (transport/).
+  double stored_volume(std::int32_t node) const {
+    const auto k = static_cast<std::size_t>(node);
+    return volume_c_[k] + 0.5 * (3 * volume_[k] - previous_volume_[k]);
+  }
+  std::size_t network_node_count() const { return network_nodes_; }
+  // A 0D vessel's nodes (its `from`, its `to`).
+  std::int32_t from_node(std::int32_t index) const { return a_[static_cast<std::size_t>(index)]; }
+  std::int32_t to_node(std::int32_t index) const { return b_[static_cast<std::size_t>(index)]; }
+  // From now on, each 0D vessel sums the volume it passes from `from` to `to` (dt times its
+  // flow at each step's end, the flow BDF2 balances the nodes with) [m^3].
+  void track_passed_volumes() { passed_.assign(vessels_.size(), 0.0); }
+  void clear_passed_volumes() { std::fill(passed_.begin(), passed_.end(), 0.0); }
+  // Each 0D vessel's viscosity is the run's times its factor (per network vessel; the
+  // vessel's own hematocrit against the blood's: red-cell transport). Empty: all 1.
+  void set_viscosity_factors(std::span<const double> per_vessel);
+  double passed_volume(std::int32_t index) const { return passed_[static_cast<std::size_t>(index)]; }
   // A capacitor's pressure, by the network's outlet index, or NaN if that outlet is not here.
   double capacitor_pressure(std::size_t outlet) const;
   // Compliance of a node at its pressure now [m^3/Pa].
@@ -273,6 +293,8 @@ class LumpedVessels {
   // The step being taken: predicted pressures, and the edges' conductances and history
   // terms of the last linearisation (Q = g (p_a - p_b) + f), the inflows and prediction.
   std::vector<double> predicted_, conductance_, history_, system_shunt_, rhs_, next_flow_;
+  std::vector<double> passed_;  // per 0D vessel, where tracked (track_passed_volumes)
+  std::vector<double> viscosity_factor_;  // per 0D vessel (empty: 1)
   std::vector<std::int32_t> coupling_nodes_;
   std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
   std::vector<std::int32_t> coupling_edge_;

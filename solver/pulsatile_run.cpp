@@ -57,9 +57,11 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
 }  // namespace
 
 PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<Probe> probes, RunPlan plan,
-                           std::filesystem::path folder)
+                           std::filesystem::path folder, FlowTransport* transport)
     : net_(net), solver_(solver), plan_(std::move(plan)), folder_(std::move(folder)),
-      stats_(net, analysis_frequency(driving_waveform(net))), probes_(std::move(probes)) {}
+      stats_(net, analysis_frequency(driving_waveform(net))), probes_(std::move(probes)), transport_(transport) {
+  plan_.transport_every = std::max<std::size_t>(plan_.transport_every, 1);
+}
 
 void PulsatileRun::snapshot() {
   CheckpointWriter out;
@@ -74,6 +76,15 @@ void PulsatileRun::snapshot() {
   out.put(static_cast<std::uint64_t>(change_.vessel));
   out.put(probes_.rows());
   solver_.save(out);
+  if (transport_) {
+    transport_->save(out);
+    out.put(red_cells_last_.discharge);
+    out.put(red_cells_last_.lowest);
+    out.put(red_cells_last_.highest);
+    out.put(std::vector<double>{red_cells_last_.red_cells, red_cells_last_.entered, red_cells_last_.left,
+                                red_cells_last_.balance_error, static_cast<double>(red_cells_last_.separating_nodes),
+                                red_cell_change_});
+  }
   out.section("end");
   snapshot_ = std::move(out);
 }
@@ -93,6 +104,20 @@ void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
   change_.vessel = static_cast<std::size_t>(in.get_u64());
   probes_.restore_rows(in.get_string());
   solver_.restore(in);
+  if (transport_) {
+    transport_->restore(in);
+    red_cells_last_.discharge = in.get_vector();
+    red_cells_last_.lowest = in.get_vector();
+    red_cells_last_.highest = in.get_vector();
+    const std::vector<double> totals = in.get_vector();
+    if (totals.size() != 6) in.fail("red-cell results of another version");
+    red_cells_last_.red_cells = totals[0];
+    red_cells_last_.entered = totals[1];
+    red_cells_last_.left = totals[2];
+    red_cells_last_.balance_error = totals[3];
+    red_cells_last_.separating_nodes = static_cast<std::size_t>(totals[4]);
+    red_cell_change_ = totals[5];
+  }
   in.section("end");
   if (!in.at_end()) in.fail("unexpected bytes after the checkpoint");
   resumed_ = true;
@@ -123,19 +148,27 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
   if (!resumed_) {
     probes_.sample(solver_);
     if (plan_.balance_compliances) solver_.balance_compliances(period);
+    if (transport_) transport_->take_volumes();
     snapshot();
   }
-  auto periodic = [&] { return plan_.until_periodic && has_change() && change_.change < plan_.periodic_tolerance; };
+  // With red cells carried, their distribution must have settled too: its largest change of
+  // a vessel's cycle-mean discharge hematocrit below the same tolerance.
+  auto periodic = [&] {
+    return plan_.until_periodic && has_change() && change_.change < plan_.periodic_tolerance &&
+           (!transport_ || red_cell_change_ < plan_.periodic_tolerance);
+  };
   try {
     while (done_ < planned && !periodic()) {
       std::optional<VtkTimeSeries> series;  // each cycle could be the last: its frames replace the previous
       if (plan_.frames > 0) series.emplace(net_, folder_ / "frames", "frames", plan_.vtk_keep);
       std::size_t frames_written = 0;
       stats_.begin(solver_);
+      if (transport_) transport_->begin_cycle();
       double sampled_until = solver_.time();
       const double started = seconds_since_epoch_start();
       for (std::size_t k = 0; k < plan_.steps_per_cycle; ++k) {
         solver_.step();
+        if (transport_ && ((k + 1) % plan_.transport_every == 0 || k + 1 == plan_.steps_per_cycle)) transport_->advance();
         if ((k + 1) % stats_every == 0 || k + 1 == plan_.steps_per_cycle) {
           stats_.sample(solver_, solver_.time(), solver_.time() - sampled_until);
           sampled_until = solver_.time();
@@ -173,6 +206,16 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
       std::vector<double> mean_pressure(last_.vessels.size());
       for (std::size_t v = 0; v < mean_pressure.size(); ++v) mean_pressure[v] = last_.vessels[v].mean_pressure;
       if (plan_.balance_compliances && solver_.balance_compliances(period, &mean_pressure) > 0) ++balances_;
+      if (transport_) {
+        RedCellCycle cycle = transport_->close_cycle();
+        if (!red_cells_last_.discharge.empty()) {
+          red_cell_change_ = 0;
+          for (std::size_t v = 0; v < cycle.discharge.size(); ++v)
+            red_cell_change_ = std::max(red_cell_change_, std::abs(cycle.discharge[v] - red_cells_last_.discharge[v]));
+        }
+        red_cells_last_ = std::move(cycle);
+        transport_->take_volumes();  // the balance's shifts, and the 0D nodes' round-off
+      }
       if (has_change()) change_ = cycle_change(previous_.vessels, last_.vessels);
       ++done_;
       snapshot();

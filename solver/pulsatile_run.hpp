@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "cli/interrupt.hpp"
 #include "solver/checkpoint.hpp"
 #include "solver/cycle_statistics.hpp"
+#include "solver/flow_transport.hpp"
 #include "solver/probes.hpp"
 #include "solver/pulse_solver.hpp"
 
@@ -37,6 +39,7 @@ struct RunPlan {
   // The run measures its own step over its first seconds and stops (too_long) when a cycle
   // would take longer than this [s]; 0: never (--force).
   double longest_cycle = 0;
+  std::size_t transport_every = 1;  // solver steps between red-cell transport steps
 };
 
 enum class RunStatus { complete, not_periodic, interrupted, broken_down, too_long };
@@ -44,8 +47,10 @@ const char* to_string(RunStatus status);
 
 class PulsatileRun {
  public:
+  // transport: red cells carried along (advanced every plan.transport_every steps and at
+  // every cycle end), or null.
   PulsatileRun(const Network& net, PulseSolver& solver, std::vector<Probe> probes, RunPlan plan,
-               std::filesystem::path folder);
+               std::filesystem::path folder, FlowTransport* transport = nullptr);
 
   // Continues from a checkpoint instead of starting (InputError for one of another run).
   void resume(const std::string& checkpoint_bytes, const std::string& source);
@@ -54,6 +59,10 @@ class PulsatileRun {
   int cycles_done() const { return done_; }
   int compliance_balances() const { return balances_; }
   const CycleSummary& last_cycle() const { return last_; }
+  // The red cells over the last cycle (empty without a transport or a cycle), and the
+  // largest change of a vessel's discharge hematocrit from the cycle before (NaN before two).
+  const RedCellCycle& last_red_cells() const { return red_cells_last_; }
+  double red_cell_change() const { return red_cell_change_; }
   bool has_change() const { return !previous_.vessels.empty(); }
   const PeriodicityChange& change() const { return change_; }
   int signal() const { return signal_; }                    // after an interrupt
@@ -81,6 +90,9 @@ class PulsatileRun {
   double measured_step_ = 0;
   std::string breakdown_;
   CheckpointWriter snapshot_;
+  FlowTransport* transport_ = nullptr;
+  RedCellCycle red_cells_last_;
+  double red_cell_change_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace hemotree

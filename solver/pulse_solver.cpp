@@ -27,6 +27,7 @@ void PulseState::set_zero_like(const PulseState& other) {
   exchanged.setZero();
   coupled.setZero(other.coupled.size());
   boundary.setZero(other.boundary.size());
+  faces.setZero(other.faces.size());
 }
 
 void PulseState::add_scaled(double factor, const PulseState& other) {
@@ -36,6 +37,7 @@ void PulseState::add_scaled(double factor, const PulseState& other) {
   exchanged += factor * other.exchanged;
   coupled += factor * other.coupled;
   boundary += factor * other.boundary;
+  faces += factor * other.faces;
 }
 
 namespace {
@@ -600,6 +602,7 @@ void PulseSolver::step_exponential(double h) {
   state_.exchanged += h * (1.5 * rate_.exchanged - 0.5 * previous_rate_.exchanged);
   state_.coupled += h * (1.5 * rate_.coupled - 0.5 * previous_rate_.coupled);
   state_.boundary += h * (1.5 * rate_.boundary - 0.5 * previous_rate_.boundary);
+  state_.faces += h * (1.5 * rate_.faces - 0.5 * previous_rate_.faces);
   std::swap(previous_rate_, rate_);
 }
 
@@ -737,6 +740,8 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
       const double a = area_q(el, q);
       source_q(el, q) = friction_k_ * viscosity_(a) / (rho * a);
     }
+  if (element_viscosity_factor_.size() > 0)
+    source_q = element_viscosity_factor_.segment(first, count).asDiagonal() * source_q;
   // Each element's friction rate, r averaged over the element: the exponential scheme
   // integrates -r Q exactly and leaves only the variation of r within the element explicit.
   friction_rate_.segment(first, count).noalias() = source_q.lazyProduct(basis.rule.weights) / 2;
@@ -765,7 +770,7 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // must stay zero, so the storage is cleared only when it is (re)allocated.
   if (rate.area.rows() != elements || rate.area.cols() != s.area.cols() ||
       rate.capacitor.size() != s.capacitor.size() || rate.coupled.size() != s.coupled.size() ||
-      rate.boundary.size() != s.boundary.size())
+      rate.boundary.size() != s.boundary.size() || rate.faces.size() != s.faces.size())
     rate.set_zero_like(s);
   friction_rate_.resize(elements);
   for (Eigen::VectorXd* v : {&area_left_, &area_right_, &flow_left_, &flow_right_, &flux_a_left_,
@@ -997,6 +1002,27 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Tapered elements: less the rest state's residual (compute_rest_correction).
   for (std::size_t row = 0; row < tapered_elements_.size(); ++row)
     rate.flow.row(tapered_elements_[row]) -= taper_rest_.row(static_cast<Eigen::Index>(row));
+  if (rate.faces.size() > 0) rate.faces = flux_a_left_;
+}
+
+void PulseSolver::set_viscosity_factors(std::vector<double> per_vessel) {
+  viscosity_factor_ = std::move(per_vessel);
+  lumped_.set_viscosity_factors(viscosity_factor_);
+  if (viscosity_factor_.empty()) {
+    element_viscosity_factor_.resize(0);
+    return;
+  }
+  element_viscosity_factor_.resize(static_cast<Eigen::Index>(element_vessel_.size()));
+  for (std::size_t el = 0; el < element_vessel_.size(); ++el)
+    element_viscosity_factor_(static_cast<Eigen::Index>(el)) = viscosity_factor_[static_cast<std::size_t>(element_vessel_[el])];
+}
+
+void PulseSolver::track_face_volumes() {
+  const Eigen::Index elements = state_.area.rows();
+  for (PulseState* s : {&state_, &rate_, &previous_rate_, &stage_[0], &stage_[1], &stage_[2], &stage_[3]})
+    if (s->area.rows() == elements) s->faces.setZero(elements);
+  lumped_.track_passed_volumes();
+  tracking_faces_ = true;
 }
 
 // ---- evaluation --------------------------------------------------------------------------
@@ -1038,7 +1064,7 @@ double PulseSolver::pressure_at(std::size_t vessel, double x) const {
 }
 
 double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
-  return viscosity_(area_at(vessel, x));
+  return viscosity(vessel, area_at(vessel, x));
 }
 
 void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
@@ -1255,6 +1281,7 @@ void PulseSolver::save(CheckpointWriter& out) const {
   out.put(dt_);
   out.put(static_cast<std::uint64_t>(steps_));
   out.put(have_previous_rate_);
+  out.put(tracking_faces_);
   for (const PulseState* s : {&state_, &previous_rate_}) {
     out.put(s->area);
     out.put(s->flow);
@@ -1263,6 +1290,7 @@ void PulseSolver::save(CheckpointWriter& out) const {
     out.put(s->exchanged(1));
     out.put(s->coupled);
     out.put(s->boundary);
+    out.put(s->faces);
   }
   out.put(previous_flow_);
   out.put(cycle_volume_);
@@ -1281,6 +1309,7 @@ void PulseSolver::save(CheckpointWriter& out) const {
     rest.push_back(o.rest_flow);
   }
   out.put(rest);
+  out.put(viscosity_factor_);
   lumped_.save(out);
 }
 
@@ -1293,6 +1322,10 @@ void PulseSolver::restore(CheckpointReader& in) {
             " s in this run: the checkpoint belongs to other options or another network");
   steps_ = static_cast<std::size_t>(in.get_u64());
   have_previous_rate_ = in.get_bool();
+  // A run with a transport tracks face volumes from its start; one without tracks none.
+  if (in.get_bool() != tracking_faces_)
+    in.fail(tracking_faces_ ? "written by a run without red-cell or tracer transport"
+                            : "written by a run that transported red cells or tracers (this one does not)");
   in.get_into(state_.area, "areas");
   in.get_into(state_.flow, "flows");
   in.get_into(state_.capacitor, "capacitors");
@@ -1300,6 +1333,7 @@ void PulseSolver::restore(CheckpointReader& in) {
   state_.exchanged(1) = in.get_double();
   in.get_into(state_.coupled, "coupled ends");
   in.get_into(state_.boundary, "boundary volumes");
+  state_.faces = in.get_eigen_vector();
   // The multistep history: empty until a multistep scheme has taken a step.
   previous_rate_.area = in.get_matrix();
   previous_rate_.flow = in.get_matrix();
@@ -1308,6 +1342,8 @@ void PulseSolver::restore(CheckpointReader& in) {
   previous_rate_.exchanged(1) = in.get_double();
   previous_rate_.coupled = in.get_eigen_vector();
   previous_rate_.boundary = in.get_eigen_vector();
+  previous_rate_.faces = in.get_eigen_vector();
+  if (tracking_faces_ && state_.faces.size() != state_.area.rows()) in.fail("face volumes of another discretisation");
   if (previous_rate_.area.size() != 0 &&
       (previous_rate_.area.rows() != state_.area.rows() || previous_rate_.area.cols() != state_.area.cols() ||
        previous_rate_.flow.rows() != state_.flow.rows() || previous_rate_.capacitor.size() != state_.capacitor.size()))
@@ -1325,6 +1361,9 @@ void PulseSolver::restore(CheckpointReader& in) {
     boundaries_.outlets[k].rest_area = rest[2 * k];
     boundaries_.outlets[k].rest_flow = rest[2 * k + 1];
   }
+  std::vector<double> factors = in.get_vector();
+  if (!factors.empty() && factors.size() != net_.vessel_count()) in.fail("viscosity factors of another network");
+  set_viscosity_factors(std::move(factors));  // before the 0D vessels' resistances are rebuilt
   lumped_.restore(in);
 }
 

@@ -70,6 +70,10 @@ struct PulseState {
   Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();
   Eigen::VectorXd coupled;     // per 1D end at a 0D node: the volume it let into the node [m^3]
   Eigen::VectorXd boundary;    // per boundary (run_boundaries' order): the volume in through it [m^3]
+  // Per element, where tracked (track_face_volumes; else empty): the volume through its left
+  // face along the vessel [m^3]. Its area's mode 0 changes by exactly the difference of two
+  // of these, which is what a transport scheme's cells need (transport/).
+  Eigen::VectorXd faces;
 
   void set_zero_like(const PulseState& other);
   void add_scaled(double factor, const PulseState& other);  // this += factor * other
@@ -104,6 +108,14 @@ class PulseSolver {
   double mean_flow(std::size_t vessel) const;
   double viscosity_at(std::size_t vessel, double x) const;  // [Pa s]
   double viscosity(double area) const { return viscosity_(area); }  // [Pa s] at a lumen area
+  // The same in a vessel: times its factor (set_viscosity_factors).
+  double viscosity(std::size_t vessel, double area) const {
+    return viscosity_factor_.empty() ? viscosity_(area) : viscosity_factor_[vessel] * viscosity_(area);
+  }
+  // Each vessel's viscosity is the run's times its factor from now on: its own hematocrit's
+  // Pries viscosity over the blood's (red-cell transport). Empty: all 1.
+  void set_viscosity_factors(std::vector<double> per_vessel);
+  const std::vector<double>& viscosity_factors() const { return viscosity_factor_; }
   // Area, flow and pressure of every vessel at the same fraction x along each, in one pass
   // (the cycle statistics sample all vessels every few steps); pressure may be null.
   // With zero_d false the 0D vessels' entries are left as they are: their state is read
@@ -116,6 +128,19 @@ class PulseSolver {
   const std::vector<NodeBoundary>& boundary_list() const { return boundaries_.list; }
   const std::vector<unsigned char>& boundary_entering() const { return boundaries_.entering; }
   double period() const { return period_; }
+  // From now on the state sums the volume through every element's left face (state().faces)
+  // and every 0D vessel the volume it passes (lumped().passed_volume): a transport's fluxes.
+  void track_face_volumes();
+  // Starts both sums again from zero (a transport takes them every few steps: small sums
+  // keep their digits over a long run).
+  void clear_face_volumes() {
+    state_.faces.setZero();
+    lumped_.clear_passed_volumes();
+  }
+  const NetworkBoundaries& network_boundaries() const { return boundaries_; }
+  std::int32_t first_element(std::size_t vessel) const { return first_element_[vessel]; }
+  int elements_per_vessel() const { return elements_per_vessel_; }
+  double element_half_length(std::size_t element) const { return half_length_(static_cast<Eigen::Index>(element)); }
   // The 1D vessels (indices), in the order of their elements.
   const std::vector<std::int32_t>& one_d_vessels() const { return one_d_vessels_; }
   int threads() const { return threads_; }
@@ -246,12 +271,15 @@ class PulseSolver {
   // Per element: the friction rate r = k mu(A_mean) / (rho A_mean) the last evaluate() used;
   // for the exponential scheme, the previous step's flow coefficients.
   Eigen::VectorXd friction_rate_;
+  std::vector<double> viscosity_factor_;  // per vessel (empty: 1)
+  Eigen::VectorXd element_viscosity_factor_;  // per element (empty: 1)
   std::vector<double> steady_resistance_;  // Poiseuille, per vessel; empty without a steady solution
   std::vector<double> cycle_volume_;       // per vessel, at the last cycle end
   std::vector<double> cycle_capacitor_;    // the capacitors there, per network outlet
   Eigen::VectorXd decay_, phi1_, phi2_, next_flow_;  // ETD2: e^(-r h), phi1, phi2 per element; scratch
   Eigen::MatrixXd previous_flow_;
   bool have_previous_rate_ = false;
+  bool tracking_faces_ = false;
   TimeScheme scheme_;
   int threads_ = 1;
   double time_ = 0, dt_ = 0;

@@ -56,6 +56,16 @@ void RedCellTransport::set_hematocrit(std::span<const double> discharge) {
   }
 }
 
+void RedCellTransport::restore(std::span<const double> discharge, std::span<const double> volume, double entered,
+                               double left, double adjusted, std::span<const double> last_outflow) {
+  discharge_.assign(discharge.begin(), discharge.end());
+  volume_.assign(volume.begin(), volume.end());
+  last_outflow_.assign(last_outflow.begin(), last_outflow.end());
+  entered_ = entered;
+  left_ = left;
+  adjusted_ = adjusted;
+}
+
 void RedCellTransport::set_volumes(std::span<const double> volume) {
   for (std::size_t c = 0; c < volume_.size(); ++c) {
     const double h = tube(c, discharge_[c]);
@@ -137,8 +147,10 @@ double RedCellTransport::solve_cell(std::size_t c, std::span<const double> face_
     else rhs += std::abs(q) * face_hematocrit(f, face_volume, inflow_hematocrit);
   }
   // W H_T(H) + out H = rhs with H_T = H (k + (1 - k) H): a H^2 + b H = rhs, the root that
-  // vanishes with rhs (written to keep its digits whatever the sign of a).
-  const double w = std::max(next_volume_[c], 0.0), k = grid_.fahraeus[c];
+  // vanishes with rhs (written to keep its digits whatever the sign of a). W is taken as it
+  // is, even the round-off below zero that a junction's volume can hold (its flows balance
+  // to the Newton tolerance): what the content is then counted with.
+  const double w = next_volume_[c], k = grid_.fahraeus[c];
   const double a = (1 - k) * w, b = k * w + out;
   if (!(b > 0)) return discharge_[c];  // nothing here and nothing through: it keeps its value
   const double disc = std::max(b * b + 4 * a * rhs, 0.0);

@@ -55,6 +55,11 @@ class RedCellTransport {
   // keeping their hematocrits; the red cells that adds or removes are kept in adjusted().
   void set_volumes(std::span<const double> volume);
   void set_hematocrit(std::span<const double> discharge);
+  // The whole state, as a checkpoint holds it (sizes checked by the caller).
+  void restore(std::span<const double> discharge, std::span<const double> volume, double entered, double left,
+               double adjusted, std::span<const double> last_outflow);
+  // Per boundary: the discharge hematocrit that last left through it.
+  const std::vector<double>& last_outflow() const { return last_outflow_; }
 
   const TransportGrid& grid() const { return grid_; }
   const CellFaces& faces() const { return faces_; }

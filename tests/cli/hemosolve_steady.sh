@@ -77,8 +77,6 @@ expect_error "--steady with --cycles" 2 "--cycles excludes --steady" -- \
 # ---- red cells: phase separation in steady flow (the rat mesentery, where it is shared) ----
 expect_error "--red-cells unknown" 2 "--red-cells must be fixed or transport (got 'sludge')" -- \
   "$HEMOSOLVE" "$WORK/diamond.json" --steady --red-cells sludge --out "$WORK/x"
-expect_error "--red-cells transport without --steady" 2 "--red-cells transport runs with --steady for now" -- \
-  "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --out "$WORK/x"
 DAT=$(dirname "$0")/../../../shared/networks/mesentery-rat/network.dat
 if [ -s "$DAT" ]; then
   "$BUILD/exchange/vimport" secomb "$DAT" --mean-cell-volume 55 --plasma-viscosity 1.0466cP -o "$WORK/mes.json" 2>/dev/null

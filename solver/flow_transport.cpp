@@ -1,0 +1,331 @@
+#include "solver/flow_transport.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
+
+#include "cli/errors.hpp"
+#include "physics/phase_separation.hpp"
+#include "physics/rheology.hpp"
+#include "solver/legendre_basis.hpp"
+
+namespace hemotree {
+
+namespace {
+
+// int of P_j over [lo, hi]: with Q_0 = x and Q_j = (P_(j+1) - P_(j-1)) / (2 j + 1), Q_j' = P_j.
+double legendre_integral(int j, double lo, double hi) {
+  auto antiderivative = [j](double x) {
+    return j == 0 ? x : (legendre(j + 1, x) - legendre(j - 1, x)) / (2 * j + 1);
+  };
+  return antiderivative(hi) - antiderivative(lo);
+}
+
+// The diameter a face stands for: a tapered vessel's mean.
+double mean_diameter(const Network& net, std::size_t v) { return 0.5 * (net.diameter[v] + net.diameter_at_to(v)); }
+
+}  // namespace
+
+FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options)
+    : net_(net), solver_(solver), options_(options) {
+  if (solver.steps() != 0)
+    throw InputError("red-cell transport: set up before the solver's first step (its face volumes start then)");
+  solver_.track_face_volumes();
+  const LumpedVessels& lumped = solver.lumped();
+  const NetworkBoundaries& ends = solver.network_boundaries();
+  const std::vector<NodeBoundary>& boundaries = solver.boundary_list();
+  const Blood blood = solver.blood();
+  const double scale = blood.pries_diameter_scale();
+  auto fahraeus = [&](double diameter) { return options_.fahraeus ? fahraeus_parameter(diameter, scale) : 1.0; };
+
+  TransportGrid grid;
+  grid.boundaries = boundaries.size();
+  std::vector<double> volume;
+
+  // Nodes of 0D vessels: k weighted by the half-vessels they hold.
+  const std::size_t lumped_nodes = lumped.empty() ? 0 : lumped.network_node_count();
+  std::vector<std::int64_t> network_node(lumped_nodes, -1);
+  for (std::size_t n = 0; n < net.node_count(); ++n)
+    if (!lumped.empty() && lumped.node_of(static_cast<std::int64_t>(n)) >= 0)
+      network_node[static_cast<std::size_t>(lumped.node_of(static_cast<std::int64_t>(n)))] = static_cast<std::int64_t>(n);
+  std::vector<double> k_sum(lumped_nodes, 0.0), weight(lumped_nodes, 0.0);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    if (!solver.is_lumped(v)) continue;
+    const std::int32_t i = lumped.vessel_index(v);
+    const double d = mean_diameter(net, v), half = 0.125 * M_PI * d * d * net.length[v];
+    for (const std::int32_t k : {lumped.from_node(i), lumped.to_node(i)}) {
+      k_sum[static_cast<std::size_t>(k)] += half * fahraeus(d);
+      weight[static_cast<std::size_t>(k)] += half;
+    }
+  }
+  for (std::size_t k = 0; k < lumped_nodes; ++k) {
+    grid.add_cell(network_node[k], weight[k] > 0 ? k_sum[k] / weight[k] : 1.0);
+    volume.push_back(lumped.stored_volume(static_cast<std::int32_t>(k)));
+  }
+
+  // Slices of the 1D elements.
+  const std::vector<std::int32_t>& one_d = solver.one_d_vessels();
+  slices_ = options_.slices > 0 ? options_.slices : solver.max_degree() + 1;
+  const int modes = solver.max_degree() + 1, per_vessel = solver.elements_per_vessel();
+  slice_integral_.resize(slices_, std::max(modes, 1));
+  for (int s = 0; s < slices_; ++s)
+    for (int j = 0; j < slice_integral_.cols(); ++j)
+      slice_integral_(s, j) = legendre_integral(j, -1 + 2.0 * s / slices_, -1 + 2.0 * (s + 1) / slices_);
+  for (const std::int32_t vi : one_d) {
+    const auto v = static_cast<std::size_t>(vi);
+    vessel_first_cell_.push_back(static_cast<std::int32_t>(grid.cell_count()));
+    const int count = per_vessel * slices_;
+    for (int s = 0; s < count; ++s) {
+      const double x = (s + 0.5) / count;
+      const double d = net.diameter[v] + x * (net.diameter_at_to(v) - net.diameter[v]);
+      grid.add_cell(-1, fahraeus(d));
+      volume.push_back(0.0);  // set below from the solver's areas
+    }
+  }
+
+  // Junctions of 1D vessels, and what meets each 1D end: (vessel, distal) -> cell or boundary.
+  std::map<std::pair<std::int32_t, bool>, std::int32_t> end_side;
+  for (std::size_t j = 0; j + 1 < ends.junction_offset.size(); ++j) {
+    const auto cell = static_cast<std::int32_t>(grid.cell_count());
+    const VesselEnd& first = ends.junction_ends[static_cast<std::size_t>(ends.junction_offset[j])];
+    const auto v = static_cast<std::size_t>(first.vessel);
+    grid.add_cell(first.distal ? net.to[v] : net.from[v], 1.0);
+    volume.push_back(0.0);
+    for (auto e = ends.junction_offset[j]; e < ends.junction_offset[j + 1]; ++e) {
+      const VesselEnd& end = ends.junction_ends[static_cast<std::size_t>(e)];
+      end_side[{end.vessel, end.distal}] = cell;
+    }
+  }
+  for (const auto& c : ends.coupled) end_side[{c.end.vessel, c.end.distal}] = lumped.node_of(c.node);
+  for (const auto* given : {&ends.flows, &ends.pressures})
+    for (const auto& g : *given) end_side[{g.end.vessel, g.end.distal}] = TransportGrid::boundary_side(static_cast<std::size_t>(g.index));
+  for (const auto& o : ends.outlets)
+    end_side[{o.end.vessel, o.end.distal}] = TransportGrid::boundary_side(static_cast<std::size_t>(o.boundary));
+  auto side_of = [&](std::int32_t v, bool distal) {
+    const auto found = end_side.find({v, distal});
+    if (found == end_side.end())
+      throw InputError("red-cell transport: vessel " + std::to_string(net.id[static_cast<std::size_t>(v)]) + ": its " +
+                       (distal ? "distal" : "proximal") + " end meets neither a vessel nor a boundary");
+    return found->second;
+  };
+
+  // Faces: the 0D vessels, the boundaries at 0D nodes, then each 1D vessel's.
+  lumped_face_.assign(lumped.vessel_count(), -1);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    if (!solver.is_lumped(v)) continue;
+    const std::int32_t i = lumped.vessel_index(v);
+    lumped_face_[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(grid.face_count());
+    grid.add_face(lumped.from_node(i), lumped.to_node(i), static_cast<std::int32_t>(v), mean_diameter(net, v));
+  }
+  for (std::size_t b = 0; b < boundaries.size(); ++b) {
+    const std::int32_t k = lumped.empty() ? -1 : lumped.node_of(boundaries[b].node);
+    if (k < 0) continue;
+    node_boundary_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
+    node_boundary_.push_back(static_cast<std::int32_t>(b));
+    grid.add_face(k, TransportGrid::boundary_side(b), -1, 0.0);
+  }
+  for (std::size_t i = 0; i < one_d.size(); ++i) {
+    const std::int32_t v = one_d[i];
+    const double d0 = net.diameter[static_cast<std::size_t>(v)], d1 = net.diameter_at_to(static_cast<std::size_t>(v));
+    const std::int32_t first = vessel_first_cell_[i], last = first + per_vessel * slices_ - 1;
+    vessel_first_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
+    const std::int32_t proximal = side_of(v, false), distal = side_of(v, true);
+    if (proximal >= 0) grid.add_face(proximal, first, v, d0);
+    else grid.add_face(first, proximal, v, d0);
+    proximal_sign_.push_back(proximal >= 0 ? 1 : -1);
+    for (std::int32_t c = first; c < last; ++c) grid.add_face(c, c + 1, v, d0 + (d1 - d0) * (c + 1 - first) / (last - first + 1.0));
+    grid.add_face(last, distal, v, d1);
+  }
+
+  inflow_hematocrit_.resize(boundaries.size());
+  for (std::size_t b = 0; b < boundaries.size(); ++b) {
+    const bool enters = boundaries[b].type == BoundaryType::flow || boundaries[b].type == BoundaryType::pressure;
+    inflow_hematocrit_[b] = !enters ? std::numeric_limits<double>::quiet_NaN()
+                                    : std::isnan(boundaries[b].hematocrit) ? blood.hematocrit : boundaries[b].hematocrit;
+  }
+
+  solver_volumes(volume);
+  red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
+                     RedCellOptions{options_.phase_separation, 1.0});
+  face_volume_.assign(red_cells_->grid().face_count(), 0.0);
+  const std::size_t vessels = net.vessel_count();
+  cycle_cells_.assign(vessels, 0.0);
+  cycle_blood_.assign(vessels, 0.0);
+  cycle_low_.assign(vessels, 0.0);
+  cycle_high_.assign(vessels, 0.0);
+  step_sum_.assign(vessels, 0.0);
+  step_count_.assign(vessels, 0);
+  if (options_.viscosity_feedback) {
+    applied_hematocrit_.assign(vessels, blood.hematocrit);
+    viscosity_factor_.assign(vessels, 1.0);
+  }
+  mark();
+  begin_cycle();
+}
+
+void FlowTransport::solver_volumes(std::vector<double>& volume) const {
+  const LumpedVessels& lumped = solver_.lumped();
+  if (!lumped.empty())
+    for (std::size_t k = 0; k < lumped.network_node_count(); ++k) volume[k] = lumped.stored_volume(static_cast<std::int32_t>(k));
+  const Eigen::MatrixXd& area = solver_.state().area;
+  const std::vector<std::int32_t>& one_d = solver_.one_d_vessels();
+  for (std::size_t i = 0; i < one_d.size(); ++i) {
+    auto cell = static_cast<std::size_t>(vessel_first_cell_[i]);
+    const auto first = solver_.first_element(static_cast<std::size_t>(one_d[i]));
+    for (auto el = first; el < first + solver_.elements_per_vessel(); ++el) {
+      const double half = solver_.element_half_length(static_cast<std::size_t>(el));
+      for (int s = 0; s < slices_; ++s)
+        volume[cell++] = half * slice_integral_.row(s).dot(area.row(el).head(slice_integral_.cols()));
+    }
+  }
+}
+
+void FlowTransport::mark() {
+  solver_.clear_face_volumes();
+  boundary_mark_ = solver_.state().boundary;
+}
+
+void FlowTransport::take_volumes() {
+  now_.assign(red_cells_->volume().begin(), red_cells_->volume().end());
+  solver_volumes(now_);
+  red_cells_->set_volumes(now_);
+}
+
+void FlowTransport::advance() {
+  const PulseState& s = solver_.state();
+  const LumpedVessels& lumped = solver_.lumped();
+  for (std::size_t i = 0; i < lumped_face_.size(); ++i)
+    face_volume_[static_cast<std::size_t>(lumped_face_[i])] =
+        lumped.passed_volume(static_cast<std::int32_t>(i));
+  for (std::size_t j = 0; j < node_boundary_face_.size(); ++j) {
+    const auto b = static_cast<Eigen::Index>(node_boundary_[j]);
+    face_volume_[static_cast<std::size_t>(node_boundary_face_[j])] = -(s.boundary(b) - boundary_mark_(b));
+  }
+  // 1D vessels: the proximal face's volume, then each slice's change passed on.
+  now_.assign(red_cells_->volume().begin(), red_cells_->volume().end());
+  solver_volumes(now_);
+  const std::span<const double> held = red_cells_->volume();
+  const std::vector<std::int32_t>& one_d = solver_.one_d_vessels();
+  const int cells_per_vessel = solver_.elements_per_vessel() * slices_;
+  for (std::size_t i = 0; i < one_d.size(); ++i) {
+    const auto el = solver_.first_element(static_cast<std::size_t>(one_d[i]));
+    double passed = s.faces(el);
+    auto face = static_cast<std::size_t>(vessel_first_face_[i]);
+    face_volume_[face++] = proximal_sign_[i] * passed;
+    for (int c = 0; c < cells_per_vessel; ++c) {
+      const auto cell = static_cast<std::size_t>(vessel_first_cell_[i] + c);
+      passed -= now_[cell] - held[cell];
+      face_volume_[face++] = passed;
+    }
+  }
+  red_cells_->step(face_volume_, inflow_hematocrit_);
+  ++advances_;
+  mark();
+
+  // The cycle's sums per vessel: red cells and blood through its faces, and the step's
+  // discharge hematocrit (the faces' mean) for its extremes.
+  const TransportGrid& grid = red_cells_->grid();
+  const CarrierStep& cells = red_cells_->cells_step();
+  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+    const std::int32_t v = grid.vessel[f];
+    const double q = face_volume_[f];
+    if (v < 0 || q == 0) continue;
+    const auto vi = static_cast<std::size_t>(v);
+    cycle_cells_[vi] += std::abs(cells.face[f]);
+    cycle_blood_[vi] += std::abs(q);
+    step_sum_[vi] += cells.face[f] / q;
+    ++step_count_[vi];
+  }
+  for (std::size_t v = 0; v < step_count_.size(); ++v) {
+    if (step_count_[v] == 0) continue;
+    const double h = step_sum_[v] / step_count_[v];
+    cycle_low_[v] = std::min(cycle_low_[v], h);
+    cycle_high_[v] = std::max(cycle_high_[v], h);
+    step_sum_[v] = 0;
+    step_count_[v] = 0;
+    if (options_.viscosity_feedback) follow_viscosities(v, h);
+  }
+  if (factors_changed_) {
+    solver_.set_viscosity_factors(viscosity_factor_);
+    factors_changed_ = false;
+  }
+}
+
+void FlowTransport::begin_cycle() {
+  std::fill(cycle_cells_.begin(), cycle_cells_.end(), 0.0);
+  std::fill(cycle_blood_.begin(), cycle_blood_.end(), 0.0);
+  std::fill(cycle_low_.begin(), cycle_low_.end(), std::numeric_limits<double>::infinity());
+  std::fill(cycle_high_.begin(), cycle_high_.end(), -std::numeric_limits<double>::infinity());
+  cycle_content_ = red_cells_->red_cells();
+  cycle_entered_ = red_cells_->entered();
+  cycle_left_ = red_cells_->left();
+  cycle_adjusted_ = red_cells_->adjusted();
+}
+
+RedCellCycle FlowTransport::close_cycle() const {
+  RedCellCycle c;
+  const std::size_t vessels = cycle_cells_.size();
+  c.discharge.resize(vessels);
+  c.lowest.resize(vessels);
+  c.highest.resize(vessels);
+  for (std::size_t v = 0; v < vessels; ++v) {
+    // A vessel no blood went through in the whole cycle holds plasma (the steady rule).
+    c.discharge[v] = cycle_blood_[v] > 0 ? cycle_cells_[v] / cycle_blood_[v] : 0.0;
+    c.lowest[v] = std::isfinite(cycle_low_[v]) ? cycle_low_[v] : 0.0;
+    c.highest[v] = std::isfinite(cycle_high_[v]) ? cycle_high_[v] : 0.0;
+  }
+  c.red_cells = red_cells_->red_cells();
+  c.entered = red_cells_->entered() - cycle_entered_;
+  c.left = red_cells_->left() - cycle_left_;
+  const double adjusted = red_cells_->adjusted() - cycle_adjusted_;
+  c.balance_error = (c.red_cells - cycle_content_ - (c.entered - c.left) - adjusted) /
+                    std::max(cycle_content_ + c.entered, std::numeric_limits<double>::min());
+  c.separating_nodes = red_cells_->separating_nodes();
+  return c;
+}
+
+void FlowTransport::follow_viscosities(std::size_t v, double hematocrit) {
+  if (std::abs(hematocrit - applied_hematocrit_[v]) <= options_.viscosity_tolerance) return;
+  const Blood blood = solver_.blood();
+  Blood own = blood;
+  own.hematocrit = hematocrit;
+  const double d = mean_diameter(net_, v);
+  // The Pries viscosity at this hematocrit over the run's, at the vessel's reference lumen.
+  viscosity_factor_[v] = apparent_viscosity(own, d) / apparent_viscosity(blood, d);
+  applied_hematocrit_[v] = hematocrit;
+  factors_changed_ = true;
+}
+
+void FlowTransport::save(CheckpointWriter& out) const {
+  out.section("red cells");
+  const RedCellTransport& t = *red_cells_;
+  out.put(std::vector<double>(t.discharge_hematocrit().begin(), t.discharge_hematocrit().end()));
+  out.put(std::vector<double>(t.volume().begin(), t.volume().end()));
+  out.put(std::vector<double>{t.entered(), t.left(), t.adjusted()});
+  out.put(t.last_outflow());
+  out.put(applied_hematocrit_);
+  out.put(viscosity_factor_);
+  out.put(static_cast<std::uint64_t>(advances_));
+}
+
+void FlowTransport::restore(CheckpointReader& in) {
+  in.section("red cells");
+  const std::vector<double> discharge = in.get_vector(), volume = in.get_vector(), totals = in.get_vector(),
+                            last_outflow = in.get_vector();
+  if (discharge.size() != cell_count() || volume.size() != cell_count() || totals.size() != 3 ||
+      last_outflow.size() != red_cells_->grid().boundaries)
+    in.fail("red cells of another network or another transport grid");
+  red_cells_->restore(discharge, volume, totals[0], totals[1], totals[2], last_outflow);
+  applied_hematocrit_ = in.get_vector();
+  viscosity_factor_ = in.get_vector();
+  if (applied_hematocrit_.size() != (options_.viscosity_feedback ? net_.vessel_count() : 0) ||
+      viscosity_factor_.size() != applied_hematocrit_.size())
+    in.fail("red-cell viscosities of another network");
+  advances_ = static_cast<std::size_t>(in.get_u64());
+  mark();
+  begin_cycle();
+}
+
+}  // namespace hemotree

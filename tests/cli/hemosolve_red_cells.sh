@@ -1,0 +1,65 @@
+# hemosolve --red-cells transport in a pulsatile run: red cells carried by the flow through a
+# looped network of microvessels, split at its diverging nodes; what summary.json and
+# vessels.csv report of them, and the refusals of the option's values.
+source "$(dirname "$0")/lib.sh"
+HEMOSOLVE=$BUILD/solver/hemosolve
+PY=/usr/bin/python3
+
+# A diamond of microvessels (0D): an inflow of 60 nl/min at hematocrit 0.45 into node 10, a
+# pressure at node 15; vessels 1 and 2 leave node 11 (a diverging bifurcation), the bridge
+# 5 closes a loop.
+cat >"$WORK/diamond.json" <<'JSON'
+{"format": "vnet", "version": 2,
+ "blood": {"hematocrit": 0.45},
+ "boundaries": [{"node": 10, "type": "flow", "flow": 1e-12, "hematocrit": 0.45},
+                {"node": 15, "type": "pressure", "pressure": 2666}],
+ "vessels": [
+  {"id": 0, "from": 10, "to": 11, "length": 2e-4, "diameter": 20e-6, "wall_thickness": 4e-06, "youngs_modulus": 4e5},
+  {"id": 1, "from": 11, "to": 12, "length": 8e-4, "diameter": 12e-6, "wall_thickness": 2.4e-06, "youngs_modulus": 4e5},
+  {"id": 2, "from": 11, "to": 13, "length": 2e-4, "diameter": 15e-6, "wall_thickness": 3e-06, "youngs_modulus": 4e5},
+  {"id": 3, "from": 12, "to": 14, "length": 2e-4, "diameter": 9e-6, "wall_thickness": 1.8e-06, "youngs_modulus": 4e5},
+  {"id": 4, "from": 14, "to": 13, "length": 4e-4, "diameter": 8e-6, "wall_thickness": 1.6e-06, "youngs_modulus": 4e5},
+  {"id": 5, "from": 12, "to": 13, "length": 2e-4, "diameter": 6e-6, "wall_thickness": 1.2e-06, "youngs_modulus": 4e5},
+  {"id": 6, "from": 13, "to": 15, "length": 2e-4, "diameter": 20e-6, "wall_thickness": 4e-06, "youngs_modulus": 4e5}]}
+JSON
+"$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 4 --out "$WORK/run" 2>"$WORK/err" \
+  && pass "--red-cells transport, pulsatile" || fail "--red-cells transport: $(cat "$WORK/err")"
+grep -q "red cells carried on" "$WORK/err" && pass "the transport is announced" || fail "no note of the transport"
+"$PY" - "$WORK/run/summary.json" "$WORK/run/vessels.csv" <<'PY' && pass "summary.json and vessels.csv: hematocrits, red-cell balance" || fail "red-cell results"
+import csv, json, sys
+s = json.load(open(sys.argv[1]))
+assert s["status"] == "complete" and s["red_cells"] == "transport", s["status"]
+r = s["red_cell_transport"]
+assert abs(r["balance_error"]) < 1e-12, r
+assert r["separating_nodes"] >= 1, r
+rows = {v["id"]: v for v in s["vessels"]}
+for v in rows.values():
+    assert 0 <= v["discharge_hematocrit_min"] <= v["discharge_hematocrit"] <= v["discharge_hematocrit_max"] < 1, v
+    assert 0 <= v["tube_hematocrit"] <= v["discharge_hematocrit"], v  # Fahraeus: H_T < H_D above 3 um
+# Red cells balance at the bifurcation node 11 (vessel 0 in, 1 and 2 out), over the cycle.
+flux = lambda i: rows[i]["mean_flow"] * rows[i]["discharge_hematocrit"]
+assert abs(flux(0) - flux(1) - flux(2)) < 1e-3 * flux(0), (flux(0), flux(1), flux(2))
+# Plasma skimming: the narrower, slower daughter gets the lower hematocrit.
+assert rows[1]["discharge_hematocrit"] < rows[2]["discharge_hematocrit"]
+header = next(csv.reader(open(sys.argv[2])))
+assert "discharge_hematocrit" in header and "tube_hematocrit" in header, header
+PY
+# Stopped after 2 cycles and resumed to 4: the same bits as 4 cycles at once (the red cells,
+# the outlets' memories and the viscosities are in the checkpoint).
+"$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 2 --checkpoint-every 1 --out "$WORK/part" --quiet &&
+  cp -r "$WORK/part" "$WORK/stopped" &&
+  "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 4 --resume "$WORK/part" --quiet &&
+  "$PY" - "$WORK/run/summary.json" "$WORK/part/summary.json" <<'PY' && pass "a resumed transport continues bit for bit" || fail "resumed transport differs"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert a["red_cell_transport"] == b["red_cell_transport"], (a["red_cell_transport"], b["red_cell_transport"])
+for x, y in zip(a["vessels"], b["vessels"]):
+    assert x == y, (x, y)
+PY
+expect_error "a checkpoint without transport" 2 "written by a run with other options" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --cycles 4 --resume "$WORK/stopped" --quiet
+expect_error "--transport-step out of range" 2 "--transport-step 0: accepted range (0, 0.5] of the period" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --transport-step 0 --out "$WORK/x"
+expect_error "--transport-step with --steady" 2 "--steady excludes --transport-step" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --steady --transport-step 0.01 --out "$WORK/x"
+finish
