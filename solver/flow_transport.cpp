@@ -28,6 +28,11 @@ double mean_diameter(const Network& net, std::size_t v) { return 0.5 * (net.diam
 
 }  // namespace
 
+FlowTransportOptions red_cells_fixed(FlowTransportOptions options) {
+  options.red_cells = options.phase_separation = options.fahraeus = options.viscosity_feedback = false;
+  return options;
+}
+
 FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options)
     : net_(net), solver_(solver), options_(options) {
   if (solver.steps() != 0)
@@ -73,8 +78,10 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   for (int s = 0; s < slices_; ++s)
     for (int j = 0; j < slice_integral_.cols(); ++j)
       slice_integral_(s, j) = legendre_integral(j, -1 + 2.0 * s / slices_, -1 + 2.0 * (s + 1) / slices_);
+  one_d_place_.assign(net.vessel_count(), -1);
   for (const std::int32_t vi : one_d) {
     const auto v = static_cast<std::size_t>(vi);
+    one_d_place_[v] = static_cast<std::int32_t>(vessel_first_cell_.size());
     vessel_first_cell_.push_back(static_cast<std::int32_t>(grid.cell_count()));
     const int count = per_vessel * slices_;
     for (int s = 0; s < count; ++s) {
@@ -161,8 +168,88 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     applied_hematocrit_.assign(vessels, blood.hematocrit);
     viscosity_factor_.assign(vessels, 1.0);
   }
+  // Tracers: clean blood at every boundary that lets blood in, what left at the others.
+  for (const TracerSpec& spec : options_.tracers) {
+    tracers_.emplace_back(cell_count(), boundaries.size(), spec.carrier);
+    curves_.emplace_back(vessels, spec.concentration, spec.centre(), spec.shape == TracerSpec::Shape::step);
+    std::vector<std::int32_t> given;
+    std::int32_t face = -1;
+    if (spec.place == TracerSpec::Place::vessel) {
+      const auto v = static_cast<std::size_t>(spec.at);
+      face = one_d_place_[v] >= 0 ? vessel_first_face_[static_cast<std::size_t>(one_d_place_[v])]
+                                  : lumped_face_[static_cast<std::size_t>(lumped.vessel_index(v))];
+    } else {
+      for (std::size_t b = 0; b < boundaries.size(); ++b) {
+        const bool enters = boundaries[b].type == BoundaryType::flow || boundaries[b].type == BoundaryType::pressure;
+        if (enters && (spec.place == TracerSpec::Place::inlet || boundaries[b].node == spec.at))
+          given.push_back(static_cast<std::int32_t>(b));
+      }
+      if (given.empty())
+        throw InputError("--tracer " + spec.name + ": " +
+                         (spec.place == TracerSpec::Place::inlet
+                              ? std::string("the network has no flow or pressure boundary to give it through")
+                              : "node " + std::to_string(net.node_id[static_cast<std::size_t>(spec.at)]) +
+                                    " has no flow or pressure boundary (at=vessel:ID gives it inside the network)"));
+    }
+    tracer_boundaries_.push_back(std::move(given));
+    tracer_face_.push_back(face);
+  }
+  last_time_ = solver.time();
   mark();
   begin_cycle();
+}
+
+void FlowTransport::step_tracers(double t0, double t1) {
+  const std::vector<NodeBoundary>& boundaries = solver_.boundary_list();
+  const TransportGrid& grid = red_cells_->grid();
+  for (std::size_t k = 0; k < tracers_.size(); ++k) {
+    const TracerSpec& spec = options_.tracers[k];
+    const double given = spec.mean_over(t0, t1);
+    tracer_inflow_.assign(boundaries.size(), 0.0);
+    for (std::size_t b = 0; b < boundaries.size(); ++b)
+      if (boundaries[b].type != BoundaryType::flow && boundaries[b].type != BoundaryType::pressure)
+        tracer_inflow_[b] = std::numeric_limits<double>::quiet_NaN();  // an outlet returns what it took
+    for (const std::int32_t b : tracer_boundaries_[k]) tracer_inflow_[static_cast<std::size_t>(b)] = given;
+    tracer_injected_.clear();
+    if (tracer_face_[k] >= 0) {
+      tracer_injected_.assign(grid.face_count(), 0.0);
+      tracer_injected_[static_cast<std::size_t>(tracer_face_[k])] = given;
+    }
+    tracers_[k].step(*red_cells_, tracer_inflow_, tracer_injected_);
+    // Each vessel's curve: the mean over its faces that passed blood of what crossed them.
+    const std::span<const double> c = tracers_[k].face_concentration();
+    std::fill(step_sum_.begin(), step_sum_.end(), 0.0);
+    std::fill(step_count_.begin(), step_count_.end(), 0);
+    for (std::size_t f = 0; f < grid.face_count(); ++f) {
+      const std::int32_t v = grid.vessel[f];
+      if (v < 0 || face_volume_[f] == 0) continue;
+      step_sum_[static_cast<std::size_t>(v)] += c[f];
+      ++step_count_[static_cast<std::size_t>(v)];
+    }
+    for (std::size_t v = 0; v < step_sum_.size(); ++v)
+      if (step_count_[v] > 0) curves_[k].add(v, t0, t1, step_sum_[v] / step_count_[v]);
+  }
+  std::fill(step_sum_.begin(), step_sum_.end(), 0.0);
+  std::fill(step_count_.begin(), step_count_.end(), 0);
+}
+
+std::size_t FlowTransport::cell_at(std::size_t v, double x) const {
+  if (one_d_place_[v] >= 0) {
+    const int count = solver_.elements_per_vessel() * slices_;
+    const int k = std::clamp(static_cast<int>(x * count), 0, count - 1);
+    return static_cast<std::size_t>(vessel_first_cell_[static_cast<std::size_t>(one_d_place_[v])] + k);
+  }
+  const LumpedVessels& lumped = solver_.lumped();
+  const std::int32_t i = lumped.vessel_index(v);
+  const double q = face_volume_[static_cast<std::size_t>(lumped_face_[static_cast<std::size_t>(i)])];
+  const bool from = q != 0 ? q > 0 : x < 0.5;
+  return static_cast<std::size_t>(from ? lumped.from_node(i) : lumped.to_node(i));
+}
+
+double FlowTransport::hematocrit_at(std::size_t v, double x) const { return red_cells_->discharge_hematocrit()[cell_at(v, x)]; }
+
+double FlowTransport::tracer_at(std::size_t k, std::size_t v, double x) const {
+  return tracers_[k].concentration()[cell_at(v, x)];
 }
 
 void FlowTransport::solver_volumes(std::vector<double>& volume) const {
@@ -223,6 +310,8 @@ void FlowTransport::advance() {
   red_cells_->step(face_volume_, inflow_hematocrit_);
   ++advances_;
   mark();
+  step_tracers(last_time_, solver_.time());
+  last_time_ = solver_.time();
 
   // The cycle's sums per vessel: red cells and blood through its faces, and the step's
   // discharge hematocrit (the faces' mean) for its extremes.
@@ -308,6 +397,14 @@ void FlowTransport::save(CheckpointWriter& out) const {
   out.put(applied_hematocrit_);
   out.put(viscosity_factor_);
   out.put(static_cast<std::uint64_t>(advances_));
+  out.put(last_time_);
+  for (std::size_t k = 0; k < tracers_.size(); ++k) {
+    const TracerTransport& t = tracers_[k];
+    out.put(std::vector<double>(t.concentration().begin(), t.concentration().end()));
+    out.put(t.last_outflow());
+    out.put(t.totals());
+    out.put(curves_[k].state());
+  }
 }
 
 void FlowTransport::restore(CheckpointReader& in) {
@@ -324,6 +421,15 @@ void FlowTransport::restore(CheckpointReader& in) {
       viscosity_factor_.size() != applied_hematocrit_.size())
     in.fail("red-cell viscosities of another network");
   advances_ = static_cast<std::size_t>(in.get_u64());
+  last_time_ = in.get_double();
+  for (std::size_t k = 0; k < tracers_.size(); ++k) {
+    const std::vector<double> c = in.get_vector(), last = in.get_vector(), totals = in.get_vector(),
+                              curve = in.get_vector();
+    if (c.size() != cell_count() || last.size() != red_cells_->grid().boundaries || totals.size() != 5 ||
+        !curves_[k].restore(curve))
+      in.fail("tracer " + options_.tracers[k].name + " of another network or transport grid");
+    tracers_[k].restore(c, last, totals);
+  }
   mark();
   begin_cycle();
 }

@@ -23,11 +23,15 @@
 #include "formats/network.hpp"
 #include "solver/checkpoint.hpp"
 #include "solver/pulse_solver.hpp"
+#include "solver/tracer_spec.hpp"
+#include "transport/indicator_curves.hpp"
 #include "transport/red_cell_transport.hpp"
+#include "transport/tracer_transport.hpp"
 
 namespace hemotree {
 
 struct FlowTransportOptions {
+  bool red_cells = true;         // reported (false: fixed, carriers of tracers only)
   int slices = 0;                // per 1D element; 0: its degree + 1
   bool phase_separation = true;  // at diverging nodes (else mixed by flux everywhere)
   bool fahraeus = true;          // tube hematocrit below discharge hematocrit in small vessels
@@ -35,7 +39,14 @@ struct FlowTransportOptions {
   // is computed again when its hematocrit has moved by more than viscosity_tolerance).
   bool viscosity_feedback = true;
   double viscosity_tolerance = 1e-4;
+  // Indicators carried along (--tracer). With the red cells fixed (all three flags above
+  // false) the cells still move, uniformly, as the tracers' carriers.
+  std::vector<TracerSpec> tracers;
 };
+
+// What the red cells do with the flags: transported (phase separation, Fahraeus, viscosity)
+// or fixed (a uniform carrier for tracers).
+FlowTransportOptions red_cells_fixed(FlowTransportOptions options);
 
 // Per vessel over one cycle: the red cells it passed over the blood it passed (the cycle's
 // discharge hematocrit), and the lowest and highest discharge hematocrit of a step.
@@ -61,6 +72,15 @@ class FlowTransport {
 
 
   const RedCellTransport& red_cells() const { return *red_cells_; }
+  const std::vector<TracerSpec>& tracer_specs() const { return options_.tracers; }
+  bool reports_red_cells() const { return options_.red_cells; }
+  const TracerTransport& tracer(std::size_t k) const { return tracers_[k]; }
+  // Per vessel, tracer k's curve landmarks over the run so far.
+  IndicatorCurves::Landmarks tracer_landmarks(std::size_t k) const { return curves_[k].landmarks(solver_.time()); }
+  // At fraction x along a vessel (probes): the discharge hematocrit, and tracer k's
+  // concentration, of the cell there (a 0D vessel: the node its blood came from last).
+  double hematocrit_at(std::size_t vessel, double x) const;
+  double tracer_at(std::size_t k, std::size_t vessel, double x) const;
   std::size_t cell_count() const { return red_cells_->grid().cell_count(); }
   std::size_t advances() const { return advances_; }
 
@@ -71,6 +91,8 @@ class FlowTransport {
   // Each 0D node's and 1D slice's volume in the solver now, into its cell's place.
   void solver_volumes(std::vector<double>& volume) const;
   void mark();  // the next advance counts from the solver's state now
+  std::size_t cell_at(std::size_t vessel, double x) const;
+  void step_tracers(double t0, double t1);
 
   const Network& net_;
   PulseSolver& solver_;
@@ -83,6 +105,7 @@ class FlowTransport {
   Eigen::MatrixXd slice_integral_;  // slices x modes: int of P_j over each slice of [-1, 1]
   // 0D vessels: their faces (in LumpedVessels' order); boundaries at 0D nodes: face and boundary.
   std::vector<std::int32_t> lumped_face_;
+  std::vector<std::int32_t> one_d_place_;  // per vessel: its place in one_d_vessels, or -1
   std::vector<std::int32_t> node_boundary_face_, node_boundary_;
   std::vector<double> inflow_hematocrit_;  // per boundary (NaN: what last left there)
   // The boundaries' volumes at the last advance (the solver's own sums, never cleared).
@@ -99,6 +122,13 @@ class FlowTransport {
   bool factors_changed_ = false;
   std::vector<std::int32_t> step_count_;
   double cycle_content_ = 0, cycle_entered_ = 0, cycle_left_ = 0, cycle_adjusted_ = 0;
+  // Tracers: their transport, curves, and where each is given (boundaries, or a face).
+  std::vector<TracerTransport> tracers_;
+  std::vector<IndicatorCurves> curves_;
+  std::vector<std::vector<std::int32_t>> tracer_boundaries_;
+  std::vector<std::int32_t> tracer_face_;
+  std::vector<double> tracer_inflow_, tracer_injected_;  // scratch
+  double last_time_ = 0;  // the solver's time at the last advance
 };
 
 }  // namespace hemotree

@@ -26,6 +26,7 @@
 #include "solver/run_estimate.hpp"
 #include "solver/run_report.hpp"
 #include "solver/steady_run.hpp"
+#include "solver/tracer_spec.hpp"
 #include "physics/phase_separation.hpp"
 
 using namespace hemotree;
@@ -199,6 +200,12 @@ int main(int argc, char** argv) {
                  "vessel's viscosity at its own hematocrit (what NetFlow computes), in a pulsatile run carried "
                  "by the flow with the Fahraeus effect (docs/transport.md)")
       ->capture_default_str();
+  std::vector<std::string> tracer_texts;
+  app.add_option("--tracer", tracer_texts,
+                 "an indicator carried by the flow (repeatable): name=N,carrier=plasma|cells|blood,"
+                 "at=inlet|node:ID|vessel:ID,shape=bolus|step,start=T,duration=T,concentration=C; its "
+                 "concentration at the probes in probes.csv, its arrival, peak and mean transit time per vessel "
+                 "(docs/transport.md)");
   double transport_step = 2e-3;
   app.add_option("--transport-step", transport_step,
                  "the red-cell transport's step as a fraction of the period (implicit: any length is stable; "
@@ -208,7 +215,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
   for (const char* pulsatile_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
-                                     "--probe", "--frames", "--dt", "--start", "--transport-step"})
+                                     "--probe", "--frames", "--dt", "--start", "--transport-step", "--tracer"})
     steady_flag->excludes(app.get_option(pulsatile_only));
 
   return run_tool(app, argc, argv, [&] {
@@ -288,6 +295,11 @@ int main(int argc, char** argv) {
       throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
     if (red_cells != "fixed" && red_cells != "transport")
       throw InputError("--red-cells must be fixed or transport (got '" + red_cells + "')");
+    std::vector<TracerSpec> tracers;
+    for (const auto& text : tracer_texts) tracers.push_back(parse_tracer(text, net, static_cast<int>(tracers.size()) + 1));
+    for (std::size_t i = 0; i < tracers.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (tracers[i].name == tracers[j].name) throw InputError("--tracer: two tracers named " + tracers[i].name);
     if (!(transport_step > 0 && transport_step <= 0.5))
       throw InputError("--transport-step " + format_rounded(transport_step) + ": accepted range (0, 0.5] of the period");
     if (steady) {
@@ -410,7 +422,8 @@ int main(int argc, char** argv) {
             << ", balance " << (balance ? "on" : "off") << ", sample interval " << sample_interval << " s, probes";
     for (const auto& t : probe_texts) shaping << ' ' << t;
     shaping << ", red cells " << red_cells;
-    if (red_cells == "transport") shaping << " every " << transport_step << " of the period";
+    for (const auto& t : tracer_texts) shaping << ", tracer " << t;
+    if (red_cells == "transport" || !tracer_texts.empty()) shaping << ", transport every " << transport_step << " of the period";
     RunPlan plan;
     plan.cycles = cycles;
     plan.until_periodic = until_periodic;
@@ -428,12 +441,17 @@ int main(int argc, char** argv) {
     plan.log_progress = !quiet && !stderr_is_terminal();
     plan.longest_cycle = force ? 0 : one_day;
     std::optional<FlowTransport> transport;
-    if (red_cells == "transport") {
-      transport.emplace(net, run);
+    if (red_cells == "transport" || !tracers.empty()) {
+      FlowTransportOptions carried;
+      carried.tracers = tracers;
+      transport.emplace(net, run, red_cells == "transport" ? carried : red_cells_fixed(carried));
       plan.transport_every = std::max<std::size_t>(
           1, static_cast<std::size_t>(std::llround(transport_step * static_cast<double>(steps_per_cycle))));
       if (!quiet)
-        note("red cells carried on " + plural(transport->cell_count(), "cell") + ", a transport step every " +
+        note(std::string(red_cells == "transport" ? "red cells" : "") +
+             (red_cells == "transport" && !tracers.empty() ? " and " : "") +
+             (tracers.empty() ? "" : plural(tracers.size(), "tracer")) + " carried on " +
+             plural(transport->cell_count(), "cell") + ", a transport step every " +
              plural(plan.transport_every, "flow step"));
     }
     PulsatileRun pulsatile(net, run, std::move(probe_list), plan, folder.staging(), transport ? &*transport : nullptr);
@@ -542,7 +560,34 @@ int main(int argc, char** argv) {
     VesselTable results =
         last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(driving));
     const RedCellCycle& cells = pulsatile.last_red_cells();
-    if (transport && !last.vessels.empty() && !cells.discharge.empty()) {
+    if (transport && !last.vessels.empty()) {
+      nlohmann::json list = nlohmann::json::array();
+      for (std::size_t k = 0; k < transport->tracer_specs().size(); ++k) {
+        const TracerSpec& t = transport->tracer_specs()[k];
+        const TracerTransport& moved = transport->tracer(k);
+        IndicatorCurves::Landmarks l = transport->tracer_landmarks(k);
+        results.add_number(t.name + "_arrival_time", std::move(l.arrival));
+        results.add_number(t.name + "_peak_time", std::move(l.peak_time));
+        results.add_number(t.name + "_peak", std::move(l.peak));
+        results.add_number(t.name + "_mean_transit_time", std::move(l.mean_transit));
+        const double amount = moved.amount(transport->red_cells());
+        const double scale = std::max({moved.injected() + moved.entered(), amount, 1e-300});
+        list.push_back({{"name", t.name},
+                        {"carrier", to_string(t.carrier)},
+                        {"shape", t.shape == TracerSpec::Shape::bolus ? "bolus" : "step"},
+                        {"start", t.start},
+                        {"duration", t.shape == TracerSpec::Shape::bolus ? nlohmann::json(t.duration) : nlohmann::json(nullptr)},
+                        {"concentration", t.concentration},
+                        {"entered", moved.entered()},
+                        {"injected", moved.injected()},
+                        {"left", moved.left()},
+                        {"in_network", amount},
+                        {"balance_error",
+                         (amount - (moved.entered() + moved.injected() - moved.left() + moved.adjusted())) / scale}});
+      }
+      if (!list.empty()) run_info["tracers"] = list;
+    }
+    if (transport && transport->reports_red_cells() && !last.vessels.empty() && !cells.discharge.empty()) {
       std::vector<double> tube(net.vessel_count());
       const double scale = run.blood().pries_diameter_scale();
       for (std::size_t v = 0; v < tube.size(); ++v)

@@ -41,6 +41,7 @@ void ProbeRecorder::sample(const PulseSolver& solver) {
     // The law where the probe is: a tapered vessel's reference lumen changes along it.
     rows_ << ',' << number(solver.law_at(p.vessel, p.x).pressure(a)) << ',' << number(q) << ',' << number(a) << ','
           << number(q / a);
+    for (std::size_t j = 0; j < headers_.size(); ++j) rows_ << ',' << number(column_(j, p));
   }
   rows_ << '\n';
 }
@@ -52,6 +53,10 @@ void ProbeRecorder::write(const std::filesystem::path& file) const {
   for (const Probe& p : probes_) {
     const std::string at = " vessel " + std::to_string(p.id) + " x " + number(p.x);
     out << ",p" << at << " [Pa],Q" << at << " [m^3/s],A" << at << " [m^2],u" << at << " [m/s]";
+    for (const std::string& h : headers_) {
+      const auto unit = h.find(" [");  // "name [unit]": the place goes between
+      out << ',' << h.substr(0, unit) << at << (unit == std::string::npos ? "" : h.substr(unit));
+    }
   }
   out << '\n' << rows_.str();
   out.commit();

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -26,6 +27,12 @@ class ProbeRecorder {
  public:
   explicit ProbeRecorder(std::vector<Probe> probes) : probes_(std::move(probes)) {}
   void sample(const PulseSolver& solver);  // one row at the solver's time
+  // Further columns at every probe (the transported red cells and tracers): their headers'
+  // names and units, and the value of column j at a probe now.
+  void add_columns(std::vector<std::string> headers, std::function<double(std::size_t, const Probe&)> value) {
+    headers_ = std::move(headers);
+    column_ = std::move(value);
+  }
   // probes.csv: a header with units, then one row per sample; nothing without probes.
   void write(const std::filesystem::path& file) const;
   // The rows recorded so far, as text (a checkpoint keeps them).
@@ -35,6 +42,8 @@ class ProbeRecorder {
  private:
   std::vector<Probe> probes_;
   std::ostringstream rows_;
+  std::vector<std::string> headers_;
+  std::function<double(std::size_t, const Probe&)> column_;
 };
 
 }  // namespace hemotree

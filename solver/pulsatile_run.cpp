@@ -61,6 +61,18 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
     : net_(net), solver_(solver), plan_(std::move(plan)), folder_(std::move(folder)),
       stats_(net, analysis_frequency(driving_waveform(net))), probes_(std::move(probes)), transport_(transport) {
   plan_.transport_every = std::max<std::size_t>(plan_.transport_every, 1);
+  if (!transport_) return;
+  // probes.csv: the discharge hematocrit and each tracer's concentration at every probe.
+  std::vector<std::string> headers;
+  if (transport_->reports_red_cells()) headers.push_back("H_D [1]");
+  for (const TracerSpec& t : transport_->tracer_specs())
+    headers.push_back("c_" + t.name + " [per " + (t.carrier == TracerCarrier::cells ? "red-cell" : to_string(t.carrier)) +
+                      " volume]");
+  const bool red = transport_->reports_red_cells();
+  probes_.add_columns(std::move(headers), [this, red](std::size_t j, const Probe& p) {
+    if (red && j == 0) return transport_->hematocrit_at(p.vessel, p.x);
+    return transport_->tracer_at(j - (red ? 1 : 0), p.vessel, p.x);
+  });
 }
 
 void PulsatileRun::snapshot() {

@@ -1005,8 +1005,8 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   if (rate.faces.size() > 0) rate.faces = flux_a_left_;
 }
 
-void PulseSolver::set_viscosity_factors(std::vector<double> per_vessel) {
-  viscosity_factor_ = std::move(per_vessel);
+void PulseSolver::set_viscosity_factors(std::span<const double> per_vessel) {
+  viscosity_factor_.assign(per_vessel.begin(), per_vessel.end());
   lumped_.set_viscosity_factors(viscosity_factor_);
   if (viscosity_factor_.empty()) {
     element_viscosity_factor_.resize(0);
@@ -1363,7 +1363,7 @@ void PulseSolver::restore(CheckpointReader& in) {
   }
   std::vector<double> factors = in.get_vector();
   if (!factors.empty() && factors.size() != net_.vessel_count()) in.fail("viscosity factors of another network");
-  set_viscosity_factors(std::move(factors));  // before the 0D vessels' resistances are rebuilt
+  set_viscosity_factors(factors);  // before the 0D vessels' resistances are rebuilt
   lumped_.restore(in);
 }
 

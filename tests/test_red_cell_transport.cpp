@@ -12,32 +12,14 @@
 
 #include "cli/errors.hpp"
 #include "physics/phase_separation.hpp"
+#include "tests/transport_grids.hpp"
 #include "transport/red_cell_transport.hpp"
 
 namespace hemotree {
 namespace {
 
+using namespace test_grids;
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-
-// A vessel of n slices between boundary 0 (at its start) and boundary 1 (at its end); face i
-// is the left face of slice i, face n the right end. k: the Fahraeus parameter of its lumen.
-TransportGrid vessel(int n, double k = 1) {
-  TransportGrid g;
-  g.boundaries = 2;
-  for (int i = 0; i < n; ++i) g.add_cell(-1, k);
-  g.add_face(0, TransportGrid::boundary_side(0), 0, 10e-6);  // positive: out to boundary 0
-  for (int i = 0; i + 1 < n; ++i) g.add_face(i, i + 1, 0, 10e-6);
-  g.add_face(n - 1, TransportGrid::boundary_side(1), 0, 10e-6);
-  return g;
-}
-
-// The face volumes of a step of length dt with flow q along the vessel (face 0 is signed
-// against it: positive leaves the vessel at its start).
-std::vector<double> along(int n, double q_dt) {
-  std::vector<double> v(static_cast<std::size_t>(n) + 1, q_dt);
-  v[0] = -q_dt;
-  return v;
-}
 
 // The red cells unaccounted for, relative to all that passed: round-off, summed over the
 // steps (a thousand steps of sums of a few terms each leave some 1e-14).

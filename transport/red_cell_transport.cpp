@@ -37,6 +37,16 @@ RedCellTransport::RedCellTransport(TransportGrid grid, std::vector<double> volum
   next_volume_.assign(cells, 0.0);
   share_.assign(grid_.face_count(), 1.0);
   last_outflow_.assign(grid_.boundaries, hematocrit);
+  // Where the law can apply: a node's cell with three faces, each in a vessel between cells.
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (grid_.node[c] < 0 || faces_.start[c + 1] - faces_.start[c] != 3) continue;
+    bool inner = true;
+    for (auto i = faces_.start[c]; i < faces_.start[c + 1]; ++i) {
+      const auto f = static_cast<std::size_t>(faces_.face[static_cast<std::size_t>(i)]);
+      inner = inner && grid_.b[f] >= 0 && grid_.vessel[f] >= 0;
+    }
+    if (inner) candidates_.push_back(static_cast<std::int32_t>(c));
+  }
   for (CarrierStep* c : {&cells_, &plasma_, &blood_}) {
     c->face.assign(grid_.face_count(), 0.0);
     c->before.assign(cells, 0.0);
@@ -84,18 +94,17 @@ void RedCellTransport::split_at_nodes(std::span<const double> face_volume) {
   std::fill(share_.begin(), share_.end(), 1.0);
   separating_ = 0;
   if (!options_.phase_separation) return;
-  for (std::size_t c = 0; c < grid_.cell_count(); ++c) {
-    if (grid_.node[c] < 0 || faces_.start[c + 1] - faces_.start[c] != 3) continue;
+  for (const std::int32_t cell : candidates_) {
+    const auto c = static_cast<std::size_t>(cell);
     std::int32_t feed = -1, first = -1, second = -1;
     bool eligible = true;
     for (auto i = faces_.start[c]; i < faces_.start[c + 1] && eligible; ++i) {
       const std::int32_t f = faces_.face[static_cast<std::size_t>(i)];
       const auto fi = static_cast<std::size_t>(f);
-      if (grid_.b[fi] < 0 || grid_.vessel[fi] < 0 || face_volume[fi] == 0) {
+      if (face_volume[fi] == 0) {
         eligible = false;
         break;
       }
-      // Out of this cell when the volume runs from its side a to b.
       const bool out = (static_cast<std::size_t>(grid_.a[fi]) == c) == (face_volume[fi] > 0);
       if (!out) {
         if (feed >= 0) eligible = false;

@@ -58,6 +58,45 @@ for x, y in zip(a["vessels"], b["vessels"]):
 PY
 expect_error "a checkpoint without transport" 2 "written by a run with other options" -- \
   "$HEMOSOLVE" "$WORK/diamond.json" --cycles 4 --resume "$WORK/stopped" --quiet
+# Tracers: a plasma bolus at the inlet and a red-cell step into vessel 1, with the red cells
+# fixed (a uniform carrier); their curves at two probes and their landmarks per vessel.
+"$HEMOSOLVE" "$WORK/diamond.json" --cycles 3 --probe 0 --probe 6 \
+  --tracer name=dye,shape=bolus,start=0.1,duration=50ms --tracer name=label,carrier=cells,at=vessel:1,shape=step,start=0.2 \
+  --out "$WORK/tracer" --quiet && pass "--tracer, twice" || fail "--tracer"
+"$PY" - "$WORK/tracer/summary.json" "$WORK/tracer/probes.csv" <<'PY' && pass "tracer curves, landmarks and balances" || fail "tracer results"
+import csv, json, math, sys
+s = json.load(open(sys.argv[1]))
+assert s["red_cells"] == "fixed" and "red_cell_transport" not in s
+dye, label = s["tracers"]
+assert dye["name"] == "dye" and dye["carrier"] == "plasma" and label["carrier"] == "cells", s["tracers"]
+for t in (dye, label):
+    assert abs(t["balance_error"]) < 1e-12, t
+# The whole bolus (1 x 50 ms of plasma) entered; by 3 s most of it has left again.
+plasma_flow = 1e-12 * (1 - 0.45)
+assert abs(dye["entered"] - 0.05 * plasma_flow) < 1e-9 * dye["entered"], dye
+assert dye["left"] > 0.95 * dye["entered"], dye
+assert label["entered"] == 0 and label["injected"] > 0
+rows = {v["id"]: v for v in s["vessels"]}
+# Downstream later: the feed, then the drain.
+assert rows[0]["dye_arrival_time"] < rows[6]["dye_arrival_time"] < rows[6]["dye_peak_time"], rows[6]
+assert rows[0]["dye_mean_transit_time"] < rows[6]["dye_mean_transit_time"]
+# Upstream of the label's injection nothing arrives.
+assert rows[0]["label_arrival_time"] is None and rows[0]["label_peak"] == 0
+with open(sys.argv[2]) as f:
+    table = list(csv.reader(f))
+header = table[0]
+dye_col = header.index("c_dye vessel 6 x 0.5 [per plasma volume]")
+assert "c_label vessel 0 x 0.5 [per red-cell volume]" in header, header
+assert not any(h.startswith("H_D") for h in header)  # red cells fixed: not reported
+curve = [float(r[dye_col]) for r in table[1:]]
+assert max(curve) > 0.05 and curve[0] == 0 and curve[-1] < 0.01 * max(curve), (max(curve), curve[-1])
+PY
+expect_error "--tracer unknown key" 2 "--tracer 'colour=red': unknown key 'colour'" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --tracer colour=red --out "$WORK/x"
+expect_error "--tracer at a node without a boundary" 2 "node 12 has no flow or pressure boundary" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --tracer at=node:12 --out "$WORK/x" --quiet
+expect_error "--tracer bad duration" 2 "duration=-1: accepted range (0, inf) s" -- \
+  "$HEMOSOLVE" "$WORK/diamond.json" --tracer duration=-1 --out "$WORK/x"
 expect_error "--transport-step out of range" 2 "--transport-step 0: accepted range (0, 0.5] of the period" -- \
   "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --transport-step 0 --out "$WORK/x"
 expect_error "--transport-step with --steady" 2 "--steady excludes --transport-step" -- \

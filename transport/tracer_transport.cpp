@@ -1,0 +1,132 @@
+#include "transport/tracer_transport.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "cli/errors.hpp"
+
+namespace hemotree {
+
+namespace {
+constexpr int max_cycle_sweeps = 10000;
+constexpr double cycle_tolerance = 1e-15;
+}  // namespace
+
+TracerTransport::TracerTransport(std::size_t cells, std::size_t boundaries, TracerCarrier carrier)
+    : carrier_(carrier), concentration_(cells, 0.0), last_outflow_(boundaries, 0.0) {}
+
+const CarrierStep& TracerTransport::carrier_step(const RedCellTransport& red_cells) const {
+  switch (carrier_) {
+    case TracerCarrier::plasma:
+      return red_cells.plasma_step();
+    case TracerCarrier::cells:
+      return red_cells.cells_step();
+    case TracerCarrier::blood:
+      break;
+  }
+  return red_cells.blood_step();
+}
+
+double TracerTransport::amount(const RedCellTransport& red_cells) const {
+  const CarrierStep& m = carrier_step(red_cells);
+  double sum = 0;
+  for (std::size_t c = 0; c < concentration_.size(); ++c) sum += m.after[c] * concentration_[c];
+  return sum;
+}
+
+// The concentration of the carrier entering through face f into its downstream cell.
+double TracerTransport::inflowing(std::size_t f, const RedCellTransport& red_cells, std::span<const double> inflow,
+                                  std::span<const double> injected) const {
+  const TransportGrid& grid = red_cells.grid();
+  const double q = red_cells.blood_step().face[f];
+  double c;
+  if (q > 0) {
+    c = concentration_[static_cast<std::size_t>(grid.a[f])];
+  } else if (grid.b[f] >= 0) {
+    c = concentration_[static_cast<std::size_t>(grid.b[f])];
+  } else {
+    const auto boundary = static_cast<std::size_t>(-1 - grid.b[f]);
+    c = std::isnan(inflow[boundary]) ? last_outflow_[boundary] : inflow[boundary];
+  }
+  return injected.empty() ? c : c + injected[f];
+}
+
+double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_cells, const CarrierStep& m,
+                                   std::span<const double> inflow, std::span<const double> injected) const {
+  const TransportGrid& grid = red_cells.grid();
+  const CellFaces& faces = red_cells.faces();
+  const std::span<const double> blood = red_cells.blood_step().face;
+  double rhs = m.before[c] * concentration_[c], carrier = m.after[c];
+  for (auto i = faces.start[c]; i < faces.start[c + 1]; ++i) {
+    const auto f = static_cast<std::size_t>(faces.face[static_cast<std::size_t>(i)]);
+    if (blood[f] == 0) continue;
+    const double through = std::abs(m.face[f]);
+    if ((static_cast<std::size_t>(grid.a[f]) == c) == (blood[f] > 0)) carrier += through;
+    else rhs += through * inflowing(f, red_cells, inflow, injected);
+  }
+  return carrier > 0 ? rhs / carrier : concentration_[c];  // no carrier here or through: unchanged
+}
+
+void TracerTransport::step(const RedCellTransport& red_cells, std::span<const double> inflow,
+                           std::span<const double> injected) {
+  const TransportGrid& grid = red_cells.grid();
+  const FlowOrder& order = red_cells.order();
+  const CarrierStep& m = carrier_step(red_cells);
+  if (inflow.size() != grid.boundaries || (!injected.empty() && injected.size() != grid.face_count()))
+    throw InputError("tracer transport: a step needs " + std::to_string(grid.boundaries) +
+                     " boundary concentrations and none or one injection per face");
+  const std::size_t cells = concentration_.size(), ordered = cells - order.cyclic;
+  double before = 0;
+  for (std::size_t c = 0; c < cells; ++c) before += m.before[c] * concentration_[c];
+  adjusted_ += before - last_amount_;
+  // What the injections add, at the concentrations upstream before they move.
+  for (std::size_t f = 0; f < injected.size(); ++f) injected_ += std::abs(m.face[f]) * injected[f];
+  for (std::size_t k = 0; k < ordered; ++k) {
+    const auto c = static_cast<std::size_t>(order.cells[k]);
+    concentration_[c] = solve_cell(c, red_cells, m, inflow, injected);
+  }
+  if (order.cyclic > 0) {
+    double change = std::numeric_limits<double>::infinity();
+    for (int sweep = 0; sweep < max_cycle_sweeps && change > cycle_tolerance; ++sweep) {
+      change = 0;
+      for (std::size_t k = ordered; k < cells; ++k) {
+        const auto c = static_cast<std::size_t>(order.cells[k]);
+        const double next = solve_cell(c, red_cells, m, inflow, injected);
+        change = std::max(change, std::abs(next - concentration_[c]) / std::max(std::abs(next), 1.0));
+        concentration_[c] = next;
+      }
+    }
+  }
+  face_concentration_.assign(grid.face_count(), 0.0);
+  const std::span<const double> blood = red_cells.blood_step().face;
+  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+    if (blood[f] == 0) continue;
+    const double c = inflowing(f, red_cells, inflow, injected);
+    face_concentration_[f] = c;
+    if (grid.b[f] >= 0) continue;
+    const auto boundary = static_cast<std::size_t>(-1 - grid.b[f]);
+    if (blood[f] > 0) {
+      left_ += std::abs(m.face[f]) * c;
+      last_outflow_[boundary] = c;
+    } else {
+      entered_ += std::abs(m.face[f]) * (injected.empty() ? c : c - injected[f]);  // an injection there is counted apart
+    }
+  }
+  last_amount_ = 0;
+  for (std::size_t c = 0; c < cells; ++c) last_amount_ += m.after[c] * concentration_[c];
+}
+
+void TracerTransport::restore(std::span<const double> concentration, std::span<const double> last_outflow,
+                              std::span<const double> totals) {
+  concentration_.assign(concentration.begin(), concentration.end());
+  last_outflow_.assign(last_outflow.begin(), last_outflow.end());
+  entered_ = totals[0];
+  left_ = totals[1];
+  injected_ = totals[2];
+  adjusted_ = totals[3];
+  last_amount_ = totals[4];
+}
+
+}  // namespace hemotree
