@@ -89,6 +89,12 @@ struct NodeBoundary {
   double hematocrit = std::numeric_limits<double>::quiet_NaN();
 
   bool is_outlet() const { return type != BoundaryType::flow && type != BoundaryType::pressure; }
+  // The discharge hematocrit blood enters with here (the blood's where none is given); NaN
+  // at an outlet, whose backflow returns what it took.
+  double entering_hematocrit(const Blood& blood) const {
+    if (is_outlet()) return std::numeric_limits<double>::quiet_NaN();
+    return hematocrit == hematocrit ? hematocrit : blood.hematocrit;
+  }
 };
 
 std::string_view to_string(OutletType type);

@@ -147,11 +147,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   }
 
   inflow_hematocrit_.resize(boundaries.size());
-  for (std::size_t b = 0; b < boundaries.size(); ++b) {
-    const bool enters = boundaries[b].type == BoundaryType::flow || boundaries[b].type == BoundaryType::pressure;
-    inflow_hematocrit_[b] = !enters ? std::numeric_limits<double>::quiet_NaN()
-                                    : std::isnan(boundaries[b].hematocrit) ? blood.hematocrit : boundaries[b].hematocrit;
-  }
+  for (std::size_t b = 0; b < boundaries.size(); ++b) inflow_hematocrit_[b] = boundaries[b].entering_hematocrit(blood);
 
   solver_volumes(volume);
   red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
@@ -180,8 +176,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
                                   : lumped_face_[static_cast<std::size_t>(lumped.vessel_index(v))];
     } else {
       for (std::size_t b = 0; b < boundaries.size(); ++b) {
-        const bool enters = boundaries[b].type == BoundaryType::flow || boundaries[b].type == BoundaryType::pressure;
-        if (enters && (spec.place == TracerSpec::Place::inlet || boundaries[b].node == spec.at))
+        if (!boundaries[b].is_outlet() && (spec.place == TracerSpec::Place::inlet || boundaries[b].node == spec.at))
           given.push_back(static_cast<std::int32_t>(b));
       }
       if (given.empty())
@@ -207,7 +202,7 @@ void FlowTransport::step_tracers(double t0, double t1) {
     const double given = spec.mean_over(t0, t1);
     tracer_inflow_.assign(boundaries.size(), 0.0);
     for (std::size_t b = 0; b < boundaries.size(); ++b)
-      if (boundaries[b].type != BoundaryType::flow && boundaries[b].type != BoundaryType::pressure)
+      if (boundaries[b].is_outlet())
         tracer_inflow_[b] = std::numeric_limits<double>::quiet_NaN();  // an outlet returns what it took
     for (const std::int32_t b : tracer_boundaries_[k]) tracer_inflow_[static_cast<std::size_t>(b)] = given;
     tracer_injected_.clear();

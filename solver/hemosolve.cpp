@@ -18,6 +18,7 @@
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "formats/network_io.hpp"
+#include "formats/topology.hpp"
 #include "solver/checkpoint.hpp"
 #include "solver/output_folder.hpp"
 #include "solver/probes.hpp"
@@ -533,6 +534,7 @@ int main(int argc, char** argv) {
         run_info["boundaries"].push_back({{"node", net.node_id[static_cast<std::size_t>(b.node)]},
                                           {"type", to_string(b.type)},
                                           {"flow", last.boundary_mean_flow[i]}});
+        if (!b.is_outlet()) run_info["boundaries"].back()["hematocrit"] = b.entering_hematocrit(run.blood());
       }
     }
     if (status == RunStatus::broken_down) run_info["error"] = pulsatile.breakdown();
@@ -562,6 +564,11 @@ int main(int argc, char** argv) {
     const RedCellCycle& cells = pulsatile.last_red_cells();
     if (transport && !last.vessels.empty()) {
       nlohmann::json list = nlohmann::json::array();
+      if (!transport->tracer_specs().empty()) {
+        // Transit times are read against the generation (scripts/plot-results).
+        const std::vector<std::int32_t> generation = generations_from_inlets(net);
+        results.add_number("generation", std::vector<double>(generation.begin(), generation.end()));
+      }
       for (std::size_t k = 0; k < transport->tracer_specs().size(); ++k) {
         const TracerSpec& t = transport->tracer_specs()[k];
         const TracerTransport& moved = transport->tracer(k);

@@ -67,6 +67,7 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
 
 nlohmann::json boundary_results(const Network& net, const SteadyFlow& steady) {
   const std::vector<double> inflow = boundary_inflow(net, steady);
+  const Blood blood = net.blood.value_or(Blood{});
   nlohmann::json list = nlohmann::json::array();
   for (const NodeBoundary& b : node_boundaries(net)) {
     const auto i = static_cast<std::size_t>(b.node);
@@ -74,6 +75,7 @@ nlohmann::json boundary_results(const Network& net, const SteadyFlow& steady) {
                     {"type", to_string(b.type)},
                     {"flow", inflow[i]},
                     {"pressure", steady.node_pressure[i]}});
+    if (!b.is_outlet()) list.back()["hematocrit"] = b.entering_hematocrit(blood);
   }
   return list;
 }
