@@ -22,9 +22,10 @@ cat >"$WORK/diamond.json" <<'JSON'
   {"id": 5, "from": 12, "to": 13, "length": 2e-4, "diameter": 6e-6, "wall_thickness": 1.2e-06, "youngs_modulus": 4e5},
   {"id": 6, "from": 13, "to": 15, "length": 2e-4, "diameter": 20e-6, "wall_thickness": 4e-06, "youngs_modulus": 4e5}]}
 JSON
-"$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 4 --out "$WORK/run" 2>"$WORK/err" \
+TRACER=name=dye,start=0.5,duration=0.5
+"$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 4 --probe 6 --tracer "$TRACER" --out "$WORK/run" 2>"$WORK/err" \
   && pass "--red-cells transport, pulsatile" || fail "--red-cells transport: $(cat "$WORK/err")"
-grep -q "red cells carried on" "$WORK/err" && pass "the transport is announced" || fail "no note of the transport"
+grep -q "red cells and 1 tracer carried on" "$WORK/err" && pass "the transport is announced" || fail "no note of the transport"
 "$PY" - "$WORK/run/summary.json" "$WORK/run/vessels.csv" <<'PY' && pass "summary.json and vessels.csv: hematocrits, red-cell balance" || fail "red-cell results"
 import csv, json, sys
 s = json.load(open(sys.argv[1]))
@@ -45,14 +46,17 @@ header = next(csv.reader(open(sys.argv[2])))
 assert "discharge_hematocrit" in header and "tube_hematocrit" in header, header
 PY
 # Stopped after 2 cycles and resumed to 4: the same bits as 4 cycles at once (the red cells,
-# the outlets' memories and the viscosities are in the checkpoint).
-"$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 2 --checkpoint-every 1 --out "$WORK/part" --quiet &&
+# the tracer and its curves, the outlets' memories and the viscosities are in the checkpoint).
+"$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 2 --probe 6 --tracer "$TRACER" --checkpoint-every 1 \
+  --out "$WORK/part" --quiet &&
   cp -r "$WORK/part" "$WORK/stopped" &&
-  "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 4 --resume "$WORK/part" --quiet &&
+  "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 4 --probe 6 --tracer "$TRACER" --resume "$WORK/part" \
+    --quiet &&
   "$PY" - "$WORK/run/summary.json" "$WORK/part/summary.json" <<'PY' && pass "a resumed transport continues bit for bit" || fail "resumed transport differs"
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:3])
 assert a["red_cell_transport"] == b["red_cell_transport"], (a["red_cell_transport"], b["red_cell_transport"])
+assert a["tracers"] == b["tracers"], (a["tracers"], b["tracers"])
 for x, y in zip(a["vessels"], b["vessels"]):
     assert x == y, (x, y)
 PY
@@ -91,6 +95,13 @@ assert not any(h.startswith("H_D") for h in header)  # red cells fixed: not repo
 curve = [float(r[dye_col]) for r in table[1:]]
 assert max(curve) > 0.05 and curve[0] == 0 and curve[-1] < 0.01 * max(curve), (max(curve), curve[-1])
 PY
+# The figures of red cells and tracers.
+/usr/bin/python3 "$(dirname "$0")/../../scripts/plot-results" "$WORK/run" 2>"$WORK/err" || fail "plot-results: $(cat "$WORK/err")"
+drawn=""
+for name in hematocrit-vs-diameter capillary-hematocrit transit-dye curves-dye; do
+  for ext in png svg; do [ -s "$WORK/run/figures/$name.$ext" ] || drawn="$drawn $name.$ext"; done
+done
+[ -z "$drawn" ] && pass "plot-results: the red-cell and tracer figures" || fail "plot-results did not draw:$drawn"
 expect_error "--tracer unknown key" 2 "--tracer 'colour=red': unknown key 'colour'" -- \
   "$HEMOSOLVE" "$WORK/diamond.json" --tracer colour=red --out "$WORK/x"
 expect_error "--tracer at a node without a boundary" 2 "node 12 has no flow or pressure boundary" -- \
