@@ -640,6 +640,20 @@ int main(int argc, char** argv) {
       m << "; results in " << out_dir;
       note(m.str());
     }
+    // The red cells' own unrest, said plainly: a network can oscillate by itself (docs/transport.md).
+    if (!quiet && transport && transport->reports_red_cells() && !cells.discharge.empty()) {
+      std::size_t widest = 0;
+      for (std::size_t v = 0; v < cells.discharge.size(); ++v)
+        if (cells.highest[v] - cells.lowest[v] > cells.highest[widest] - cells.lowest[widest]) widest = v;
+      std::ostringstream m;
+      m << "red cells: discharge hematocrit " << format_rounded(*std::min_element(cells.discharge.begin(), cells.discharge.end()))
+        << " to " << format_rounded(*std::max_element(cells.discharge.begin(), cells.discharge.end()))
+        << " over the vessels; within the last cycle a vessel's swings by up to "
+        << format_rounded(cells.highest[widest] - cells.lowest[widest]) << " (vessel " << net.id[widest] << ")";
+      if (!std::isnan(pulsatile.red_cell_change()))
+        m << "; its cycle mean changed by up to " << format_rounded(pulsatile.red_cell_change()) << " from the cycle before";
+      note(m.str());
+    }
     double low = INFINITY, high = -INFINITY;
     std::size_t highest = 0;
     for (std::size_t v = 0; v < last.vessels.size(); ++v) {
