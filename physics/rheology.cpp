@@ -35,6 +35,21 @@ double hematocrit_factor(double hematocrit, double c) {
   return std::expm1(c * log_plasma_fraction) / std::expm1(c * log_reference_fraction);
 }
 
+// The law's terms in D alone [um].
+struct DiameterTerms {
+  double k, eta045, c;
+};
+DiameterTerms diameter_terms(double d) {
+  DiameterTerms t;
+  t.k = std::pow(d / (d - singular_diameter_um), 2);
+  t.eta045 = 6 * std::exp(-0.085 * d) + 3.2 - 2.44 * std::exp(-0.06 * std::pow(d, 0.645));
+  // s switches C from about 1 below ~8 um to -(0.8 + exp(-0.075 D)) above. D^12 overflows
+  // only beyond D ~ 1e25 um, and then s = 1 / (1 + inf) = 0 is still the right limit.
+  const double s = 1 / (1 + 1e-11 * std::pow(d, 12));
+  t.c = (0.8 + std::exp(-0.075 * d)) * (-1 + s) + s;
+  return t;
+}
+
 }  // namespace
 
 double pries_relative_viscosity(double diameter, double hematocrit) {
@@ -53,17 +68,10 @@ double pries_relative_viscosity(double diameter, double hematocrit) {
     throw InputError(message.str());
   }
 
-  const double k = std::pow(d / (d - singular_diameter_um), 2);
-  const double eta045 =
-      6 * std::exp(-0.085 * d) + 3.2 - 2.44 * std::exp(-0.06 * std::pow(d, 0.645));
-  // s switches C from about 1 below ~8 um to -(0.8 + exp(-0.075 D)) above. D^12 overflows
-  // only beyond D ~ 1e25 um, and then s = 1 / (1 + inf) = 0 is still the right limit.
-  const double s = 1 / (1 + 1e-11 * std::pow(d, 12));
-  const double c = (0.8 + std::exp(-0.075 * d)) * (-1 + s) + s;
-
+  const DiameterTerms t = diameter_terms(d);
   // At H_d = 0, F = 0 and eta = k(D): plasma alone, in a lumen narrowed by the in vivo
   // wall layer; k -> 1 (pure plasma) as D grows.
-  return (1 + (eta045 - 1) * hematocrit_factor(hematocrit, c) * k) * k;
+  return (1 + (t.eta045 - 1) * hematocrit_factor(hematocrit, t.c) * t.k) * t.k;
 }
 
 double apparent_viscosity(const Blood& blood, double diameter) {
@@ -80,6 +88,20 @@ double apparent_viscosity(const Blood& blood, double diameter) {
                                       blood.hematocrit);
   }
   throw InputError("unknown rheology");  // unreachable for valid enumerators
+}
+
+HematocritScaling::HematocritScaling(const Blood& blood, double diameter) {
+  if (blood.rheology != Rheology::pries) return;
+  // The diameter apparent_viscosity gives the law (frozen above the threshold, scaled by the
+  // cells' size); its validity checks are apparent_viscosity's.
+  const double blood_viscosity = apparent_viscosity(blood, diameter);
+  const double d = std::min(diameter, blood.pries_max_diameter) * blood.pries_diameter_scale() * metres_to_micrometres;
+  const DiameterTerms t = diameter_terms(d);
+  exponent_ = t.c;
+  const double denominator = t.c == 0 ? std::log(1 - 0.45) : std::expm1(t.c * std::log(1 - 0.45));
+  slope_ = (t.eta045 - 1) * t.k / denominator;
+  // eta(H) / eta(H_blood) with eta = (1 + slope f(H)) k plasma: the k and the plasma cancel.
+  scale_ = blood.plasma_viscosity * t.k / blood_viscosity;
 }
 
 }  // namespace hemotree

@@ -163,6 +163,8 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   if (options_.viscosity_feedback) {
     applied_hematocrit_.assign(vessels, blood.hematocrit);
     viscosity_factor_.assign(vessels, 1.0);
+    viscosity_scaling_.reserve(vessels);
+    for (std::size_t v = 0; v < vessels; ++v) viscosity_scaling_.emplace_back(blood, mean_diameter(net, v));
   }
   // Tracers: clean blood at every boundary that lets blood in, what left at the others.
   for (const TracerSpec& spec : options_.tracers) {
@@ -372,12 +374,8 @@ RedCellCycle FlowTransport::close_cycle() const {
 
 void FlowTransport::follow_viscosities(std::size_t v, double hematocrit) {
   if (std::abs(hematocrit - applied_hematocrit_[v]) <= options_.viscosity_tolerance) return;
-  const Blood blood = solver_.blood();
-  Blood own = blood;
-  own.hematocrit = hematocrit;
-  const double d = mean_diameter(net_, v);
   // The Pries viscosity at this hematocrit over the run's, at the vessel's reference lumen.
-  viscosity_factor_[v] = apparent_viscosity(own, d) / apparent_viscosity(blood, d);
+  viscosity_factor_[v] = viscosity_scaling_[v](hematocrit);
   applied_hematocrit_[v] = hematocrit;
   factors_changed_ = true;
 }

@@ -21,6 +21,7 @@
 #include <Eigen/Dense>
 
 #include "formats/network.hpp"
+#include "physics/rheology.hpp"
 #include "solver/checkpoint.hpp"
 #include "solver/pulse_solver.hpp"
 #include "solver/tracer_spec.hpp"
@@ -118,6 +119,7 @@ class FlowTransport {
   std::vector<double> step_sum_;
   // The viscosity feedback: per vessel the hematocrit its factor was computed at, the factor.
   std::vector<double> applied_hematocrit_, viscosity_factor_;
+  std::vector<HematocritScaling> viscosity_scaling_;  // per vessel
   void follow_viscosities(std::size_t vessel, double hematocrit);  // one vessel's factor
   bool factors_changed_ = false;
   std::vector<std::int32_t> step_count_;

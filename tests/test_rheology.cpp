@@ -196,3 +196,27 @@ TEST(PoiseuilleResistance, HagenPoiseuilleForParabolicProfile) {
   expect_relative(poiseuille_resistance(mu, length, diameter, 4.0 / 3.0), 8.1169020976866621e13,
                   1e-12);
 }
+
+// The transport's per-vessel viscosity factor (physics/rheology.hpp: HematocritScaling)
+// against the law evaluated whole at both hematocrits: capillaries, the zero of C near
+// 8.05 um, arterioles, beyond the law's threshold, and rat red cells (the size scaling).
+TEST(HematocritScaling, IsTheLawsRatioAtEachHematocrit) {
+  for (const double mcv : {92e-18, 55e-18}) {
+    Blood blood;
+    blood.hematocrit = 0.42;
+    blood.mean_cell_volume = mcv;
+    for (const double d : {3e-6, 5e-6, 8.05e-6, 8.0517e-6, 12e-6, 40e-6, 300e-6, 2e-3}) {
+      const HematocritScaling scaling(blood, d);
+      for (const double h : {0.0, 0.05, 0.2, 0.42, 0.6, 0.9}) {
+        Blood own = blood;
+        own.hematocrit = h;
+        const double expected = apparent_viscosity(own, d) / apparent_viscosity(blood, d);
+        EXPECT_NEAR(scaling(h), expected, 1e-13 * expected) << "D " << d << " H " << h << " MCV " << mcv;
+      }
+    }
+  }
+  Blood newtonian;
+  newtonian.rheology = Rheology::newtonian;
+  EXPECT_EQ(HematocritScaling(newtonian, 10e-6)(0.1), 1.0);
+  EXPECT_EQ(HematocritScaling()(0.3), 1.0);
+}
