@@ -17,9 +17,10 @@ from pathlib import Path
 UM_PER_M = 1e6
 
 
-def fahraeus_tube(hd, d_um):
+def fahraeus_tube(hd, d_um, scale=1.0):
     """H_T from H_D in a tube of d_um micrometres (Pries, Neuhaus & Gaehtgens 1992, eq. 7;
-    physics/phase_separation.hpp)."""
+    physics/phase_separation.hpp), the diameter scaled by the red cells' size as the run did."""
+    d_um *= scale
     x = 1 + 1.7 * math.exp(-0.415 * d_um) - 0.6 * math.exp(-0.011 * d_um)
     return hd * (hd + (1 - hd) * x)
 
@@ -60,8 +61,10 @@ def plot_hematocrit(run, out, written, save, scatter_by_class, binned_median, no
     feed = feed_hematocrit(run)
     if feed is not None:
         grid = np.geomspace(d[ok].min(), d[ok].max(), 200)
+        mcv = run.summary.get("mean_cell_volume")
+        scale = (92e-18 / mcv) ** (1 / 3) if isinstance(mcv, (int, float)) and mcv > 0 else 1.0
         ax.axhline(feed, color="tab:gray", lw=1, label=f"feed H_D {feed:.2f}")
-        ax.plot(grid, [fahraeus_tube(feed, x) for x in grid], color="tab:orange", lw=2,
+        ax.plot(grid, [fahraeus_tube(feed, x, scale) for x in grid], color="tab:orange", lw=2,
                 label="Fahraeus law: tube H_T at the feed's H_D")
     ax.set_xscale("log")
     ax.set_xlabel("diameter [um]")

@@ -151,7 +151,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
 
   solver_volumes(volume);
   red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
-                     RedCellOptions{options_.phase_separation, 1.0});
+                     RedCellOptions{options_.phase_separation, 1.0, !options_.tracers.empty()});
   face_volume_.assign(red_cells_->grid().face_count(), 0.0);
   const std::size_t vessels = net.vessel_count();
   cycle_cells_.assign(vessels, 0.0);
@@ -162,7 +162,6 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   step_count_.assign(vessels, 0);
   if (options_.viscosity_feedback) {
     applied_hematocrit_.assign(vessels, blood.hematocrit);
-    viscosity_factor_.assign(vessels, 1.0);
     viscosity_scaling_.reserve(vessels);
     for (std::size_t v = 0; v < vessels; ++v) viscosity_scaling_.emplace_back(blood, mean_diameter(net, v));
   }
@@ -288,7 +287,7 @@ void FlowTransport::advance() {
     face_volume_[static_cast<std::size_t>(node_boundary_face_[j])] = -(s.boundary(b) - boundary_mark_(b));
   }
   // 1D vessels: the proximal face's volume, then each slice's change passed on.
-  now_.assign(red_cells_->volume().begin(), red_cells_->volume().end());
+  now_.resize(cell_count());  // only its 0D nodes and slices are read below
   solver_volumes(now_);
   const std::span<const double> held = red_cells_->volume();
   const std::vector<std::int32_t>& one_d = solver_.one_d_vessels();
@@ -333,10 +332,6 @@ void FlowTransport::advance() {
     step_count_[v] = 0;
     if (options_.viscosity_feedback) follow_viscosities(v, h);
   }
-  if (factors_changed_) {
-    solver_.set_viscosity_factors(viscosity_factor_);
-    factors_changed_ = false;
-  }
 }
 
 void FlowTransport::begin_cycle() {
@@ -375,9 +370,8 @@ RedCellCycle FlowTransport::close_cycle() const {
 void FlowTransport::follow_viscosities(std::size_t v, double hematocrit) {
   if (std::abs(hematocrit - applied_hematocrit_[v]) <= options_.viscosity_tolerance) return;
   // The Pries viscosity at this hematocrit over the run's, at the vessel's reference lumen.
-  viscosity_factor_[v] = viscosity_scaling_[v](hematocrit);
+  solver_.set_viscosity_factor(v, viscosity_scaling_[v](hematocrit));
   applied_hematocrit_[v] = hematocrit;
-  factors_changed_ = true;
 }
 
 void FlowTransport::save(CheckpointWriter& out) const {
@@ -387,8 +381,7 @@ void FlowTransport::save(CheckpointWriter& out) const {
   out.put(std::vector<double>(t.volume().begin(), t.volume().end()));
   out.put(std::vector<double>{t.entered(), t.left(), t.adjusted()});
   out.put(t.last_outflow());
-  out.put(applied_hematocrit_);
-  out.put(viscosity_factor_);
+  out.put(applied_hematocrit_);  // the factors themselves are the solver's (its checkpoint)
   out.put(static_cast<std::uint64_t>(advances_));
   out.put(last_time_);
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
@@ -409,9 +402,7 @@ void FlowTransport::restore(CheckpointReader& in) {
     in.fail("red cells of another network or another transport grid");
   red_cells_->restore(discharge, volume, totals[0], totals[1], totals[2], last_outflow);
   applied_hematocrit_ = in.get_vector();
-  viscosity_factor_ = in.get_vector();
-  if (applied_hematocrit_.size() != (options_.viscosity_feedback ? net_.vessel_count() : 0) ||
-      viscosity_factor_.size() != applied_hematocrit_.size())
+  if (applied_hematocrit_.size() != (options_.viscosity_feedback ? net_.vessel_count() : 0))
     in.fail("red-cell viscosities of another network");
   advances_ = static_cast<std::size_t>(in.get_u64());
   last_time_ = in.get_double();

@@ -207,7 +207,7 @@ int main(int argc, char** argv) {
                  "at=inlet|node:ID|vessel:ID,shape=bolus|step,start=T,duration=T,concentration=C; its "
                  "concentration at the probes in probes.csv, its arrival, peak and mean transit time per vessel "
                  "(docs/transport.md)");
-  double transport_step = 2e-3;
+  double transport_step = 5e-3;
   app.add_option("--transport-step", transport_step,
                  "the red-cell transport's step as a fraction of the period (implicit: any length is stable; "
                  "shorter fronts spread less), at least the flow's step")
@@ -506,6 +506,7 @@ int main(int argc, char** argv) {
                                {"threads", options.threads},
                                {"rheology", to_string(run.blood().rheology)},
                                {"red_cells", red_cells},
+                               {"mean_cell_volume", run.blood().mean_cell_volume},
                                {"start", steady_start ? "steady" : "rest"},
                                {"start_requested", start},
                                {"balance_compliances", balance && steady_start},

@@ -316,14 +316,25 @@ void LumpedVessels::set_viscosity_factors(std::span<const double> per_vessel) {
     const double f = per_vessel.empty() ? 1.0 : per_vessel[static_cast<std::size_t>(vessels_[e])];
     if (f == viscosity_factor_[e]) continue;
     viscosity_factor_[e] = f;
-    if (!started) continue;
-    // What restore() computes from the pressures: a run resumed from a checkpoint has the
-    // same resistances, whenever the factors changed.
-    double capacity_a, capacity_b;
-    const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
-    previous_resistance_[e] = resistance(e, previous_pressure_[a], previous_pressure_[b], capacity_a, capacity_b);
-    resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
+    if (started) refresh_resistance(e);
   }
+}
+
+void LumpedVessels::set_viscosity_factor(std::int32_t index, double factor) {
+  const auto e = static_cast<std::size_t>(index);
+  if (viscosity_factor_.empty()) viscosity_factor_.assign(vessels_.size(), 1.0);
+  if (factor == viscosity_factor_[e]) return;
+  viscosity_factor_[e] = factor;
+  if (!resistance_.empty() && !previous_pressure_.empty()) refresh_resistance(e);
+}
+
+void LumpedVessels::refresh_resistance(std::size_t e) {
+  // What restore() computes from the pressures: a run resumed from a checkpoint has the same
+  // resistances, whenever the factors changed.
+  double capacity_a, capacity_b;
+  const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
+  previous_resistance_[e] = resistance(e, previous_pressure_[a], previous_pressure_[b], capacity_a, capacity_b);
+  resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
 }
 
 void LumpedVessels::update_dynamic_pressures() {

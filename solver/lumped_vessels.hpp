@@ -182,6 +182,7 @@ class LumpedVessels {
   // Each 0D vessel's viscosity is the run's times its factor (per network vessel; the
   // vessel's own hematocrit against the blood's: red-cell transport). Empty: all 1.
   void set_viscosity_factors(std::span<const double> per_vessel);
+  void set_viscosity_factor(std::int32_t index, double factor);  // one 0D vessel's
   double passed_volume(std::int32_t index) const { return passed_[static_cast<std::size_t>(index)]; }
   // A capacitor's pressure, by the network's outlet index, or NaN if that outlet is not here.
   double capacitor_pressure(std::size_t outlet) const;
@@ -295,6 +296,7 @@ class LumpedVessels {
   std::vector<double> predicted_, conductance_, history_, system_shunt_, rhs_, next_flow_;
   std::vector<double> passed_;  // per 0D vessel, where tracked (track_passed_volumes)
   std::vector<double> viscosity_factor_;  // per 0D vessel (empty: 1)
+  void refresh_resistance(std::size_t e);  // after its factor changed: what restore() computes
   std::vector<std::int32_t> coupling_nodes_;
   std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
   std::vector<std::int32_t> coupling_edge_;

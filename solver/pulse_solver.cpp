@@ -1017,6 +1017,16 @@ void PulseSolver::set_viscosity_factors(std::span<const double> per_vessel) {
     element_viscosity_factor_(static_cast<Eigen::Index>(el)) = viscosity_factor_[static_cast<std::size_t>(element_vessel_[el])];
 }
 
+void PulseSolver::set_viscosity_factor(std::size_t vessel, double factor) {
+  if (viscosity_factor_.empty()) set_viscosity_factors(std::vector<double>(net_.vessel_count(), 1.0));
+  viscosity_factor_[vessel] = factor;
+  if (zero_d_[vessel]) {
+    lumped_.set_viscosity_factor(lumped_.vessel_index(vessel), factor);
+    return;
+  }
+  for (auto el = first_element_[vessel]; el < end_element(vessel); ++el) element_viscosity_factor_(el) = factor;
+}
+
 void PulseSolver::track_face_volumes() {
   const Eigen::Index elements = state_.area.rows();
   for (PulseState* s : {&state_, &rate_, &previous_rate_, &stage_[0], &stage_[1], &stage_[2], &stage_[3]})

@@ -116,6 +116,8 @@ class PulseSolver {
   // Each vessel's viscosity is the run's times its factor from now on: its own hematocrit's
   // Pries viscosity over the blood's (red-cell transport). Empty: all 1.
   void set_viscosity_factors(std::span<const double> per_vessel);
+  // The same for one vessel (the rest keep theirs): O(1), as a transport updates them.
+  void set_viscosity_factor(std::size_t vessel, double factor);
   const std::vector<double>& viscosity_factors() const { return viscosity_factor_; }
   // Area, flow and pressure of every vessel at the same fraction x along each, in one pass
   // (the cycle statistics sample all vessels every few steps); pressure may be null.

@@ -209,8 +209,8 @@ void RedCellTransport::step(std::span<const double> face_volume, std::span<const
     const double q = face_volume[f];
     const double cells_through = q == 0 ? 0.0 : q * face_hematocrit(f, face_volume, inflow_hematocrit);
     cells_.face[f] = cells_through;
-    plasma_.face[f] = q - cells_through;
     blood_.face[f] = q;
+    if (options_.all_carriers) plasma_.face[f] = q - cells_through;
     if (grid_.b[f] >= 0 || q == 0) continue;
     const auto boundary = static_cast<std::size_t>(-1 - grid_.b[f]);
     if (q > 0) {
@@ -220,13 +220,14 @@ void RedCellTransport::step(std::span<const double> face_volume, std::span<const
       entered_ -= cells_through;
     }
   }
-  for (std::size_t c = 0; c < cells; ++c) {
-    cells_.after[c] = next_volume_[c] * tube(c, discharge_[c]);
-    plasma_.before[c] = volume_[c] - cells_.before[c];
-    plasma_.after[c] = next_volume_[c] - cells_.after[c];
-    blood_.before[c] = volume_[c];
-    blood_.after[c] = next_volume_[c];
-  }
+  for (std::size_t c = 0; c < cells; ++c) cells_.after[c] = next_volume_[c] * tube(c, discharge_[c]);
+  if (options_.all_carriers)
+    for (std::size_t c = 0; c < cells; ++c) {
+      plasma_.before[c] = volume_[c] - cells_.before[c];
+      plasma_.after[c] = next_volume_[c] - cells_.after[c];
+      blood_.before[c] = volume_[c];
+      blood_.after[c] = next_volume_[c];
+    }
   volume_.swap(next_volume_);
 }
 

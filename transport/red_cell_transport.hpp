@@ -30,6 +30,9 @@ namespace hemotree {
 struct RedCellOptions {
   bool phase_separation = true;
   double diameter_scale = 1;  // what the phase separation law multiplies diameters by
+  // Keep the plasma's and the blood's CarrierStep too (what tracers on them need; the red
+  // cells' own and the blood's face volumes are kept always).
+  bool all_carriers = true;
 };
 
 // What a step moved of one carrier (red cells, plasma or whole blood): the volume of it each

@@ -20,6 +20,15 @@ CellFaces::CellFaces(const TransportGrid& grid) {
 
 void FlowOrder::update(const TransportGrid& grid, const CellFaces& faces, std::span<const double> volume) {
   const std::size_t cells = grid.cell_count();
+  // The flow's directions change only where it reverses or stops: most steps keep the order.
+  bool same = direction.size() == grid.face_count() && this->cells.size() == cells;
+  direction.resize(grid.face_count());
+  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+    const signed char d = volume[f] > 0 ? 1 : volume[f] < 0 ? -1 : 0;
+    same = same && d == direction[f];
+    direction[f] = d;
+  }
+  if (same) return;
   pending.assign(cells, 0);
   // The cell a face's blood enters, or -1 (a boundary, or no flow, or it comes from a boundary).
   auto downstream = [&](std::size_t f) -> std::int32_t {

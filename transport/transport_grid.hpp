@@ -62,8 +62,10 @@ struct CellFaces {
 struct FlowOrder {
   std::vector<std::int32_t> cells;
   std::size_t cyclic = 0;
-  // Scratch kept between steps: inflowing faces not yet visited, per cell.
+  // Scratch kept between steps: inflowing faces not yet visited, per cell; each face's
+  // direction at the last update (the order stands while no face changes it).
   std::vector<std::int32_t> pending;
+  std::vector<signed char> direction;
   void update(const TransportGrid& grid, const CellFaces& faces, std::span<const double> volume);
 };
 
