@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <utility>
 
 #include "cli/errors.hpp"
@@ -59,7 +60,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
     if (!solver.is_lumped(v)) continue;
     const std::int32_t i = lumped.vessel_index(v);
-    const double d = mean_diameter(net, v), half = 0.125 * M_PI * d * d * net.length[v];
+    const double d = mean_diameter(net, v), half = 0.125 * std::numbers::pi * d * d * net.length[v];
     for (const std::int32_t k : {lumped.from_node(i), lumped.to_node(i)}) {
       k_sum[static_cast<std::size_t>(k)] += half * fahraeus(d);
       weight[static_cast<std::size_t>(k)] += half;

@@ -75,6 +75,7 @@ class FlowTransport {
   const RedCellTransport& red_cells() const { return *red_cells_; }
   const std::vector<TracerSpec>& tracer_specs() const { return options_.tracers; }
   bool reports_red_cells() const { return options_.red_cells; }
+  const Blood& red_cells_blood() const { return solver_.blood(); }
   const TracerTransport& tracer(std::size_t k) const { return tracers_[k]; }
   // Per vessel, tracer k's curve landmarks over the run so far.
   IndicatorCurves::Landmarks tracer_landmarks(std::size_t k) const { return curves_[k].landmarks(solver_.time()); }

@@ -28,6 +28,7 @@
 #include "solver/run_report.hpp"
 #include "solver/steady_run.hpp"
 #include "solver/tracer_spec.hpp"
+#include "solver/transport_report.hpp"
 #include "physics/phase_separation.hpp"
 
 using namespace hemotree;
@@ -563,59 +564,9 @@ int main(int argc, char** argv) {
     VesselTable results =
         last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(driving));
     const RedCellCycle& cells = pulsatile.last_red_cells();
-    if (transport && !last.vessels.empty()) {
-      nlohmann::json list = nlohmann::json::array();
-      if (!transport->tracer_specs().empty()) {
-        // Transit times are read against the generation (scripts/plot-results).
-        const std::vector<std::int32_t> generation = generations_from_inlets(net);
-        results.add_number("generation", std::vector<double>(generation.begin(), generation.end()));
-      }
-      for (std::size_t k = 0; k < transport->tracer_specs().size(); ++k) {
-        const TracerSpec& t = transport->tracer_specs()[k];
-        const TracerTransport& moved = transport->tracer(k);
-        IndicatorCurves::Landmarks l = transport->tracer_landmarks(k);
-        results.add_number(t.name + "_arrival_time", std::move(l.arrival));
-        results.add_number(t.name + "_peak_time", std::move(l.peak_time));
-        results.add_number(t.name + "_peak", std::move(l.peak));
-        results.add_number(t.name + "_mean_transit_time", std::move(l.mean_transit));
-        const double amount = moved.amount(transport->red_cells());
-        const double scale = std::max({moved.injected() + moved.entered(), amount, 1e-300});
-        list.push_back({{"name", t.name},
-                        {"carrier", to_string(t.carrier)},
-                        {"shape", t.shape == TracerSpec::Shape::bolus ? "bolus" : "step"},
-                        {"start", t.start},
-                        {"duration", t.shape == TracerSpec::Shape::bolus ? nlohmann::json(t.duration) : nlohmann::json(nullptr)},
-                        {"concentration", t.concentration},
-                        {"entered", moved.entered()},
-                        {"injected", moved.injected()},
-                        {"left", moved.left()},
-                        {"in_network", amount},
-                        {"balance_error",
-                         (amount - (moved.entered() + moved.injected() - moved.left() + moved.adjusted())) / scale}});
-      }
-      if (!list.empty()) run_info["tracers"] = list;
-    }
-    if (transport && transport->reports_red_cells() && !last.vessels.empty() && !cells.discharge.empty()) {
-      std::vector<double> tube(net.vessel_count());
-      const double scale = run.blood().pries_diameter_scale();
-      for (std::size_t v = 0; v < tube.size(); ++v)
-        tube[v] = tube_hematocrit(cells.discharge[v], 0.5 * (net.diameter[v] + net.diameter_at_to(v)), scale);
-      results.add_number("discharge_hematocrit", cells.discharge);
-      results.add_number("tube_hematocrit", std::move(tube));
-      results.add_number("discharge_hematocrit_min", cells.lowest);
-      results.add_number("discharge_hematocrit_max", cells.highest);
-      nlohmann::json r = {{"cells", transport->cell_count()},
-                          {"steps", transport->advances()},
-                          {"step", plan.transport_every * dt},
-                          {"red_cells", cells.red_cells},
-                          {"entered", cells.entered},
-                          {"left", cells.left},
-                          {"balance_error", cells.balance_error},
-                          {"separating_nodes", cells.separating_nodes}};
-      r["cycle_change"] = std::isnan(pulsatile.red_cell_change()) ? nlohmann::json(nullptr)
-                                                                   : nlohmann::json(pulsatile.red_cell_change());
-      run_info["red_cell_transport"] = r;
-    }
+    if (transport && !last.vessels.empty())
+      report_transport(net, *transport, cells, pulsatile.red_cell_change(), static_cast<double>(plan.transport_every) * dt,
+                       results, run_info);
     if (!last.vessels.empty()) run_info["statistics"] = group_statistics(net, results);
     write_summary(dir / "summary.json", run_info, results, last);
     write_vessel_table(dir / "vessels.csv", results);
@@ -642,19 +593,8 @@ int main(int argc, char** argv) {
       note(m.str());
     }
     // The red cells' own unrest, said plainly: a network can oscillate by itself (docs/transport.md).
-    if (!quiet && transport && transport->reports_red_cells() && !cells.discharge.empty()) {
-      std::size_t widest = 0;
-      for (std::size_t v = 0; v < cells.discharge.size(); ++v)
-        if (cells.highest[v] - cells.lowest[v] > cells.highest[widest] - cells.lowest[widest]) widest = v;
-      std::ostringstream m;
-      m << "red cells: discharge hematocrit " << format_rounded(*std::min_element(cells.discharge.begin(), cells.discharge.end()))
-        << " to " << format_rounded(*std::max_element(cells.discharge.begin(), cells.discharge.end()))
-        << " over the vessels; within the last cycle a vessel's swings by up to "
-        << format_rounded(cells.highest[widest] - cells.lowest[widest]) << " (vessel " << net.id[widest] << ")";
-      if (!std::isnan(pulsatile.red_cell_change()))
-        m << "; its cycle mean changed by up to " << format_rounded(pulsatile.red_cell_change()) << " from the cycle before";
-      note(m.str());
-    }
+    if (!quiet && transport && transport->reports_red_cells() && !cells.discharge.empty())
+      note(red_cell_line(net, cells, pulsatile.red_cell_change()));
     double low = INFINITY, high = -INFINITY;
     std::size_t highest = 0;
     for (std::size_t v = 0; v < last.vessels.size(); ++v) {

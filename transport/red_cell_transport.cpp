@@ -47,11 +47,15 @@ RedCellTransport::RedCellTransport(TransportGrid grid, std::vector<double> volum
     }
     if (inner) candidates_.push_back(static_cast<std::int32_t>(c));
   }
+  // The plasma's and the blood's contents only where tracers ride on them (memory: a full
+  // tree's millions of cells); the blood's face volumes always.
   for (CarrierStep* c : {&cells_, &plasma_, &blood_}) {
+    if (c != &cells_ && !options_.all_carriers) continue;
     c->face.assign(grid_.face_count(), 0.0);
     c->before.assign(cells, 0.0);
     c->after.assign(cells, 0.0);
   }
+  blood_.face.assign(grid_.face_count(), 0.0);
 }
 
 void RedCellTransport::set_hematocrit(std::span<const double> discharge) {
