@@ -1,0 +1,103 @@
+// PulseSolver's state written to a checkpoint and read back bit for bit (solver/checkpoint.hpp):
+// what evolves (solution, multistep history, junction guesses, compliance balance marks,
+// viscosity factors, time); the rest is rebuilt from the network and the options.
+#include <string>
+#include <vector>
+
+#include "solver/pulse_solver.hpp"
+
+namespace hemotree {
+
+void PulseSolver::save(CheckpointWriter& out) const {
+  out.section("pulse solver");
+  out.put(time_);
+  out.put(dt_);
+  out.put(static_cast<std::uint64_t>(steps_));
+  out.put(have_previous_rate_);
+  out.put(tracking_faces_);
+  for (const PulseState* s : {&state_, &previous_rate_}) {
+    out.put(s->area);
+    out.put(s->flow);
+    out.put(s->capacitor);
+    out.put(s->exchanged(0));
+    out.put(s->exchanged(1));
+    out.put(s->coupled);
+    out.put(s->boundary);
+    out.put(s->faces);
+  }
+  out.put(previous_flow_);
+  out.put(cycle_volume_);
+  out.put(cycle_capacitor_);
+  // The junctions' Newton iterations start from the last end states.
+  std::vector<double> ends;
+  ends.reserve(2 * boundaries_.end_state.size());
+  for (const EndState& e : boundaries_.end_state) {
+    ends.push_back(e.area);
+    ends.push_back(e.flow);
+  }
+  out.put(ends);
+  std::vector<double> rest;
+  for (const auto& o : boundaries_.outlets) {
+    rest.push_back(o.rest_area);
+    rest.push_back(o.rest_flow);
+  }
+  out.put(rest);
+  out.put(viscosity_factor_);
+  lumped_.save(out);
+}
+
+void PulseSolver::restore(CheckpointReader& in) {
+  in.section("pulse solver");
+  time_ = in.get_double();
+  const double dt = in.get_double();
+  if (dt != dt_)
+    in.fail("time step " + std::to_string(dt) + " s in the checkpoint, " + std::to_string(dt_) +
+            " s in this run: the checkpoint belongs to other options or another network");
+  steps_ = static_cast<std::size_t>(in.get_u64());
+  have_previous_rate_ = in.get_bool();
+  // A run with a transport tracks face volumes from its start; one without tracks none.
+  if (in.get_bool() != tracking_faces_)
+    in.fail(tracking_faces_ ? "written by a run without red-cell or tracer transport"
+                            : "written by a run that transported red cells or tracers (this one does not)");
+  in.get_into(state_.area, "areas");
+  in.get_into(state_.flow, "flows");
+  in.get_into(state_.capacitor, "capacitors");
+  state_.exchanged(0) = in.get_double();
+  state_.exchanged(1) = in.get_double();
+  in.get_into(state_.coupled, "coupled ends");
+  in.get_into(state_.boundary, "boundary volumes");
+  state_.faces = in.get_eigen_vector();
+  // The multistep history: empty until a multistep scheme has taken a step.
+  previous_rate_.area = in.get_matrix();
+  previous_rate_.flow = in.get_matrix();
+  previous_rate_.capacitor = in.get_eigen_vector();
+  previous_rate_.exchanged(0) = in.get_double();
+  previous_rate_.exchanged(1) = in.get_double();
+  previous_rate_.coupled = in.get_eigen_vector();
+  previous_rate_.boundary = in.get_eigen_vector();
+  previous_rate_.faces = in.get_eigen_vector();
+  if (tracking_faces_ && state_.faces.size() != state_.area.rows()) in.fail("face volumes of another discretisation");
+  if (previous_rate_.area.size() != 0 &&
+      (previous_rate_.area.rows() != state_.area.rows() || previous_rate_.area.cols() != state_.area.cols() ||
+       previous_rate_.flow.rows() != state_.flow.rows() || previous_rate_.capacitor.size() != state_.capacitor.size()))
+    in.fail("multistep history of another discretisation");
+  previous_flow_ = in.get_matrix();
+  cycle_volume_ = in.get_vector();
+  cycle_capacitor_ = in.get_vector();
+  const std::vector<double> ends = in.get_vector();
+  if (ends.size() != 2 * boundaries_.end_state.size()) in.fail("vessel ends of another network");
+  for (std::size_t k = 0; k < boundaries_.end_state.size(); ++k)
+    boundaries_.end_state[k] = {ends[2 * k], ends[2 * k + 1]};
+  const std::vector<double> rest = in.get_vector();
+  if (rest.size() != 2 * boundaries_.outlets.size()) in.fail("outlets of another network");
+  for (std::size_t k = 0; k < boundaries_.outlets.size(); ++k) {
+    boundaries_.outlets[k].rest_area = rest[2 * k];
+    boundaries_.outlets[k].rest_flow = rest[2 * k + 1];
+  }
+  std::vector<double> factors = in.get_vector();
+  if (!factors.empty() && factors.size() != net_.vessel_count()) in.fail("viscosity factors of another network");
+  set_viscosity_factors(factors);  // before the 0D vessels' resistances are rebuilt
+  lumped_.restore(in);
+}
+
+}  // namespace hemotree
