@@ -32,6 +32,12 @@ struct Blood {
 
   // The factor on a diameter before it enters the Pries laws.
   double pries_diameter_scale() const;
+  // The same for the Pries-Secomb phase separation law, whose constants were fitted to
+  // networks of the rat mesentery (Pries et al. 1989, Pries & Secomb 2005), cells of about
+  // 55 fl: (55 fl / MCV)^(1/3), 1 for rat blood (NetFlow's dishem.cpp, which does not scale)
+  // and 0.84 for human blood (larger cells see a narrower vessel).
+  double phase_separation_diameter_scale() const;
+  static constexpr double phase_separation_mean_cell_volume = 55e-18;
 };
 
 // A periodic boundary value f(t): a volume flow [m^3/s] or a pressure [Pa].

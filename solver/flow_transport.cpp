@@ -152,7 +152,8 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
 
   solver_volumes(volume);
   red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
-                     RedCellOptions{options_.phase_separation, 1.0, !options_.tracers.empty()});
+                     RedCellOptions{options_.phase_separation, blood.phase_separation_diameter_scale(),
+                                    !options_.tracers.empty()});
   face_volume_.assign(red_cells_->grid().face_count(), 0.0);
   const std::size_t vessels = net.vessel_count();
   cycle_cells_.assign(vessels, 0.0);

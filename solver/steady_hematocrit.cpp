@@ -180,7 +180,8 @@ SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, co
   SteadyHematocritResult result;
   for (int it = 1; it <= max_iterations; ++it) {
     SteadyFlow s = solve_steady_flow(net, vessel_resistances(net, blood, h), inlet_flow);
-    std::vector<double> target = distribute_hematocrit(net, s.flow, blood.hematocrit, 1.0);
+    std::vector<double> target =
+        distribute_hematocrit(net, s.flow, blood.hematocrit, blood.phase_separation_diameter_scale());
     double q_scale = 0;
     for (const double q : s.flow) q_scale = std::max(q_scale, std::abs(q));
     // No previous flow to compare with on the first pass: not converged yet.

@@ -96,7 +96,8 @@ TEST(FlowTransport, ConstantBoundariesSettleOnTheSteadyDistributionOfTheFlows) {
     const RedCellCycle cycle = transport.close_cycle();
     // The last advance's faces: their hematocrits, against the node-by-node rule on the
     // run's own flows (mixing, the law at 1-in 2-out nodes, 0.45 at the inflow).
-    const std::vector<double> expected = distribute_hematocrit(net, flows(solver, net), 0.45, 1.0);
+    const std::vector<double> expected =
+        distribute_hematocrit(net, flows(solver, net), 0.45, net.blood->phase_separation_diameter_scale());
     const RedCellTransport& cells = transport.red_cells();
     const TransportGrid& grid = cells.grid();
     std::vector<double> got(net.vessel_count(), -1);

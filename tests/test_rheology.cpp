@@ -176,6 +176,10 @@ TEST(ApparentViscosity, MeanCellVolumeScalesTheDiameterTheLawSees) {
   expect_relative(apparent_viscosity(human, 10 * um), 1.0466e-3 * 5.0059805425975064, 1e-9);
   // The threshold is the vessel's own diameter: above it the value is frozen as before.
   EXPECT_EQ(apparent_viscosity(rat, 1e-3), apparent_viscosity(rat, rat.pries_max_diameter));
+  // The phase separation law was fitted to rat networks: rat cells see the diameter as it
+  // is, human cells (92 fl) (55/92)^(1/3) = 0.8424128 of it.
+  EXPECT_EQ(rat.phase_separation_diameter_scale(), 1.0);
+  expect_relative(human.phase_separation_diameter_scale(), 0.8424127940950442, 1e-14);
 }
 
 TEST(ApparentViscosity, NewtonianIgnoresDiameterAndHematocrit) {
