@@ -15,6 +15,7 @@
 
 #include "cli/errors.hpp"
 #include "exchange/openbf.hpp"
+#include "tests/shared_networks.hpp"
 
 using namespace hemotree;
 namespace fs = std::filesystem;
@@ -415,10 +416,7 @@ TEST_F(OpenbfTest, WritesATubeLawGivenByBetaAsYoungsModulus) {
 
 // --- the models openBF ships -------------------------------------------------------------------
 
-fs::path networks_dir() {
-  if (const char* env = std::getenv("HEMOTREE_NETWORKS_DIR")) return env;
-  return fs::path(HEMOTREE_SOURCE_DIR) / ".." / "shared" / "networks";
-}
+fs::path networks_dir() { return shared_networks_dir(); }
 
 struct Shipped {
   const char* path;

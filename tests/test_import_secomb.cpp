@@ -15,6 +15,7 @@
 
 #include "cli/errors.hpp"
 #include "exchange/secomb.hpp"
+#include "tests/shared_networks.hpp"
 #include "formats/network_io.hpp"
 
 using namespace hemotree;
@@ -95,12 +96,7 @@ const std::string boundaries_2 =
     "4 0 15.0 0.3 40.0 *\n";
 const std::string three_segments = header(3) + segments_3 + nodes_4 + boundaries_2;
 
-std::string networks_dir() {
-  if (const char* env = std::getenv("HEMOTREE_NETWORKS_DIR")) return env;
-  return std::string(HEMOTREE_SOURCE_DIR) + "/../shared/networks";
-}
-
-fs::path mesentery_path() { return fs::path(networks_dir()) / "mesentery-rat" / "network.dat"; }
+fs::path mesentery_path() { return shared_mesentery(); }
 
 // Expects read_secomb to refuse text with exactly "PATH:" + message.
 void expect_refusal(const std::string& text, const std::string& message) {

@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include "exchange/secomb.hpp"
+#include "tests/shared_networks.hpp"
 #include "solver/steady_flow.hpp"
 
 using namespace hemotree;
@@ -27,10 +28,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string networks_dir() {
-  if (const char* env = std::getenv("HEMOTREE_NETWORKS_DIR")) return env;
-  return std::string(HEMOTREE_SOURCE_DIR) + "/../shared/networks";
-}
 
 // Pries, Secomb, Gessner et al. 1994 (Circ Res 75:904), in vivo, D in um, with the diameter
 // the cells see scaled by (92/55)^(1/3) (rat cells) as NetFlow's viscor.cpp does.
@@ -56,7 +53,7 @@ Spread spread(std::vector<double> x) {
 }  // namespace
 
 TEST(MesenteryValidation, SteadyFlowsAndPressuresMatchAnIndependentDenseSolve) {
-  const fs::path path = fs::path(networks_dir()) / "mesentery-rat" / "network.dat";
+  const fs::path path = shared_mesentery();
   if (!fs::exists(path)) GTEST_SKIP() << path << " absent (the shared public networks)";
   Network net = read_secomb(path.string(), ImportOptions{});
   Blood blood;

@@ -23,6 +23,7 @@
 #include "solver/pulse_solver.hpp"
 #include "solver/steady_flow.hpp"
 #include "tests/network_builders.hpp"
+#include "tests/shared_networks.hpp"
 
 using namespace hemotree;
 using namespace hemotree::test_networks;
@@ -309,9 +310,7 @@ TEST(NetworkGraphsPulsatile, RefusesWhatItCannotRun) {
 // state of its own compliant vessels, and against the rigid steady solution (--steady's)
 // the distension shows; the numbers are printed for the record.
 TEST(NetworkGraphsPulsatile, RatMesenteryRunsAndMatchesItsSteadyState) {
-  const char* env = std::getenv("HEMOTREE_NETWORKS_DIR");
-  const std::string dir = env ? env : std::string(HEMOTREE_SOURCE_DIR) + "/../shared/networks";
-  const std::string file = dir + "/mesentery-rat/network.dat";
+  const std::string file = shared_mesentery().string();
   if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " is absent";
   Network net = read_secomb(file, ImportOptions{});
   fill_missing_walls(net, ImportOptions{});

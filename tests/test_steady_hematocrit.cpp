@@ -18,6 +18,7 @@
 
 #include "cli/errors.hpp"
 #include "exchange/secomb.hpp"
+#include "tests/shared_networks.hpp"
 #include "network_builders.hpp"
 #include "physics/phase_separation.hpp"
 #include "physics/rheology.hpp"
@@ -255,11 +256,9 @@ TEST(SteadyWithPhaseSeparation, ReportsNonConvergence) {
 }
 
 // The rat mesentery as NetFlow runs it: the file's boundary hematocrits, plasma 1.0466 mPa s,
-// rat cells (55 fl) in the viscosity law, phase separation unscaled.
+// rat cells (55 fl) in the viscosity law and in phase separation (scale 1 there, as NetFlow).
 TEST(SteadyWithPhaseSeparation, RatMesenteryConverges) {
-  const char* env = std::getenv("HEMOTREE_NETWORKS_DIR");
-  const fs::path path = fs::path(env ? env : std::string(HEMOTREE_SOURCE_DIR) + "/../shared/networks") /
-                        "mesentery-rat" / "network.dat";
+  const fs::path path = shared_mesentery();
   if (!fs::exists(path)) GTEST_SKIP() << path << " absent (the shared public networks)";
   const Network net = read_secomb(path.string(), ImportOptions{});
   Blood blood = rat_blood();
