@@ -78,6 +78,11 @@ PhaseSeparationLaw phase_separation_law(const Bifurcation& bifurcation) {
   return law;
 }
 
+bool law_splits(const Bifurcation& b) {
+  const double feed_um = b.feed_diameter * b.diameter_scale * metres_to_micrometres;
+  return threshold_coefficient * (1 - b.feed_hematocrit) / feed_um < 0.5;
+}
+
 double red_cell_fraction(const Bifurcation& bifurcation) {
   const PhaseSeparationLaw law = phase_separation_law(bifurcation);
   const double fqb = bifurcation.flow_fraction;

@@ -36,6 +36,9 @@ struct PhaseSeparationLaw {
   double b = 0;
 };
 PhaseSeparationLaw phase_separation_law(const Bifurcation& bifurcation);
+// Whether the law splits this feed at all: X0 < 1/2 (a scaled feed wider than
+// 1.928 (1 - H_F) um). Does not throw; the other arguments are not checked.
+bool law_splits(const Bifurcation& bifurcation);
 
 // FQE: the fraction of the feed's red-cell flux that enters daughter 1, in [0, 1]:
 //   FQE = 0                                      for FQB <= X0 (daughter 1 gets plasma only)

@@ -257,3 +257,24 @@ TEST(Fahraeus, RefusesInputsOutsideTheDomain) {
     EXPECT_THROW(tube_hematocrit(0.45, 10 * um, d), InputError);
   }
 }
+
+namespace hemotree {
+namespace {
+// law_splits is the domain phase_separation_law refuses outside: X0 < 1/2, a scaled feed
+// wider than 2 x 0.964 (1 - H_F) um (1.0604 um at H_F 0.45).
+TEST(PhaseSeparation, LawSplitsWhereItsThresholdIsBelowOneHalf) {
+  Bifurcation b;
+  b.first_diameter = b.second_diameter = 1e-6;
+  b.flow_fraction = 0.5;
+  b.feed_hematocrit = 0.45;
+  b.feed_diameter = 1.07e-6;
+  EXPECT_TRUE(law_splits(b));
+  EXPECT_NO_THROW(phase_separation_law(b));
+  b.feed_diameter = 1.05e-6;
+  EXPECT_FALSE(law_splits(b));
+  EXPECT_THROW(phase_separation_law(b), InputError);
+  b.diameter_scale = 1.1;  // the cells' size moves the edge
+  EXPECT_TRUE(law_splits(b));
+}
+}  // namespace
+}  // namespace hemotree

@@ -131,7 +131,7 @@ void RedCellTransport::split_at_nodes(std::span<const double> face_volume) {
     bif.feed_hematocrit = discharge_[c];
     bif.diameter_scale = options_.diameter_scale;
     // The law has no split where X0 >= 1/2 (a feed under 1.93 (1 - H) um): mixed there.
-    if (!(0.964 * (1 - bif.feed_hematocrit) / (bif.feed_diameter * bif.diameter_scale * 1e6) < 0.5)) continue;
+    if (!law_splits(bif)) continue;
     const double fqe = red_cell_fraction(bif);
     share_[f1] = fqe / bif.flow_fraction;
     share_[f2] = (1 - fqe) / (1 - bif.flow_fraction);
