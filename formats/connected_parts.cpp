@@ -1,0 +1,95 @@
+#include "formats/connected_parts.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+
+namespace hemotree {
+
+ConnectedParts connected_parts(const Network& net, std::span<const NodeBoundary> boundaries) {
+  const std::size_t nodes = net.node_count(), n = net.vessel_count();
+  NodeParts roots(net);
+  // Parts numbered as their roots are first met along the vessels, then sorted.
+  std::vector<std::int32_t> part_of_root(nodes, -1);
+  std::vector<ConnectedPart> parts;
+  std::vector<std::int32_t> part_of_node(nodes, -1);
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto r = static_cast<std::size_t>(roots.root(net.from[v]));
+    if (part_of_root[r] < 0) {
+      part_of_root[r] = static_cast<std::int32_t>(parts.size());
+      parts.emplace_back().lowest_vessel_id = net.id[v];
+    }
+    ConnectedPart& part = parts[static_cast<std::size_t>(part_of_root[r])];
+    ++part.vessels;
+    part.lowest_vessel_id = std::min(part.lowest_vessel_id, net.id[v]);
+    for (const std::int32_t i : {net.from[v], net.to[v]}) {
+      auto& mine = part_of_node[static_cast<std::size_t>(i)];
+      if (mine < 0) {
+        mine = part_of_root[r];
+        ++part.nodes;
+      }
+    }
+  }
+  for (const NodeBoundary& b : boundaries) {
+    const std::int32_t k = part_of_node[static_cast<std::size_t>(b.node)];
+    if (k < 0) continue;
+    ConnectedPart& part = parts[static_cast<std::size_t>(k)];
+    part.boundary_nodes.push_back(b.node);
+    if (b.type != BoundaryType::flow) {
+      part.pressure_reference = true;
+      continue;
+    }
+    const double q = b.waveform.mean_value();
+    part.net_inflow += q;
+    part.largest_flow = std::max(part.largest_flow, std::abs(q));
+    if (b.waveform.shape != Waveform::Shape::constant) part.time_varying_flows = true;
+  }
+
+  std::vector<std::int32_t> order(parts.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+    const ConnectedPart &pa = parts[static_cast<std::size_t>(a)], &pb = parts[static_cast<std::size_t>(b)];
+    return pa.vessels != pb.vessels ? pa.vessels > pb.vessels : pa.lowest_vessel_id < pb.lowest_vessel_id;
+  });
+  std::vector<std::int32_t> rank(parts.size());
+  ConnectedParts out;
+  out.parts.reserve(parts.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    rank[static_cast<std::size_t>(order[k])] = static_cast<std::int32_t>(k);
+    out.parts.push_back(std::move(parts[static_cast<std::size_t>(order[k])]));
+  }
+  for (auto& k : part_of_node)
+    if (k >= 0) k = rank[static_cast<std::size_t>(k)];
+  for (ConnectedPart& part : out.parts) std::sort(part.boundary_nodes.begin(), part.boundary_nodes.end());
+  out.part_of_node = std::move(part_of_node);
+  return out;
+}
+
+ConnectedParts connected_parts(const Network& net) {
+  const std::vector<NodeBoundary> boundaries = node_boundaries(net);
+  return connected_parts(net, boundaries);
+}
+
+std::string part_name(const ConnectedPart& part) {
+  return "the part with vessel " + std::to_string(part.lowest_vessel_id) + " (" + std::to_string(part.vessels) +
+         (part.vessels == 1 ? " vessel)" : " vessels)");
+}
+
+std::string boundary_node_list(const Network& net, const ConnectedPart& part, std::size_t shown) {
+  const std::size_t count = part.boundary_nodes.size();
+  std::string s;
+  for (std::size_t k = 0; k < std::min(count, shown); ++k)
+    s += (k == 0 ? "" : ", ") + std::to_string(net.node_id[static_cast<std::size_t>(part.boundary_nodes[k])]);
+  if (count > shown) s += " and " + std::to_string(count - shown) + " more";
+  return s;
+}
+
+std::string flow_balance(const ConnectedPart& part) {
+  const std::string mean = part.time_varying_flows ? "mean " : "";
+  if (part.flows_balance()) return "the " + mean + "flows balance";
+  char text[64];
+  std::snprintf(text, sizeof text, "%.6g ml/min", part.net_inflow * 60e6);
+  return "the net " + mean + "inflow is " + text;
+}
+
+}  // namespace hemotree
