@@ -14,6 +14,7 @@
 #include "exchange/secomb.hpp"
 #include "exchange/vtk_centerline.hpp"
 #include "formats/field_ranges.hpp"
+#include "formats/largest_part.hpp"
 #include "formats/network_io.hpp"
 
 using namespace hemotree;
@@ -59,6 +60,7 @@ void make_provenance_writable(nlohmann::json& provenance) {
 int main(int argc, char** argv) {
   CLI::App app{"Reads a network in another program's format and writes it as vnet JSON.", "vimport"};
   std::string format, input, output = "-";
+  bool keep_largest_part = false;
   std::string youngs_text, wall_ratio_text, mcv_text, plasma_text, hematocrit_text, radius_array, unit_text;
   app.add_option("FORMAT", format,
                  "secomb (network.dat), openbf (YAML), vtk (centerlines, .vtp or legacy .vtk), graphml, "
@@ -86,6 +88,8 @@ int main(int argc, char** argv) {
   app.add_option("--unit", unit_text,
                  "vtk, graphml, networkx: the length unit of the file's coordinates, lengths and radii (m, cm, mm, "
                  "um; VMTK models are usually in mm; default m, or a graph's own \"unit\" attribute)");
+  app.add_flag("--keep-largest-part", keep_largest_part,
+               "keep only the connected part with the most vessels, dropping the fragments (ids unchanged)");
   app.set_version_flag("--version", std::string("vimport ") + HEMOTREE_VERSION);
 
   return run_tool(app, argc, argv, [&] {
@@ -141,6 +145,12 @@ int main(int argc, char** argv) {
                   : format == "vtk"    ? read_vtk_centerline(input, options, centerline)
                   : format == "graphml" ? read_graphml(input, options, graph)
                                         : read_node_link_json(input, options, graph);
+    if (keep_largest_part) {
+      DroppedParts dropped;
+      net = largest_connected_part(net, &dropped);
+      options.note(describe(net, dropped));
+      parameters["keep_largest_part"] = true;
+    }
 
     // ---- blood: the file's, with what the flags set --------------------------------------
     if (mean_cell_volume || plasma_viscosity || hematocrit) {
