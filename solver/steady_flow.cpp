@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli/errors.hpp"
+#include "formats/connected_parts.hpp"
 #include "formats/topology.hpp"
 #include "network_flow/flow_network.hpp"
 #include "physics/poiseuille.hpp"
@@ -126,30 +127,6 @@ std::vector<std::int32_t> steady_outlets(const Network& net) {
 }
 
 namespace {
-
-// Union-find over nodes (keeping the lower root: short paths on a network numbered from its
-// root): the connected parts of the network.
-class NodeParts {
- public:
-  explicit NodeParts(const Network& net) : up_(net.node_count()) {
-    std::iota(up_.begin(), up_.end(), 0);
-    for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-      const std::int32_t rf = root(net.from[v]), rt = root(net.to[v]);
-      up_[static_cast<std::size_t>(std::max(rf, rt))] = std::min(rf, rt);
-    }
-  }
-  std::int32_t root(std::int32_t i) {
-    while (up_[static_cast<std::size_t>(i)] != i) {
-      auto& next = up_[static_cast<std::size_t>(i)];
-      next = up_[static_cast<std::size_t>(next)];  // path halving
-      i = next;
-    }
-    return i;
-  }
-
- private:
-  std::vector<std::int32_t> up_;
-};
 
 // The steady flow as the nodal system of the network's node pressures (flow_network.hpp):
 // each vessel an edge of conductance 1/R, each outlet a shunt 1/R to its outflow pressure
@@ -292,26 +269,37 @@ void SteadySystem::check_node_form(const std::vector<NodeBoundary>& boundaries) 
                        node_name(static_cast<std::int64_t>(i)) +
                        ", which no other vessel meets and which has no boundary condition (a dead end; a "
                        "closed one is {\"node\": " + std::to_string(net.node_id[i]) + ", \"type\": \"flow\", \"flow\": 0})");
-  // Each connected part needs a pressure to refer to: a prescribed one or an outlet's.
-  NodeParts parts(net);
-  std::vector<unsigned char> part_boundary(nodes, 0), part_reference(nodes, 0);
-  for (const NodeBoundary& b : boundaries) {
-    const auto r = static_cast<std::size_t>(parts.root(b.node));
-    part_boundary[r] = 1;
-    if (b.type != BoundaryType::flow) part_reference[r] = 1;
+  // Each connected part needs a pressure to refer to: a prescribed one or an outlet's. All
+  // parts without one are named at once: a measured network has many fragments.
+  const ConnectedParts parts = connected_parts(net, boundaries);
+  std::vector<const ConnectedPart*> floating;
+  for (const ConnectedPart& part : parts.parts)
+    if (!part.pressure_reference) floating.push_back(&part);
+  if (floating.empty()) return;
+  const std::size_t total = parts.parts.size();
+  std::string why;
+  for (const ConnectedPart* part : floating) {
+    why += why.empty() ? "" : "; ";
+    why += part_name(*part);
+    if (part->boundary_nodes.empty())
+      why += " has no boundary condition: it is cut off from every inflow and outflow";
+    else
+      why += " has flow boundaries only: its pressure is undetermined (at " +
+             std::string(part->boundary_nodes.size() == 1 ? "node " : "nodes ") + boundary_node_list(net, *part) +
+             "; " + flow_balance(*part) + ")";
   }
-  std::vector<std::size_t> part_vessels(nodes, 0);
-  for (std::size_t v = 0; v < n; ++v) ++part_vessels[static_cast<std::size_t>(parts.root(net.from[v]))];
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto r = static_cast<std::size_t>(parts.root(net.from[v]));
-    if (part_reference[r]) continue;
-    const std::string part = "the part of the network with vessel " + std::to_string(net.id[v]) + " (" +
-                             std::to_string(part_vessels[r]) + (part_vessels[r] == 1 ? " vessel" : " vessels") + ")";
-    if (!part_boundary[r])
-      throw InputError(part + " has no boundary condition: it is cut off from every inflow and outflow");
-    throw InputError(part + " has flow boundaries only: its pressure is undetermined (give a node a pressure or "
-                     "an outlet)");
-  }
+  const std::string which = total == 1 ? "the network has no pressure to refer to"
+                            : floating.size() == total
+                                ? "none of the network's " + std::to_string(total) + " connected parts has a pressure to refer to"
+                            : floating.size() == 1
+                                ? "1 of the network's " + std::to_string(total) + " connected parts has no pressure to refer to"
+                                : std::to_string(floating.size()) + " of the network's " + std::to_string(total) +
+                                      " connected parts have no pressure to refer to";
+  const std::string remedy = floating.size() == 1 ? " (give a node a pressure or an outlet; where the flows balance, "
+                                                    "hemosolve --pressure-at NODE=PRESSURE fixes the level): "
+                                                  : " (give a node of each a pressure or an outlet; where a part's flows "
+                                                    "balance, hemosolve --pressure-at NODE=PRESSURE fixes its level): ";
+  throw InputError(which + remedy + why);
 }
 
 SteadyFlow SteadySystem::solve(const std::vector<double>& resistance, double inlet_flow) {

@@ -9,6 +9,7 @@
 
 #include "cli/errors.hpp"
 #include "formats/network_io.hpp"
+#include "formats/pressure_reference.hpp"
 #include "physics/rheology.hpp"
 #include "solver/loaded_tree.hpp"
 #include "solver/steady_flow.hpp"
@@ -302,14 +303,18 @@ TEST(SteadyFlowAtNodes, RefusesNetworksWithoutAPressureReference) {
   };
   Network flows_only = bridged_diamond(1e-9, 0);
   flows_only.boundaries[1] = flow_boundary(3, -1e-9);
-  expect_refusal(flows_only, "the part of the network with vessel 0 (5 vessels) has flow boundaries only");
+  expect_refusal(flows_only, "the network has no pressure to refer to (give a node a pressure or an outlet");
+  expect_refusal(flows_only, ": the part with vessel 0 (5 vessels) has flow boundaries only: its pressure is undetermined "
+                             "(at nodes 0, 3; the flows balance)");
   // A second part, 4 -> 5 -> 6 -> 4, with no boundary at all.
   Network apart = bridged_diamond(1e-9, 0);
   for (int n = 4; n < 7; ++n) apart.add_node(n);
   apart.add_vessel(5, 4, 5, 0.01, 1e-3, 1e-4, 2e5, 0);
   apart.add_vessel(6, 5, 6, 0.01, 1e-3, 1e-4, 2e5, 0);
   apart.add_vessel(7, 6, 4, 0.01, 1e-3, 1e-4, 2e5, 0);
-  expect_refusal(apart, "the part of the network with vessel 5 (3 vessels) has no boundary condition");
+  expect_refusal(apart, "1 of the network's 2 connected parts has no pressure to refer to");
+  expect_refusal(apart, ": the part with vessel 5 (3 vessels) has no boundary condition: it is cut off from every "
+                        "inflow and outflow");
   // A dead end: 2 -> 4 with nothing at node 4.
   Network dead = bridged_diamond(1e-9, 0);
   dead.add_node(4);
@@ -321,6 +326,81 @@ TEST(SteadyFlowAtNodes, RefusesNetworksWithoutAPressureReference) {
   Network reflecting = bridged_diamond(1e-9, 0);
   reflecting.boundaries[1].type = BoundaryType::reflection;
   expect_refusal(reflecting, "node 3: a reflection outlet has no steady resistance");
+}
+
+// A measured network comes in parts, most of them fragments: every part without a pressure to
+// refer to is named in the one refusal, largest first, with its boundary nodes (five, then how
+// many more) and whether its flows balance.
+TEST(SteadyFlowAtNodes, RefusalNamesEveryPartWithoutAPressureReference) {
+  Network net = bridged_diamond(1e-9, 0);  // vessels 0-4, a pressure at node 3: referred
+  auto add_node = [&](std::int64_t id) { return net.add_node(id); };
+  auto add_vessel = [&](std::int64_t id, std::int32_t from, std::int32_t to) {
+    net.add_vessel(id, from, to, 0.01, 1e-3, 1e-4, 2e5, 0);
+  };
+  // A star of 7 arms from hub 10, flows at its 7 tips summing to 1e-12 m^3/s (0.00006 ml/min).
+  const std::int32_t hub = add_node(10);
+  for (int k = 0; k < 7; ++k) {
+    const std::int32_t tip = add_node(11 + k);
+    add_vessel(20 + k, hub, tip);
+    net.boundaries.push_back(flow_boundary(tip, k < 6 ? 1e-9 : -6e-9 + 1e-12));
+  }
+  // A closed triangle (vessels 40-42) with no boundary, and a single vessel 30 whose ends carry
+  // balancing flows.
+  const std::int32_t a = add_node(30), b = add_node(31), c = add_node(32);
+  add_vessel(40, a, b);
+  add_vessel(41, b, c);
+  add_vessel(42, c, a);
+  const std::int32_t d = add_node(40), e = add_node(41);
+  add_vessel(30, d, e);
+  net.boundaries.push_back(flow_boundary(d, 2e-9));
+  net.boundaries.push_back(flow_boundary(e, -2e-9));
+  try {
+    solve_steady_flow(net, std::vector<double>(net.vessel_count(), 1e9), 0.0);
+    ADD_FAILURE() << "no refusal";
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line";
+    EXPECT_EQ(what.rfind("3 of the network's 4 connected parts have no pressure to refer to", 0), 0u) << what;
+    const std::string star = "the part with vessel 20 (7 vessels) has flow boundaries only: its pressure is "
+                             "undetermined (at nodes 11, 12, 13, 14, 15 and 2 more; the net inflow is 6e-05 ml/min)";
+    const std::string triangle = "the part with vessel 40 (3 vessels) has no boundary condition";
+    const std::string single = "the part with vessel 30 (1 vessel) has flow boundaries only: its pressure is "
+                               "undetermined (at nodes 40, 41; the flows balance)";
+    for (const std::string& part : {star, triangle, single}) EXPECT_NE(what.find(part), std::string::npos) << part << "\n" << what;
+    EXPECT_LT(what.find(star), what.find(triangle)) << "largest first";
+    EXPECT_LT(what.find(triangle), what.find(single));
+    EXPECT_EQ(what.find("vessel 0 "), std::string::npos) << "the referred part is not named: " << what;
+  }
+}
+
+// A part with flow boundaries only whose flows balance: its flows follow from them alone, and a
+// pressure fixed at any one node (fix_pressure_at) sets the level without changing them. The
+// bridged diamond with Q in at node 0 and out at node 3 carries Kirchhoff's flows by hand
+// (LoopedNetworkMatchesKirchhoffByHand), wherever its pressure is fixed.
+TEST(SteadyFlowAtNodes, ABalancedFlowsOnlyPartSolvesWithAPressureFixedAtANode) {
+  const double r = 1e9, q = 1e-9;
+  const std::vector<double> resistance{r, r, r, 2 * r, r};
+  const double expected_q[] = {6.0 / 11, 5.0 / 11, 7.0 / 11, -4.0 / 11, -1.0 / 11};
+  const double expected_p[] = {13.0 / 11, 7.0 / 11, 8.0 / 11, 0};  // above node 3's [Pa]
+  for (const std::int64_t node : {1, 2}) {
+    Network net = bridged_diamond(q, 0);
+    net.boundaries[1] = flow_boundary(3, -q);
+    EXPECT_THROW(solve_steady_flow(net, resistance, 0.0), InputError);
+    const double level = 1333.0;
+    fix_pressure_at(net, node, level);
+    const SteadyFlow s = solve_steady_flow(net, resistance, 0.0);
+    for (int v = 0; v < 5; ++v) EXPECT_NEAR(s.flow[v], q * expected_q[v], 1e-12 * q) << "vessel " << v;
+    EXPECT_DOUBLE_EQ(s.node_pressure[static_cast<std::size_t>(node)], level);
+    const double offset = level - expected_p[node];
+    for (int n = 0; n < 4; ++n) EXPECT_NEAR(s.node_pressure[n], offset + expected_p[n], 1e-12 * level) << "node " << n;
+    // The fixed node takes up nothing: what enters it leaves it.
+    double out_of_node = 0;
+    for (std::size_t v = 0; v < 5; ++v) {
+      if (net.from[v] == node) out_of_node += s.flow[v];
+      if (net.to[v] == node) out_of_node -= s.flow[v];
+    }
+    EXPECT_NEAR(out_of_node, 0.0, 1e-12 * q) << "node " << node;
+  }
 }
 
 // A tapered vessel resists as the integral of Poiseuille's law along it: for Newtonian
