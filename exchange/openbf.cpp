@@ -12,6 +12,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -19,6 +20,7 @@
 #include <set>
 #include <sstream>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
@@ -49,6 +51,12 @@ double avolio_wall_thickness(double radius) {
 double characteristic_impedance(double density, double youngs_modulus, double wall, double radius) {
   const double c0 = std::sqrt(2.0 / 3.0 * youngs_modulus * wall / (density * radius));
   return density * c0 / (std::numbers::pi * radius * radius);
+}
+
+// That law as hemotree's p = p_ext + beta (sqrt(A) - sqrt(A0)): beta = 4 E h0 / (3 sqrt(pi) R0^2)
+// [Pa/m] (openBF's own beta, sqrt(pi / A0) h0 E / (1 - 1/4), is this times sqrt(A0)).
+double openbf_beta(double youngs_modulus, double wall, double radius) {
+  return 4 * youngs_modulus * wall / (3 * std::sqrt(std::numbers::pi) * radius * radius);
 }
 
 // A velocity profile u ~ 1 - (r/R)^gamma (openBF's gamma_profile) has the momentum-flux
@@ -83,17 +91,26 @@ struct Source {
   }
 };
 
-// A YAML mapping's entries in file order; refuses anything else and keys given twice.
+// A YAML mapping's entries in file order; refuses anything else, keys it does not know (with
+// `unknown`, checked first, so that a file of many unknown keys is refused at the first) and
+// keys given twice (a hash set: many keys cost linear time).
 class Fields {
  public:
-  Fields(const Source& source, const YAML::Node& node, std::string what)
+  // `unknown(key)`: the message for a key this mapping does not have, "" where it has it.
+  using Unknown = std::function<std::string(const std::string&)>;
+
+  Fields(const Source& source, const YAML::Node& node, std::string what, const Unknown& unknown = {})
       : source_(source), what_(std::move(what)), mark_(node.Mark()) {
     if (!node.IsMap()) source_.fail(mark_, what_ + " must be a mapping of keys to values");
+    std::unordered_set<std::string> seen;
     for (const auto& item : node) {
       if (!item.first.IsScalar()) source_.fail(item.first.Mark(), what_ + ": a key must be a plain name");
       Entry e{item.first.as<std::string>(), item.first.Mark(), item.second};
-      for (const Entry& seen : entries_)
-        if (seen.key == e.key) source_.fail(e.mark, what_ + ": \"" + e.key + "\" given twice");
+      if (unknown) {
+        const std::string why = unknown(e.key);
+        if (!why.empty()) source_.fail(e.mark, what_ + ": " + why);
+      }
+      if (!seen.insert(e.key).second) source_.fail(e.mark, what_ + ": \"" + e.key + "\" given twice");
       entries_.push_back(std::move(e));
     }
   }
@@ -159,15 +176,55 @@ class Fields {
   std::vector<Entry> entries_;
 };
 
-YAML::Node load_yaml(const std::string& path) {
+// --- reading files with bounds ------------------------------------------------------------
+
+// openBF's models and inlet tables are small text files (ADAN56's model is 30 kB, its table 22
+// rows). Caps on what is read keep a wrong name (a device, a pipe, a file that never ends, a
+// huge one) from taking memory and time without bound: far above any model, and below what
+// yaml-cpp's nodes (tens of bytes of memory per byte of YAML) can hold comfortably.
+constexpr std::size_t model_cap = std::size_t{8} << 20;   // bytes
+constexpr std::size_t inlet_cap = std::size_t{64} << 20;  // bytes
+constexpr std::size_t line_cap = 4096;                    // bytes of one inlet-table line
+
+// The whole of a regular file of at most `cap` bytes. `named` names it in the IoError of a file
+// that cannot be read; `kind` says what the file should be ("an inlet table").
+std::string read_capped(const std::string& path, const std::string& named, const std::string& kind, std::size_t cap) {
+  const std::string limit = kind + " is a text file of at most " + std::to_string(cap >> 20) + " MB";
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (error || !fs::exists(status))
+    throw IoError("cannot read " + named + ": " + (error ? error.message() : std::string("no such file")));
+  // Before opening: opening a pipe waits for a writer.
+  if (!fs::is_regular_file(status)) throw InputError(path + ": not a regular file; " + limit);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot read " + path + ": " + std::strerror(errno));
+  if (!in) throw IoError("cannot read " + named + ": " + std::strerror(errno));
+  std::string text;
+  std::vector<char> block(1 << 16);
+  while (in) {
+    in.read(block.data(), static_cast<std::streamsize>(block.size()));
+    const auto got = static_cast<std::size_t>(in.gcount());
+    if (text.size() + got > cap) throw InputError(path + ": larger than " + std::to_string(cap >> 20) + " MB; " + limit);
+    text.append(block.data(), got);
+  }
+  if (in.bad()) throw IoError("cannot read " + named + ": " + std::strerror(errno));
+  return text;
+}
+
+// The model: one YAML document. A second one (after "---") would be dropped, so it is refused.
+YAML::Node load_yaml(const std::string& path) {
+  const std::string text = read_capped(path, path, "an openBF model", model_cap);
+  std::vector<YAML::Node> documents;
   try {
-    return YAML::Load(in);
+    documents = YAML::LoadAll(text);
   } catch (const YAML::Exception& e) {
     // yaml-cpp's own message carries "yaml-cpp: error at line L, column C: "; keep its reason.
     Source{path}.fail(e.mark, "not valid YAML: " + e.msg);
   }
+  for (std::size_t k = 1; k < documents.size(); ++k)
+    if (!documents[k].IsNull())
+      Source{path}.fail(documents[k].Mark(), "a second YAML document (after \"---\"); an openBF model is one "
+                                             "document, and hemotree reads nothing it would drop");
+  return documents.empty() ? YAML::Node() : documents.front();
 }
 
 // --- one vessel, as openBF reads it --------------------------------------------------------
@@ -185,7 +242,8 @@ struct VesselModel {
   double wall = unset;                // h0, NaN: openBF's law
   double external_pressure = 0;       // Pext
   YAML::Mark external_pressure_mark;  // where Pext was given
-  std::optional<double> profile;      // gamma_profile
+  std::optional<double> profile;      // gamma_profile, or openBF 1.x's "gamma profile"
+  bool profile_spaced = false;        // given as "gamma profile", which openBF 2.x does not read
   YAML::Mark profile_mark;
   // The outlet's keys, NaN where absent; `outlet` (wk2, wk3, reflection) only names the kind.
   double r1 = unset, r2 = unset, cc = unset, rt = unset, pout = unset;
@@ -200,9 +258,20 @@ struct VesselModel {
 
 bool has_outlet(const VesselModel& v) { return v.first_outlet_key != nullptr; }
 
+// The keys of a vessel that hemotree reads, refuses with a reason, or ignores.
+const std::set<std::string, std::less<>> vessel_keys = {
+    "label", "sn", "tn", "L", "E", "R0", "Rp", "Rd", "h0", "Pext", "gamma_profile", "gamma profile",
+    "R1", "R2", "Cc", "Rt", "Pout", "outlet", "inlet_impedance_matching", "visco-elastic", "phi", "inlet",
+    "inlet file", "M", "to_save", "initial_pressure", "initial_flow", "inlet number"};
+
+std::string unknown_vessel_key(const std::string& key) {
+  return vessel_keys.contains(key) ? ""
+                                   : "\"" + key + "\" is not an openBF vessel key that hemotree reads or may safely ignore";
+}
+
 VesselModel read_vessel(const Source& source, const YAML::Node& node, std::size_t position,
                         std::set<std::string, std::less<>>& ignored, std::deque<Fields>& keep) {
-  const Fields& f = keep.emplace_back(source, node, "vessel " + std::to_string(position));
+  const Fields& f = keep.emplace_back(source, node, "vessel " + std::to_string(position), unknown_vessel_key);
   VesselModel v;
   v.mark = node.Mark();
   v.label = f.text(f.require("label"));
@@ -236,6 +305,7 @@ VesselModel read_vessel(const Source& source, const YAML::Node& node, std::size_
   }
   if (const Entry* e = f.find("gamma_profile", "gamma profile")) {
     v.profile = f.number(*e, profile_range);
+    v.profile_spaced = e->key == "gamma profile";
     v.profile_mark = e->mark;
   }
 
@@ -303,15 +373,20 @@ struct Row {
 };
 
 std::vector<Row> read_rows(const std::string& path, const std::string& named_by) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot read the inlet file " + path + " (" + named_by + "): " + std::strerror(errno));
+  const std::string text = read_capped(path, "the inlet file " + path + " (" + named_by + ")", "an inlet table", inlet_cap);
   std::vector<Row> rows;
-  std::string line;
-  for (std::size_t number = 1; std::getline(in, line); ++number) {
+  std::size_t number = 0;
+  for (std::size_t start = 0; start < text.size();) {
+    const std::size_t stop = std::min(text.find('\n', start), text.size());
+    ++number;
+    if (stop - start > line_cap)
+      throw InputError(path + ":" + std::to_string(number) + ": a line longer than " + std::to_string(line_cap) +
+                       " characters; an inlet table has two numbers a line, t [s] and Q [m^3/s]");
     double row[2];
     std::size_t count = 0;
-    const char* c = line.data();
-    const char* end = c + line.size();
+    const char* c = text.data() + start;
+    const char* end = text.data() + stop;
+    start = stop + 1;
     while (true) {
       while (c < end && (*c == ' ' || *c == '\t' || *c == '\r' || *c == ',')) ++c;
       if (c == end) break;
@@ -326,24 +401,46 @@ std::vector<Row> read_rows(const std::string& path, const std::string& named_by)
     if (count != 2) throw InputError(path + ":" + std::to_string(number) + ": expected two numbers, t [s] and Q [m^3/s]");
     rows.push_back({row[0], row[1], number});
   }
-  if (in.bad()) throw IoError("cannot read the inlet file " + path + ": " + std::strerror(errno));
   return rows;
 }
 
-// The flow openBF reads at time t in [0, period] (boundary_conditions.jl, inputFromData): the
-// first pair of consecutive rows whose times enclose t, interpolated linearly. A row earlier
-// than the one before it opens no interval of its own.
-double openbf_flow(const std::vector<Row>& rows, double t) {
-  for (std::size_t k = 0; k + 1 < rows.size(); ++k)
-    if (t >= rows[k].t && t <= rows[k + 1].t)
-      return rows[k + 1].t == rows[k].t ? rows[k].q
-                                         : rows[k].q + (t - rows[k].t) * (rows[k + 1].q - rows[k].q) / (rows[k + 1].t - rows[k].t);
-  return std::numeric_limits<double>::quiet_NaN();
-}
+// The flow openBF reads at time t in [0, period] (boundary_conditions.jl, inlet_from_data):
+// the first pair of consecutive rows, in file order, whose times enclose t, interpolated
+// linearly. A pair that goes back in time encloses nothing, and a pair only counts beyond the
+// latest time of the rows before it (earlier pairs cover everything up to there), so openBF's
+// reading is a chain of pieces: each pair that reaches past the running latest time gives the
+// piece from there to its end. Found by bisection, so that a long table costs n log n.
+class OpenbfFlow {
+ public:
+  explicit OpenbfFlow(const std::vector<Row>& rows) {
+    double latest = rows.front().t;
+    for (std::size_t k = 0; k + 1 < rows.size(); ++k)
+      if (rows[k + 1].t > latest) {
+        pieces_.push_back({rows[k + 1].t, &rows[k], &rows[k + 1]});
+        latest = rows[k + 1].t;
+      }
+  }
+  double operator()(double t) const {
+    const auto p = std::lower_bound(pieces_.begin(), pieces_.end(), t,
+                                    [](const Piece& piece, double time) { return piece.end < time; });
+    if (p == pieces_.end()) return std::numeric_limits<double>::quiet_NaN();
+    const Row &a = *p->from, &b = *p->to;
+    return a.q + (t - a.t) * (b.q - a.q) / (b.t - a.t);
+  }
+
+ private:
+  struct Piece {
+    double end;
+    const Row *from, *to;
+  };
+  std::vector<Piece> pieces_;
+};
 
 Waveform read_inlet_table(const std::string& path, const std::string& named_by, const ImportOptions& options) {
   const std::vector<Row> rows = read_rows(path, named_by);
-  if (rows.size() < 3) throw InputError(path + ": an inlet table needs at least 3 rows, from t = 0 to the period");
+  // openBF interpolates between a row and the next, so it needs two rows: t = 0 and the period
+  // (two rows with one flow are a constant inflow, as vexport writes it).
+  if (rows.size() < 2) throw InputError(path + ": an inlet table needs at least 2 rows, t = 0 and the period");
   if (rows.front().t != 0)
     throw InputError(path + ":" + std::to_string(rows.front().line) + ": openBF's inlet table starts at t = 0 (got " +
                      format_number(rows.front().t) + " s)");
@@ -370,18 +467,28 @@ Waveform read_inlet_table(const std::string& path, const std::string& named_by, 
   const double last = w.value.back();
   w.time.pop_back();
   w.value.pop_back();
+  // Two rows leave one sample; hemotree's table needs two: openBF's flow at mid-period joins it
+  // (the same flow where the two rows give one, a constant inflow).
+  if (w.time.size() == 1) {
+    w.time.push_back(period / 2);
+    w.value.push_back((w.value.front() + last) / 2);
+  }
   check_waveform(w, path);
   if (!backward.empty()) {
     std::string lines;
-    for (std::size_t l : backward) lines += (lines.empty() ? "" : ", ") + std::to_string(l);
+    // A few line numbers say where; a table that steps back everywhere is told by its count.
+    for (std::size_t k = 0; k < std::min<std::size_t>(backward.size(), 10); ++k)
+      lines += (lines.empty() ? "" : ", ") + std::to_string(backward[k]);
+    if (backward.size() > 10) lines += " and " + std::to_string(backward.size() - 10) + " more";
+    const OpenbfFlow openbf(rows);
     double deviation = 0;
     constexpr int samples = 20000;
     for (int k = 0; k < samples; ++k) {
       const double t = period * k / samples;
-      deviation = std::max(deviation, std::abs(w(t) - openbf_flow(rows, t)));
+      deviation = std::max(deviation, std::abs(w(t) - openbf(t)));
     }
     for (const Row& r : rows)
-      if (r.t < period) deviation = std::max(deviation, std::abs(w(r.t) - openbf_flow(rows, r.t)));
+      if (r.t < period) deviation = std::max(deviation, std::abs(w(r.t) - openbf(r.t)));
     options.note("inlet table " + path + ": rows " + lines + " go back in time and are left out; the flow then " +
                  "differs from openBF's reading by at most " + three_digits(deviation) + " m^3/s (" +
                  three_digits(100 * deviation / w.peak()) + " % of the peak)");
@@ -450,11 +557,16 @@ std::vector<std::int32_t> generations(const Source& source, const std::vector<Ve
 
 }  // namespace
 
-Network read_openbf(const std::string& path, const ImportOptions& options) {
+Network read_openbf(const std::string& path, const ImportOptions& options, OpenbfReading reading) {
+  const bool as_coded = reading == OpenbfReading::code;
   const Source source{path};
   const YAML::Node root = load_yaml(path);
   if (!root.IsMap()) source.fail(root.Mark(), "an openBF model is a mapping with \"network\", \"blood\" and \"solver\"");
-  const Fields top(source, root, "model");
+  const Fields top(source, root, "model", [](const std::string& key) -> std::string {
+    static const std::set<std::string, std::less<>> known = {
+        "project_name", "project name", "inlet_file", "write_results", "output_directory", "solver", "blood", "network"};
+    return known.contains(key) ? "" : "\"" + key + "\" is not an openBF key that hemotree reads or may safely ignore";
+  });
 
   std::set<std::string, std::less<>> ignored;
   std::string project_name, inlet_file;
@@ -472,17 +584,16 @@ Network read_openbf(const std::string& path, const ImportOptions& options) {
     } else if (e.key == "write_results" || e.key == "output_directory") {
       ignored.insert(e.key);
     } else if (e.key == "solver") {
-      const Fields solver(source, e.value, "solver");
-      for (const Entry& s : solver.entries()) {
-        if (s.key != "Ccfl" && s.key != "cycles" && s.key != "jump" && s.key != "convergence_tolerance" &&
-            s.key != "convergence tolerance")
-          solver.fail(s, "\"" + s.key + "\" is not an openBF solver setting that hemotree knows");
-        ignored.insert(s.key);
-      }
+      const Fields solver(source, e.value, "solver", [](const std::string& key) -> std::string {
+        static const std::set<std::string, std::less<>> known = {"Ccfl", "cycles", "jump", "convergence_tolerance",
+                                                                 "convergence tolerance"};
+        return known.contains(key) ? "" : "\"" + key + "\" is not an openBF solver setting that hemotree knows";
+      });
+      for (const Entry& s : solver.entries()) ignored.insert(s.key);
     } else if (e.key == "blood") {
-      const Fields blood(source, e.value, "blood");
-      for (const Entry& b : blood.entries())
-        if (b.key != "rho" && b.key != "mu") blood.fail(b, "\"" + b.key + "\" is not an openBF blood key (rho, mu)");
+      const Fields blood(source, e.value, "blood", [](const std::string& key) -> std::string {
+        return key == "rho" || key == "mu" ? "" : "\"" + key + "\" is not an openBF blood key (rho, mu)";
+      });
       density = blood.number(blood.require("rho"), ranges::density);
       viscosity = blood.number(blood.require("mu"), ranges::viscosity);
     } else if (e.key == "network") {
@@ -490,22 +601,26 @@ Network read_openbf(const std::string& path, const ImportOptions& options) {
         top.fail(e, "\"network\" must be a list of vessels");
       for (std::size_t k = 0; k < e.value.size(); ++k)
         vessels.push_back(read_vessel(source, e.value[k], k + 1, ignored, vessel_fields));
-    } else {
-      top.fail(e, "\"" + e.key + "\" is not an openBF key that hemotree reads or may safely ignore");
     }
   }
   top.require("network");
   top.require("blood");
 
   // One velocity profile and one external pressure for the whole network: hemotree has one
-  // blood.alpha and one interstitial pressure (hemosolve --external-pressure).
-  const double profile = vessels.front().profile.value_or(default_profile);
+  // blood.alpha and one interstitial pressure. openBF 2.x's code reads "gamma_profile" only:
+  // where a file spells it "gamma profile" (openBF 1.x), the code takes its default.
+  std::size_t spaced_profiles = 0;
+  const auto profile_of = [&](const VesselModel& v) {
+    return as_coded && v.profile_spaced ? default_profile : v.profile.value_or(default_profile);
+  };
+  for (const VesselModel& v : vessels) spaced_profiles += v.profile_spaced;
+  const double profile = profile_of(vessels.front());
   const double external_pressure = vessels.front().external_pressure;
   for (std::size_t k = 1; k < vessels.size(); ++k) {
     const VesselModel& v = vessels[k];
-    if (v.profile.value_or(default_profile) != profile)
+    if (profile_of(v) != profile)
       source.fail(v.profile.has_value() ? v.profile_mark : v.mark,
-                  "vessel " + std::to_string(k + 1) + ": gamma_profile " + format_number(v.profile.value_or(default_profile)) +
+                  "vessel " + std::to_string(k + 1) + ": gamma_profile " + format_number(profile_of(v)) +
                       " differs from vessel 1's " + format_number(profile) +
                       ": hemotree has one velocity profile (blood alpha) for the network");
     if (v.external_pressure != external_pressure)
@@ -581,21 +696,28 @@ Network read_openbf(const std::string& path, const ImportOptions& options) {
   net.blood = blood;
 
   std::size_t law_walls = 0, tapered_law_walls = 0, ratio_walls = 0, open_ends = 0, wk2 = 0, wk3_without_r2 = 0;
+  std::size_t tapers = 0;
   nlohmann::json labels = nlohmann::json::array();
   for (std::size_t k = 0; k < vessels.size(); ++k) {
     const VesselModel& v = vessels[k];
     const std::string name = "vessel " + std::to_string(k + 1);
+    // openBF's code (vessel.jl) sets the radius of cell i to Rp + (Rd - Rp) / (M - 1) (i - 1) dx:
+    // a slope per cell taken as one per metre, so that along the vessel the radius changes by
+    // (Rd - Rp) dx, dx <= 1 mm, a thousandth of Rd - Rp or less. Its tapered vessels are
+    // uniform at Rp; its documentation tapers them linearly from Rp to Rd.
+    tapers += v.rd != v.rp;
+    const double rd = as_coded ? v.rp : v.rd;
     double wall = v.wall;
     if (std::isnan(wall)) {
-      // openBF evaluates its law along the vessel; one thickness per vessel is its value at
-      // the mean radius (openBF 1.x's choice), exact for a vessel that does not taper.
+      // openBF evaluates its law along the vessel: at Rp in its code; one thickness per vessel,
+      // as documented, is its value at the mean radius (openBF 1.x's choice).
       if (options.wall_ratio) {
         wall = *options.wall_ratio * 2 * v.rp;
         ++ratio_walls;
       } else {
-        wall = avolio_wall_thickness((v.rp + v.rd) / 2);
+        wall = avolio_wall_thickness((v.rp + rd) / 2);
         ++law_walls;
-        if (v.rp != v.rd) ++tapered_law_walls;
+        if (v.rp != rd) ++tapered_law_walls;
       }
       if (!ranges::wall_thickness.contains(wall))
         source.fail(v.mark, name + ": the wall thickness openBF derives from the radius, " +
@@ -603,17 +725,26 @@ Network read_openbf(const std::string& path, const ImportOptions& options) {
     }
     net.add_vessel(static_cast<std::int64_t>(k + 1), node_index.at(v.sn), node_index.at(v.tn), v.length, 2 * v.rp,
                    wall, v.youngs_modulus, generation[k]);
-    if (v.rd != v.rp) {
+    if (rd != v.rp) {
       net.distal_diameter.resize(k, unset);
-      net.distal_diameter.push_back(2 * v.rd);
+      net.distal_diameter.push_back(2 * rd);
     }
+    // openBF's tube law is the thin wall's (Poisson ratio 1/2) at its external pressure, given
+    // here as beta so that no option of hemosolve (its thick-wall law above h/D = 0.1, its one
+    // external pressure) changes it; a tapered vessel's beta follows 1 / D^2 (E h constant).
+    const double beta = openbf_beta(v.youngs_modulus, wall, v.rp);
+    if (!ranges::beta.contains(beta))
+      source.fail(v.mark, name + ": openBF's tube law 4 E h0 / (3 sqrt(pi) R^2) gives " + out_of_range("beta", ranges::beta, beta));
+    net.beta.push_back(beta);
+    net.reference_pressure.push_back(v.external_pressure);
     labels.push_back(v.label);
 
     // The outlet: at a vessel whose end no vessel leaves. openBF decides by the keys given
     // (vessel.jl), "outlet" only names the kind: R1, R2 and Cc a three-element Windkessel;
-    // R1 and Cc alone a two-element one, R1 the total resistance, which openBF splits into
-    // the vessel's characteristic impedance Z and R1 - Z; Rt (or nothing) a reflection
-    // coefficient (0 by default: non-reflecting).
+    // R1 and Cc alone a two-element one; Rt (or nothing) a reflection coefficient (0 by
+    // default: non-reflecting). The two-element Windkessel's R1 is, in openBF's documentation,
+    // the total resistance, split into the vessel's characteristic impedance Z and R1 - Z; its
+    // code keeps R1 before the compliance and puts R2 = R1 - Z beyond it (total 2 R1 - Z).
     const bool terminal = !topo.leaving.contains(v.tn);
     if (!terminal) {
       if (has_outlet(v))
@@ -644,12 +775,13 @@ Network read_openbf(const std::string& path, const ImportOptions& options) {
         o.r1 = v.r1;
         o.r2 = v.r2;
       } else {
+        // Z at the vessel's last cell: at Rd as documented, at (about) Rp in the code.
         const double z = characteristic_impedance(density, v.youngs_modulus,
-                                                  std::isnan(v.wall) ? avolio_wall_thickness(v.rd) : v.wall, v.rd);
+                                                  std::isnan(v.wall) ? avolio_wall_thickness(rd) : v.wall, rd);
         if (!(v.r1 > z))
-          fail("R1", "\"R1\" " + format_number(v.r1) + " Pa s/m^3, a two-element Windkessel's total resistance, is not above "
-               "the vessel's characteristic impedance Z = " + format_number(z) + " Pa s/m^3 that openBF puts before it");
-        o.r1 = z;
+          fail("R1", "\"R1\" " + format_number(v.r1) + " Pa s/m^3 of a two-element Windkessel is not above the vessel's "
+               "characteristic impedance Z = " + format_number(z) + " Pa s/m^3, so R2 = R1 - Z would not be positive");
+        o.r1 = as_coded ? v.r1 : z;
         o.r2 = v.r1 - z;
         ++wk2;
         if (v.outlet_kind == "wk3") ++wk3_without_r2;
@@ -675,24 +807,51 @@ Network read_openbf(const std::string& path, const ImportOptions& options) {
   net.provenance["external_pressure"] = external_pressure;
 
   // What was assumed, one line each.
+  // Where openBF's code and its documentation part, one line each: what was built, and how to
+  // get the other reading (docs/import.md).
+  const std::string reading_note = as_coded ? " (openBF's code; --as-documented for its documentation's reading)"
+                                            : " (openBF's documentation; its code differs: vimport's default)";
+  if (tapers > 0)
+    options.note(plural(tapers, "tapered vessel") + " (Rp != Rd): " +
+                 (as_coded ? "uniform at Rp, as openBF's code builds them (its radius changes by (Rd - Rp) dx, dx <= 1 mm, "
+                             "along the vessel), where its documentation tapers them linearly to Rd"
+                           : "tapered linearly from Rp to Rd, as openBF documents them; its code keeps them uniform at Rp") +
+                 reading_note);
+  if (spaced_profiles > 0)
+    options.note("\"gamma profile\" (openBF 1.x's spelling) on " + plural(spaced_profiles, "vessel") + ": " +
+                 (as_coded ? "not read by openBF 2.x's code, which takes its default gamma_profile 2 (friction 8 pi mu, "
+                             "blood alpha 4/3), where the documented key gives gamma " +
+                                 format_number(vessels.front().profile.value_or(default_profile))
+                           : "read as the profile exponent gamma (blood alpha " + three_digits(blood.alpha) +
+                                 "), which openBF 2.x's code ignores for its default 2") +
+                 reading_note);
+  if (wk2 > 0)
+    options.note(plural(wk2, "two-element Windkessel outlet") + " (R1 and Cc" +
+                 (wk3_without_r2 > 0 ? ", " + std::to_string(wk3_without_r2) + " of them marked wk3 without R2" : "") +
+                 "): " +
+                 (as_coded ? "R1 kept before the compliance and R2 = R1 - Z beyond it, Z the vessel's characteristic "
+                             "impedance (total 2 R1 - Z), as openBF's code builds them; its documentation makes R1 the "
+                             "total, split into Z and R1 - Z"
+                           : "R1 taken as the total resistance, split into the vessel's characteristic impedance Z and "
+                             "R1 - Z, as openBF documents it; its code adds R2 = R1 - Z to R1") +
+                 reading_note);
   if (law_walls > 0)
     options.note("wall thickness from openBF's law h0 = R (0.2802 e^(-505.3 R) + 0.1324 e^(-11.14 R)) [R in m] for " +
                  plural(law_walls, "vessel") +
                  (tapered_law_walls > 0 ? " (at the mean radius for the " + plural(tapered_law_walls, "tapered vessel") + ")"
-                                        : std::string()));
+                  : as_coded && tapers > 0 ? " (at Rp, as openBF's code has it, for the tapered ones)"
+                                           : std::string()));
   if (ratio_walls > 0)
     options.note("wall thickness h = " + format_number(*options.wall_ratio) + " D for " + plural(ratio_walls, "vessel") +
                  " without h0 (--wall-ratio)");
-  if (wk2 > 0)
-    options.note(plural(wk2, "two-element Windkessel outlet") + " (R1 and Cc" +
-                 (wk3_without_r2 > 0 ? ", " + std::to_string(wk3_without_r2) + " of them marked wk3 without R2" : "") +
-                 "): R1 taken as the total resistance, split into the vessel's characteristic impedance and the rest, "
-                 "as openBF documents it");
   if (open_ends > 0)
     options.note(plural(open_ends, "outlet") + " without outlet keys: openBF's default, non-reflecting (Rt = 0)");
-  options.note("openBF's external pressure Pext = " + format_number(external_pressure) +
-               " Pa (provenance external_pressure): run hemosolve with --external-pressure " +
-               format_number(external_pressure) + "Pa to match it");
+  options.note("tube laws: openBF's thin wall, each vessel's beta = 4 E h0 / (3 sqrt(pi) R^2) at its reference_pressure, "
+               "openBF's external pressure Pext = " + format_number(external_pressure) +
+               " Pa; hemosolve's --thick-wall-ratio and --external-pressure do not change them");
+  options.note("momentum flux: openBF's code takes alpha = 1 (a flat profile) and its friction from gamma_profile; "
+               "hemotree's one blood alpha = " + three_digits(blood.alpha) +
+               " sets both, so its convective term is that multiple of openBF's (no vnet field separates them)");
   if (!ignored.empty()) {
     std::string list;
     for (const std::string& k : ignored) list += (list.empty() ? "" : ", ") + k;
@@ -881,16 +1040,17 @@ void write_openbf(const Network& net, OutputStream& out, const std::string& inle
   out << y;
 
   for (std::size_t v = 0; v < nv; ++v) {
-    // A tube law given by beta is openBF's thin wall with E h0 = 3 beta A0 / (4 sqrt(pi)): h0
-    // is the vessel's (or openBF's law), E follows, exact where the vessel does not taper.
+    // A tube law given by beta is openBF's thin wall with E h0 = 3 beta A0 / (4 sqrt(pi)) at the
+    // vessel's `from` end: h0 is the vessel's (or openBF's law), E follows, or stays the vessel's
+    // where beta is that E and h0's (an import from openBF). Along a tapered vessel hemotree's
+    // given beta goes as 1 / D^2, as openBF's documented law with h0 and E fixed.
     double youngs_modulus = net.youngs_modulus[v], wall = net.wall_thickness[v];
     if (has_beta(v)) {
-      if (net.is_tapered(v))
-        throw InputError(vessel_name(v) + ": a tapered vessel whose tube law is given by beta; openBF derives a "
-                         "tapered vessel's from E and h0");
       const double r = net.diameter[v] / 2;
       if (std::isnan(wall)) wall = avolio_wall_thickness(r);
-      youngs_modulus = 3 * net.beta[v] * std::numbers::pi * r * r / (4 * std::sqrt(std::numbers::pi) * wall);
+      const bool own = !std::isnan(youngs_modulus) &&
+                       std::abs(openbf_beta(youngs_modulus, wall, r) - net.beta[v]) <= 1e-12 * net.beta[v];
+      if (!own) youngs_modulus = 3 * net.beta[v] * std::numbers::pi * r * r / (4 * std::sqrt(std::numbers::pi) * wall);
     }
     if (std::isnan(youngs_modulus))
       throw InputError(vessel_name(v) + ": no Young's modulus; openBF needs E for every vessel");

@@ -60,7 +60,7 @@ void make_provenance_writable(nlohmann::json& provenance) {
 int main(int argc, char** argv) {
   CLI::App app{"Reads a network in another program's format and writes it as vnet JSON.", "vimport"};
   std::string format, input, output = "-";
-  bool keep_largest_part = false;
+  bool keep_largest_part = false, as_documented = false;
   std::string youngs_text, wall_ratio_text, mcv_text, plasma_text, hematocrit_text, radius_array, unit_text;
   app.add_option("FORMAT", format,
                  "secomb (network.dat), openbf (YAML), vtk (centerlines, .vtp or legacy .vtk), graphml, "
@@ -90,6 +90,9 @@ int main(int argc, char** argv) {
                  "um; VMTK models are usually in mm; default m, or a graph's own \"unit\" attribute)");
   app.add_flag("--keep-largest-part", keep_largest_part,
                "keep only the connected part with the most vessels, dropping the fragments (ids unchanged)");
+  app.add_flag("--as-documented", as_documented,
+               "openbf: read the model as openBF's documentation describes it (default: as openBF's code computes "
+               "it; the notes name each difference)");
   app.set_version_flag("--version", std::string("vimport ") + HEMOTREE_VERSION);
 
   return run_tool(app, argc, argv, [&] {
@@ -97,12 +100,14 @@ int main(int argc, char** argv) {
     if (format != "secomb" && format != "openbf" && format != "vtk" && format != "graphml" && format != "networkx")
       throw InputError("FORMAT must be secomb, openbf, vtk, graphml or networkx (got '" + format + "')");
     if (!radius_array.empty() && format != "vtk") throw InputError("--radius-array applies to FORMAT vtk only");
+    if (as_documented && format != "openbf") throw InputError("--as-documented applies to FORMAT openbf only");
     if (!unit_text.empty() && (format == "secomb" || format == "openbf"))
       throw InputError("--unit applies to FORMAT vtk, graphml and networkx only (" + format + " files have their units)");
 
     ImportOptions options;
     options.note = [](const std::string& line) { note("note: " + line); };
     nlohmann::json parameters = nlohmann::json::object();
+    if (as_documented) parameters["as_documented"] = true;
     if (!youngs_text.empty()) {
       options.youngs_modulus = parse_quantity(youngs_text, Dimension::pressure, "--youngs-modulus",
                                               accepted(ranges::youngs_modulus), "Pa");
@@ -141,7 +146,8 @@ int main(int argc, char** argv) {
 
     // ---- read ----------------------------------------------------------------------------
     Network net = format == "secomb"   ? read_secomb(input, options)
-                  : format == "openbf" ? read_openbf(input, options)
+                  : format == "openbf" ? read_openbf(input, options,
+                                                     as_documented ? OpenbfReading::documented : OpenbfReading::code)
                   : format == "vtk"    ? read_vtk_centerline(input, options, centerline)
                   : format == "graphml" ? read_graphml(input, options, graph)
                                         : read_node_link_json(input, options, graph);

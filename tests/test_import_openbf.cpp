@@ -40,9 +40,9 @@ class OpenbfTest : public ::testing::Test {
   std::string path(const std::string& name) const { return (folder_ / name).string(); }
 
   // The message of the InputError that reading the model throws ("" when none).
-  std::string refusal(const std::string& model) {
+  std::string refusal(const std::string& model, OpenbfReading reading = OpenbfReading::code) {
     try {
-      read_openbf(model, options_);
+      read_openbf(model, options_, reading);
     } catch (const InputError& e) {
       return e.what();
     }
@@ -110,10 +110,19 @@ double avolio_wall_m(double radius_m) {
   return radius_m * (0.2802 * std::exp(-5.053 * r_cm) + 0.1324 * std::exp(-0.1114 * r_cm));
 }
 
+// openBF's thin-wall tube law as openBF writes it (vessel.jl): its beta = sqrt(pi / A0) h0 E /
+// (1 - 1/4), its pressure P = Pext + beta (sqrt(A / A0) - 1); hemotree's beta multiplies
+// sqrt(A) - sqrt(A0), so it is openBF's over sqrt(A0).
+double openbf_tube_beta(double e, double h, double r) {
+  const double a0 = std::numbers::pi * r * r;
+  return std::sqrt(std::numbers::pi / a0) * h * e / (1 - 0.25) / std::sqrt(a0);
+}
+
+// As openBF's documentation reads the model.
 TEST_F(OpenbfTest, ReadsEveryKeyOfAHandWrittenModel) {
   file("tee_inlet.dat", inlet_table);
   options_.note = [this](const std::string& s) { notes_.push_back(s); };
-  const Network net = read_openbf(file("tee.yaml", three_vessels), options_);
+  const Network net = read_openbf(file("tee.yaml", three_vessels), options_, OpenbfReading::documented);
 
   ASSERT_EQ(net.vessel_count(), 3u);
   ASSERT_EQ(net.node_count(), 4u);
@@ -184,6 +193,14 @@ TEST_F(OpenbfTest, ReadsEveryKeyOfAHandWrittenModel) {
   EXPECT_NEAR(net.wall_thickness[2], h, 1e-15);
 
   EXPECT_DOUBLE_EQ(net.provenance["external_pressure"].get<double>(), 0.0);
+  // openBF's thin wall, given as beta at Pext, whatever hemosolve's wall options.
+  ASSERT_EQ(net.beta.size(), 3u);
+  ASSERT_EQ(net.reference_pressure.size(), 3u);
+  for (std::size_t v = 0; v < 3; ++v) {
+    EXPECT_NEAR(net.beta[v], openbf_tube_beta(net.youngs_modulus[v], net.wall_thickness[v], net.diameter[v] / 2),
+                1e-12 * net.beta[v]);
+    EXPECT_EQ(net.reference_pressure[v], 0.0);
+  }
   bool told_two_element = false, told_ignored = false;
   for (const std::string& n : notes_) {
     told_two_element |= n.find("two-element Windkessel") != std::string::npos;
@@ -191,6 +208,63 @@ TEST_F(OpenbfTest, ReadsEveryKeyOfAHandWrittenModel) {
   }
   EXPECT_TRUE(told_two_element);
   EXPECT_TRUE(told_ignored);
+}
+
+// By default the model openBF's code computes (vessel.jl of openBF 2.x): a tapered vessel stays
+// at Rp (its code moves the radius by (Rd - Rp) dx only), with its law's wall at Rp; a
+// two-element Windkessel keeps R1 and gets R2 = R1 - Z beyond it; each difference from the
+// documented reading is one note naming --as-documented.
+TEST_F(OpenbfTest, ByDefaultBuildsTheModelOpenbfsCodeComputes) {
+  file("tee_inlet.dat", inlet_table);
+  options_.note = [this](const std::string& s) { notes_.push_back(s); };
+  const Network net = read_openbf(file("tee.yaml", three_vessels), options_);
+
+  EXPECT_FALSE(net.is_tapered(0));
+  EXPECT_DOUBLE_EQ(net.diameter[0], 0.020);
+  EXPECT_NEAR(net.wall_thickness[0], avolio_wall_m(0.010), 1e-15);
+  EXPECT_NEAR(net.beta[0], openbf_tube_beta(4e5, avolio_wall_m(0.010), 0.010), 1e-12 * net.beta[0]);
+  EXPECT_DOUBLE_EQ(net.blood->alpha, 1.1);  // gamma_profile (with the underscore) is read
+
+  // R1 = 2e9 stays proximal; R2 = R1 - Z with Z = 3.66e8 as in the documented reading.
+  const double r = 0.003, h = avolio_wall_m(r);
+  const double z = 1060 * std::sqrt(8e5 * h / (2 * 1060 * r * 0.75)) / (std::numbers::pi * r * r);
+  const Outlet& wk2 = net.outlets[1];
+  EXPECT_DOUBLE_EQ(wk2.r1, 2e9);
+  EXPECT_NEAR(wk2.r2, 2e9 - z, 1e-6);
+  EXPECT_NEAR(wk2.r1 + wk2.r2, 4e9 - z, 1e-6);
+  const Outlet& wk3 = net.outlets[0];  // R1, R2 and Cc given: the same in both readings
+  EXPECT_DOUBLE_EQ(wk3.r1, 1e8);
+  EXPECT_DOUBLE_EQ(wk3.r2, 1e9);
+
+  std::size_t named = 0;
+  bool told_taper = false, told_split = false, told_alpha = false;
+  for (const std::string& n : notes_) {
+    named += n.find("--as-documented") != std::string::npos;
+    told_taper |= n.rfind("1 tapered vessel (Rp != Rd): uniform at Rp", 0) == 0;
+    told_split |= n.find("R2 = R1 - Z beyond it") != std::string::npos;
+    told_alpha |= n.rfind("momentum flux: openBF's code takes alpha = 1", 0) == 0;
+  }
+  EXPECT_EQ(named, 2u);  // the taper and the two-element Windkessel
+  EXPECT_TRUE(told_taper);
+  EXPECT_TRUE(told_split);
+  EXPECT_TRUE(told_alpha);
+}
+
+// openBF 2.x's code reads "gamma_profile" only: "gamma profile" (1.x's spelling, as the circle
+// of Willis has it) leaves its default 2, a parabolic profile and friction 8 pi mu.
+TEST_F(OpenbfTest, TheSpacedGammaProfileIsReadOnlyAsDocumented) {
+  file("tee_inlet.dat", inlet_table);
+  std::string text = three_vessels;
+  for (std::size_t at; (at = text.find("gamma_profile")) != std::string::npos;) text.replace(at, 13, "gamma profile");
+  file("spaced.yaml", text);
+  options_.note = [this](const std::string& s) { notes_.push_back(s); };
+  EXPECT_DOUBLE_EQ(read_openbf(path("spaced.yaml"), options_).blood->alpha, 4.0 / 3.0);
+  bool told = false;
+  for (const std::string& n : notes_)
+    told |= n.rfind("\"gamma profile\" (openBF 1.x's spelling) on 3 vessels: not read by openBF 2.x's code", 0) == 0 &&
+            n.find("--as-documented") != std::string::npos;
+  EXPECT_TRUE(told);
+  EXPECT_DOUBLE_EQ(read_openbf(path("spaced.yaml"), options_, OpenbfReading::documented).blood->alpha, 1.1);
 }
 
 // The inlet file is found beside the model, whatever the working folder.
@@ -237,7 +311,7 @@ TEST_F(OpenbfTest, RefusesMalformedModelsNamingFileLineAndKey) {
                             "profile (blood alpha) for the network");
 
   file("m.yaml", replaced(three_vessels, "    R1: 2.0e9", "    R1: 1.0e8"));
-  EXPECT_EQ(refusal(p).rfind(p + ":42: vessel 3: \"R1\" 1e8 Pa s/m^3, a two-element Windkessel's total", 0), 0u)
+  EXPECT_EQ(refusal(p).rfind(p + ":42: vessel 3: \"R1\" 1e8 Pa s/m^3 of a two-element Windkessel is not above", 0), 0u)
       << refusal(p);
 
   file("m.yaml", replaced(three_vessels, "    R1: 1.0e8\n", ""));
@@ -319,23 +393,28 @@ void expect_same(const Network& a, const Network& b) {
     EXPECT_EQ(a.outlets[k].p_out, b.outlets[k].p_out);
     EXPECT_EQ(a.outlets[k].reflection, b.outlets[k].reflection);
   }
+  EXPECT_EQ(a.beta, b.beta);
+  EXPECT_EQ(a.reference_pressure, b.reference_pressure);
   EXPECT_EQ(a.provenance["labels"], b.provenance["labels"]);
   EXPECT_EQ(a.provenance["external_pressure"], b.provenance["external_pressure"]);
 }
 
-Network round_trip(const Network& net, const std::string& yaml, const std::string& inlet) {
+Network round_trip(const Network& net, const std::string& yaml, const std::string& inlet,
+                   OpenbfReading reading = OpenbfReading::code) {
   {
     OutputStream out(yaml);
     write_openbf(net, out, inlet);
     out.commit();
   }
-  return read_openbf(yaml, ImportOptions{});
+  return read_openbf(yaml, ImportOptions{}, reading);
 }
 
 TEST_F(OpenbfTest, WritesWhatItReads) {
   file("tee_inlet.dat", inlet_table);
-  const Network net = read_openbf(file("tee.yaml", three_vessels), options_);
   fs::create_directories(folder_ / "out");
+  const Network documented = read_openbf(file("tee.yaml", three_vessels), options_, OpenbfReading::documented);
+  expect_same(documented, round_trip(documented, path("out/doc.yaml"), path("out/doc_inlet.dat"), OpenbfReading::documented));
+  const Network net = read_openbf(file("tee.yaml", three_vessels), options_);
   const Network back = round_trip(net, path("out/copy.yaml"), path("out/copy_inlet.dat"));
   expect_same(net, back);
 
@@ -423,8 +502,9 @@ struct Shipped {
   std::size_t vessels, nodes, tapered, outlets;
 };
 
-// Counted from the files: vessels (list items), nodes (distinct sn/tn), tapered (Rp != Rd),
-// outlets (vessels whose tn no vessel leaves, each with R1 and Cc).
+// Counted from the files: vessels (list items), nodes (distinct sn/tn), tapered (Rp != Rd: as
+// documented; openBF's code keeps them at Rp), outlets (vessels whose tn no vessel leaves,
+// each with R1 and Cc).
 const Shipped shipped[] = {
     {"openbf/alastruey2007/circle_of_willis.yaml", 33, 30, 0, 11},
     {"openbf/boileau2015/adan56/adan56.yaml", 77, 78, 39, 31},
@@ -433,14 +513,15 @@ const Shipped shipped[] = {
 
 TEST_F(OpenbfTest, ReadsAndRoundTripsTheShippedModels) {
   if (!fs::exists(networks_dir() / "openbf")) GTEST_SKIP() << "no " << networks_dir() << "/openbf";
-  for (const Shipped& s : shipped) {
-    SCOPED_TRACE(s.path);
-    const Network net = read_openbf((networks_dir() / s.path).string(), options_);
+  for (const Shipped& s : shipped)
+    for (const OpenbfReading reading : {OpenbfReading::code, OpenbfReading::documented}) {
+    SCOPED_TRACE(std::string(s.path) + (reading == OpenbfReading::code ? " as coded" : " as documented"));
+    const Network net = read_openbf((networks_dir() / s.path).string(), options_, reading);
     EXPECT_EQ(net.vessel_count(), s.vessels);
     EXPECT_EQ(net.node_count(), s.nodes);
     std::size_t tapered = 0;
     for (std::size_t v = 0; v < net.vessel_count(); ++v) tapered += net.is_tapered(v);
-    EXPECT_EQ(tapered, s.tapered);
+    EXPECT_EQ(tapered, reading == OpenbfReading::code ? 0u : s.tapered);
     EXPECT_EQ(net.outlets.size(), s.outlets);
     for (const Outlet& o : net.outlets) {
       EXPECT_EQ(o.type, OutletType::rcr);
@@ -449,7 +530,7 @@ TEST_F(OpenbfTest, ReadsAndRoundTripsTheShippedModels) {
     }
     ASSERT_TRUE(net.inlet);
     EXPECT_EQ(net.node_id[net.from[static_cast<std::size_t>(net.index_of(net.inlet->vessel))]], 1);
-    const Network back = round_trip(net, path("copy.yaml"), path("copy_inlet.dat"));
+    const Network back = round_trip(net, path("copy.yaml"), path("copy_inlet.dat"), reading);
     expect_same(net, back);
   }
 }
@@ -459,7 +540,11 @@ TEST_F(OpenbfTest, TheCircleOfWillisClosesLoopsAndAdan56HasItsOwnExternalPressur
   const Network willis = read_openbf((networks_dir() / shipped[0].path).string(), options_);
   // Independent cycles of a connected graph: vessels - nodes + 1 (33 - 30 + 1).
   EXPECT_EQ(static_cast<long>(willis.vessel_count()) - static_cast<long>(willis.node_count()) + 1, 4);
-  EXPECT_DOUBLE_EQ(willis.blood->alpha, 1.1);  // "gamma profile: 9", openBF 1.x's spelling
+  // "gamma profile: 9", openBF 1.x's spelling: openBF 2.x's code reads its default 2.
+  EXPECT_DOUBLE_EQ(willis.blood->alpha, 4.0 / 3.0);
+  EXPECT_DOUBLE_EQ(read_openbf((networks_dir() / shipped[0].path).string(), options_, OpenbfReading::documented)
+                       .blood->alpha,
+                   1.1);
 
   const Network adan = read_openbf((networks_dir() / shipped[1].path).string(), options_);
   EXPECT_DOUBLE_EQ(adan.provenance["external_pressure"].get<double>(), 1e4);
