@@ -4,12 +4,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <numeric>
 #include <span>
 #include <stdexcept>
 #include <string>
 
 #include "cli/errors.hpp"
+#include "formats/connected_parts.hpp"
 
 namespace hemotree {
 
@@ -122,6 +122,35 @@ std::string format(const char* pattern, Args... args) {
   return buffer;
 }
 
+// The connected parts, largest first: all of them up to a screenful, then what the rest hold.
+void print_parts(const NetworkStats& stats, std::ostream& out) {
+  constexpr std::size_t shown = 20;
+  const auto& parts = stats.parts_by_size;
+  if (parts.empty()) return;
+  out << '\n'
+      << format("%-22s %10s %10s %15s  %s\n", "connected parts", "vessels", "nodes", "boundary nodes",
+                "pressure reference");
+  for (std::size_t k = 0; k < std::min(parts.size(), shown); ++k) {
+    const PartStats& part = parts[k];
+    const std::string reference = part.pressure_reference ? "yes"
+                                  : part.boundary_nodes == 0 ? "no (no boundary)"
+                                  : part.flows_balance      ? "no (flows balance)"
+                                                            : format("no (net inflow %.6g ml/min)", part.net_inflow * 60e6);
+    out << format("%-22s %10zu %10zu %15zu  %s\n", ("  with vessel " + std::to_string(part.lowest_vessel_id)).c_str(),
+                  part.vessels, part.nodes, part.boundary_nodes, reference.c_str());
+  }
+  if (parts.size() > shown) {
+    std::size_t vessels = 0, nodes = 0, boundary_nodes = 0;
+    for (std::size_t k = shown; k < parts.size(); ++k) {
+      vessels += parts[k].vessels;
+      nodes += parts[k].nodes;
+      boundary_nodes += parts[k].boundary_nodes;
+    }
+    out << format("%-22s %10zu %10zu %15zu  (--json lists them all)\n",
+                  ("  " + std::to_string(parts.size() - shown) + " more").c_str(), vessels, nodes, boundary_nodes);
+  }
+}
+
 }  // namespace
 
 NetworkStats compute_stats(const Network& net) {
@@ -139,17 +168,7 @@ NetworkStats compute_stats(const Network& net) {
   for (std::size_t node = 0; node < net.node_count(); ++node)
     if (ending[node] >= 1 && beginning[node] >= 2) ++stats.bifurcations;
 
-  // Degrees, parts (union-find), loops: the graph as it is, directions aside.
-  std::vector<std::int32_t> up(net.node_count());
-  std::iota(up.begin(), up.end(), 0);
-  auto root = [&](std::int32_t i) {
-    while (up[static_cast<std::size_t>(i)] != i) i = up[static_cast<std::size_t>(i)] = up[static_cast<std::size_t>(up[static_cast<std::size_t>(i)])];
-    return i;
-  };
-  for (std::size_t v = 0; v < n; ++v) {
-    const std::int32_t a = root(net.from[v]), b = root(net.to[v]);
-    up[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
-  }
+  // Degrees, parts, loops: the graph as it is, directions aside.
   std::size_t touched = 0;
   for (std::size_t node = 0; node < net.node_count(); ++node) {
     const std::size_t degree = ending[node] + beginning[node];
@@ -157,10 +176,14 @@ NetworkStats compute_stats(const Network& net) {
     ++touched;
     if (stats.nodes_by_degree.size() <= degree) stats.nodes_by_degree.resize(degree + 1, 0);
     ++stats.nodes_by_degree[degree];
-    if (root(static_cast<std::int32_t>(node)) == static_cast<std::int32_t>(node)) ++stats.parts;
   }
+  const std::vector<NodeBoundary> boundaries = node_boundaries(net);
+  for (const ConnectedPart& part : connected_parts(net, boundaries).parts)
+    stats.parts_by_size.push_back({part.lowest_vessel_id, part.vessels, part.nodes, part.boundary_nodes.size(),
+                                   part.pressure_reference, part.flows_balance(), part.net_inflow});
+  stats.parts = stats.parts_by_size.size();
   stats.loops = n + stats.parts - touched;
-  for (const NodeBoundary& b : node_boundaries(net)) ++stats.boundaries_by_type[static_cast<std::size_t>(b.type)];
+  for (const NodeBoundary& b : boundaries) ++stats.boundaries_by_type[static_cast<std::size_t>(b.type)];
 
   int max_generation = -1;
   for (std::size_t v = 0; v < n; ++v) {
@@ -220,6 +243,16 @@ nlohmann::json to_json(const NetworkStats& stats) {
     if (stats.nodes_by_degree[d] > 0) degrees[std::to_string(d)] = stats.nodes_by_degree[d];
   out["nodes_by_degree"] = std::move(degrees);
   out["parts"] = stats.parts;
+  nlohmann::json parts = nlohmann::json::array();
+  for (const PartStats& part : stats.parts_by_size)
+    parts.push_back({{"lowest_vessel_id", part.lowest_vessel_id},
+                     {"vessels", part.vessels},
+                     {"nodes", part.nodes},
+                     {"boundary_nodes", part.boundary_nodes},
+                     {"pressure_reference", part.pressure_reference},
+                     {"flows_balance", part.flows_balance},
+                     {"net_inflow", part.net_inflow}});
+  out["connected_parts"] = std::move(parts);
   out["loops"] = stats.loops;
   nlohmann::json boundaries = nlohmann::json::object();
   for (std::size_t t = 0; t < stats.boundaries_by_type.size(); ++t)
@@ -293,6 +326,8 @@ void print_table(const NetworkStats& stats, std::ostream& out) {
     out << format("%-22s %5d to %3d  (%d generations)\n", "capillary generations",
                   stats.capillary_generation_min, stats.capillary_generation_max,
                   stats.capillary_generation_max - stats.capillary_generation_min + 1);
+
+  print_parts(stats, out);
 
   // Class columns in VesselClass order, abbreviated so a row fits 110 characters.
   out << '\n'

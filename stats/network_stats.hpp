@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <ostream>
 #include <vector>
 
@@ -24,6 +25,20 @@ struct GenerationStats {
   Quartiles diameter;  // [m]
 };
 
+// One connected part of the network (formats/connected_parts.hpp), named by its lowest vessel
+// id: its size, its boundary nodes, and whether one of them is a pressure or an outlet (a
+// pressure to refer to); if none is, whether its flow boundaries balance (net_inflow, the sum
+// of their mean flows into it, within 1e-9 of the largest) as a pressure at one node needs.
+struct PartStats {
+  std::int64_t lowest_vessel_id = 0;
+  std::size_t vessels = 0;
+  std::size_t nodes = 0;
+  std::size_t boundary_nodes = 0;
+  bool pressure_reference = false;
+  bool flows_balance = true;
+  double net_inflow = 0;  // [m^3/s]
+};
+
 struct NetworkStats {
   std::size_t vessels = 0;
   std::size_t bifurcations = 0;  // nodes where one vessel ends and two or more begin (trees)
@@ -34,6 +49,7 @@ struct NetworkStats {
   // tree), and boundary conditions by type (flow, pressure, RCR, R, reflection).
   std::vector<std::size_t> nodes_by_degree;
   std::size_t parts = 0;
+  std::vector<PartStats> parts_by_size;  // largest first: most vessels, then lowest vessel id
   std::size_t loops = 0;
   std::array<std::size_t, 5> boundaries_by_type{};
   double total_length = 0;       // [m]

@@ -253,10 +253,16 @@ TEST(NetworkStats, JsonKeysAndValues) {
 
   const std::set<std::string> classes = {"artery", "small_artery", "arteriole", "capillary"};
   EXPECT_EQ(keys(j), (std::set<std::string>{"vessels", "bifurcations", "terminals", "nodes_by_degree", "parts",
-                                            "loops", "boundary_nodes", "total_length", "total_volume", "classes",
-                                            "capillary_generations", "generations"}));
+                                            "loops", "connected_parts", "boundary_nodes", "total_length",
+                                            "total_volume", "classes", "capillary_generations", "generations"}));
   EXPECT_EQ(j["nodes_by_degree"], (nlohmann::json{{"1", 3}, {"3", 1}}));
   EXPECT_EQ(j["parts"], 1);
+  ASSERT_EQ(j["connected_parts"].size(), 1u);
+  EXPECT_EQ(keys(j["connected_parts"][0]), (std::set<std::string>{"lowest_vessel_id", "vessels", "nodes",
+                                                                   "boundary_nodes", "pressure_reference",
+                                                                   "flows_balance", "net_inflow"}));
+  EXPECT_EQ(j["connected_parts"][0]["vessels"], 3);
+  EXPECT_EQ(j["connected_parts"][0]["nodes"], 4);
   EXPECT_EQ(j["loops"], 0);
   EXPECT_EQ(j["boundary_nodes"]["flow"], 0);
   EXPECT_EQ(keys(j["classes"]), classes);
@@ -307,6 +313,62 @@ TEST(NetworkStats, LoopsPartsDegreesAndBoundaryNodes) {
   std::ostringstream table;
   print_table(s, table);
   EXPECT_NE(table.str().find("boundary nodes                    2  (1 flow, 1 pressure)"), std::string::npos) << table.str();
+  // The parts, largest first, each named by its lowest vessel id.
+  ASSERT_EQ(s.parts_by_size.size(), 2u);
+  const PartStats& loop = s.parts_by_size[0];
+  EXPECT_EQ(loop.lowest_vessel_id, 1);
+  EXPECT_EQ(loop.vessels, 6u);
+  EXPECT_EQ(loop.nodes, 5u);
+  EXPECT_EQ(loop.boundary_nodes, 1u);
+  EXPECT_FALSE(loop.pressure_reference);  // a flow in at node 0 only
+  const PartStats& single = s.parts_by_size[1];
+  EXPECT_EQ(single.lowest_vessel_id, 7);
+  EXPECT_EQ(single.vessels, 1u);
+  EXPECT_EQ(single.nodes, 2u);
+  EXPECT_TRUE(single.pressure_reference);
+  EXPECT_NE(table.str().find("  with vessel 1                 6          5               1  no (flows balance)\n"
+                             "  with vessel 7                 1          2               1  yes\n"),
+            std::string::npos)
+      << table.str();
+  const nlohmann::json j = to_json(s);
+  EXPECT_EQ(j["connected_parts"][0]["lowest_vessel_id"], 1);
+  EXPECT_EQ(j["connected_parts"][1]["pressure_reference"], true);
+}
+
+// Fragments of a measured network: equal parts ordered by their lowest vessel id, flows that
+// do not balance reported in ml/min, and the table listing twenty parts, then what the rest hold.
+TEST(NetworkStats, ConnectedPartsLargestFirst) {
+  Network net = with_nodes(2 * 23);
+  for (int k = 0; k < 23; ++k) net.add_vessel(100 - k, 2 * k, 2 * k + 1, mm(1), um(20), 1e-6, 1e6, 0);
+  net.add_vessel(200, 44, 45, mm(1), um(20), 1e-6, 1e6, 0);  // the last pair twice: a part of 2
+  NodeBoundary in;
+  in.node = 20;  // the part of vessel 90
+  in.waveform = Waveform::constant_value(1e-9);
+  net.boundaries = {in};
+  const NetworkStats s = compute_stats(net);
+  ASSERT_EQ(s.parts_by_size.size(), 23u);
+  EXPECT_EQ(s.parts_by_size[0].lowest_vessel_id, 78);  // vessels 78 and 200
+  EXPECT_EQ(s.parts_by_size[0].vessels, 2u);
+  for (std::size_t k = 1; k < 23; ++k) EXPECT_EQ(s.parts_by_size[k].lowest_vessel_id, 78 + static_cast<int>(k));
+  const PartStats& fed = s.parts_by_size[12];
+  EXPECT_EQ(fed.lowest_vessel_id, 90);
+  EXPECT_FALSE(fed.flows_balance);
+  EXPECT_DOUBLE_EQ(fed.net_inflow, 1e-9);
+  std::ostringstream table;
+  print_table(s, table);
+  const std::string text = table.str();
+  EXPECT_NE(text.find("  with vessel 97"), std::string::npos) << text;  // the twentieth
+  EXPECT_EQ(text.find("  with vessel 98"), std::string::npos) << text;
+  EXPECT_NE(text.find("  with vessel 90                1          2               1  no (net inflow 0.06 ml/min)\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("  with vessel 91                1          2               0  no (no boundary)\n"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("  3 more                        3          6               0  (--json lists them all)"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(to_json(s)["connected_parts"].size(), 23u);
+  EXPECT_EQ(to_json(s)["connected_parts"][12]["flows_balance"], false);
 }
 
 TEST(NetworkStats, EmptyNetwork) {
