@@ -339,6 +339,62 @@ TEST_F(OpenbfTest, RefusesABadInletTableNamingItsLine) {
   EXPECT_EQ(refusal(path("tee.yaml")), path("tee_inlet.dat") + ":1: openBF's inlet table starts at t = 0 (got 0.1 s)");
 }
 
+// openBF interpolates between a row and the next (boundary_conditions.jl), so two rows, t = 0
+// and the period, are a table it reads: with one flow, a constant inflow (what vexport writes
+// for one). One row is not.
+TEST_F(OpenbfTest, ReadsATwoRowTableAndRefusesOneRow) {
+  file("tee_inlet.dat", "0.0 2.5e-6\n0.8 2.5e-6\n");
+  const Network net = read_openbf(file("tee.yaml", three_vessels), options_);
+  EXPECT_DOUBLE_EQ(net.inlet->waveform.period, 0.8);
+  EXPECT_EQ(net.inlet->waveform.time, (std::vector<double>{0.0, 0.4}));
+  EXPECT_EQ(net.inlet->waveform.value, (std::vector<double>{2.5e-6, 2.5e-6}));
+  EXPECT_DOUBLE_EQ(net.inlet->waveform.mean_value(), 2.5e-6);
+  file("tee_inlet.dat", "0.0 2.5e-6\n");
+  EXPECT_EQ(refusal(path("tee.yaml")), path("tee_inlet.dat") + ": an inlet table needs at least 2 rows, t = 0 and the period");
+}
+
+// An inlet file that is a device, a folder, too large, or one endless line is refused before it
+// is read whole (/dev/zero was read without bound: 1.6 GB and growing).
+TEST_F(OpenbfTest, RefusesAnInletFileThatIsNotABoundedTextFile) {
+  const std::string model = replaced(three_vessels, "inlet_file: tee_inlet.dat", "inlet_file: /dev/zero");
+  EXPECT_EQ(refusal(file("zero.yaml", model)), "/dev/zero: not a regular file; an inlet table is a text file of at most 64 MB");
+  fs::create_directories(folder_ / "folder");
+  EXPECT_EQ(refusal(file("folder.yaml", replaced(three_vessels, "tee_inlet.dat", "folder"))),
+            path("folder") + ": not a regular file; an inlet table is a text file of at most 64 MB");
+  // A sparse file just over the cap: refused once the cap is passed, without keeping it.
+  { std::ofstream(path("huge.dat")) << "0 0\n"; }
+  fs::resize_file(path("huge.dat"), (std::uintmax_t{64} << 20) + 1);
+  EXPECT_EQ(refusal(file("huge.yaml", replaced(three_vessels, "tee_inlet.dat", "huge.dat"))),
+            path("huge.dat") + ": larger than 64 MB; an inlet table is a text file of at most 64 MB");
+  file("tee_inlet.dat", "0 0\n0.5 1e-4" + std::string(5000, ' ') + "\n1 0\n");
+  EXPECT_EQ(refusal(file("tee.yaml", three_vessels)),
+            path("tee_inlet.dat") + ":2: a line longer than 4096 characters; an inlet table has two numbers a line, t [s] "
+                                    "and Q [m^3/s]");
+}
+
+// A second YAML document would be dropped: refused, at its line. An empty one drops nothing.
+TEST_F(OpenbfTest, RefusesASecondYamlDocument) {
+  file("tee_inlet.dat", inlet_table);
+  const std::string p = file("two.yaml", std::string(three_vessels) + "---\nproject_name: x\n");
+  EXPECT_EQ(refusal(p), p + ":45: a second YAML document (after \"---\"); an openBF model is one document, and hemotree "
+                            "reads nothing it would drop");
+  EXPECT_EQ(refusal(file("end.yaml", std::string(three_vessels) + "---\n")), "");
+}
+
+// Keys are checked in file order, unknown ones first, and repeats found by hashing: 60,000
+// top-level keys were compared pairwise (55 s) before the first unknown one was named.
+TEST_F(OpenbfTest, RefusesManyKeysAtTheFirstUnknownOne) {
+  std::string text;
+  for (int k = 0; k < 60000; ++k) text += "key" + std::to_string(k) + ": 1\n";
+  const std::string p = file("keys.yaml", text);
+  EXPECT_EQ(refusal(p), p + ":1: model: \"key0\" is not an openBF key that hemotree reads or may safely ignore");
+  const std::string twice = file("twice.yaml", "project_name: a\nproject_name: b\nsolver: 1\n");
+  EXPECT_EQ(refusal(twice), twice + ":2: model: \"project_name\" given twice");
+  file("tee_inlet.dat", inlet_table);
+  const std::string vessel = file("vessel.yaml", replaced(three_vessels, "    M: 100\n", "    M: 100\n    E: 1.0e6\n"));
+  EXPECT_EQ(refusal(vessel), vessel + ":21: vessel 1: \"E\" given twice");
+}
+
 // A row earlier than the one before it opens no interval in openBF's interpolation; hemotree
 // leaves it out and says how far that is from openBF's reading: here openBF follows the line
 // from (0.4 s, 8e-5) to (0.6 s, 6e-5) just after 0.5 s (7e-5 m^3/s), hemotree the one from
@@ -428,6 +484,21 @@ TEST_F(OpenbfTest, WritesWhatItReads) {
   std::stringstream model;
   model << yaml.rdbuf();
   EXPECT_NE(model.str().find("inlet_file: \"copy_inlet.dat\"\n"), std::string::npos) << model.str();
+}
+
+// vexport writes a constant inflow as two rows; vimport reads them back as that flow.
+TEST_F(OpenbfTest, AConstantInflowRoundTrips) {
+  file("tee_inlet.dat", inlet_table);
+  Network net = read_openbf(file("tee.yaml", three_vessels), options_);
+  net.inlet->waveform = Waveform::constant_value(1e-7);
+  fs::create_directories(folder_ / "out");
+  const Network back = round_trip(net, path("out/c.yaml"), path("out/c_inlet.dat"));
+  std::ifstream table(path("out/c_inlet.dat"));
+  std::stringstream rows;
+  rows << table.rdbuf();
+  EXPECT_EQ(rows.str(), "0.0 1.0e-07\n1.0 1.0e-07\n");
+  for (const double t : {0.0, 0.3, 0.5, 0.99}) EXPECT_DOUBLE_EQ(back.inlet->waveform(t), 1e-7);
+  EXPECT_DOUBLE_EQ(back.inlet->waveform.mean_value(), 1e-7);
 }
 
 TEST_F(OpenbfTest, RefusesToWriteWhatOpenbfCannotExpress) {
