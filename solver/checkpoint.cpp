@@ -1,11 +1,13 @@
 #include "solver/checkpoint.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <unistd.h>
 
 #include "cli/errors.hpp"
@@ -14,20 +16,68 @@ namespace hemotree {
 
 namespace {
 constexpr std::string_view magic = "hemotree checkpoint\n";
-constexpr std::uint64_t format_version = 4;  // 2: the 0D vessels keep their previous pressures; 3: their volumes above c; 4: face volumes
+// 2: the 0D vessels keep their previous pressures; 3: their volumes above c; 4: face volumes;
+// 5: sections framed by their length and checksummed, and the file checksummed.
+constexpr std::uint64_t format_version = 5;
+constexpr std::size_t word = sizeof(std::uint64_t);
+constexpr std::size_t header = magic.size() + word;  // the magic line and the format
+
+std::uint64_t checksum(const std::string& bytes, std::size_t begin, std::size_t end) {
+  Fingerprint f;
+  f.add(bytes.data() + begin, end - begin);
+  return f.value();
+}
+
+void append_word(std::string& bytes, std::uint64_t x) { bytes.append(reinterpret_cast<const char*>(&x), word); }
+
+std::uint64_t word_at(const std::string& bytes, std::size_t at) {
+  std::uint64_t x;
+  std::memcpy(&x, bytes.data() + at, word);
+  return x;
+}
+
+// A section as a message names it: by its name where that is readable text (a damaged length
+// can make it any bytes), else by its place in the file.
+std::string describe_section(const std::string& name, std::size_t index) {
+  const bool readable = !name.empty() && name.size() <= 40 &&
+                        std::all_of(name.begin(), name.end(), [](char c) { return c >= ' ' && c <= '~'; });
+  return readable ? "section \"" + name + "\"" : "section " + std::to_string(index + 1);
+}
 }  // namespace
 
 CheckpointWriter::CheckpointWriter() {
   bytes_.append(magic);
-  put(format_version);
+  append_word(bytes_, format_version);
 }
 
 void CheckpointWriter::raw(const void* data, std::size_t size) {
+  if (section_start_ == std::string::npos) throw std::logic_error("checkpoint: a value written before any section");
   if (size == 0) return;  // an empty matrix's data() is null, which memcpy must not see
   bytes_.append(static_cast<const char*>(data), size);
 }
 
-void CheckpointWriter::section(std::string_view name) { put(std::string(name)); }
+// The section from start: its payload's length in the word after its name, its checksum after it.
+void CheckpointWriter::close_section(std::string& bytes, std::size_t start) {
+  const std::size_t length_at = start + word + word_at(bytes, start);
+  const std::uint64_t length = bytes.size() - length_at - word;
+  std::memcpy(bytes.data() + length_at, &length, word);
+  append_word(bytes, checksum(bytes, start, bytes.size()));
+}
+
+void CheckpointWriter::section(std::string_view name) {
+  if (section_start_ != std::string::npos) close_section(bytes_, section_start_);
+  section_start_ = bytes_.size();
+  append_word(bytes_, name.size());
+  bytes_.append(name);
+  append_word(bytes_, 0);  // the payload's length, known when the section closes
+}
+
+std::string CheckpointWriter::bytes() const {
+  std::string file = bytes_;
+  if (section_start_ != std::string::npos) close_section(file, section_start_);
+  append_word(file, checksum(file, 0, file.size()));
+  return file;
+}
 void CheckpointWriter::put(double x) { raw(&x, sizeof x); }
 void CheckpointWriter::put(std::uint64_t x) { raw(&x, sizeof x); }
 
@@ -54,12 +104,55 @@ void CheckpointWriter::put(const Eigen::VectorXd& v) {
 
 CheckpointReader::CheckpointReader(std::string bytes, std::string source)
     : bytes_(std::move(bytes)), source_(std::move(source)) {
-  if (bytes_.compare(0, magic.size(), magic) != 0) fail("not a hemosolve checkpoint");
-  at_ = magic.size();
-  const std::uint64_t version = get_u64();
+  const std::string_view start(bytes_.data(), std::min(bytes_.size(), magic.size()));
+  if (bytes_.empty()) fail("empty checkpoint (0 bytes): nothing to resume");
+  if (start != magic.substr(0, start.size())) fail("not a hemosolve checkpoint");
+  if (bytes_.size() < header) fail("truncated checkpoint (" + std::to_string(bytes_.size()) + " bytes)");
+  const std::uint64_t version = word_at(bytes_, magic.size());
+  if (version >= 1 && version < format_version)
+    fail("checkpoint format " + std::to_string(version) + " of an earlier hemosolve; this build reads format " +
+         std::to_string(format_version) + " only: start the run afresh");
   if (version != format_version)
     fail("checkpoint format " + std::to_string(version) + ", this build reads format " +
-         std::to_string(format_version));
+         std::to_string(format_version) + " (a newer hemosolve's, or a damaged file)");
+  index_sections();
+}
+
+// Walks the sections, checking each against its checksum and the whole file against its
+// own, so that nothing is read from a file changed after it was written.
+void CheckpointReader::index_sections() {
+  const std::size_t size = bytes_.size();
+  const bool whole = size >= header + word && word_at(bytes_, size - word) == checksum(bytes_, 0, size - word);
+  const std::size_t last = size >= header + word ? size - word : header;  // where the sections end
+  std::size_t at = header;
+  std::string before = "the format";  // for a message about what follows it
+  auto damaged = [&](const std::string& what) {
+    fail("truncated or damaged checkpoint (" + std::to_string(size) + " bytes): " + what +
+         "; it cannot be resumed");
+  };
+  while (at < last) {
+    // Each length is checked against what is left before it is used.
+    if (last - at < word) damaged("the section after " + before + " is cut short");
+    const std::uint64_t name_length = word_at(bytes_, at);
+    if (name_length > last - at - word || last - at - word - name_length < word)
+      damaged("the section after " + before + " runs past the end");
+    const std::size_t name_at = at + word, length_at = name_at + name_length;
+    std::string name = bytes_.substr(name_at, name_length);
+    const std::uint64_t length = word_at(bytes_, length_at);
+    const std::size_t begin = length_at + word;
+    const std::string described = describe_section(name, sections_.size());
+    if (length > last - begin || last - begin - length < word) damaged(described + " runs past the end");
+    const std::size_t end = begin + length;
+    if (word_at(bytes_, end) != checksum(bytes_, at, end))
+      fail(described + " does not match its checksum: the file was changed or damaged after it was written; "
+           "it cannot be resumed");
+    before = described;
+    sections_.push_back({std::move(name), begin, end});
+    at = end + word;
+  }
+  if (!whole || at != last)
+    damaged("the file's checksum does not match (the bytes after " + before + " or the checksum itself)");
+  at_ = end_ = header;
 }
 
 void CheckpointReader::fail(const std::string& message) const {
@@ -67,15 +160,23 @@ void CheckpointReader::fail(const std::string& message) const {
 }
 
 void CheckpointReader::raw(void* data, std::size_t size) {
-  if (size > bytes_.size() - at_) fail("truncated checkpoint");
+  // The checksums held: a section shorter than this build reads was written by another layout.
+  if (size > left()) fail("checkpoint of another kind or version (a section ends before this build has read it)");
   if (size == 0) return;  // an empty matrix's data() is null, which memcpy must not see
   std::memcpy(data, bytes_.data() + at_, size);
   at_ += size;
 }
 
 void CheckpointReader::section(std::string_view name) {
-  const std::string found = get_string();
-  if (found != name) fail("checkpoint of another kind or version (expected section \"" + std::string(name) + "\")");
+  const std::string expected = "(expected section \"" + std::string(name) + "\")";
+  if (at_ != end_) fail("checkpoint of another kind or version (section \"" + sections_[next_ - 1].name +
+                        "\" holds more than this build reads) " + expected);
+  if (next_ == sections_.size()) fail("checkpoint of another kind or version (it ends early) " + expected);
+  const Section& s = sections_[next_++];
+  if (s.name != name) fail("checkpoint of another kind or version (section \"" + s.name + "\" where this build reads \"" +
+                           std::string(name) + "\")");
+  at_ = s.begin;
+  end_ = s.end;
 }
 
 double CheckpointReader::get_double() {
@@ -92,7 +193,7 @@ std::uint64_t CheckpointReader::get_u64() {
 
 std::string CheckpointReader::get_string() {
   const std::uint64_t size = get_u64();
-  if (size > bytes_.size() - at_) fail("truncated checkpoint");
+  if (size > left()) fail("checkpoint of another kind or version (a string runs past its section)");
   std::string text(bytes_.data() + at_, size);
   at_ += size;
   return text;
@@ -100,7 +201,7 @@ std::string CheckpointReader::get_string() {
 
 std::vector<double> CheckpointReader::get_vector() {
   const std::uint64_t size = get_u64();
-  if (size > (bytes_.size() - at_) / sizeof(double)) fail("truncated checkpoint");
+  if (size > left() / sizeof(double)) fail("checkpoint of another kind or version (a vector runs past its section)");
   std::vector<double> values(size);
   raw(values.data(), size * sizeof(double));
   return values;
@@ -108,7 +209,8 @@ std::vector<double> CheckpointReader::get_vector() {
 
 Eigen::MatrixXd CheckpointReader::get_matrix() {
   const std::uint64_t rows = get_u64(), cols = get_u64();
-  if (cols != 0 && rows > (bytes_.size() - at_) / sizeof(double) / cols) fail("truncated checkpoint");
+  if (cols != 0 && rows > left() / sizeof(double) / cols)
+    fail("checkpoint of another kind or version (a matrix runs past its section)");
   Eigen::MatrixXd m(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
   raw(m.data(), static_cast<std::size_t>(m.size()) * sizeof(double));
   return m;
@@ -116,7 +218,7 @@ Eigen::MatrixXd CheckpointReader::get_matrix() {
 
 Eigen::VectorXd CheckpointReader::get_eigen_vector() {
   const std::uint64_t size = get_u64();
-  if (size > (bytes_.size() - at_) / sizeof(double)) fail("truncated checkpoint");
+  if (size > left() / sizeof(double)) fail("checkpoint of another kind or version (a vector runs past its section)");
   Eigen::VectorXd v(static_cast<Eigen::Index>(size));
   raw(v.data(), size * sizeof(double));
   return v;
@@ -139,11 +241,10 @@ void CheckpointReader::get_into(Eigen::VectorXd& v, const char* what) {
   v = std::move(read);
 }
 
-void write_checkpoint_file(const std::filesystem::path& file, const CheckpointWriter& checkpoint) {
+void write_checkpoint_file(const std::filesystem::path& file, const std::string& bytes) {
   const std::filesystem::path temp = file.string() + ".tmp";
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw IoError("cannot write " + temp.string() + ": " + std::strerror(errno));
-  const std::string& bytes = checkpoint.bytes();
   std::size_t written = 0;
   while (written < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
@@ -173,6 +274,7 @@ std::string read_checkpoint_file(const std::filesystem::path& file) {
   if (!in) throw IoError("cannot open " + file.string());
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw IoError("cannot read " + file.string());
+  if (bytes.empty()) throw InputError(file.string() + ": empty checkpoint (0 bytes): nothing to resume");
   return bytes;
 }
 

@@ -4,7 +4,16 @@
 // Numbers are stored as their bytes (a checkpoint resumes a run on the same kind of
 // machine; nothing is rounded, so the resumed run continues bit for bit). Named sections
 // let the reader refuse, with a clear line, a file of another kind or version instead of
-// reading it as garbage.
+// reading it as garbage, and checksums a file changed after it was written: a flipped bit
+// in a stored state would otherwise resume as a plausible run with wrong numbers.
+//
+// The file (format 5):
+//   "hemotree checkpoint\n", u64 format
+//   each section: u64 name length, name, u64 payload length, payload,
+//                 u64 checksum of the section (its name, length and payload)
+//   u64 checksum of everything before it
+// Checksums are 64-bit FNV-1a: every step of it is a bijection of the state, so any change
+// of a single byte changes it; a random change passes with odds 2^-64.
 #pragma once
 
 #include <cstdint>
@@ -20,6 +29,7 @@ namespace hemotree {
 class CheckpointWriter {
  public:
   CheckpointWriter();  // starts with the file's magic line and format version
+  // Closes the section before (its length and checksum) and opens one; every value is in one.
   void section(std::string_view name);
   void put(double x);
   void put(std::uint64_t x);
@@ -28,11 +38,14 @@ class CheckpointWriter {
   void put(const std::vector<double>& values);
   void put(const Eigen::MatrixXd& m);
   void put(const Eigen::VectorXd& v);
-  const std::string& bytes() const { return bytes_; }
+  // The whole file: the open section closed and the file's checksum appended.
+  std::string bytes() const;
 
  private:
   void raw(const void* data, std::size_t size);
+  static void close_section(std::string& bytes, std::size_t start);
   std::string bytes_;
+  std::size_t section_start_ = std::string::npos;  // of the open section
 };
 
 // Reads what a CheckpointWriter wrote, in the same order; InputError naming the file at the
@@ -40,7 +53,10 @@ class CheckpointWriter {
 // section or size of another run).
 class CheckpointReader {
  public:
+  // Checks the whole file before anything is read from it: an empty or truncated file, one
+  // of another format, a section whose bytes do not match its checksum (named) are refused.
   CheckpointReader(std::string bytes, std::string source);
+  // The next section, which must be this one; the one before must have been read whole.
   void section(std::string_view name);
   double get_double();
   std::uint64_t get_u64();
@@ -52,16 +68,27 @@ class CheckpointReader {
   // The matrix or vector read must have these dimensions (the run's discretisation).
   void get_into(Eigen::MatrixXd& m, const char* what);
   void get_into(Eigen::VectorXd& v, const char* what);
-  bool at_end() const { return at_ == bytes_.size(); }
+  bool at_end() const { return next_ == sections_.size() && at_ == end_; }
   [[noreturn]] void fail(const std::string& message) const;
 
  private:
+  struct Section {
+    std::string name;
+    std::size_t begin, end;  // of the payload
+  };
   void raw(void* data, std::size_t size);
+  std::size_t left() const { return end_ - at_; }
+  void index_sections();
   std::string bytes_, source_;
-  std::size_t at_ = 0;
+  std::vector<Section> sections_;
+  std::size_t next_ = 0;          // the section that section() opens next
+  std::size_t at_ = 0, end_ = 0;  // where reading is, and the open section's end
 };
 
-void write_checkpoint_file(const std::filesystem::path& file, const CheckpointWriter& checkpoint);
+// bytes: a CheckpointWriter's bytes().
+void write_checkpoint_file(const std::filesystem::path& file, const std::string& bytes);
+// An empty file is refused here (InputError): it holds no run, and resuming nothing would
+// silently start again from the first cycle.
 std::string read_checkpoint_file(const std::filesystem::path& file);
 
 // FNV-1a over bytes: a fingerprint of what a checkpoint belongs to (the network's arrays).

@@ -4,7 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
 
+#include "cli/errors.hpp"
 #include "cli/tool.hpp"
 #include "formats/vtk_series.hpp"
 #include "solver/run_report.hpp"
@@ -98,7 +102,7 @@ void PulsatileRun::snapshot() {
                                 red_cell_change_});
   }
   out.section("end");
-  snapshot_ = std::move(out);
+  snapshot_ = out.bytes();
 }
 
 void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
@@ -133,22 +137,78 @@ void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
   in.section("end");
   if (!in.at_end()) in.fail("unexpected bytes after the checkpoint");
   resumed_ = true;
+  snapshot_ = bytes;  // written again as it is if no cycle follows
+  if (!cycles_left()) check_run_end(source);
+}
+
+bool PulsatileRun::periodic() const {
+  // With red cells carried, their distribution must have settled too: its largest change of
+  // a vessel's cycle-mean discharge hematocrit below the same tolerance.
+  return plan_.until_periodic && has_change() && change_.change < plan_.periodic_tolerance &&
+         (!transport_ || red_cell_change_ < plan_.periodic_tolerance);
+}
+
+bool PulsatileRun::cycles_left() const { return done_ < planned() && !periodic(); }
+
+// A checkpoint with no cycle left to run: the run ends where it ended, and its results are
+// written from the checkpoint. Right only where the results of that end are not already
+// published, and where the frames of its last cycle are at hand: a run killed between its
+// last checkpoint and publishing its folder left both in its staging folder.
+void PulsatileRun::check_run_end(const std::filesystem::path& source) const {
+  const std::string cycles = std::to_string(done_) + (done_ == 1 ? " cycle" : " cycles");
+  const std::string raise = plan_.until_periodic ? "--max-cycles" : "--cycles";
+  if (source.parent_path() != folder_) {
+    const std::string dir = source.parent_path().string();
+    if (periodic())
+      throw InputError("--resume " + dir + ": the run is already periodic after its " + cycles +
+                       "; nothing is left to run");
+    throw InputError("--resume " + dir + ": the run already has its " + cycles + "; raise " + raise + " to continue");
+  }
+  if (done_ > planned())
+    throw InputError("--resume: " + source.string() + " is after cycle " + std::to_string(done_) + ", beyond " + raise +
+                     " " + std::to_string(planned()) + "; raise " + raise + " to continue");
+  if (!has_last_cycle_frames())
+    throw InputError("--resume: " + source.string() + " ends the run after its " + cycles +
+                     ", but the frames of that last cycle are not in " + (folder_ / "frames").string() + " as --frames " +
+                     std::to_string(plan_.frames) + " asks; raise " + raise + " to compute another cycle's");
+}
+
+// The folder's frames/frames.pvd lists the frames of the cycle that ended at the
+// checkpoint's time, as many as the plan asks, and each is there. (A series removes its .pvd
+// when a cycle begins and writes it when the cycle's frames are complete.)
+bool PulsatileRun::has_last_cycle_frames() const {
+  if (plan_.frames == 0) return true;
+  const std::filesystem::path dir = folder_ / "frames";
+  std::ifstream in(dir / "frames.pvd");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<double> times;
+  std::error_code ec;
+  for (std::size_t at = text.find("<DataSet"); at != std::string::npos; at = text.find("<DataSet", at + 1)) {
+    const std::size_t time_at = text.find("timestep=\"", at), file_at = text.find("file=\"", at);
+    if (time_at == std::string::npos || file_at == std::string::npos) return false;
+    const std::size_t name_at = file_at + 6, name_end = text.find('"', name_at);
+    if (name_end == std::string::npos || !std::filesystem::is_regular_file(dir / text.substr(name_at, name_end - name_at), ec))
+      return false;
+    times.push_back(std::strtod(text.c_str() + time_at + 10, nullptr));
+  }
+  const double period = solver_.period(), end = solver_.time();
+  // The .pvd keeps 9 significant digits of each time; another cycle's lie a period away.
+  return times.size() == static_cast<std::size_t>(plan_.frames) &&
+         std::abs(times.back() - end) <= 1e-6 * period + 1e-8 * std::abs(end) && times.front() > end - period;
 }
 
 void PulsatileRun::write_checkpoint() const { write_checkpoint_file(folder_ / "checkpoint.bin", snapshot_); }
 
 void PulsatileRun::progress(std::size_t k, double started) {
   const double elapsed = seconds_since_epoch_start() - started;
-  const int planned = plan_.until_periodic ? plan_.max_cycles : plan_.cycles;
   const double rate = static_cast<double>(k + 1) / std::max(elapsed, 1e-9);
   const double left = static_cast<double>(plan_.steps_per_cycle - k - 1) / rate;
   std::fprintf(stderr, "\rhemosolve: cycle %d/%d  t = %.4f s  %.0f steps/s  %.0f s left in this cycle   ", done_ + 1,
-               planned, solver_.time(), rate, left);
+               planned(), solver_.time(), rate, left);
 }
 
 RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
   const double period = solver_.period();
-  const int planned = plan_.until_periodic ? plan_.max_cycles : plan_.cycles;
   // Statistics every 1e-4 of a period (or every step if that is longer): means and extrema
   // of the smooth pulse are then exact to ~1e-7, at a few per cent of the run's time. With
   // 0D vessels the steps are few (1e-3 of the period) and a sample costs as much as a step
@@ -163,14 +223,8 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
     if (transport_) transport_->take_volumes();
     snapshot();
   }
-  // With red cells carried, their distribution must have settled too: its largest change of
-  // a vessel's cycle-mean discharge hematocrit below the same tolerance.
-  auto periodic = [&] {
-    return plan_.until_periodic && has_change() && change_.change < plan_.periodic_tolerance &&
-           (!transport_ || red_cell_change_ < plan_.periodic_tolerance);
-  };
   try {
-    while (done_ < planned && !periodic()) {
+    while (cycles_left()) {
       std::optional<VtkTimeSeries> series;  // each cycle could be the last: its frames replace the previous
       if (plan_.frames > 0) series.emplace(net_, folder_ / "frames", "frames", plan_.vtk_keep);
       std::size_t frames_written = 0;
@@ -235,7 +289,7 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
       if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
       if (plan_.log_progress) {
         const double wall = seconds_since_epoch_start() - started;
-        std::string line = "cycle " + std::to_string(done_) + "/" + std::to_string(planned) + " done in " +
+        std::string line = "cycle " + std::to_string(done_) + "/" + std::to_string(planned()) + " done in " +
                            std::to_string(static_cast<long long>(std::lround(wall))) + " s";
         if (has_change()) {
           char text[64];

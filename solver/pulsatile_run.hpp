@@ -53,8 +53,16 @@ class PulsatileRun {
                std::filesystem::path folder, FlowTransport* transport = nullptr);
 
   // Continues from a checkpoint instead of starting (InputError for one of another run).
+  // source: the checkpoint file. One at the run's end (no cycle left to run) is taken only
+  // from a killed run's staging folder (the run's folder), whose frames of that last cycle
+  // are then this run's; a published run that already has its cycles is refused as it is.
   void resume(const std::string& checkpoint_bytes, const std::string& source);
   RunStatus run(InterruptRequests& interrupts);
+  // Whether run() has a cycle to compute (false after a resume at the run's end).
+  bool cycles_left() const;
+  // The frames a killed run left in the folder are this run's last cycle's, to be kept by
+  // OutputFolder::open(true): resumed at the run's end, with frames asked for.
+  bool keeps_frames() const { return resumed_ && !cycles_left() && plan_.frames > 0; }
 
   int cycles_done() const { return done_; }
   int compliance_balances() const { return balances_; }
@@ -75,6 +83,10 @@ class PulsatileRun {
 
  private:
   void snapshot();  // the checkpoint of this cycle end, in memory
+  int planned() const { return plan_.until_periodic ? plan_.max_cycles : plan_.cycles; }
+  bool periodic() const;
+  void check_run_end(const std::filesystem::path& source) const;
+  bool has_last_cycle_frames() const;
   void progress(std::size_t step_in_cycle, double started);
 
   const Network& net_;
@@ -89,7 +101,7 @@ class PulsatileRun {
   bool resumed_ = false;
   double measured_step_ = 0;
   std::string breakdown_;
-  CheckpointWriter snapshot_;
+  std::string snapshot_;  // a checkpoint file's bytes
   FlowTransport* transport_ = nullptr;
   RedCellCycle red_cells_last_;
   double red_cell_change_ = std::numeric_limits<double>::quiet_NaN();

@@ -1,9 +1,11 @@
 // A checkpoint holds the solver's evolving state bit for bit: a solver restored from it goes
 // on exactly as the one that wrote it (every scheme, with RCR capacitors, after a compliance
-// balance), and a file that is not such a checkpoint is refused with a clear message.
+// balance), and a file that is not such a checkpoint, or one changed after it was written
+// (any byte of it), is refused with a clear message.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -68,13 +70,61 @@ TEST(Checkpoint, RefusesWhatIsNotOne) {
 TEST(Checkpoint, FileIsReplacedWhole) {
   const auto file = std::filesystem::temp_directory_path() / ("checkpoint-test-" + std::to_string(::getpid()));
   CheckpointWriter a, b;
+  a.section("a");
   a.put(1.0);
+  b.section("b");
   b.put(2.0);
-  write_checkpoint_file(file, a);
-  write_checkpoint_file(file, b);
+  write_checkpoint_file(file, a.bytes());
+  write_checkpoint_file(file, b.bytes());
   EXPECT_EQ(read_checkpoint_file(file), b.bytes());
   EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp"));
   std::filesystem::remove(file);
+}
+
+TEST(Checkpoint, RefusesAnEmptyFileAndAnEarlierFormat) {
+  const auto file = std::filesystem::temp_directory_path() / ("checkpoint-empty-" + std::to_string(::getpid()));
+  { std::ofstream touch(file); }
+  // Resuming nothing would start the run again from its first cycle, as if resumed.
+  try {
+    read_checkpoint_file(file);
+    FAIL() << "read an empty checkpoint";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("empty checkpoint"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(file);
+  EXPECT_THROW(CheckpointReader("", "empty"), InputError);
+  // Format 4: the same magic line, sections without lengths or checksums.
+  std::string old = "hemotree checkpoint\n";
+  const std::uint64_t four = 4;
+  old.append(reinterpret_cast<const char*>(&four), sizeof four);
+  old.append(std::string(64, '\0'));
+  try {
+    CheckpointReader in(old, "old.bin");
+    FAIL() << "read a format 4 checkpoint";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("old.bin: checkpoint format 4 of an earlier hemosolve"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Checkpoint, ASectionIsReadWholeOrRefused) {
+  CheckpointWriter out;
+  out.section("a");
+  out.put(1.0);
+  out.put(2.0);
+  out.section("b");
+  CheckpointReader in(out.bytes(), "file");
+  in.section("a");
+  in.get_double();
+  // A build that reads less of "a" than was written reads another layout.
+  EXPECT_THROW(in.section("b"), InputError);
+  CheckpointReader again(out.bytes(), "file");
+  again.section("a");
+  again.get_double();
+  again.get_double();
+  EXPECT_THROW(again.get_double(), InputError);  // past the section's end, not into the next
+  again.section("b");
+  EXPECT_TRUE(again.at_end());
 }
 
 // A chain of three vessels fed by a pulse, ending in an RCR outlet.
@@ -115,6 +165,53 @@ TEST_P(ResumedSolver, GoesOnBitForBit) {
   EXPECT_TRUE((second.state().flow.array() == first.state().flow.array()).all());
   EXPECT_TRUE((second.state().capacitor.array() == first.state().capacitor.array()).all());
   EXPECT_EQ(second.state().exchanged, first.state().exchanged);
+}
+
+// A bit changed anywhere in a checkpoint (a disk's, a copy's, a person's) is refused before
+// anything is read: the solver's state, the 0D vessels, the framing, the format, the
+// checksums themselves. A change inside a section names it.
+TEST(ResumedSolver, RefusesEveryFlippedByte) {
+  const Network net = pulsed_chain();
+  SolverOptions options;
+  options.degree = 2;
+  options.elements = 2;
+  PulseSolver writer(net, options);
+  for (int k = 0; k < 20; ++k) writer.step();
+  CheckpointWriter out;
+  out.section("run");
+  out.put(std::string("options"));
+  writer.save(out);
+  out.section("end");
+  const std::string bytes = out.bytes();
+  std::size_t refused = 0, named = 0;
+  const std::size_t solver_at = bytes.find("pulse solver");
+  for (std::size_t i = 0; i < bytes.size(); ++i)
+    for (const unsigned char bit : {0x01, 0x04, 0x80}) {
+      std::string changed = bytes;
+      changed[i] = static_cast<char>(changed[i] ^ bit);
+      try {
+        CheckpointReader in(changed, "c.bin");
+        in.section("run");
+        in.get_string();
+        PulseSolver reader(net, options);
+        reader.restore(in);
+        in.section("end");
+        ADD_FAILURE() << "byte " << i << " ^ " << int{bit} << " accepted";
+      } catch (const InputError& e) {
+        ++refused;
+        const std::string message = e.what();
+        EXPECT_EQ(message.rfind("c.bin: ", 0), 0u) << message;
+        // A byte of the solver's state, well inside its section (not in its name or length).
+        if (i > solver_at + 20 && i + 100 < bytes.size() && i < bytes.find("0D vessels") - 30) {
+          EXPECT_NE(message.find("section \"pulse solver\" does not match its checksum"), std::string::npos) << message;
+          ++named;
+        }
+      }
+    }
+  EXPECT_EQ(refused, 3 * bytes.size());
+  EXPECT_GT(named, 3 * 200u);
+  // Cut anywhere: refused.
+  for (std::size_t cut = 0; cut < bytes.size(); cut += 7) EXPECT_THROW(CheckpointReader(bytes.substr(0, cut), "c"), InputError);
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, ResumedSolver,

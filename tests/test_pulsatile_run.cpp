@@ -1,13 +1,16 @@
 // The time loop of a run (solver/pulsatile_run): its cycles, its own measurement of the step
 // against the longest cycle it may take, interrupt requests answered at a step's end, and a
-// resume from its in-memory checkpoint that goes on as the run would have.
+// resume from its in-memory checkpoint that goes on as the run would have, a checkpoint
+// changed after it was written refused, and a resume with no cycle left to run.
 #include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "cli/errors.hpp"
 #include "cli/interrupt.hpp"
 #include "network_builders.hpp"
 #include "solver/pulsatile_run.hpp"
@@ -100,6 +103,84 @@ TEST(PulsatileRun, ResumesFromItsCheckpointAsIfNeverStopped) {
   EXPECT_TRUE((second.state().flow.array() == whole.state().flow.array()).all());
   EXPECT_EQ(c.last_cycle().vessels[0].mean_pressure, a.last_cycle().vessels[0].mean_pressure);
   EXPECT_EQ(c.change().change, a.change().change);
+}
+
+// A run's own checkpoint file, each of its bytes flipped in turn: every one is refused
+// before the run takes anything from it (the probes' rows and the cycle results too).
+TEST(PulsatileRun, RefusesItsCheckpointWithAnyByteChanged) {
+  Fixture f;
+  PulseSolver first(f.net, f.options);
+  PulsatileRun a(f.net, first, {}, f.plan(first, 2), f.folder);
+  InterruptRequests interrupts;
+  ASSERT_EQ(a.run(interrupts), RunStatus::complete);
+  a.write_checkpoint();
+  const std::string bytes = read_checkpoint_file(f.folder / "checkpoint.bin");
+  PulseSolver second(f.net, f.options);
+  PulsatileRun b(f.net, second, {}, f.plan(second, 4), f.folder);
+  std::size_t refused = 0;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    std::string changed = bytes;
+    changed[i] = static_cast<char>(changed[i] ^ 0x04);
+    try {
+      b.resume(changed, "checkpoint.bin");
+      ADD_FAILURE() << "byte " << i << " of " << bytes.size() << " changed and accepted";
+    } catch (const InputError&) {
+      ++refused;
+    }
+  }
+  EXPECT_EQ(refused, bytes.size());
+  EXPECT_EQ(b.cycles_done(), 0);
+  b.resume(bytes, "checkpoint.bin");  // the file as written
+  EXPECT_EQ(b.cycles_done(), 2);
+}
+
+// A checkpoint at the run's end: nothing is left to compute. A published run's is refused as
+// it stands; a killed run's (in the folder the run writes) is taken, its results written from
+// it, and its checkpoint written again byte for byte.
+TEST(PulsatileRun, ResumedAtItsEnd) {
+  Fixture f;
+  PulseSolver first(f.net, f.options);
+  PulsatileRun a(f.net, first, {}, f.plan(first, 2), f.folder);
+  InterruptRequests interrupts;
+  ASSERT_EQ(a.run(interrupts), RunStatus::complete);
+  a.write_checkpoint();
+  const std::string bytes = read_checkpoint_file(f.folder / "checkpoint.bin");
+  const std::filesystem::path staging = f.folder.string() + ".partial";
+  std::filesystem::create_directories(staging);
+
+  PulseSolver s1(f.net, f.options);
+  PulsatileRun published(f.net, s1, {}, f.plan(s1, 2), staging);
+  try {
+    published.resume(bytes, (f.folder / "checkpoint.bin").string());
+    FAIL() << "resumed a published run that has its cycles";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the run already has its 2 cycles; raise --cycles to continue"),
+              std::string::npos)
+        << e.what();
+  }
+
+  PulseSolver s2(f.net, f.options);
+  PulsatileRun fewer(f.net, s2, {}, f.plan(s2, 1), f.folder);
+  EXPECT_THROW(fewer.resume(bytes, (f.folder / "checkpoint.bin").string()), InputError);  // beyond --cycles 1
+
+  PulseSolver s3(f.net, f.options);
+  RunPlan with_frames = f.plan(s3, 2);
+  with_frames.frames = 2;
+  PulsatileRun framed(f.net, s3, {}, with_frames, f.folder);
+  EXPECT_THROW(framed.resume(bytes, (f.folder / "checkpoint.bin").string()), InputError);  // no frames of it here
+
+  PulseSolver s4(f.net, f.options);
+  PulsatileRun killed(f.net, s4, {}, f.plan(s4, 2), f.folder);
+  killed.resume(bytes, (f.folder / "checkpoint.bin").string());
+  EXPECT_FALSE(killed.cycles_left());
+  EXPECT_FALSE(killed.keeps_frames());  // none asked for
+  EXPECT_EQ(killed.run(interrupts), RunStatus::complete);
+  EXPECT_EQ(killed.cycles_done(), 2);
+  EXPECT_EQ(killed.last_cycle().vessels[0].mean_pressure, a.last_cycle().vessels[0].mean_pressure);
+  std::filesystem::remove(f.folder / "checkpoint.bin");
+  killed.write_checkpoint();
+  EXPECT_EQ(read_checkpoint_file(f.folder / "checkpoint.bin"), bytes);
+  std::filesystem::remove_all(staging);
 }
 
 }  // namespace
