@@ -1,10 +1,15 @@
 // hemosolve's output folder: a run writes into OUT.partial, which replaces OUT whole; a
-// folder of other files is never replaced; a live writer's staging folder is never taken.
+// folder of other files is never replaced; a live writer's staging folder is never taken,
+// however many runs start into it at once; a dead one's is.
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -65,20 +70,113 @@ TEST(OutputFolder, RefusesAFolderOfOtherFiles) {
 TEST(OutputFolder, RefusesALiveWriterAndTakesOverADeadOne) {
   Scratch s;
   const fs::path out = s.dir / "run", staging = out.string() + ".partial";
-  fs::create_directories(staging);
-  write(staging / ".hemosolve-owner", std::to_string(::getpid()) + "\n");  // alive: this process
-  EXPECT_THROW(OutputFolder{out}, InputError);
-  // A process id that no process has (above the kernel's pid_max).
-  write(staging / ".hemosolve-owner", "2147483647\n");
-  write(staging / "checkpoint.bin", "x");
+  {
+    OutputFolder live(out);  // holds run's lock: a second writer, in any process, is refused
+    try {
+      OutputFolder second(out);
+      FAIL() << "two writers of one folder";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("hemosolve (process " + std::to_string(::getpid()) + ") is writing " +
+                                           out.string() + ".partial; wait for it"),
+                std::string::npos)
+          << e.what();
+    }
+    live.open();
+    write(live.staging() / "checkpoint.bin", "x");
+    EXPECT_TRUE(fs::exists(staging / "checkpoint.bin"));  // the refused one removed nothing
+  }
+  // Its process gone (here: its lock let go without publishing), the folder is a dead run's,
+  // whatever process ids came and went; an owner file of an earlier version is no owner.
+  write(staging / ".hemosolve-owner", std::to_string(::getpid()) + "\n");
+  fs::create_directories(staging / "frames");
+  write(staging / "frames" / "frames.pvd", "last cycle");
   OutputFolder f(out);
   ASSERT_TRUE(f.latest_checkpoint());
   EXPECT_EQ(*f.latest_checkpoint(), staging / "checkpoint.bin");
-  f.open();  // the dead run's folder goes
+  EXPECT_TRUE(f.open());  // the dead run's folder goes, its frames too unless kept
   EXPECT_FALSE(fs::exists(staging / "checkpoint.bin"));
+  EXPECT_FALSE(fs::exists(staging / "frames"));
+  EXPECT_FALSE(fs::exists(out.string() + ".partial.stale"));
   f.discard();
   EXPECT_FALSE(fs::exists(staging));
   EXPECT_FALSE(fs::exists(out));
+}
+
+// A resume at the run's end publishes the frames the killed run wrote of its last cycle.
+TEST(OutputFolder, KeepsADeadRunsFramesWhenAsked) {
+  Scratch s;
+  const fs::path out = s.dir / "run", staging = out.string() + ".partial";
+  fs::create_directories(staging / "frames");
+  write(staging / "checkpoint.bin", "x");
+  write(staging / "frames" / "frames_0000.vtp", "frame");
+  OutputFolder f(out);
+  EXPECT_TRUE(f.open(true));
+  EXPECT_EQ(read(staging / "frames" / "frames_0000.vtp"), "frame");
+  EXPECT_FALSE(fs::exists(staging / "checkpoint.bin"));
+  f.publish();
+  EXPECT_EQ(read(out / "frames" / "frames_0000.vtp"), "frame");
+}
+
+// Many writers started at once: exactly one takes the folder, every other is refused while
+// it holds it, and nothing of the winner's is touched. (flock excludes open file
+// descriptions, so threads of one process contend as processes would.)
+TEST(OutputFolder, OneWriterOfManyStartedAtOnce) {
+  Scratch s;
+  const fs::path out = s.dir / "run";
+  for (int round = 0; round < 40; ++round) {
+    constexpr int writers = 6;
+    std::atomic<int> ready{0}, won{0}, refused{0}, attempted{0};
+    std::vector<std::thread> threads;
+    for (int w = 0; w < writers; ++w)
+      threads.emplace_back([&, w] {
+        ++ready;
+        while (ready < writers) std::this_thread::yield();  // all start together
+        std::optional<OutputFolder> f;
+        try {
+          f.emplace(out);
+        } catch (const InputError&) {
+          ++refused;
+        }
+        ++attempted;
+        if (!f) return;
+        ++won;
+        f->open();
+        write(f->staging() / "summary.json", std::to_string(round) + " " + std::to_string(w));
+        while (attempted < writers) std::this_thread::yield();  // held until every other has tried
+        f->publish();
+      });
+    for (auto& t : threads) t.join();
+    ASSERT_EQ(won, 1) << "round " << round;
+    ASSERT_EQ(refused, writers - 1);
+    EXPECT_EQ(read(out / "summary.json").substr(0, std::to_string(round).size() + 1), std::to_string(round) + " ");
+    EXPECT_FALSE(fs::exists(out.string() + ".partial"));
+  }
+  // Nothing but the results is left beside them: the lock file goes with its holder.
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(s.dir)) ++entries;
+  EXPECT_EQ(entries, 1u);
+}
+
+// A lock file that is not this run's any more (removed by hand) stops the run from renaming
+// a folder that another run may now be writing.
+TEST(OutputFolder, PublishesOnlyWhileItHoldsTheFolder) {
+  Scratch s;
+  const fs::path out = s.dir / "run";
+  OutputFolder f(out);
+  f.open();
+  write(f.staging() / "summary.json", "mine");
+  fs::remove(s.dir / ".run.hemosolve-lock");
+  OutputFolder other(out);  // now possible
+  EXPECT_THROW(f.publish(), IoError);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// A run refused before open() leaves nothing: no lock file, no parent folders it made.
+TEST(OutputFolder, ARunThatNeverOpenedLeavesNothing) {
+  Scratch s;
+  { OutputFolder f(s.dir / "a" / "b" / "run"); }
+  EXPECT_FALSE(fs::exists(s.dir / "a"));
+  EXPECT_TRUE(fs::is_empty(s.dir));
 }
 
 TEST(RunEstimate, DurationsReadAsPeopleSayThem) {
