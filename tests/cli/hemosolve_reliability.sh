@@ -1,7 +1,8 @@
 # hemosolve as a hostile user or a killed job would find it (issue 11): values that give
 # nothing computed are refused before any work; a run is "complete" only when its numbers
 # say so; the output folder never mixes two runs; a run killed and resumed gives the same
-# bits as one never stopped. About 40 s.
+# bits as one never stopped, a damaged checkpoint is refused, two runs into one folder never
+# collide. About 60 s.
 source "$(dirname "$0")/lib.sh"
 VPRUNE=$BUILD/pruner/vprune
 HEMOSOLVE=$BUILD/solver/hemosolve
@@ -96,6 +97,16 @@ assert abs(s["mass_balance"] - (s["inlet_mean_flow"] - s["outlets_mean_flow"]) /
 assert abs(s["inlet_mean_flow"] - 6.5e-6) < 1e-3 * 6.5e-6, s["inlet_mean_flow"]
 PY
 
+same_summary() {  # summary.json without the wall time
+  "$PY" - "$1" "$2" <<'PY'
+import json, sys, os
+a, b = (json.load(open(os.path.join(d, "summary.json"))) for d in sys.argv[1:3])
+for s in (a, b):
+    s.pop("wall_time")
+assert a == b, [k for k in a if a.get(k) != b.get(k)]
+PY
+}
+
 same_results() {  # summary.json without the wall time, probes.csv, results.vtp and frames, bit for bit
   "$PY" - "$1" "$2" <<'PY'
 import json, sys, filecmp, os
@@ -136,6 +147,80 @@ kill -TERM $pid; wait $pid; status=$?
   && pass "SIGTERM: checkpoint, summary interrupted, exit 143" || fail "SIGTERM: exit $status: $(cat "$WORK/err")"
 "$HEMOSOLVE" "$CCA" "${ARGS[@]}" --resume "$WORK/term" --quiet 2>"$WORK/err" && same_results "$WORK/whole" "$WORK/term" \
   && pass "SIGTERM and --resume: bit-identical" || fail "resume after SIGTERM: $(cat "$WORK/err")"
+
+# A checkpoint changed after it was written is refused, whatever byte changed (issue 21): a
+# bit flipped at 40 places spread over the file (the format, each section's name, length,
+# payload and checksum, the file's checksum), and the folder is left as it was.
+cp -r "$WORK/whole" "$WORK/flip"
+MORE=(--probe 1:0.5 --frames 3 --vtk --cycles 31)
+size=$(stat -c %s "$WORK/whole/checkpoint.bin")
+flips_refused=0
+for k in $(seq 0 39); do
+  at=$(( k == 39 ? size - 203 : k * size / 39 + k ))
+  "$PY" -c 'import sys; p, a = sys.argv[1], int(sys.argv[2]); b = bytearray(open(sys.argv[3], "rb").read()); b[a] ^= 0x04; open(p, "wb").write(b)' \
+    "$WORK/flip/checkpoint.bin" "$at" "$WORK/whole/checkpoint.bin"
+  "$HEMOSOLVE" "$CCA" "${MORE[@]}" --resume "$WORK/flip" --quiet 2>"$WORK/err"
+  status=$?
+  if [ "$status" -eq 2 ] && [ "$(wc -l <"$WORK/err")" -eq 1 ] && grep -q "flip/checkpoint.bin: " "$WORK/err" \
+     && cmp -s "$WORK/flip/summary.json" "$WORK/whole/summary.json" && [ ! -e "$WORK/flip.partial" ]; then
+    flips_refused=$((flips_refused + 1))
+  else
+    fail "byte $at of $size flipped: exit $status: $(cat "$WORK/err")"
+  fi
+done
+[ "$flips_refused" -eq 40 ] && pass "a flipped bit in the checkpoint: 40 of 40 refused, the folder untouched"
+grep -q 'section "pulse solver" does not match its checksum' "$WORK/err" || fail "the damaged section not named: $(cat "$WORK/err")"
+: >"$WORK/flip/checkpoint.bin"
+expect_error "an empty checkpoint" 2 "empty checkpoint" -- \
+  "$HEMOSOLVE" "$CCA" "${MORE[@]}" --resume "$WORK/flip" --quiet
+
+# Resumed with no cycle left to run: a published run's results stand as they are (refused);
+# a run killed between its last checkpoint and publishing its folder (its staging folder
+# holds that checkpoint and the last cycle's frames, nothing else yet) ends with the bits of
+# the uninterrupted run, frames included.
+cp -r "$WORK/whole" "$WORK/ended"
+expect_error "--resume a run that has its cycles" 2 "the run already has its 30 cycles; raise --cycles to continue" -- \
+  "$HEMOSOLVE" "$CCA" "${ARGS[@]}" --resume "$WORK/ended" --quiet
+diff -r "$WORK/whole" "$WORK/ended" >/dev/null && [ ! -e "$WORK/ended.partial" ] \
+  && pass "the published run untouched" || fail "--resume at the run's end changed the folder"
+mkdir "$WORK/late.partial"
+cp -r "$WORK/whole/checkpoint.bin" "$WORK/whole/frames" "$WORK/late.partial/"
+"$HEMOSOLVE" "$CCA" "${ARGS[@]}" --resume "$WORK/late" --checkpoint-every 1 --quiet 2>"$WORK/err" \
+  && same_results "$WORK/whole" "$WORK/late" && cmp -s "$WORK/whole/checkpoint.bin" "$WORK/late/checkpoint.bin" \
+  && [ "$(ls "$WORK/late/frames" | wc -l)" -eq 4 ] && [ ! -e "$WORK/late.partial" ] \
+  && pass "killed before publishing, resumed: the uninterrupted run's bits, frames and checkpoint" \
+  || fail "resume after the last checkpoint: $(cat "$WORK/err")"
+mkdir "$WORK/late2.partial"
+cp "$WORK/whole/checkpoint.bin" "$WORK/late2.partial/"
+expect_error "--resume at the run's end without its frames" 2 "the frames of that last cycle are not in" -- \
+  "$HEMOSOLVE" "$CCA" "${ARGS[@]}" --resume "$WORK/late2" --quiet
+[ -e "$WORK/late2.partial/checkpoint.bin" ] && pass "the killed run's checkpoint kept" || fail "the checkpoint was lost"
+
+# Two runs started at once into one --out, 20 times: one writes it, the other is refused at
+# once with one line, and the winner's results are a lone run's.
+RACE=(--cycles 8 --probe 1:0.5 --checkpoint-every 1 --quiet)
+"$HEMOSOLVE" "$CCA" "${RACE[@]}" --out "$WORK/lone" 2>"$WORK/err" || fail "lone run: $(cat "$WORK/err")"
+pairs_right=0
+for i in $(seq 20); do
+  rm -rf "$WORK/race"
+  "$HEMOSOLVE" "$CCA" "${RACE[@]}" --out "$WORK/race" 2>"$WORK/race-1.err" & a=$!
+  "$HEMOSOLVE" "$CCA" "${RACE[@]}" --out "$WORK/race" 2>"$WORK/race-2.err" & b=$!
+  wait $a; sa=$?
+  wait $b; sb=$?
+  loser=$WORK/race-2.err
+  [ "$sa" -ne 0 ] && loser=$WORK/race-1.err
+  if [ $((sa + sb)) -eq 2 ] && [ $((sa * sb)) -eq 0 ] && [ "$(wc -l <"$loser")" -eq 1 ] \
+     && grep -q "^hemosolve: error: --out .*/race: hemosolve (process [0-9]*) is writing .*/race.partial; wait for it or choose another folder$" "$loser" \
+     && same_summary "$WORK/lone" "$WORK/race" && cmp -s "$WORK/lone/probes.csv" "$WORK/race/probes.csv" \
+     && cmp -s "$WORK/lone/vessels.csv" "$WORK/race/vessels.csv" && cmp -s "$WORK/lone/checkpoint.bin" "$WORK/race/checkpoint.bin" \
+     && [ ! -e "$WORK/race.partial" ]; then
+    pairs_right=$((pairs_right + 1))
+  else
+    fail "two runs into one --out: exits $sa and $sb: $(cat "$WORK/race-1.err" "$WORK/race-2.err")"
+  fi
+done
+[ "$pairs_right" -eq 20 ] && pass "two runs into one --out: 20 of 20 pairs, one refused, the other a lone run's results"
+[ -z "$(ls -A "$WORK" | grep hemosolve-lock)" ] && pass "no lock file left" || fail "lock files left: $(ls -a "$WORK" | grep lock)"
 
 # A checkpoint of other options or another network is refused, naming what differs.
 expect_error "resume with another scheme" 2 "other options" -- \
