@@ -100,10 +100,15 @@ std::string describe(const Network& kept, const DroppedParts& dropped) {
     return std::to_string(k) + " " + (k == 1 ? one : many);
   };
   std::string s = "kept the largest connected part, " + count(kept.vessel_count(), "vessel", "vessels") + " and " +
-                  count(kept.node_count(), "node", "nodes") + "; dropped " +
-                  (dropped.parts == 0 ? std::string("no other part") : count(dropped.parts, "part", "parts")) + ": " +
-                  count(dropped.vessels, "vessel", "vessels") + ", " + count(dropped.nodes, "node", "nodes") + ", " +
-                  count(dropped.boundary_nodes, "boundary node", "boundary nodes");
+                  count(kept.node_count(), "node", "nodes");
+  if (dropped.parts > 0)
+    s += "; dropped " + count(dropped.parts, "part", "parts") + ": " + count(dropped.vessels, "vessel", "vessels") +
+         ", " + count(dropped.nodes, "node", "nodes") + ", " +
+         count(dropped.boundary_nodes, "boundary node", "boundary nodes");
+  else if (dropped.nodes > 0)
+    s += "; the network is one part: dropped only " + count(dropped.nodes, "node", "nodes") + " that no vessel meets";
+  else
+    s += "; the network is one part: nothing dropped";
   if (dropped.generations_recounted)
     s += "; the kept vessels' generations exceeded their count and were counted again from the part's inlets";
   return s;

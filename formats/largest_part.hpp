@@ -27,7 +27,7 @@ struct DroppedParts {
 Network largest_connected_part(const Network& net, DroppedParts* dropped = nullptr);
 
 // For a note: "kept the largest connected part, 120 vessels and 98 nodes; dropped 4 parts:
-// 23 vessels, 30 nodes, 6 boundary nodes".
+// 23 vessels, 30 nodes, 6 boundary nodes" (or "the network is one part: nothing dropped").
 std::string describe(const Network& kept, const DroppedParts& dropped);
 
 }  // namespace hemotree

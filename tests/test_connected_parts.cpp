@@ -246,6 +246,8 @@ TEST(LargestPart, OfEqualPartsTheOneWithTheLowestVesselId) {
   EXPECT_EQ(whole.id, part.id);
   EXPECT_EQ(none.parts, 0u);
   EXPECT_EQ(none.vessels, 0u);
+  EXPECT_EQ(describe(whole, none), "kept the largest connected part, 1 vessel and 2 nodes; the network is one part: "
+                                   "nothing dropped");
 }
 
 TEST(PressureReference, FixesThePressureOfABalancedFlowsOnlyPart) {

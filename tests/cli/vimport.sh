@@ -125,4 +125,43 @@ else
   echo "skip: $MESENTERY absent (the shared public networks); the mesentery checks did not run"
 fi
 
+
+# Fragments (issue 21): a network of three parts, listed by vstats largest first; --keep-largest-part
+# keeps the largest (ids and boundaries unchanged) and says on stderr what it dropped.
+{
+  header 6
+  printf '10 5 1 2 20.0 0.0 0.0\n11 5 2 3 15.0 0.0 0.0\n12 5 3 4 8.0 0.0 0.0\n'
+  printf '30 5 8 9 10.0 0.0 0.0\n20 5 5 6 10.0 0.0 0.0\n21 5 6 7 10.0 0.0 0.0\n'
+  printf '9 number of nodes\nName x y z\n1 0 0 0\n2 300 400 0\n3 300 400 120\n4 320 430 180\n'
+  printf '5 0 0 500\n6 0 100 500\n7 0 200 500\n8 50 0 600\n9 50 50 600\n'
+  printf '6 total number of boundary nodes\nNode Bctype Press/Flow HD PO2\n1 2 6.0 0.45 40\n4 0 15.0 0.3 40\n'
+  printf '5 2 3.0 0.45 40\n7 2 -3.0 0.45 40\n8 2 1.0 0.45 40\n9 2 -2.0 0.45 40\n'
+} >"$WORK/fragments.dat"
+"$VIMPORT" secomb "$WORK/fragments.dat" -o "$WORK/fragments.json" 2>/dev/null \
+  && "$VSTATS" --json "$WORK/fragments.json" >"$WORK/fragments-stats.json" \
+  && /usr/bin/python3 - "$WORK/fragments-stats.json" <<'PY' && pass "vstats lists the parts largest first" || fail "vstats parts: $(cat "$WORK/fragments-stats.json")"
+import json, sys
+parts = json.load(open(sys.argv[1]))["connected_parts"]
+assert [(p["lowest_vessel_id"], p["vessels"], p["nodes"], p["boundary_nodes"], p["pressure_reference"]) for p in parts] \
+    == [(10, 3, 4, 2, True), (20, 2, 3, 2, False), (30, 1, 2, 2, False)], parts
+assert parts[1]["flows_balance"] and not parts[2]["flows_balance"]
+PY
+"$VSTATS" "$WORK/fragments.json" | grep -q "^  with vessel 20 .* no (flows balance)$" \
+  && pass "vstats table of parts" || fail "vstats table of parts: $("$VSTATS" "$WORK/fragments.json")"
+"$VIMPORT" secomb "$WORK/fragments.dat" --keep-largest-part -o "$WORK/largest.json" 2>"$WORK/log" \
+  && grep -q "^vimport: note: kept the largest connected part, 3 vessels and 4 nodes; dropped 2 parts: 3 vessels, 5 nodes, 4 boundary nodes$" "$WORK/log" \
+  && /usr/bin/python3 - "$WORK/largest.json" <<'PY' && pass "--keep-largest-part" || fail "--keep-largest-part: $(cat "$WORK/log")"
+import json, sys
+net = json.load(open(sys.argv[1]))
+assert [v["id"] for v in net["vessels"]] == [10, 11, 12]
+assert [(v["from"], v["to"]) for v in net["vessels"]] == [(1, 2), (2, 3), (3, 4)]
+assert [(b["node"], b["type"]) for b in net["boundaries"]] == [(1, "flow"), (4, "pressure")]
+assert net["provenance"]["parameters"]["keep_largest_part"] is True
+PY
+if [ -f "$MESENTERY" ]; then
+  "$VIMPORT" secomb "$MESENTERY" --keep-largest-part -o "$WORK/mesentery-largest.json" 2>"$WORK/log" \
+    && grep -q "kept the largest connected part, 1130 vessels and 972 nodes; the network is one part: nothing dropped" "$WORK/log" \
+    && pass "rat mesentery: one part, --keep-largest-part drops nothing" || fail "mesentery --keep-largest-part: $(cat "$WORK/log")"
+fi
+
 finish
