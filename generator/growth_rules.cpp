@@ -325,10 +325,9 @@ GrowthRules read_rules(const std::string& path) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path + ": " + e.what());
-  } catch (const nlohmann::json::out_of_range& e) {
-    // A number beyond a double ("1e3081") is the file's fault, not an internal error.
+  } catch (const nlohmann::json::exception& e) {
+    // Any exception of parsing is the file's fault, not an internal error: a syntax error,
+    // a number beyond a double ("1e3081", out_of_range), whatever a later nlohmann adds.
     throw InputError(path + ": " + e.what());
   }
   try {
