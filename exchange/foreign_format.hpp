@@ -2,9 +2,11 @@
 // (wall thickness, Young's modulus) and where to say what was assumed.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "formats/network.hpp"
 
@@ -25,6 +27,17 @@ struct ImportOptions {
 // The whole file as bytes (formats read whole: centerlines, graphs); IoError naming it when it
 // cannot be opened or read.
 std::string read_whole_file(const std::string& path);
+
+// The deepest element nesting refuse_deep_xml lets through: GraphML and VTK PolyData nest
+// fewer than 10 deep, and the recursive XML parser (rapidxml, under Boost.PropertyTree)
+// spends a stack frame on each level, so 200,000 nested elements overflow the stack.
+constexpr std::size_t xml_depth_cap = 256;
+
+// Refuses, as InputError "PATH:LINE: ...", XML whose elements nest deeper than
+// xml_depth_cap, before any recursive parser sees it. One linear pass over the bytes that
+// skips comments, CDATA, processing instructions, declarations and quoted attribute values;
+// it counts what a parser would, so anything it lets through is at most that deep.
+void refuse_deep_xml(const std::string& path, std::string_view xml);
 
 // Fills wall_thickness and youngs_modulus where they are NaN, from the options or the
 // toolkit's tables, and notes what it did (one line each, with the count of vessels).

@@ -177,8 +177,10 @@ RawGraph parse_graphml(const std::string& path) {
   g.path = path;
   g.format = "graphml";
   ptree tree;
+  const std::string text = read_whole_file(path);
+  refuse_deep_xml(path, text);  // before the recursive parser: deep nesting would overflow its stack
   try {
-    std::istringstream in(read_whole_file(path));
+    std::istringstream in(text);
     boost::property_tree::read_xml(in, tree, boost::property_tree::xml_parser::no_comments);
   } catch (const boost::property_tree::xml_parser_error& e) {
     throw InputError(path + ":" + std::to_string(e.line()) + ": not well-formed XML: " + e.message());
@@ -256,6 +258,44 @@ RawGraph parse_graphml(const std::string& path) {
 
 // --- node-link JSON ----------------------------------------------------------------------------
 
+// Where nlohmann's parser stops on text: a second pass that builds nothing, since only a
+// syntax error carries its byte in the exception, a number overflow does not.
+std::size_t json_error_line(const std::string& text) {
+  struct Locator final : nlohmann::json_sax<nlohmann::json> {
+    std::size_t byte = 0;
+    bool null() override { return true; }
+    bool boolean(bool) override { return true; }
+    bool number_integer(number_integer_t) override { return true; }
+    bool number_unsigned(number_unsigned_t) override { return true; }
+    bool number_float(number_float_t, const string_t&) override { return true; }
+    bool string(string_t&) override { return true; }
+    bool binary(binary_t&) override { return true; }
+    bool start_object(std::size_t) override { return true; }
+    bool key(string_t&) override { return true; }
+    bool end_object() override { return true; }
+    bool start_array(std::size_t) override { return true; }
+    bool end_array() override { return true; }
+    bool parse_error(std::size_t position, const std::string&, const nlohmann::json::exception&) override {
+      byte = position;  // just past the offending token
+      return false;
+    }
+  } locator;
+  nlohmann::json::sax_parse(text, &locator);
+  const std::size_t end = std::min(locator.byte, text.size());
+  const auto last = text.begin() + static_cast<long>(end > 0 ? end - 1 : 0);
+  return 1 + static_cast<std::size_t>(std::count(text.begin(), last, '\n'));
+}
+
+// nlohmann's message without its "[json.exception.parse_error.101] parse error at line 3,
+// column 5:" prefix (the caller names the line), and what a double holds after an overflow.
+std::string json_error_text(const nlohmann::json::exception& e) {
+  std::string what = e.what();
+  if (const auto at = what.find("syntax error"); at != std::string::npos) return "not JSON: " + what.substr(at);
+  if (const auto at = what.find("] "); at != std::string::npos) what = what.substr(at + 2);
+  if (e.id == 406) what += ": numbers must lie within +-1.8e308 (a double)";
+  return what;
+}
+
 RawGraph parse_node_link(const std::string& path) {
   RawGraph g;
   g.path = path;
@@ -264,12 +304,10 @@ RawGraph parse_node_link(const std::string& path) {
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    const std::size_t end = std::min<std::size_t>(e.byte, text.size());
-    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(end > 0 ? end - 1 : 0), '\n');
-    std::string what = e.what();
-    if (const auto at = what.find("syntax error"); at != std::string::npos) what = what.substr(at);
-    throw InputError(path + ":" + std::to_string(line) + ": not JSON: " + what);
+  } catch (const nlohmann::json::exception& e) {
+    // Any exception of parsing is the file's: a syntax error (parse_error) and a number
+    // beyond a double ("1e400", out_of_range 406) alike.
+    throw InputError(path + ":" + std::to_string(json_error_line(text)) + ": " + json_error_text(e));
   }
   if (!doc.is_object()) g.fail("the document", "must be a JSON object (networkx.node_link_data)");
   if (doc.contains("links") && doc.contains("edges"))
@@ -394,6 +432,7 @@ void check_range(const RawGraph& g, const std::string& where, const char* field,
 }
 
 Network build_network(RawGraph& g, const ImportOptions& options, const GraphOptions& graph_options) {
+  const std::string edge_word = g.format == "graphml" ? "edge" : "link";
   // Units: the caller's, the file's, or metres.
   double u = 1;
   std::string unit_from = "metres, the default";
@@ -463,7 +502,10 @@ Network build_network(RawGraph& g, const ImportOptions& options, const GraphOpti
     }
   }
 
-  // Vessels.
+  // Vessels. An edgeless graph would make a network of none, which no tool can use.
+  if (g.edges.empty())
+    g.fail("the graph", "has no " + edge_word + " (" + plural(g.nodes.size(), "node", "nodes") +
+                            "): a network needs one vessel at least");
   std::size_t straight = 0, from_radius = 0, tapered = 0;
   const bool generations = !g.edges.empty() && std::all_of(g.edges.begin(), g.edges.end(),
                                                            [](const RawEdge& e) { return e.generation.has_value(); });
@@ -552,7 +594,6 @@ Network build_network(RawGraph& g, const ImportOptions& options, const GraphOpti
   net.provenance["format"] = g.format;
   net.provenance["source"] = g.path;
 
-  const std::string edge_word = g.format == "graphml" ? "edge" : "link";
   options.note("read " + plural(g.nodes.size(), "node", "nodes") + " and " +
                plural(g.edges.size(), (edge_word).c_str(), (edge_word + "s").c_str()) + "; lengths in " + unit_from +
                "; node ids: " + node_how + "; vessel ids: " + vessel_how);

@@ -305,6 +305,65 @@ TEST_F(ImportGraphs, MalformedNodeLink) {
             ": links[1] (2 -> 1): its \"id\" 4 is also that of links[0] (1 -> 2)");
 }
 
+// Issue 21, defect 1: a number beyond a double raised nlohmann's out_of_range (406), which
+// escaped as an internal error (exit 70); it is the file's fault, refused with its line.
+TEST_F(ImportGraphs, NumbersBeyondADoubleAreRefusedWithTheirLine) {
+  EXPECT_EQ(json_message("{\"nodes\": [{\"id\": 1}, {\"id\": 2}],\n \"links\": [\n"
+                         "  {\"source\": 1, \"target\": 2, \"length\": 1e400, \"diameter\": 1e-4}]}"),
+            ":3: number overflow parsing '1e400': numbers must lie within +-1.8e308 (a double)");
+  EXPECT_EQ(json_message("{\"graph\": {\"scale\": -1e999}, \"nodes\": [], \"links\": []}"),
+            ":1: number overflow parsing '-1e999': numbers must lie within +-1.8e308 (a double)");
+  EXPECT_EQ(json_message("{\"nodes\": [],\n\n\n \"links\": [], \"x\": 1e309}"),
+            ":4: number overflow parsing '1e309': numbers must lie within +-1.8e308 (a double)");
+}
+
+// Issue 21, defect 2: 200,000 nested elements overflowed rapidxml's recursion (SIGSEGV);
+// the depth is now counted before parsing, by what a parser counts and nothing else.
+TEST_F(ImportGraphs, DeeplyNestedGraphmlIsRefusedBeforeParsing) {
+  std::string deep = "<?xml version=\"1.0\"?>\n<graphml><graph edgedefault=\"undirected\">\n";
+  for (int k = 0; k < 200000; ++k) deep += "<a>";
+  for (int k = 0; k < 200000; ++k) deep += "</a>";
+  deep += "</graph></graphml>\n";
+  EXPECT_EQ(graphml_message(deep), ":3: <a> lies 257 elements deep: hemotree reads XML nested at most 256 deep");
+
+  // 256 deep is read (and refused for what it holds, not its depth).
+  std::string at_cap = "<graphml><graph>";
+  for (int k = 0; k < 254; ++k) at_cap += "<desc>";
+  for (int k = 0; k < 254; ++k) at_cap += "</desc>";
+  EXPECT_EQ(graphml_message(at_cap + "</graph></graphml>"), ": the graph: has no edge (0 nodes): a network needs one vessel at least");
+
+  // Comments, CDATA, processing instructions, self-closing tags and '>' in quoted values nest nothing.
+  std::string flat = R"(<graphml><key id="d" for="edge" attr.name="diameter"/><key id="l" for="edge" attr.name="length"/><graph>)";
+  flat += "<desc><!--";
+  for (int k = 0; k < 300; ++k) flat += "<a>";
+  flat += "--><![CDATA[";
+  for (int k = 0; k < 300; ++k) flat += "<a>";
+  flat += "]]><?pi <a><a> ?>";
+  for (int k = 0; k < 300; ++k) flat += "<x note=\"a>b\" other='/>'/>";
+  flat += R"(</desc><node id="a"/><node id="b"/><edge source="a" target="b"><data key="l">1e-3</data><data key="d">1e-4</data></edge></graph></graphml>)";
+  EXPECT_EQ(graphml(flat).vessel_count(), 1u);
+  // A '/>' inside a quoted value does not close the tag: 300 of them nest 300 deep.
+  std::string quoted = "<graphml><graph>";
+  for (int k = 0; k < 300; ++k) quoted += "<a b=\"/>\">";
+  EXPECT_EQ(graphml_message(quoted), ":1: <a> lies 257 elements deep: hemotree reads XML nested at most 256 deep");
+  // What rapidxml reads as markup is counted, not hidden: a quote in a name opens no value
+  // (<x"> is an element), a declaration other than DOCTYPE ends at its first '>'.
+  for (const std::string opener : {"<x\">", "<!X [ >", "<!DOCTYPEx [ >"}) {
+    std::string hidden = "<graphml><graph>" + opener;
+    for (int k = 0; k < 300; ++k) hidden += "<a>";
+    EXPECT_EQ(graphml_message(hidden + "]\">"), ":1: <a> lies 257 elements deep: hemotree reads XML nested at most 256 deep")
+        << opener;
+  }
+}
+
+// Issue 21, defect 13c: an edgeless graph imported as a network of no vessel (exit 0).
+TEST_F(ImportGraphs, AGraphWithoutEdgesIsRefused) {
+  EXPECT_EQ(json_message(R"({"nodes": [], "links": []})"),
+            ": the graph: has no link (0 nodes): a network needs one vessel at least");
+  EXPECT_EQ(graphml_message(R"(<graphml><graph edgedefault="undirected"><node id="a"/></graph></graphml>)"),
+            ": the graph: has no edge (1 node): a network needs one vessel at least");
+}
+
 TEST_F(ImportGraphs, UnreadableFileIsIoError) {
   EXPECT_THROW(read_graphml("/nonexistent/g.graphml", ImportOptions{}), IoError);
   EXPECT_THROW(read_node_link_json("/nonexistent/g.json", ImportOptions{}), IoError);
