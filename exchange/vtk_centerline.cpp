@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <numeric>
 #include <sstream>
 #include <string>
@@ -74,6 +75,9 @@ class ByteReader {
   virtual ~ByteReader() = default;
   // Appends n bytes to out; throws BadData when the data end first.
   virtual void read(std::size_t n, std::string& out) = 0;
+  // At most how many bytes are left to read: a header's counts are checked against it
+  // before anything is allocated for them.
+  virtual std::size_t available() const = 0;
 };
 
 class RawReader final : public ByteReader {
@@ -85,6 +89,7 @@ class RawReader final : public ByteReader {
     out.append(data_.substr(at_, n));
     at_ += n;
   }
+  std::size_t available() const override { return at_ > data_.size() ? 0 : data_.size() - at_; }
 
  private:
   std::string_view data_;
@@ -105,6 +110,10 @@ class Base64Reader final : public ByteReader {
       pending_.erase(0, take);
       n -= take;
     }
+  }
+  // Three bytes per four characters left, fewer where there are spaces or padding.
+  std::size_t available() const override {
+    return pending_.size() + (at_ > text_.size() ? 0 : (text_.size() - at_) / 4 * 3);
   }
 
  private:
@@ -157,8 +166,14 @@ std::uint64_t to_integer(const std::string& bytes, bool big_endian) {
   return v;
 }
 
+// Deflate's densest code, a 258-byte match in about 2 bits: no zlib stream inflates to more
+// than 1032 times its own size, so a header that claims more is corrupt, not compressed.
+constexpr std::uint64_t zlib_max_ratio = 1032;
+
 // An array's bytes after its header: [size] uncompressed; [blocks, block size, last block
 // size (0: a full block), compressed size of each block] then the blocks, zlib-compressed.
+// Every size in a header is checked against the bytes present before anything is
+// allocated for it: a corrupt header of a few bytes must not allocate gigabytes.
 std::string decode_binary(ByteReader& in, const Encoding& enc, std::size_t expected_bytes) {
   auto word = [&] {
     std::string b;
@@ -170,6 +185,9 @@ std::string decode_binary(ByteReader& in, const Encoding& enc, std::size_t expec
     const std::uint64_t n = word();
     if (n != expected_bytes)
       throw BadData{"its header gives " + std::to_string(n) + " bytes, expected " + std::to_string(expected_bytes)};
+    if (n > in.available())
+      throw BadData{"its header gives " + std::to_string(n) + " bytes, but the data hold at most " +
+                    std::to_string(in.available())};
     in.read(n, data);
     return data;
   }
@@ -182,8 +200,22 @@ std::string decode_binary(ByteReader& in, const Encoding& enc, std::size_t expec
     throw BadData{"its compression header gives " + std::to_string(blocks) + " blocks of " +
                   std::to_string(block_size) + " bytes (last " + std::to_string(last_size) + "), expected " +
                   std::to_string(expected_bytes) + " bytes in all"};
+  if (blocks > in.available() / enc.header_bytes)
+    throw BadData{"its compression header gives " + std::to_string(blocks) + " blocks, but the data hold at most " +
+                  std::to_string(in.available() / enc.header_bytes) + " block sizes"};
   std::vector<std::uint64_t> compressed(blocks);
-  for (auto& c : compressed) c = word();
+  std::uint64_t compressed_total = 0;
+  for (auto& c : compressed) {
+    c = word();
+    if (c > in.available() || compressed_total + c > in.available())
+      throw BadData{"its compressed blocks take more than the " + std::to_string(in.available()) +
+                    " bytes the data hold"};
+    compressed_total += c;
+  }
+  if (expected_bytes > zlib_max_ratio * compressed_total)
+    throw BadData{"its " + std::to_string(compressed_total) + " compressed bytes cannot inflate to " +
+                  std::to_string(expected_bytes) + " (zlib inflates at most " + std::to_string(zlib_max_ratio) +
+                  " times)"};
   data.resize(expected_bytes);
   std::size_t at = 0;
   std::string block;
@@ -277,8 +309,8 @@ std::vector<double> read_data_array(const XmlFile& f, const ptree& array, const 
   try {
     if (format == "ascii") {
       std::vector<double> values;
-      values.reserve(count);
       const std::string& text = array.data();
+      values.reserve(std::min(count, text.size() / 2 + 1));  // a number and a space each, at least
       for (std::size_t at = 0; at < text.size();) {
         while (at < text.size() && is_space(text[at])) ++at;
         std::size_t end = at;
@@ -363,6 +395,7 @@ Centerlines read_xml(const std::string& path, std::string text, const Centerline
   XmlFile f;
   f.path = path;
   const std::string xml = cut_appended(f, std::move(text));
+  refuse_deep_xml(path, xml);  // before the recursive parser: deep nesting would overflow its stack
   ptree tree;
   try {
     std::istringstream in(xml);
@@ -498,7 +531,7 @@ class LegacyReader {
           word("");
           word("the lookup table name");
         }
-        auto values = numbers(components * section_count, "SCALARS " + name);
+        auto values = numbers(product(components, section_count), "SCALARS " + name);
         keep(c, section, name, components, std::move(values), options, have_radius);
       } else if (key == "FIELD") {
         word("the field name");
@@ -508,7 +541,7 @@ class LegacyReader {
           const std::string name = word("the array name");
           const std::size_t components = count("the component count"), tuples = count("the tuple count");
           word("the data type");
-          auto values = numbers(components * tuples, "array " + name);
+          auto values = numbers(product(components, tuples), "array " + name);
           if (!section.empty() && tuples != section_count)
             fail("array " + name + " has " + std::to_string(tuples) + " tuples, " + section + " has " +
                  std::to_string(section_count));
@@ -525,11 +558,11 @@ class LegacyReader {
         const std::string name = word("the array name");
         const std::size_t dim = count("the dimension");
         word("the data type");
-        numbers(dim * section_count, key + " " + name);
+        numbers(product(dim, section_count), key + " " + name);
         (section == "POINT_DATA" ? c.point_arrays : c.cell_arrays).push_back(name);
       } else if (key == "COLOR_SCALARS") {
         const std::string name = word("the array name");
-        numbers(count("the component count") * section_count, key + " " + name);
+        numbers(product(count("the component count"), section_count), key + " " + name);
         (section == "POINT_DATA" ? c.point_arrays : c.cell_arrays).push_back(name);
       } else if (key == "LOOKUP_TABLE") {
         word("the table name");
@@ -574,6 +607,7 @@ class LegacyReader {
   // OFFSETS (cells numbers, the first 0) and CONNECTIVITY (size numbers).
   void read_cells(const std::string& key, std::size_t cells, std::size_t size, std::vector<std::int64_t>& offsets,
                   std::vector<std::int64_t>& ids) {
+    fits(size, key);  // either layout holds size numbers at least; said at the count's line
     offsets.assign(1, 0);
     if (peek_word() == "OFFSETS") {
       word("");
@@ -647,7 +681,21 @@ class LegacyReader {
       fail("expected " + what + ", got '" + w + "'");
     return static_cast<std::size_t>(n);
   }
+  // Two counts multiplied, at most 2^80: saturated rather than wrapped, for fits() to refuse.
+  static std::size_t product(std::size_t a, std::size_t b) {
+    return b != 0 && a > std::numeric_limits<std::size_t>::max() / b ? std::numeric_limits<std::size_t>::max() : a * b;
+  }
+  // Refuses at once a count of numbers that the rest of the file cannot hold (each takes a
+  // character and a space at least), before anything is allocated for them: "POINTS
+  // 100000000" in an 82-byte file must not allocate gigabytes.
+  void fits(std::size_t n, const std::string& what) const {
+    const std::size_t left = text_.size() - pos_;
+    if (n > left / 2 + 1)
+      fail(what + ": " + std::to_string(n) + " numbers cannot fit in the " + std::to_string(left) +
+           " bytes left in the file");
+  }
   std::vector<double> numbers(std::size_t n, const std::string& what) {
+    fits(n, what);
     std::vector<double> values(n);
     for (std::size_t k = 0; k < n; ++k) {
       const std::string_view w = peek_word();
@@ -658,6 +706,7 @@ class LegacyReader {
     return values;
   }
   std::vector<std::int64_t> integers(std::size_t n, const std::string& what) {
+    fits(n, what);
     std::vector<std::int64_t> values(n);
     for (std::size_t k = 0; k < n; ++k) {
       const std::string_view w = peek_word();

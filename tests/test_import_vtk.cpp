@@ -422,12 +422,13 @@ TEST_F(ImportVtk, MalformedBinary) {
   bad[at] = '!';
   EXPECT_EQ(message("a.vtp", bad),
             ": PolyData/Piece/PointData/DataArray[Name=MaximumInscribedSphereRadius]: '!' is not a base64 character");
-  // The blocks cut short.
+  // The blocks cut short: seen from the header's sizes, before any block is read.
   std::string cut = zlib;
   const auto end = cut.find("</DataArray>");
   cut.erase(end - 8, 8);
   EXPECT_EQ(message("b.vtp", cut),
-            ": PolyData/Piece/PointData/DataArray[Name=MaximumInscribedSphereRadius]: the base64 text ends early");
+            ": PolyData/Piece/PointData/DataArray[Name=MaximumInscribedSphereRadius]: its compressed blocks take "
+            "more than the 36 bytes the data hold");
   // A block that is not zlib: the raw file's bytes with the compressor declared.
   const std::string raw = VtpWriter({Mode::appended_raw}).file(y_shape());
   EXPECT_EQ(message("c.vtp", replaced(raw, "header_type=\"UInt32\"", "header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\"")),
@@ -453,6 +454,61 @@ TEST_F(ImportVtk, MalformedLegacy) {
   EXPECT_EQ(message("d.vtk", replaced(classic, "POINT_DATA 6", "POINT_DATA 7")), ":15: POINT_DATA 7: expected 6");
   EXPECT_EQ(message("e.vtk", replaced(classic, "DATASET POLYDATA", "DATASET UNSTRUCTURED_GRID")),
             ":4: hemotree reads DATASET POLYDATA (centerlines)");
+}
+
+// Issue 21, defect 9: a count in a few bytes must not allocate for what it announces; each
+// is refused by what the file can hold, before any allocation (a refusal after allocating
+// would take seconds and gigabytes, or end in bad_alloc, not this InputError).
+TEST_F(ImportVtk, LegacyCountsBeyondTheFileAreRefusedAtOnce) {
+  const std::string head = "# vtk DataFile Version 3.0\ncenterlines\nASCII\nDATASET POLYDATA\n";
+  EXPECT_EQ(message("points.vtk", head + "POINTS 100000000 double\n0 0 0\n"),
+            ":5: POINTS: 300000000 numbers cannot fit in the 7 bytes left in the file");
+  EXPECT_EQ(message("points_max.vtk", head + "POINTS 1099511627776 double\n0 0 0\n"),
+            ":5: POINTS: 3298534883328 numbers cannot fit in the 7 bytes left in the file");
+  EXPECT_EQ(message("lines.vtk", head + "POINTS 2 double\n0 0 0 0 0 1\nLINES 1 300000000\n2 0 1\n"),
+            ":7: LINES: 300000000 numbers cannot fit in the 7 bytes left in the file");
+  // Two counts whose product wraps around 2^64 to 0: saturated, so refused, not read as empty.
+  EXPECT_EQ(message("field.vtk", head + "POINTS 2 double\n0 0 0 0 0 1\nFIELD f 1\nr 4294967296 4294967296 double\n"),
+            ":8: array r: 18446744073709551615 numbers cannot fit in the 1 bytes left in the file");
+}
+
+TEST_F(ImportVtk, XmlCountsBeyondTheDataAreRefusedBeforeAllocating) {
+  // 1e8 points of Float64: 2.4e9 bytes announced by a header of a few bytes.
+  const auto file = [](const std::string& header_attributes, const std::string& format, const std::string& data) {
+    return "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" " +
+           header_attributes + ">\n<PolyData><Piece NumberOfPoints=\"100000000\" NumberOfLines=\"1\"><Points>" +
+           "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"" + format + "\">" + data +
+           "</DataArray></Points></Piece></PolyData></VTKFile>\n";
+  };
+  const std::string zlib = "header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\"";
+  const std::string at = ": PolyData/Piece/Points/DataArray: ";
+  // 2e8 blocks of 12 bytes: their sizes alone would take 1.6 GB.
+  EXPECT_EQ(message("blocks.vtp", file(zlib, "binary", base64(word(200000000, true) + word(12, true) + word(0, true)))),
+            at + "its compression header gives 200000000 blocks, but the data hold at most 0 block sizes");
+  // One block of 2.4e9 bytes, 16 compressed bytes that are there: more than zlib can inflate.
+  EXPECT_EQ(message("ratio.vtp", file(zlib, "binary",
+                                      base64(word(1, true) + word(2400000000, true) + word(0, true) + word(16, true)) +
+                                          base64(std::string(16, 'x')))),
+            at + "its 16 compressed bytes cannot inflate to 2400000000 (zlib inflates at most 1032 times)");
+  // One block whose compressed size is more than the file holds.
+  EXPECT_EQ(message("oneblock.vtp", file(zlib, "binary",
+                                         base64(word(1, true) + word(2400000000, true) + word(0, true) +
+                                                word(2000000000, true)))),
+            at + "its compressed blocks take more than the 0 bytes the data hold");
+  // Uncompressed: the header's size agrees with the count, the bytes are not there.
+  EXPECT_EQ(message("raw.vtp", file("header_type=\"UInt64\"", "binary", base64(word(2400000000, true)))),
+            at + "its header gives 2400000000 bytes, but the data hold at most 0");
+  // ascii: 3e8 numbers announced, 3 given (reserving for the count would take 2.4 GB).
+  EXPECT_EQ(message("ascii.vtp", file("", "ascii", "0 0 0")), at + "holds 3 numbers, expected 300000000");
+}
+
+// Issue 21, defect 2: 200,000 nested elements overflowed rapidxml's recursion (SIGSEGV).
+TEST_F(ImportVtk, DeeplyNestedXmlIsRefusedBeforeParsing) {
+  std::string deep = "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\"><PolyData>";
+  for (int k = 0; k < 200000; ++k) deep += "<PolyData>";
+  for (int k = 0; k < 200000; ++k) deep += "</PolyData>";
+  deep += "</PolyData></VTKFile>\n";
+  EXPECT_EQ(message("deep.vtp", deep), ":2: <PolyData> lies 257 elements deep: hemotree reads XML nested at most 256 deep");
 }
 
 TEST_F(ImportVtk, RefusesUnmergedBranchTracts) {
