@@ -104,14 +104,20 @@ void write_lines(OutputStream& out, std::size_t count, AppendLine append_line) {
 #pragma omp parallel for ordered schedule(static, 1) firstprivate(text)
   for (std::size_t b = 0; b < blocks; ++b) {
     text.clear();
-    const std::size_t end = std::min(count, (b + 1) * block);
-    for (std::size_t i = b * block; i < end; ++i) {
-      append_line(text, i);
-      text += i + 1 < count ? ",\n" : "\n";
+    std::exception_ptr made;  // a block's text (an allocation) may fail too
+    try {
+      const std::size_t end = std::min(count, (b + 1) * block);
+      for (std::size_t i = b * block; i < end; ++i) {
+        append_line(text, i);
+        text += i + 1 < count ? ",\n" : "\n";
+      }
+    } catch (...) {
+      made = std::current_exception();
     }
 #pragma omp ordered
     {
       // Exceptions must not cross the parallel region: keep the first, rethrow after.
+      if (!error && made) error = made;
       if (!error) {
         try {
           out.write(text);

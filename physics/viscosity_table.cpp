@@ -1,8 +1,10 @@
 #include "physics/viscosity_table.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
+#include "cli/errors.hpp"
 #include "physics/rheology.hpp"
 
 namespace hemotree {
@@ -51,6 +53,16 @@ ViscosityTable::ViscosityTable(const Blood& blood) : blood_(blood) {
   }
 }
 
-double ViscosityTable::below_table(double area) const { return apparent_viscosity(blood_, diameter_of(area)); }
+double ViscosityTable::below_table(double area) const {
+  // A lumen outside the law's domain (collapsed, or not a number once a solution has broken
+  // down) gives NaN rather than the law's exception: this runs inside OpenMP regions, which no
+  // exception may leave, and the solver's breakdown checks then name the vessel and the time.
+  if (!(area > 0) || !std::isfinite(area)) return std::numeric_limits<double>::quiet_NaN();
+  try {
+    return apparent_viscosity(blood_, diameter_of(area));
+  } catch (const InputError&) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
 
 }  // namespace hemotree

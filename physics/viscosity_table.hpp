@@ -43,7 +43,7 @@ class ViscosityTable {
   static constexpr std::size_t intervals = 512;  // per octave of the area
   static constexpr std::uint64_t mantissa_mask = (std::uint64_t{1} << 52) - 1;
   static constexpr std::uint64_t one_bits = std::uint64_t{1023} << 52;  // the bits of 1.0
-  double below_table(double area) const;  // the law itself (collapsing lumens)
+  double below_table(double area) const;  // the law itself (collapsing lumens); NaN outside its domain
 
   Blood blood_;
   bool constant_ = false;

@@ -5,10 +5,16 @@
 #include <limits>
 #include <numbers>
 
+#include "core/parallel_errors.hpp"
+
 namespace hemotree {
 
 double wall_shear_stress(double viscosity, double mean_velocity, double radius, double alpha) {
   return viscosity * mean_velocity * alpha / ((alpha - 1) * radius);
+}
+
+double exchange_scale(double in, double out, double network_volume) {
+  return std::max({std::abs(in), std::abs(out), 1e-6 * network_volume});
 }
 
 double phase_velocity(std::complex<double> z0, std::complex<double> z1, double omega, double dx) {
@@ -74,12 +80,14 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     solver.sample_all(0.0, area_end_, q_end_, &p_end_, false);
     solver.sample_all(1.0, area_out_, q_out_, &p_out_end_, false);
     const auto count = static_cast<std::int64_t>(one_d.size());
+    ParallelErrors errors;
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-    for (std::int64_t j = 0; j < count; ++j) {
+    for (std::int64_t j = 0; j < count; ++j) errors.guard(j, [&] {
       const auto v = static_cast<std::size_t>(one_d[static_cast<std::size_t>(j)]);
       centre(v, area_[v], q_[v], p_[v], solver.mean_flow(v));
       ends(v, p_end_[v], q_end_[v] / area_end_[v], p_out_end_[v], q_out_[v] / area_out_[v]);
-    }
+    });
+    errors.rethrow();
   }
   // The 0D vessels straight from their state, all three points in one pass (their flow is
   // one along the vessel: its mean).
@@ -111,7 +119,8 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   const Eigen::VectorXd through = solver.state().boundary - boundary_start_;
   for (Eigen::Index i = 0; i < through.size(); ++i) summary.boundary_mean_flow.push_back(through(i) / duration_);
   summary.volume_change = solver.network_volume() - volume_start_;
-  summary.conservation_error = (exchanged(0) - exchanged(1) - summary.volume_change) / exchanged(0);
+  summary.conservation_error =
+      (exchanged(0) - exchanged(1) - summary.volume_change) / exchange_scale(exchanged(0), exchanged(1), volume_start_);
   if (duration_ > 0) record_ends(solver, last_);  // the state of the cycle's last sample
   begin(solver);  // the next cycle starts here unless begin() is called again
   std::vector<VesselCycle>& out = summary.vessels;

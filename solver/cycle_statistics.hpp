@@ -48,9 +48,16 @@ struct CycleSummary {
   // Per boundary (PulseSolver::boundary_list), the mean flow in through it [m^3/s].
   std::vector<double> boundary_mean_flow;
   // The change of the blood volume in the vessels over the cycle [m^3], and the scheme's
-  // mass balance: (in - out - change) / in, round-off and the junctions' tolerance.
+  // mass balance: (in - out - change) / exchange_scale(in, out, volume), round-off and the
+  // junctions' tolerance.
   double volume_change = 0, conservation_error = 0;
 };
+
+// What the mass balance is relative to: the volume that went in or out over the cycle [m^3],
+// and where (almost) nothing did (zero boundary flows: a network at rest) a millionth of the
+// network's volume, against which the stored volume's round-off (1e-16 of it) stays far below
+// any tolerance: the balance is defined, and a run where nothing flows balances.
+double exchange_scale(double in, double out, double network_volume);
 
 class CycleStatistics {
  public:

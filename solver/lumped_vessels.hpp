@@ -36,6 +36,7 @@
 #include <span>
 #include <vector>
 
+#include "core/parallel_errors.hpp"
 #include "formats/network.hpp"
 #include "network_flow/nodal_system.hpp"
 #include "physics/viscosity_table.hpp"
@@ -137,8 +138,9 @@ class LumpedVessels {
   template <class F>
   void for_each_sample(F&& f, int threads) const {
     const auto vessels = static_cast<std::int64_t>(vessels_.size());
+    ParallelErrors errors;  // f may throw (the caller's statistics)
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-    for (std::int64_t i = 0; i < vessels; ++i) {
+    for (std::int64_t i = 0; i < vessels; ++i) errors.guard(i, [&] {
       const auto e = static_cast<std::size_t>(i);
       Sample s;
       s.flow = flow_[e];
@@ -151,7 +153,8 @@ class LumpedVessels {
       s.area_centre = root_centre * root_centre;
       s.area_out = root_out * root_out;
       f(static_cast<std::size_t>(vessels_[e]), s);
-    }
+    });
+    errors.rethrow();
   }
   // A tapered 0D vessel's volume, half at each of its nodes' pressures as the nodes hold it [m^3].
   double tapered_volume(std::int32_t index) const;

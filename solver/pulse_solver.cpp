@@ -11,6 +11,7 @@
 #include <omp.h>
 
 #include "cli/errors.hpp"
+#include "core/parallel_errors.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/wall_law.hpp"
 #include "solver/solution_breakdown.hpp"
@@ -190,8 +191,13 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     why << "0D step of " << options.lumped_step << " of the period";
     if (std::isfinite(stable_1d_)) why << ", " << substeps << " 1D substeps set by the " << dt_reason_;
     dt_reason_ = why.str();
-    stable_dt_ = std::numeric_limits<double>::infinity();
-    stable_dt_reason_ = "the 0D step is implicit; the 1D substeps keep their own limit";
+    // The implicit 0D step is stable at any length, but not accurate: BDF2 follows the pulse
+    // only at steps of about --lumped-step of the period (a --dt of one step a cycle stored
+    // 16 % of the inflow and was called complete). The 1D substeps keep their own limit.
+    stable_dt_ = target;
+    std::ostringstream limit;
+    limit << "the 0D step's accuracy limit, --lumped-step " << options.lumped_step << " of the period";
+    stable_dt_reason_ = limit.str();
   }
   set_time_step(dt_);
   if (options.dt > 0) {
@@ -778,18 +784,22 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
 
   // Element terms: each degree's block split into one part per thread.
   Eigen::Index bad = -1;
+  ParallelErrors errors;
   for (const DegreeBlock& b : blocks_) {
     const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
     {
       const int threads = omp_get_num_threads(), me = omp_get_thread_num();
       const Eigen::Index first = b.first + b.count * me / threads, last = b.first + b.count * (me + 1) / threads;
-      const Eigen::Index found = element_terms(s, rate, basis, first, last - first);
-      if (found >= 0) {
+      errors.guard(first, [&] {
+        const Eigen::Index found = element_terms(s, rate, basis, first, last - first);
+        if (found >= 0) {
 #pragma omp critical
-        bad = bad < 0 ? found : std::min(bad, found);
-      }
+          bad = bad < 0 ? found : std::min(bad, found);
+        }
+      });
     }
+    errors.rethrow();
   }
   if (bad >= 0) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad])], t);
 
@@ -923,8 +933,9 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Junctions are independent: each writes only its own ends' fluxes.
   const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
   std::int64_t failed_junction = -1;
+  // (errors, above: a junction of many vessels allocates its scratch)
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t jj = 0; jj < junctions; ++jj) {
+  for (std::int64_t jj = 0; jj < junctions; ++jj) errors.guard(jj, [&] {
     const auto j = static_cast<std::size_t>(jj);
     // Left uninitialised: only the first `count` entries are used (zeroing all 16 was 5 % of a step).
     // A node of more than 16 vessels (measured networks) takes its scratch from the heap.
@@ -965,11 +976,12 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     if (!junction_state({laws, count}, {ja, count}, {jq, count}, {sign, count}, {out, count})) {
 #pragma omp critical
       failed_junction = failed_junction < 0 ? jj : std::min(failed_junction, jj);
-      continue;
+      return;
     }
     for (std::size_t i = 0; i < count; ++i)
       set_end_flux(boundaries_.junction_ends[static_cast<std::size_t>(first) + i], out[i]);
-  }
+  });
+  errors.rethrow();
   if (failed_junction >= 0) {
     const auto first = boundaries_.junction_offset[static_cast<std::size_t>(failed_junction)];
     throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);

@@ -95,8 +95,9 @@ class PulseSolver {
   bool is_lumped(std::size_t vessel) const { return zero_d_[vessel]; }
   std::size_t lumped_count() const { return lumped_.vessel_count(); }
   const std::string& dt_reason() const { return dt_reason_; }
-  // The largest stable step of the scheme (at --cfl 1 would be the limit itself; this is
-  // cfl times it), whatever --dt asked for, and what sets it.
+  // The largest step the run takes without --force, whatever --dt asked for, and what sets
+  // it: the scheme's stability limit (cfl times it) with 1D vessels alone; with 0D vessels the
+  // 0D step's accuracy limit (--lumped-step of the period; the 1D substeps keep their own).
   double stable_dt() const { return stable_dt_; }
   const std::string& stable_dt_reason() const { return stable_dt_reason_; }
   std::size_t steps() const { return steps_; }

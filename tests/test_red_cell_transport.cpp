@@ -198,6 +198,28 @@ TEST(RedCellTransport, BifurcationSplitsAsThePriesSecombLaw) {
   EXPECT_NEAR(mixed.discharge_hematocrit()[static_cast<std::size_t>(b.second) + 2], 0.45, 1e-12);
 }
 
+// hostile-inputs 00: a closed end passes round-off flows (1e-27 against 1e-7), so that the
+// flow fraction q1 / (q1 + q2) is 1 exactly; the daughters' shares once divided by 1 - that,
+// and the 0 / 0 put NaN into the run (and the Pries law then aborted it).
+TEST(RedCellTransport, DaughterOfRoundOffFlowKeepsFiniteHematocrits) {
+  const Bifurcating b = bifurcation(12e-6, 10e-6, 7e-6);
+  std::vector<double> volume(b.grid.cell_count(), 1e-13);
+  volume[static_cast<std::size_t>(b.node)] = 0;
+  RedCellTransport t(b.grid, volume, 0.45);
+  const std::vector<double> inflow{0.45, nan, nan};
+  for (const double round_off : {1e-31, -1e-31}) {  // into the closed branch, and back out of it
+    std::vector<double> q = b.faces(2e-14, 1.0);
+    for (int i = 8; i <= 10; ++i) q[static_cast<std::size_t>(i)] = round_off;
+    q[11] = 0;
+    for (int s = 0; s < 50; ++s) t.step(q, inflow);
+    for (const double h : t.discharge_hematocrit()) {
+      EXPECT_TRUE(h >= 0 && h < 1) << h;
+    }
+  }
+  // The main daughter carries what the feed brings.
+  EXPECT_NEAR(t.discharge_hematocrit()[static_cast<std::size_t>(b.first) + 2], 0.45, 1e-9);
+}
+
 TEST(RedCellTransport, LoopWithCirculatingReversingFlowOverManyCycles) {
   // Two paths of 5 slices between nodes A and B, fed through a slice from an inlet and
   // drained through one to an outlet, with a circulation around the loop that reverses each

@@ -48,3 +48,16 @@ TEST(ViscosityTable, NewtonianIsConstant) {
   EXPECT_DOUBLE_EQ(table(1e-12), 3.4e-3);
   EXPECT_DOUBLE_EQ(table(1e-6), 3.4e-3);
 }
+
+// The table runs inside the solver's OpenMP regions, which no exception may leave: a lumen
+// outside the law's domain (collapsed, or NaN once a solution breaks down) gives NaN, which
+// the solver's breakdown checks then report (hostile-inputs 00 aborted with the law's throw).
+TEST(ViscosityTable, OutsideTheLawsDomainIsNaNNotAnException) {
+  const ViscosityTable table{Blood{}};
+  for (const double area : {std::nan(""), -1e-12, 0.0, std::numbers::pi / 4 * 1e-6 * 1e-6}) {
+    double mu = 0;
+    EXPECT_NO_THROW(mu = table(area)) << area;
+    EXPECT_TRUE(std::isnan(mu)) << area;
+  }
+  EXPECT_THROW(apparent_viscosity(Blood{}, 1e-6), std::exception);  // the law itself still refuses
+}

@@ -133,8 +133,11 @@ void RedCellTransport::split_at_nodes(std::span<const double> face_volume) {
     // The law has no split where X0 >= 1/2 (a feed under 1.93 (1 - H) um): mixed there.
     if (!law_splits(bif)) continue;
     const double fqe = red_cell_fraction(bif);
-    share_[f1] = fqe / bif.flow_fraction;
-    share_[f2] = (1 - fqe) / (1 - bif.flow_fraction);
+    // Each daughter's hematocrit over the feed's: its share of the cells over its share of the
+    // flow, the latter from the flows themselves: a daughter of round-off flow (a closed end:
+    // 1e-27 against 1e-7) has 1 - flow_fraction = 0 exactly, and 0 / 0 put NaN in the run.
+    share_[f1] = fqe * (q1 + q2) / q1;
+    share_[f2] = (1 - fqe) * (q1 + q2) / q2;
     ++separating_;
   }
 }
