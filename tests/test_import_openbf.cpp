@@ -617,6 +617,25 @@ TEST_F(OpenbfTest, TheCircleOfWillisClosesLoopsAndAdan56HasItsOwnExternalPressur
                        .blood->alpha,
                    1.1);
 
+  // Its 11 outlets give R1 and Cc only. openBF's code: R1 stays, R2 = R1 - Z, Z = rho c0 / A0
+  // of the thin wall (c0^2 = 2 E h / (3 rho R), h from Avolio's law as he published it); the
+  // documented reading splits R1 into Z and R1 - Z. Both share R2, and the code's R1 is the
+  // documented total.
+  const Network documented =
+      read_openbf((networks_dir() / shipped[0].path).string(), options_, OpenbfReading::documented);
+  ASSERT_EQ(willis.outlets.size(), 11u);
+  for (std::size_t k = 0; k < willis.outlets.size(); ++k) {
+    const Outlet &code = willis.outlets[k], &doc = documented.outlets[k];
+    const auto v = static_cast<std::size_t>(code.vessel);
+    const double r = willis.diameter[v] / 2, h = avolio_wall_m(r), e = willis.youngs_modulus[v];
+    const double z = 1060 * std::sqrt(2 * e * h / (3 * 1060 * r)) / (std::numbers::pi * r * r);
+    EXPECT_DOUBLE_EQ(willis.blood->density, 1060);
+    EXPECT_NEAR(doc.r1, z, 1e-9 * z);
+    EXPECT_EQ(code.r1, doc.r1 + doc.r2);
+    EXPECT_NEAR(code.r2, code.r1 - z, 1e-9 * code.r1);
+    EXPECT_EQ(code.r2, doc.r2);
+  }
+
   const Network adan = read_openbf((networks_dir() / shipped[1].path).string(), options_);
   EXPECT_DOUBLE_EQ(adan.provenance["external_pressure"].get<double>(), 1e4);
   EXPECT_DOUBLE_EQ(adan.blood->alpha, 4.0 / 3.0);  // gamma_profile 2
