@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -25,6 +26,7 @@
 #include "solver/pulsatile_run.hpp"
 #include "solver/pulse_solver.hpp"
 #include "solver/run_estimate.hpp"
+#include "solver/run_outcome.hpp"
 #include "solver/run_report.hpp"
 #include "solver/steady_run.hpp"
 #include "solver/tracer_spec.hpp"
@@ -349,11 +351,15 @@ int main(int argc, char** argv) {
     // ---- the discretisation, its step and its cost ---------------------------------------
     PulseSolver run(net, options);  // the steady solve: minutes on the full tree
     stop_if_interrupted();
-    if (options.dt > 0 && options.dt > run.stable_dt() * (1 + 1e-9) && !force)
-      throw InputError("--dt " + format_quantity(options.dt, "s") + " is " + format_rounded(options.dt / run.stable_dt()) +
-                       " times the stability limit " + format_quantity(run.stable_dt(), "s") + " (" +
-                       run.stable_dt_reason() + "); the solution would blow up or be wrong: use a --dt of at "
-                       "most the limit, or --force to run it anyway");
+    const bool beyond_limit = options.dt > 0 && options.dt > run.stable_dt() * (1 + 1e-9);
+    const std::string over_limit =
+        beyond_limit ? "--dt " + format_quantity(options.dt, "s") + " is " + format_rounded(options.dt / run.stable_dt()) +
+                           " times the largest step allowed, " + format_quantity(run.stable_dt(), "s") + " (" +
+                           run.stable_dt_reason() + ")"
+                     : std::string();
+    if (beyond_limit && !force)
+      throw InputError(over_limit + "; the solution would blow up or be wrong: use a --dt of at most the limit, or "
+                       "--force to run it anyway");
     const double steps_wanted = std::ceil(period / run.dt() - 1e-9);
     if (!(steps_wanted <= most_steps_per_cycle))
       throw InputError("a time step of " + format_quantity(run.dt(), "s") + " (" + run.dt_reason() + ") needs " +
@@ -414,6 +420,7 @@ int main(int argc, char** argv) {
 
     // ---- the run ------------------------------------------------------------------------------
     std::ostringstream shaping;  // the options a checkpoint must share with the run resuming it
+    shaping.precision(std::numeric_limits<double>::max_digits10);  // every bit: 6 digits let 0.10000001 pass as 0.1
     shaping << "model " << model << " (" << options.lumped_transit << ", " << options.lumped_rc << ", "
             << options.lumped_step << ", " << options.lumped_passes << " passes), scheme "
             << scheme << ", degree " << degree_text << " (" << options.degree_rule.low << "/"
@@ -476,7 +483,11 @@ int main(int argc, char** argv) {
 
     // A run is complete only when its numbers say so.
     std::string failure;
-    if (status == RunStatus::complete || status == RunStatus::not_periodic) {
+    // A forced step beyond the limit runs, for whoever wants to see what it gives, but its
+    // numbers are outside the scheme's accuracy: never complete.
+    if (beyond_limit && (status == RunStatus::complete || status == RunStatus::not_periodic))
+      failure = over_limit + ", forced: the results are outside the scheme's accuracy";
+    if (failure.empty() && (status == RunStatus::complete || status == RunStatus::not_periodic)) {
       if (!(std::abs(last.conservation_error) < conservation_tolerance))
         failure = "the scheme lost mass: (in - out - stored) / in = " + format_rounded(last.conservation_error) +
                   " over the last cycle, above " + format_rounded(conservation_tolerance);
@@ -495,6 +506,11 @@ int main(int argc, char** argv) {
       }
     }
 
+    const RunOutcome outcome = !failure.empty()                     ? RunOutcome::failed
+                               : status == RunStatus::broken_down  ? RunOutcome::broken_down
+                               : status == RunStatus::interrupted  ? RunOutcome::interrupted
+                               : status == RunStatus::not_periodic ? RunOutcome::not_periodic
+                                                                   : RunOutcome::complete;
     nlohmann::json run_info = {{"tool", "hemosolve"}, {"version", HEMOTREE_VERSION},
                                {"network", input},
                                {"degree", options.degree == SolverOptions::automatic ? nlohmann::json("auto")
@@ -516,7 +532,7 @@ int main(int argc, char** argv) {
                                {"analysis_frequency", analysis_frequency(driving)},
                                {"time_step", dt}, {"time_step_limit", dt_reason},
                                {"steps_per_cycle", steps_per_cycle},
-                               {"status", failure.empty() ? to_string(status) : "failed"},
+                               {"status", to_string(outcome)},
                                {"cycles", pulsatile.cycles_done()},
                                {"steps", static_cast<std::uint64_t>(pulsatile.cycles_done()) * steps_per_cycle},
                                {"compliance_balances", pulsatile.compliance_balances()},
@@ -579,7 +595,7 @@ int main(int argc, char** argv) {
            (pulsatile.cycles_done() > 0 ? " holds the results of the last whole cycle and its checkpoint"
                                         : " holds the checkpoint of the start (no cycle was completed)") +
            "; --resume " + out_dir + " continues");
-      return InterruptRequests::exit_status(pulsatile.signal());
+      return exit_status(outcome, pulsatile.signal());
     }
     if (status == RunStatus::broken_down) throw InputError(pulsatile.breakdown());
     if (!failure.empty()) throw InputError("the results are wrong and marked failed in summary.json: " + failure);
@@ -602,8 +618,19 @@ int main(int argc, char** argv) {
       if (last.vessels[v].mean_pressure > high) high = last.vessels[(highest = v)].mean_pressure;
     }
     warn_unphysiological(low, high, net.id[highest], net, "mean pressures");
-    if (status == RunStatus::not_periodic)
-      warn("not periodic within " + std::to_string(max_cycles) + " cycles (--max-cycles)");
-    return 0;
+    // A tracer whose injection the run never reached has no curves: said, not left to be found.
+    for (std::size_t k = 0; transport && k < tracers.size(); ++k)
+      if (const TracerTransport& moved = transport->tracer(k); moved.entered() + moved.injected() == 0)
+        warn("tracer " + tracers[k].name + " never entered the network (its injection starts at t = " +
+             format_quantity(tracers[k].start, "s") + ", the run ended at t = " + format_quantity(run.time(), "s") +
+             "): its arrival, peak and transit times are null");
+    if (outcome == RunOutcome::not_periodic)
+      warn("not periodic within " + std::to_string(max_cycles) + " cycles (--max-cycles)" +
+           (pulsatile.has_change() ? ": the last cycle changed by " + format_rounded(pulsatile.change().change) +
+                                         " (vessel " + std::to_string(net.id[pulsatile.change().vessel]) + ")"
+                                   : std::string()) +
+           ", above --until-periodic " + format_rounded(periodic_tol) + "; exit status " +
+           std::to_string(exit_status(outcome)));
+    return exit_status(outcome);
   });
 }

@@ -2,6 +2,7 @@
 
 #include "cli/errors.hpp"
 #include "formats/output_stream.hpp"
+#include "formats/quoting.hpp"
 
 namespace hemotree {
 
@@ -55,7 +56,7 @@ void ProbeRecorder::write(const std::filesystem::path& file) const {
     out << ",p" << at << " [Pa],Q" << at << " [m^3/s],A" << at << " [m^2],u" << at << " [m/s]";
     for (const std::string& h : headers_) {
       const auto unit = h.find(" [");  // "name [unit]": the place goes between
-      out << ',' << h.substr(0, unit) << at << (unit == std::string::npos ? "" : h.substr(unit));
+      out << ',' << csv_field(h.substr(0, unit) + at + (unit == std::string::npos ? "" : h.substr(unit)));
     }
   }
   out << '\n' << rows_.str();

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "formats/output_stream.hpp"
+#include "formats/quoting.hpp"
 #include "physics/womersley.hpp"
 
 namespace hemotree {
@@ -34,7 +35,8 @@ WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_
 }
 
 VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vector<std::uint8_t> model,
-                        std::vector<std::string> model_labels, std::vector<std::int64_t> degree) {
+                        std::vector<std::string> model_labels, std::vector<std::int64_t> degree,
+                        const std::vector<std::uint8_t>& wave_travels) {
   const std::size_t n = cycle.vessels.size();
   VesselTable table(n);
   std::vector<std::uint8_t> vessel_class(n);
@@ -62,8 +64,14 @@ VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vect
   column("least_flow", [](const VesselCycle& c) { return c.least_flow; });
   column("mean_wss", [](const VesselCycle& c) { return c.mean_wss; });
   column("reynolds", [](const VesselCycle& c) { return c.reynolds; });
-  column("pwv_pressure", [](const VesselCycle& c) { return c.pwv_pressure; });
-  column("pwv_velocity", [](const VesselCycle& c) { return c.pwv_velocity; });
+  const double null = std::numeric_limits<double>::quiet_NaN();
+  auto measured = [&](double VesselCycle::*speed) {
+    std::vector<double> x(n);
+    for (std::size_t v = 0; v < n; ++v) x[v] = wave_travels.empty() || wave_travels[v] ? cycle.vessels[v].*speed : null;
+    return x;
+  };
+  table.add_number("pwv_pressure", measured(&VesselCycle::pwv_pressure));
+  table.add_number("pwv_velocity", measured(&VesselCycle::pwv_velocity));
   return table;
 }
 
@@ -71,19 +79,18 @@ VesselTable vessel_results(const Network& net, const PulseSolver& solver, const 
   const double omega = 2 * std::numbers::pi * frequency;
   const std::size_t n = cycle.vessels.size();
   std::vector<std::int64_t> degree(n);
-  std::vector<std::uint8_t> model(n);
+  std::vector<std::uint8_t> model(n), travels(n);
+  std::vector<double> womersley(n), elastic(n), theory(n);
   for (std::size_t v = 0; v < n; ++v) {
     degree[v] = solver.is_lumped(v) ? VesselTable::null_integer : solver.degree(v);
     model[v] = solver.is_lumped(v) ? 1 : 0;
-  }
-  VesselTable table = cycle_table(net, cycle, std::move(model), {"1d", "0d"}, std::move(degree));
-  std::vector<double> womersley(n), elastic(n), theory(n);
-  for (std::size_t v = 0; v < n; ++v) {
     const WaveTheory t = wave_theory(solver, net, v, omega);
     womersley[v] = t.womersley;
     elastic[v] = t.pwv_elastic;
     theory[v] = t.pwv_theory;
+    travels[v] = !solver.is_lumped(v);
   }
+  VesselTable table = cycle_table(net, cycle, std::move(model), {"1d", "0d"}, std::move(degree), travels);
   table.add_number("womersley", std::move(womersley));
   table.add_number("pwv_elastic", std::move(elastic));
   table.add_number("pwv_theory", std::move(theory));
@@ -95,7 +102,10 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
   nlohmann::json summary = run;
   summary["inlet_mean_flow"] = cycle.inlet_mean_flow;
   summary["outlets_mean_flow"] = cycle.outlets_mean_flow;
-  summary["mass_balance"] = (cycle.inlet_mean_flow - cycle.outlets_mean_flow) / cycle.inlet_mean_flow;
+  // Relative to the inflow: null where nothing flowed in (there is no fraction to give).
+  summary["mass_balance"] = cycle.inlet_mean_flow > 0
+                                ? nlohmann::json((cycle.inlet_mean_flow - cycle.outlets_mean_flow) / cycle.inlet_mean_flow)
+                                : nlohmann::json(nullptr);
   summary["volume_change"] = cycle.volume_change;
   summary["conservation_error"] = cycle.conservation_error;
   summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}, {"wss", "Pa"},
@@ -176,8 +186,11 @@ nlohmann::json group_statistics(const Network& net, const VesselTable& vessels) 
 void write_vessel_table(const std::filesystem::path& file, const VesselTable& vessels) {
   OutputStream out(file.string());
   const auto& columns = vessels.columns();
+  std::vector<std::vector<std::string>> labels(columns.size());  // as CSV fields, quoted where they must be
+  for (std::size_t f = 0; f < columns.size(); ++f)
+    for (const std::string& label : columns[f].labels) labels[f].push_back(csv_field(label));
   if (vessels.rows() > 0) {
-    for (std::size_t f = 0; f < columns.size(); ++f) out << (f ? "," : "") << columns[f].name;
+    for (std::size_t f = 0; f < columns.size(); ++f) out << (f ? "," : "") << csv_field(columns[f].name);
     out << '\n';
   }
   for (std::size_t v = 0; v < vessels.rows(); ++v) {
@@ -190,7 +203,7 @@ void write_vessel_table(const std::filesystem::path& file, const VesselTable& ve
       } else if (c.kind == VesselTable::Kind::number) {
         write_csv_number(out, c.number[v]);  // summary.json's text of the same double
       } else {
-        out << c.labels[c.code[v]];  // class and model names: no commas
+        out << labels[f][c.code[v]];
       }
     }
     out << '\n';

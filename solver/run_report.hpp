@@ -38,11 +38,18 @@ WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_
 // The columns every run reports, one row per vessel in the network's order: id, geometry,
 // class, the vessel's model (a label per vessel: model_labels[model[v]]) and degree (null
 // where none), and the cycle's statistics.
+// wave_travels (one flag per vessel, or empty for all): where the measured wave speeds
+// (pwv_pressure, pwv_velocity) are a wave's; null elsewhere.
 VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vector<std::uint8_t> model,
-                        std::vector<std::string> model_labels, std::vector<std::int64_t> degree);
+                        std::vector<std::string> model_labels, std::vector<std::int64_t> degree,
+                        const std::vector<std::uint8_t>& wave_travels = {});
 
 // The per-vessel results, one row per vessel in the network's order: cycle_table's, and the
-// linear wave theory's Womersley number and wave speeds.
+// linear wave theory's Womersley number and wave speeds. A measured wave speed is given only
+// where a wave travels: in 1D vessels. A 0D vessel is one the pulse crosses with no lag to
+// speak of (--model auto's criteria); its flow is one along it and its ends' pressures differ
+// by its resistive drop, so a phase "lag" between them is no wave's (it read as 100 to
+// 10,000 m/s).
 VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
                            double analysis_frequency);
 

@@ -1,5 +1,6 @@
 #include "solver/steady_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -61,7 +62,9 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
     (q > 0 ? cycle.inlet_mean_flow : cycle.outlets_mean_flow) += std::abs(q);
   }
   cycle.volume_change = 0;
-  cycle.conservation_error = (cycle.inlet_mean_flow - cycle.outlets_mean_flow) / cycle.inlet_mean_flow;
+  // Where nothing flows (zero boundary flows, equal pressures) nothing is lost either.
+  const double scale = std::max(cycle.inlet_mean_flow, cycle.outlets_mean_flow);
+  cycle.conservation_error = scale > 0 ? (cycle.inlet_mean_flow - cycle.outlets_mean_flow) / scale : 0.0;
   return cycle;
 }
 

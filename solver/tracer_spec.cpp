@@ -1,6 +1,8 @@
 #include "solver/tracer_spec.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cstdio>
 #include <cmath>
 #include <sstream>
 
@@ -28,8 +30,24 @@ double TracerSpec::mean_over(double t0, double t1) const {
 
 namespace {
 
+// The spec as typed, its control and non-ASCII bytes shown as \xNN: an error is one line.
+std::string printable(const std::string& text) {
+  std::string shown;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f) {
+      shown += c;
+    } else {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
+      shown += escaped;
+    }
+  }
+  return shown;
+}
+
 [[noreturn]] void refuse(const std::string& spec, const std::string& what) {
-  throw InputError("--tracer '" + spec + "': " + what);
+  throw InputError("--tracer '" + printable(spec) + "': " + what);
 }
 
 double number(const std::string& spec, const std::string& key, const std::string& value, bool time) {
@@ -45,6 +63,28 @@ double number(const std::string& spec, const std::string& key, const std::string
   else if (!(unit.empty() || (time && unit == "s"))) refuse(spec, key + "=" + value + ": unknown unit '" + unit + "'" + (time ? " (s or ms)" : ""));
   if (!std::isfinite(x)) refuse(spec, key + "=" + value + " is not finite");
   return x;
+}
+
+// A tracer's name becomes column names (c_NAME, NAME_arrival_time, ...) in JSON, CSV and
+// VTK, and is typed in scripts: a word of letters, digits, '_', '-' and '.', as a column name
+// wants; the writers quote anything anyway, but a name that needs quoting is a name that
+// breaks somebody's script.
+constexpr std::size_t longest_name = 64;
+
+void check_name(const std::string& spec, const std::string& name) {
+  if (name.empty()) refuse(spec, "name= is empty: a word of letters, digits, '_', '-' and '.'");
+  if (name.size() > longest_name)
+    refuse(spec, "name is " + std::to_string(name.size()) + " characters long: at most " +
+                     std::to_string(longest_name));
+  for (const char c : name) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (std::isalnum(byte) && byte < 0x80) continue;
+    if (c == '_' || c == '-' || c == '.') continue;
+    char shown[8];
+    std::snprintf(shown, sizeof shown, "0x%02X", byte);
+    refuse(spec, "name holds " + (byte >= 0x20 && byte < 0x7f ? "'" + std::string(1, c) + "'" : std::string("byte ") + shown) +
+                     ": a word of letters, digits, '_', '-' and '.' (ASCII)");
+  }
 }
 
 std::int64_t identifier(const std::string& spec, const std::string& value) {
@@ -69,8 +109,7 @@ TracerSpec parse_tracer(const std::string& spec, const Network& net, int ordinal
     if (eq == std::string::npos) refuse(spec, "'" + item + "' is not key=value");
     const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
     if (key == "name") {
-      if (value.empty() || value.find_first_of(" \t\",") != std::string::npos)
-        refuse(spec, "name='" + value + "': a word without spaces, quotes or commas");
+      check_name(spec, value);
       t.name = value;
     } else if (key == "carrier") {
       if (value == "plasma") t.carrier = TracerCarrier::plasma;

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "formats/quoting.hpp"
+
 namespace hemotree {
 
 const VesselTable::Column* VesselTable::find(const std::string& name) const {
@@ -21,28 +23,41 @@ void check_size(std::size_t size, std::size_t rows, const std::string& name) {
 }
 }  // namespace
 
+void VesselTable::push(Column c) {
+  // Quoted once here, not per row: a name or label may hold anything a user typed.
+  c.json_name = json_quoted(c.name);
+  for (const std::string& label : c.labels) c.json_labels.push_back(json_quoted(label));
+  columns_.push_back(std::move(c));
+}
+
 void VesselTable::add_integer(std::string name, std::vector<std::int64_t> values) {
   check_size(values.size(), rows_, name);
-  Column c{std::move(name), Kind::integer};
+  Column c;
+  c.name = std::move(name);
+  c.kind = Kind::integer;
   c.integer = std::move(values);
-  columns_.push_back(std::move(c));
+  push(std::move(c));
 }
 
 void VesselTable::add_number(std::string name, std::vector<double> values) {
   check_size(values.size(), rows_, name);
-  Column c{std::move(name), Kind::number};
+  Column c;
+  c.name = std::move(name);
+  c.kind = Kind::number;
   c.number = std::move(values);
-  columns_.push_back(std::move(c));
+  push(std::move(c));
 }
 
 void VesselTable::add_text(std::string name, std::vector<std::uint8_t> codes, std::vector<std::string> labels) {
   check_size(codes.size(), rows_, name);
   for (const std::uint8_t k : codes)
     if (k >= labels.size()) throw std::invalid_argument("VesselTable: column " + name + " has a code without a label");
-  Column c{std::move(name), Kind::text};
+  Column c;
+  c.name = std::move(name);
+  c.kind = Kind::text;
   c.code = std::move(codes);
   c.labels = std::move(labels);
-  columns_.push_back(std::move(c));
+  push(std::move(c));
 }
 
 void write_csv_number(OutputStream& out, double x) {
@@ -66,7 +81,7 @@ void VesselTable::write_json_row(OutputStream& out, std::size_t row) const {
   out << '{';
   for (std::size_t f = 0; f < columns_.size(); ++f) {
     const Column& c = columns_[f];
-    out << (f ? ",\"" : "\"") << c.name << "\":";
+    out << (f ? "," : "") << c.json_name << ':';
     switch (c.kind) {
       case Kind::integer:
         if (c.integer[row] == null_integer) out << "null";
@@ -76,7 +91,7 @@ void VesselTable::write_json_row(OutputStream& out, std::size_t row) const {
         write_json_number(out, c.number[row]);
         break;
       case Kind::text:
-        out << '"' << c.labels[c.code[row]] << '"';  // labels are names: nothing to escape
+        out << c.json_labels[c.code[row]];
         break;
     }
   }

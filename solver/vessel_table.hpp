@@ -25,6 +25,8 @@ class VesselTable {
     std::vector<std::int64_t> integer;  // integer: null_integer is null
     std::vector<std::uint8_t> code;     // text: an index into labels
     std::vector<std::string> labels;
+    std::string json_name;                // name and labels as JSON strings, quotes included
+    std::vector<std::string> json_labels;
   };
 
   explicit VesselTable(std::size_t rows = 0) : rows_(rows) {}
@@ -43,6 +45,8 @@ class VesselTable {
   void write_json_row(OutputStream& out, std::size_t row) const;
 
  private:
+  void push(Column c);
+
   std::size_t rows_;
   std::vector<Column> columns_;
 };

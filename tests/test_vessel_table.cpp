@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "formats/quoting.hpp"
 #include "solver/vessel_table.hpp"
 
 using namespace hemotree;
@@ -65,4 +66,33 @@ TEST(VesselTable, RefusesAColumnOfAnotherLength) {
   EXPECT_THROW(t.add_number("x", {1.0}), std::invalid_argument);
   EXPECT_THROW(t.add_text("c", {0, 2}, {"a", "b"}), std::invalid_argument);
   EXPECT_EQ(t.find("x"), nullptr);
+}
+
+// Any string a user can give reaches column names (a tracer's) and labels: the JSON row still
+// parses and gives it back (control characters escaped, bytes that are not UTF-8 replaced),
+// and a CSV field is quoted where it must be (hostile-inputs 07).
+TEST(VesselTable, AnyNameOrLabelKeepsTheRowJson) {
+  for (const std::string name : {std::string("a\nb"), std::string("q\"uote\\"), std::string("t\tab\x01"),
+                                  std::string("caf\xc3\xa9"), std::string("bad\xff")}) {
+    VesselTable t(1);
+    t.add_number(name + "_arrival_time", {1.5});
+    t.add_text("class", {0}, {name});
+    const std::string text = written([&](OutputStream& out) { t.write_json_row(out, 0); });
+    nlohmann::json j;
+    ASSERT_NO_THROW(j = nlohmann::json::parse(text)) << text;
+    if (name != "bad\xff") {
+      EXPECT_EQ(j[name + "_arrival_time"].get<double>(), 1.5);
+      EXPECT_EQ(j["class"].get<std::string>(), name);
+    } else {
+      EXPECT_EQ(j["class"].get<std::string>(), "bad\xef\xbf\xbd");  // U+FFFD
+    }
+  }
+}
+
+TEST(Quoting, CsvFieldsQuotedOnlyWhereTheyMustBe) {
+  EXPECT_EQ(csv_field("p vessel 3 x 0.5 [Pa]"), "p vessel 3 x 0.5 [Pa]");
+  EXPECT_EQ(csv_field("a,b"), "\"a,b\"");
+  EXPECT_EQ(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+  EXPECT_EQ(csv_field("two\nlines"), "\"two\nlines\"");
+  EXPECT_EQ(json_quoted("a\"b\n"), "\"a\\\"b\\n\"");
 }
