@@ -1,6 +1,7 @@
 // openBF's YAML models, read into a Network and written from one. What each key means is
-// openBF's own reading of it (src/vessel.jl, network.jl, boundary_conditions.jl of openBF 2.x,
-// and initialise.jl of 1.x for the keys it spelled with spaces); docs/import.md has the table.
+// openBF's own reading of it (src/vessel.jl, network.jl, solver.jl, boundary_conditions.jl of
+// openBF 2.x), or, where that code departs from openBF's documentation (docs/src/man/config.md)
+// and on request, the documentation's; docs/import.md has the table and the differences.
 #include "exchange/openbf.hpp"
 
 #include <algorithm>
@@ -346,7 +347,7 @@ VesselModel read_vessel(const Source& source, const YAML::Node& node, std::size_
     } else if (k == "inlet file") {
       v.inlet_file = f.text(e);
     } else {
-      f.fail(e, "\"" + k + "\" is not an openBF vessel key that hemotree reads or may safely ignore");
+      f.fail(e, "\"" + k + "\" is listed in vessel_keys but not read");  // a slip between the two lists
     }
   }
   if (v.inlet && v.inlet_file.empty()) f.missing("\"inlet file\" for its \"inlet\"");
