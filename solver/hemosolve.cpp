@@ -354,7 +354,8 @@ int main(int argc, char** argv) {
     const bool beyond_limit = options.dt > 0 && options.dt > run.stable_dt() * (1 + 1e-9);
     const std::string over_limit =
         beyond_limit ? "--dt " + format_quantity(options.dt, "s") + " is " + format_rounded(options.dt / run.stable_dt()) +
-                           " times the largest step allowed, " + format_quantity(run.stable_dt(), "s") + " (" +
+                           " times the " + (run.lumped_count() > 0 ? "0D step's accuracy limit " : "stability limit ") +
+                           format_quantity(run.stable_dt(), "s") + " (" +
                            run.stable_dt_reason() + ")"
                      : std::string();
     if (beyond_limit && !force)

@@ -196,7 +196,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     // 16 % of the inflow and was called complete). The 1D substeps keep their own limit.
     stable_dt_ = target;
     std::ostringstream limit;
-    limit << "the 0D step's accuracy limit, --lumped-step " << options.lumped_step << " of the period";
+    limit << "--lumped-step " << options.lumped_step << " of the period: BDF2 is stable at any step but follows "
+             "the pulse only at steps like it";
     stable_dt_reason_ = limit.str();
   }
   set_time_step(dt_);
