@@ -4,6 +4,7 @@
 // with flow boundaries only has a solution (up to its pressure level) only where they balance.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -24,7 +25,7 @@ class NodeParts {
     std::iota(up_.begin(), up_.end(), 0);
     for (std::size_t v = 0; v < net.vessel_count(); ++v) {
       const std::int32_t rf = root(net.from[v]), rt = root(net.to[v]);
-      up_[static_cast<std::size_t>(rf < rt ? rt : rf)] = rf < rt ? rf : rt;
+      up_[static_cast<std::size_t>(std::max(rf, rt))] = std::min(rf, rt);
     }
   }
   std::int32_t root(std::int32_t i) {
