@@ -206,16 +206,8 @@ void OutputStream::commit() {
     return;
   }
   if (anonymous_) {
-    // The complete file gets a name only now; rename() then replaces the target atomically
-    // (linkat cannot replace an existing file).
-    temp_path_ = partial_path(final_path_);
-    const std::string fd_path = "/proc/self/fd/" + std::to_string(::fileno(file_));
-    if (::linkat(AT_FDCWD, fd_path.c_str(), AT_FDCWD, temp_path_.c_str(), AT_SYMLINK_FOLLOW) != 0) {
-      const std::string why = errno_text();
-      temp_path_.clear();
-      throw IoError("cannot create " + final_path_ + ": " + why);
-    }
-    watch_temp(temp_path_);
+    commit_anonymous();
+    return;
   }
   if (std::fclose(file_) != 0) {
     file_ = nullptr;
@@ -230,6 +222,54 @@ void OutputStream::commit() {
   std::filesystem::rename(temp_path_, final_path_, ec);
   if (ec) throw IoError("cannot rename into " + final_path_ + ": " + ec.message());
   unwatch_temp();
+  committed_ = true;
+}
+
+// The complete file gets a name only now. linkat() cannot replace a file: a new target is
+// linked in at its own name, atomically and with no other name ever seen; an existing one is
+// replaced by rename() from NAME.partial-HOST-PID, the very next system call, so that only a
+// SIGKILL between the two can leave that name behind (and the next writer of NAME removes it).
+void OutputStream::commit_anonymous() {
+  // Closed before linking, so that no write error can come after the file is in place; a
+  // duplicate descriptor keeps the unnamed file alive meanwhile.
+  const int fd = ::dup(::fileno(file_));
+  if (fd < 0) throw IoError("cannot write " + display_name_ + ": " + errno_text());
+  const int closed = std::fclose(file_);
+  file_ = nullptr;
+  if (closed != 0) {
+    const std::string why = errno_text();
+    ::close(fd);
+    throw IoError("cannot write " + display_name_ + ": " + why);
+  }
+  const std::string fd_path = "/proc/self/fd/" + std::to_string(fd);
+  const auto link_as = [&](const std::string& name) {
+    return ::linkat(AT_FDCWD, fd_path.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0;
+  };
+  if (!link_as(final_path_)) {
+    if (errno != EEXIST) {
+      const std::string why = errno_text();
+      ::close(fd);
+      throw IoError("cannot create " + final_path_ + ": " + why);
+    }
+    temp_path_ = partial_path(final_path_);
+    watch_temp(temp_path_);  // SIGINT, SIGTERM or SIGHUP between the two calls remove it
+    // A partial under this process's own id can only be a killed writer's whose id this
+    // process reuses (remove_stale_partials spares our own): it goes.
+    if (!link_as(temp_path_) && !(errno == EEXIST && ::unlink(temp_path_.c_str()) == 0 && link_as(temp_path_))) {
+      const std::string why = errno_text();
+      temp_path_.clear();
+      unwatch_temp();
+      ::close(fd);
+      throw IoError("cannot create " + final_path_ + ": " + why);
+    }
+    if (::rename(temp_path_.c_str(), final_path_.c_str()) != 0) {
+      const std::string why = errno_text();
+      ::close(fd);  // the destructor removes temp_path_
+      throw IoError("cannot rename into " + final_path_ + ": " + why);
+    }
+    unwatch_temp();
+  }
+  ::close(fd);
   committed_ = true;
 }
 

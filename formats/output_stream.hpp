@@ -1,8 +1,11 @@
 // Buffered output that never leaves a file looking complete when it is not, nor a stray
 // temporary after the writer is killed:
 // - a named file is written into an anonymous file in the target's folder (O_TMPFILE),
-//   which commit() links in under a temporary name and renames over the target; killed at
-//   any moment, even by SIGKILL, the writer leaves the folder as it was;
+//   which commit() links in at the target's name when there is none yet, else under
+//   NAME.partial-HOST-PID renamed over the target at once; killed at any moment, even by
+//   SIGKILL, the writer leaves the target as it was, and no other name, except after a
+//   SIGKILL between those last two system calls: that NAME.partial-HOST-PID, which the next
+//   writer of NAME removes;
 // - where the file system has no O_TMPFILE (NFS, old overlayfs), into NAME.partial-HOST-PID,
 //   removed on failure, on SIGINT, SIGTERM and SIGHUP, and, after a SIGKILL, by the next
 //   writer of NAME once no process PID runs on HOST;
@@ -44,6 +47,7 @@ class OutputStream {
 
  private:
   void flush_buffer();
+  void commit_anonymous();
   std::FILE* file_ = nullptr;
   bool is_stdout_ = false;
   bool direct_ = false;     // a device or pipe given by name: written in place

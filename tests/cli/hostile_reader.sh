@@ -80,4 +80,48 @@ refused inlet_huge 'inlet: unknown vessel 18446744073709551615'
 "$PY" -c 'import sys;sys.stdout.write("{\"format\":\"vnet\",\"version\":1,\"provenance\":{\"a\":\""+"p"*40+"\\n\"},\"vessels\":[{\"\\u0069d\":\""+"v"*200+"\\n\"}]}")' >"$WORK/uaf.json"
 expect_error "vstats: key name after a moved buffer" 2 'standard input:1:116: vessels[0]: "id" must be an integer' \
   -- sh -c "\"$VSTATS\" - <\"$WORK/uaf.json\""
+# Hostile foreign files (issue 21, defects 1, 2, 9 and 13c): vimport refuses each with one
+# line and exit 2; never exit 70, a crash, or gigabytes allocated for a count in a few bytes
+# (each runs under a 500 MB address-space limit, where such an allocation fails with exit 1).
+VIMPORT=$BUILD/exchange/vimport
+limited() { bash -c 'ulimit -v 500000 && exec "$0" "$@"' "$@"; }
+refused_import() {  # refused_import NAME FORMAT FRAGMENT
+  expect_error "vimport: $1" 2 "$3" -- limited "$VIMPORT" "$2" "$WORK/$1" -o "$WORK/$1.out.json"
+  [ -e "$WORK/$1.out.json" ] && fail "vimport: $1 left an output file"
+}
+printf '{"nodes": [{"id": 1}, {"id": 2}],\n "links": [\n {"source": 1, "target": 2, "length": 1e400, "diameter": 1e-4}]}\n' \
+  >"$WORK/overflow.json"
+refused_import overflow.json networkx "overflow.json:3: number overflow parsing '1e400': numbers must lie within +-1.8e308"
+printf '{"nodes": [], "links": []}\n' >"$WORK/empty.json"
+refused_import empty.json networkx "empty.json: the graph: has no link (0 nodes): a network needs one vessel at least"
+printf '<graphml><graph edgedefault="undirected"><node id="a"/></graph></graphml>\n' >"$WORK/lonely.graphml"
+refused_import lonely.graphml graphml "lonely.graphml: the graph: has no edge (1 node)"
+"$PY" -c "n=200000; print('<?xml version=\"1.0\"?><graphml><graph edgedefault=\"undirected\">' + '<a>'*n + '</a>'*n + '</graph></graphml>')" \
+  >"$WORK/deep.graphml"
+refused_import deep.graphml graphml "deep.graphml:1: <a> lies 257 elements deep: hemotree reads XML nested at most 256 deep"
+"$PY" -c "n=200000; print('<?xml version=\"1.0\"?><VTKFile type=\"PolyData\" version=\"0.1\"><PolyData>' + '<PolyData>'*n + '</PolyData>'*n + '</PolyData></VTKFile>')" \
+  >"$WORK/deep.vtp"
+refused_import deep.vtp vtk "deep.vtp:1: <PolyData> lies 257 elements deep"
+legacy='# vtk DataFile Version 3.0\ncenterlines\nASCII\nDATASET POLYDATA\n'
+printf "${legacy}POINTS 100000000 double\n0 0 0\n" >"$WORK/points.vtk"
+refused_import points.vtk vtk "points.vtk:5: POINTS: 300000000 numbers cannot fit in the 7 bytes left in the file"
+printf "${legacy}POINTS 1099511627776 double\n0 0 0\n" >"$WORK/points_max.vtk"
+refused_import points_max.vtk vtk "points_max.vtk:5: POINTS: 3298534883328 numbers cannot fit"
+printf "${legacy}POINTS 2 double\n0 0 0 0 0 1\nLINES 1 300000000\n2 0 1\n" >"$WORK/lines.vtk"
+refused_import lines.vtk vtk "lines.vtk:7: LINES: 300000000 numbers cannot fit"
+# .vtp, zlib: 1e8 points (2.4e9 bytes) announced in 2e8 blocks, or in one block of 2.4e9.
+vtp() {  # vtp FILE HEADER_WORDS...: a Points array whose base64 data are those UInt64 words
+  "$PY" - "$@" <<'PY'
+import base64, struct, sys
+data = base64.b64encode(b"".join(struct.pack("<Q", int(w)) for w in sys.argv[2:])).decode()
+open(sys.argv[1], "w").write('<?xml version="1.0"?>\n<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
+    'header_type="UInt64" compressor="vtkZLibDataCompressor">\n<PolyData><Piece NumberOfPoints="100000000" '
+    'NumberOfLines="1"><Points><DataArray type="Float64" NumberOfComponents="3" format="binary">' + data +
+    '</DataArray></Points></Piece></PolyData></VTKFile>\n')
+PY
+}
+vtp "$WORK/blocks.vtp" 200000000 12 0
+refused_import blocks.vtp vtk "its compression header gives 200000000 blocks, but the data hold at most 0 block sizes"
+vtp "$WORK/oneblock.vtp" 1 2400000000 0 2400000000
+refused_import oneblock.vtp vtk "its compressed blocks take more than the 0 bytes the data hold"
 finish

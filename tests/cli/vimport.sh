@@ -101,6 +101,28 @@ PY
 expect_error "vexport secomb of an RCR outlet" 2 "node 4: an outlet model (RCR) cannot be written to network.dat" -- \
   "$VEXPORT" secomb "$WORK/rcr.json" -o "$WORK/rcr.dat"
 
+# Issue 21, defect 13d: killed by SIGKILL at its rename, vimport left out.json.partial-HOST-PID
+# beside a new out.json. A new file is now linked in at its own name (no rename to kill at);
+# one that replaces a file is renamed from the partial name, and a kill just there leaves
+# that partial, which the next writer removes. strace injects the kill at the rename.
+if strace -f -o /dev/null true 2>/dev/null; then
+  killed_at_rename() { strace -f -o /dev/null -e inject=rename:signal=KILL:when=1 "$@" 2>/dev/null; }
+  mkdir "$WORK/atomic"
+  killed_at_rename "$VIMPORT" secomb "$WORK/small.dat" -o "$WORK/atomic/out.json"
+  [ "$(ls "$WORK/atomic")" = "out.json" ] && "$VSTATS" "$WORK/atomic/out.json" >/dev/null \
+    && pass "a new output is linked in under its own name: no rename to be killed at" \
+    || fail "new output under a kill at rename: $(ls "$WORK/atomic")"
+  printf 'previous' >"$WORK/atomic/out.json"
+  killed_at_rename "$VIMPORT" secomb "$WORK/small.dat" -o "$WORK/atomic/out.json"
+  [ "$(cat "$WORK/atomic/out.json")" = "previous" ] && [ "$(ls "$WORK/atomic" | wc -l)" -eq 2 ] \
+    && "$VIMPORT" secomb "$WORK/small.dat" -o "$WORK/atomic/out.json" 2>/dev/null \
+    && [ "$(ls "$WORK/atomic")" = "out.json" ] && "$VSTATS" "$WORK/atomic/out.json" >/dev/null \
+    && pass "killed at the rename over a file: the old file whole, the partial removed by the next run" \
+    || fail "replacing under a kill at rename: $(ls "$WORK/atomic")"
+else
+  echo "skip: strace cannot run here; the kill-at-rename checks did not run"
+fi
+
 # The rat mesentery.
 if [ -f "$MESENTERY" ]; then
   "$VIMPORT" secomb "$MESENTERY" -o "$WORK/mesentery.json" 2>"$WORK/log" \
