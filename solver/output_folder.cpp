@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <fcntl.h>
 #include <string>
 #include <sys/file.h>
@@ -18,7 +19,9 @@ namespace hemotree {
 namespace fs = std::filesystem;
 
 namespace {
-constexpr const char* owner_file = ".hemosolve-owner";  // in the staging folders of earlier versions
+// In a staging folder from its creation: hemosolve made it, even where a run killed early
+// left nothing else in it but a frame or a temporary. Says who (for people; the lock decides).
+constexpr const char* owner_file = ".hemosolve-owner";
 
 bool is_results_folder(const fs::path& dir) {
   std::error_code ec;
@@ -167,6 +170,9 @@ bool OutputFolder::open(bool keep_frames) {
   if (!fs::create_directory(staging_, ec) || ec)
     throw IoError("cannot create " + staging_.string() + (ec ? ": " + ec.message() : std::string(": it exists")));
   opened_ = true;
+  std::ofstream owner(staging_ / owner_file);
+  owner << ::getpid() << ' ' << host_name() << '\n';
+  if (!owner.flush()) throw IoError("cannot write " + (staging_ / owner_file).string());
   if (stale) {
     if (keep_frames && fs::exists(stale_ / "frames", ec) &&
         std::rename((stale_ / "frames").c_str(), (staging_ / "frames").c_str()) != 0)

@@ -102,6 +102,22 @@ TEST(OutputFolder, RefusesALiveWriterAndTakesOverADeadOne) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A run killed before its first checkpoint left a frame or a temporary: its folder is still
+// known for hemosolve's, and taken over.
+TEST(OutputFolder, TakesOverARunKilledEarly) {
+  Scratch s;
+  const fs::path out = s.dir / "run";
+  {
+    OutputFolder killed(out);
+    killed.open();
+    fs::create_directories(killed.staging() / "frames");
+    write(killed.staging() / "frames" / "frames_0000.vtp", "half");
+  }  // its lock let go, as the kernel does for a killed process
+  OutputFolder next(out);
+  EXPECT_TRUE(next.open());
+  EXPECT_FALSE(fs::exists(next.staging() / "frames"));
+}
+
 // A resume at the run's end publishes the frames the killed run wrote of its last cycle.
 TEST(OutputFolder, KeepsADeadRunsFramesWhenAsked) {
   Scratch s;
