@@ -694,6 +694,9 @@ Network read_openbf(const std::string& path, const ImportOptions& options, Openb
   blood.rheology = Rheology::newtonian;
   blood.newtonian_viscosity = viscosity;
   blood.alpha = alpha_of_profile(profile);
+  // openBF's code writes its momentum flux with alpha = 1 whatever the profile, which sets
+  // its friction only (docs/import.md).
+  if (as_coded) blood.momentum_flux_coefficient = 1;
   net.blood = blood;
 
   std::size_t law_walls = 0, tapered_law_walls = 0, ratio_walls = 0, open_ends = 0, wk2 = 0, wk3_without_r2 = 0;
@@ -850,9 +853,12 @@ Network read_openbf(const std::string& path, const ImportOptions& options, Openb
   options.note("tube laws: openBF's thin wall, each vessel's beta = 4 E h0 / (3 sqrt(pi) R^2) at its reference_pressure, "
                "openBF's external pressure Pext = " + format_number(external_pressure) +
                " Pa; hemosolve's --thick-wall-ratio and --external-pressure do not change them");
-  options.note("momentum flux: openBF's code takes alpha = 1 (a flat profile) and its friction from gamma_profile; "
-               "hemotree's one blood alpha = " + three_digits(blood.alpha) +
-               " sets both, so its convective term is that multiple of openBF's (no vnet field separates them)");
+  options.note(as_coded ? "momentum flux: alpha = 1 (blood momentum_flux_coefficient), as openBF's code has it; the "
+                         "friction and the wall shear stress from the profile (blood alpha " + three_digits(blood.alpha) + ")" +
+                             reading_note
+                       : "momentum flux: blood alpha " + three_digits(blood.alpha) +
+                             " in the flux as in the friction, as openBF documents the profile; its code takes 1 in "
+                             "the flux" + reading_note);
   if (!ignored.empty()) {
     std::string list;
     for (const std::string& k : ignored) list += (list.empty() ? "" : ", ") + k;

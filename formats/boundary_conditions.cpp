@@ -163,14 +163,16 @@ nlohmann::json to_json(const Waveform& w, const char* values) {
 }  // namespace
 
 nlohmann::json to_json(const Blood& b) {
-  return {{"density", b.density},
-          {"plasma_viscosity", b.plasma_viscosity},
-          {"hematocrit", b.hematocrit},
-          {"alpha", b.alpha},
-          {"rheology", to_string(b.rheology)},
-          {"newtonian_viscosity", b.newtonian_viscosity},
-          {"pries_max_diameter", b.pries_max_diameter},
-          {"mean_cell_volume", b.mean_cell_volume}};
+  nlohmann::json j = {{"density", b.density},
+                      {"plasma_viscosity", b.plasma_viscosity},
+                      {"hematocrit", b.hematocrit},
+                      {"alpha", b.alpha},
+                      {"rheology", to_string(b.rheology)},
+                      {"newtonian_viscosity", b.newtonian_viscosity},
+                      {"pries_max_diameter", b.pries_max_diameter},
+                      {"mean_cell_volume", b.mean_cell_volume}};
+  if (!std::isnan(b.momentum_flux_coefficient)) j["momentum_flux_coefficient"] = b.momentum_flux_coefficient;
+  return j;
 }
 
 Blood blood_from_json(const nlohmann::json& j) {
@@ -182,6 +184,8 @@ Blood blood_from_json(const nlohmann::json& j) {
       in_range_or(j, "plasma_viscosity", ranges::viscosity, b.plasma_viscosity, where);
   b.hematocrit = in_range_or(j, "hematocrit", ranges::hematocrit, b.hematocrit, where);
   b.alpha = in_range_or(j, "alpha", ranges::alpha, b.alpha, where);
+  b.momentum_flux_coefficient = in_range_or(j, "momentum_flux_coefficient", ranges::momentum_flux_coefficient,
+                                            b.momentum_flux_coefficient, where);
   const std::string rheology =
       text(j, "rheology", "pries", where, "\"pries\" or \"newtonian\"");
   if (rheology == "pries") b.rheology = Rheology::pries;

@@ -21,6 +21,10 @@ struct Blood {
   double plasma_viscosity = 1.0e-3;   // [Pa s], water (the paper's nu = 1e-6 m^2/s)
   double hematocrit = 0.45;           // discharge hematocrit H_d
   double alpha = 4.0 / 3.0;           // velocity-profile (Coriolis) coefficient; 4/3 parabolic
+  // The coefficient of the momentum flux alpha Q^2 / A alone, where a model takes it apart from
+  // the profile that sets the friction and the wall shear stress (openBF: 1 in the flux, its
+  // friction 8 pi mu); NaN: alpha, as the profile says.
+  double momentum_flux_coefficient = std::numeric_limits<double>::quiet_NaN();
   Rheology rheology = Rheology::pries;
   double newtonian_viscosity = 3.4e-3;   // [Pa s], the paper's constant-viscosity runs
   double pries_max_diameter = 300e-6;    // [m]; above it the viscosity stays at its value there
@@ -30,6 +34,8 @@ struct Blood {
   double mean_cell_volume = human_mean_cell_volume;
   static constexpr double human_mean_cell_volume = 92e-18;
 
+  // The momentum flux's coefficient: momentum_flux_coefficient where given, else alpha.
+  double momentum_alpha() const { return momentum_flux_coefficient == momentum_flux_coefficient ? momentum_flux_coefficient : alpha; }
   // The factor on a diameter before it enters the Pries laws.
   double pries_diameter_scale() const;
   // The same for the Pries-Secomb phase separation law, whose constants were fitted to

@@ -80,6 +80,8 @@ inline constexpr FieldRange hematocrit{0, 0.9, ""};
 // alpha = (n + 2) / (n + 1) for a profile u ~ 1 - (r/R)^n: 2 for n = 0, 4/3 parabolic,
 // 1.1 for n = 9; the friction ~ alpha / (alpha - 1) diverges at 1 (a flat profile).
 inline constexpr FieldRange alpha{1.001, 2, ""};
+// The flux's coefficient alone has no friction to diverge: a flat profile's 1 is its floor.
+inline constexpr FieldRange momentum_flux_coefficient{1, 2, ""};
 inline constexpr FieldRange pries_max_diameter{2e-6, 0.5, "m"};  // as the diameters
 // Mammalian red cells: about 20 fl (goat) to 120 fl (elephant), human 92, rat 55-60; birds
 // up to about 160. Diameters enter the Pries laws times (92 fl / MCV)^(1/3): within this

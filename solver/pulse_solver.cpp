@@ -65,7 +65,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     const std::string name = "vessel " + std::to_string(net.id[v]);
     VesselLaw& law = laws_[v];
     law.density = blood_.density;
-    law.alpha = blood_.alpha;
+    law.alpha = blood_.momentum_alpha();
     if (!net.beta.empty() && !std::isnan(net.beta[v])) {
       law.beta = net.beta[v];
       law.reference_area = std::numbers::pi / 4 * net.diameter[v] * net.diameter[v];
@@ -87,7 +87,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
       taper.d1 = net.distal_diameter[v];
       taper.length = net.length[v];
       taper.density = blood_.density;
-      taper.alpha = blood_.alpha;
+      taper.alpha = blood_.momentum_alpha();
       taper.given_beta = !net.beta.empty() && !std::isnan(net.beta[v]);
       taper.beta0 = law.beta;
       taper.reference_pressure = law.reference_pressure;
@@ -708,7 +708,7 @@ void PulseSolver::step_1d(double dt) {
 // and give the same bits whatever the number of threads.
 Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, const ModalBasis& basis,
                                         Eigen::Index first, Eigen::Index count) {
-  const double rho = blood_.density, alpha = blood_.alpha;
+  const double rho = blood_.density, alpha = blood_.momentum_alpha();
   const Eigen::Index modes = basis.degree + 1, points = basis.points;
   auto area_q = area_q_.block(first, 0, count, points);
   auto flow_q = flow_q_.block(first, 0, count, points);

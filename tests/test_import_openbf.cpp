@@ -224,6 +224,8 @@ TEST_F(OpenbfTest, ByDefaultBuildsTheModelOpenbfsCodeComputes) {
   EXPECT_NEAR(net.wall_thickness[0], avolio_wall_m(0.010), 1e-15);
   EXPECT_NEAR(net.beta[0], openbf_tube_beta(4e5, avolio_wall_m(0.010), 0.010), 1e-12 * net.beta[0]);
   EXPECT_DOUBLE_EQ(net.blood->alpha, 1.1);  // gamma_profile (with the underscore) is read
+  EXPECT_EQ(net.blood->momentum_flux_coefficient, 1.0);  // openBF's flux: Q^2 / A
+  EXPECT_EQ(net.blood->momentum_alpha(), 1.0);
 
   // R1 = 2e9 stays proximal; R2 = R1 - Z with Z = 3.66e8 as in the documented reading.
   const double r = 0.003, h = avolio_wall_m(r);
@@ -242,9 +244,9 @@ TEST_F(OpenbfTest, ByDefaultBuildsTheModelOpenbfsCodeComputes) {
     named += n.find("--as-documented") != std::string::npos;
     told_taper |= n.rfind("1 tapered vessel (Rp != Rd): uniform at Rp", 0) == 0;
     told_split |= n.find("R2 = R1 - Z beyond it") != std::string::npos;
-    told_alpha |= n.rfind("momentum flux: openBF's code takes alpha = 1", 0) == 0;
+    told_alpha |= n.rfind("momentum flux: alpha = 1 (blood momentum_flux_coefficient)", 0) == 0;
   }
-  EXPECT_EQ(named, 2u);  // the taper and the two-element Windkessel
+  EXPECT_EQ(named, 3u);  // the taper, the two-element Windkessel and the momentum flux
   EXPECT_TRUE(told_taper);
   EXPECT_TRUE(told_split);
   EXPECT_TRUE(told_alpha);
@@ -264,7 +266,9 @@ TEST_F(OpenbfTest, TheSpacedGammaProfileIsReadOnlyAsDocumented) {
     told |= n.rfind("\"gamma profile\" (openBF 1.x's spelling) on 3 vessels: not read by openBF 2.x's code", 0) == 0 &&
             n.find("--as-documented") != std::string::npos;
   EXPECT_TRUE(told);
-  EXPECT_DOUBLE_EQ(read_openbf(path("spaced.yaml"), options_, OpenbfReading::documented).blood->alpha, 1.1);
+  const Network documented = read_openbf(path("spaced.yaml"), options_, OpenbfReading::documented);
+  EXPECT_DOUBLE_EQ(documented.blood->alpha, 1.1);
+  EXPECT_EQ(documented.blood->momentum_alpha(), 1.1);  // as documented, one profile for flux and friction
 }
 
 // The inlet file is found beside the model, whatever the working folder.

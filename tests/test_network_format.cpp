@@ -303,6 +303,23 @@ const char* looped = R"({"format": "vnet", "version": 2,
 
 }  // namespace
 
+// The momentum flux's coefficient apart from the profile (openBF's code: 1 in the flux): read,
+// written back, absent meaning alpha, and refused outside [1, 2].
+TEST(NetworkFormat, MomentumFluxCoefficientApartFromTheProfile) {
+  const auto with = [](const std::string& blood) {
+    return R"({"format": "vnet", "version": 1, "blood": )" + blood +
+           R"(, "vessels": [{"id": 0, "from": 0, "to": 1, "length": 0.01, "diameter": 0.001, "beta": 1e6, "reference_pressure": 0}]})";
+  };
+  const Network net = parse_network(with(R"({"alpha": 1.1, "momentum_flux_coefficient": 1})"));
+  EXPECT_EQ(net.blood->alpha, 1.1);
+  EXPECT_EQ(net.blood->momentum_alpha(), 1.0);
+  EXPECT_EQ(to_json(*net.blood).at("momentum_flux_coefficient"), 1.0);
+  const Network plain = parse_network(with(R"({"alpha": 1.1})"));
+  EXPECT_EQ(plain.blood->momentum_alpha(), 1.1);
+  EXPECT_FALSE(to_json(*plain.blood).contains("momentum_flux_coefficient"));  // files without it unchanged
+  expect_refusal(with(R"({"momentum_flux_coefficient": 0.9})"), "\"momentum_flux_coefficient\" must lie in [1, 2]");
+}
+
 TEST(NetworkFormatVersion2, BoundariesAtNodesTaperAndCellVolumeRoundTrip) {
   const Network net = parse_network(looped);
   ASSERT_EQ(net.boundaries.size(), 4u);

@@ -937,3 +937,22 @@ TEST(PulseSolverVerification, HighDegreeChainRunsWithRK4OrASmallerStep) {
     EXPECT_LT(residue, 0.01 * 1e-6);
   }
 }
+
+// The momentum flux takes blood.momentum_flux_coefficient where the network gives one
+// (openBF's code: 1), its friction stays the profile's (alpha): the vessels' laws carry the
+// flux's coefficient, and the steady state, set by friction alone in a rigid-enough tube,
+// stays where it was.
+TEST(PulseSolverVerification, MomentumFluxCoefficientApartFromTheFriction) {
+  const double length = 0.1, diameter = 4e-3, area = std::numbers::pi / 4 * diameter * diameter;
+  Network net = chain(1, length, diameter, beta_for_wave_speed(50.0, area), 1333.0, newtonian(4e-3));
+  net.outlets.push_back(resistance_outlet(0, 3e9, 1333.0));
+  net.inlet = Inlet{0, Waveform::constant_value(2e-8)};
+  SolverOptions options;
+  options.model = ModelChoice::one_d;
+  const PulseSolver profile(net, options);
+  net.blood->momentum_flux_coefficient = 1;
+  const PulseSolver flat(net, options);
+  EXPECT_DOUBLE_EQ(profile.law_at(0, 0.5).alpha, 4.0 / 3.0);
+  EXPECT_DOUBLE_EQ(flat.law_at(0, 0.5).alpha, 1.0);
+  EXPECT_EQ(profile.steady_pressure_max(), flat.steady_pressure_max());  // the friction is the profile's
+}
