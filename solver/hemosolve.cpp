@@ -471,7 +471,7 @@ int main(int argc, char** argv) {
         note("resuming from " + checkpoint_source + " after " + std::to_string(pulsatile.cycles_done()) +
              " cycles (t = " + format_quantity(run.time(), "s") + ")");
     }
-    folder.open();
+    folder.open(pulsatile.keeps_frames());  // a resume at the run's end keeps the killed run's last frames
     if (frames > 0) {
       std::error_code ec;
       std::filesystem::create_directories(folder.staging() / "frames", ec);
