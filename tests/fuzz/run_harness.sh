@@ -15,6 +15,12 @@ mkdir -p "$corpus" "$artifacts" || exit 1
 options=(-timeout=10 -rss_limit_mb=2048 -print_final_stats=1)
 # The tools' own messages (thousands a second) would bury libFuzzer's; findings still show.
 case $name in cli_* | inflow_table) options+=(-close_fd_mask=3) ;; esac
+# The importers: inputs of a small file's size (openBF's: a model and its inlet table), and
+# no single allocation above 512 MB (what an 8 KB input asks for beyond that is a finding).
+case $name in
+  import_openbf) options+=(-max_len=8192 -malloc_limit_mb=512) ;;
+  import_*) options+=(-max_len=4096 -malloc_limit_mb=512) ;;
+esac
 [ -f "$here/dict/$name.dict" ] && options+=(-dict="$here/dict/$name.dict")
 
 shopt -s nullglob
