@@ -70,6 +70,38 @@ ConnectedParts connected_parts(const Network& net) {
   return connected_parts(net, boundaries);
 }
 
+std::string pressure_reference_refusal(const Network& net, std::span<const NodeBoundary> boundaries) {
+  const ConnectedParts parts = connected_parts(net, boundaries);
+  std::vector<const ConnectedPart*> floating;
+  for (const ConnectedPart& part : parts.parts)
+    if (!part.pressure_reference) floating.push_back(&part);
+  if (floating.empty()) return {};
+  const std::size_t total = parts.parts.size();
+  std::string why;
+  for (const ConnectedPart* part : floating) {
+    why += why.empty() ? "" : "; ";
+    why += part_name(*part);
+    if (part->boundary_nodes.empty())
+      why += " has no boundary condition: it is cut off from every inflow and outflow";
+    else
+      why += " has flow boundaries only: its pressure is undetermined (at " +
+             std::string(part->boundary_nodes.size() == 1 ? "node " : "nodes ") + boundary_node_list(net, *part) +
+             "; " + flow_balance(*part) + ")";
+  }
+  const std::string which = total == 1 ? "the network has no pressure to refer to"
+                            : floating.size() == total
+                                ? "none of the network's " + std::to_string(total) + " connected parts has a pressure to refer to"
+                            : floating.size() == 1
+                                ? "1 of the network's " + std::to_string(total) + " connected parts has no pressure to refer to"
+                                : std::to_string(floating.size()) + " of the network's " + std::to_string(total) +
+                                      " connected parts have no pressure to refer to";
+  const std::string remedy = floating.size() == 1 ? " (give a node a pressure or an outlet; where the flows balance, "
+                                                    "hemosolve --pressure-at NODE=PRESSURE fixes the level): "
+                                                  : " (give a node of each a pressure or an outlet; where a part's flows "
+                                                    "balance, hemosolve --pressure-at NODE=PRESSURE fixes its level): ";
+  return which + remedy + why;
+}
+
 std::string part_name(const ConnectedPart& part) {
   return "the part with vessel " + std::to_string(part.lowest_vessel_id) + " (" + std::to_string(part.vessels) +
          (part.vessels == 1 ? " vessel)" : " vessels)");

@@ -19,6 +19,7 @@
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "formats/network_io.hpp"
+#include "formats/pressure_reference.hpp"
 #include "formats/topology.hpp"
 #include "solver/checkpoint.hpp"
 #include "solver/output_folder.hpp"
@@ -215,6 +216,10 @@ int main(int argc, char** argv) {
                  "the red-cell transport's step as a fraction of the period (implicit: any length is stable; "
                  "shorter fronts spread less), at least the flow's step")
       ->capture_default_str();
+  std::vector<std::string> pressure_at_texts;
+  app.add_option("--pressure-at", pressure_at_texts,
+                 "NODE=PRESSURE (e.g. 12=10mmHg): fixes the pressure level of a connected part whose boundaries are "
+                 "flows only and balance, at that node (repeatable; a measured network's fragment, docs/import.md)");
   app.add_flag("--quiet", quiet, "no progress lines or notes (warnings and errors still)");
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
@@ -280,7 +285,20 @@ int main(int argc, char** argv) {
 
     // Ctrl-C and kill are answered at a step's end from here on (cli/interrupt.hpp).
     InterruptRequests interrupts;
-    const Network net = read_network(input);
+    Network net = read_network(input);
+    for (const std::string& text : pressure_at_texts) {
+      const auto eq = text.find('=');
+      if (eq == std::string::npos)
+        throw InputError("--pressure-at must be NODE=PRESSURE, e.g. 12=10mmHg (got '" + text + "')");
+      const std::int64_t node = parse_integer(text.substr(0, eq), "--pressure-at NODE",
+                                              std::numeric_limits<std::int64_t>::min(),
+                                              std::numeric_limits<std::int64_t>::max());
+      const double pressure = parse_quantity(text.substr(eq + 1), Dimension::pressure, "--pressure-at PRESSURE",
+                                             {-1e5, 1e5}, "mmHg");
+      const ConnectedPart part = fix_pressure_at(net, node, pressure);
+      if (!quiet)
+        note("--pressure-at " + text + ": the pressure level of " + part_name(part) + " (" + flow_balance(part) + ")");
+    }
     std::vector<std::uint8_t> vtk_keep;
     if (!vtk_min_text.empty()) {
       if (!vtk && frames == 0) throw InputError("--vtk-min-diameter applies to --vtk and --frames only");

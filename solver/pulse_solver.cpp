@@ -12,6 +12,7 @@
 
 #include "cli/errors.hpp"
 #include "core/parallel_errors.hpp"
+#include "formats/connected_parts.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/wall_law.hpp"
 #include "solver/solution_breakdown.hpp"
@@ -104,8 +105,14 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     }
   }
 
+  // The steady solve's rule (docs/network-format.md): a part with flow boundaries only has no
+  // pressure level, and a run from rest over it was called complete (hostile-inputs 05), or
+  // failed deep in the 0D solve. Refused here, before the steady solve is even tried.
+  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
+  if (const std::string refusal = pressure_reference_refusal(net, boundaries); !refusal.empty())
+    throw InputError(refusal);
   period_ = driving_waveform(net).period;
-  run_outlets_ = run_outlets(run_boundaries(net));
+  run_outlets_ = run_outlets(boundaries);
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_);
   lumped_.set_passes(options.lumped_passes);

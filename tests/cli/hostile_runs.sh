@@ -100,6 +100,36 @@ else
   fail "05 zero inflow: exit $status: $(cat "$WORK/err")"
 fi
 
+# 05/03: a part with flow boundaries only has no pressure level: the pulsatile run refuses it
+# as the steady solve does, naming every such part (it ran "complete", or ended in exit 70).
+cat >"$WORK/flows_only.json" <<'JSON'
+{"format": "vnet", "version": 2,
+ "vessels": [{"id": 0, "from": 0, "to": 1, "length": 0.01, "diameter": 0.001, "wall_thickness": 0.0001, "youngs_modulus": 4e5},
+             {"id": 1, "from": 1, "to": 2, "length": 0.01, "diameter": 0.0008, "wall_thickness": 8e-05, "youngs_modulus": 4e5},
+             {"id": 2, "from": 1, "to": 3, "length": 0.01, "diameter": 0.0007, "wall_thickness": 7e-05, "youngs_modulus": 4e5}],
+ "boundaries": [{"node": 0, "type": "flow", "flow": 1e-7}, {"node": 2, "type": "flow", "flow": -5e-8},
+                {"node": 3, "type": "flow", "flow": -5e-8}]}
+JSON
+for model in auto 0d 1d; do
+  expect_error "05 flows only, --model $model: refused, naming the part" 2 \
+    "the part with vessel 0 (3 vessels) has flow boundaries only" -- \
+    "$HEMOSOLVE" "$WORK/flows_only.json" --out "$WORK/fo" --model $model --quiet
+done
+branch '{"node": 3, "type": "pressure", "pressure": 1000}' 1e-7 \
+  ', {"id": 4, "x": 0.2, "y": 0, "z": 0}, {"id": 5, "x": 0.3, "y": 0, "z": 0}' \
+  ', {"id": 3, "from": 4, "to": 5, "length": 0.01, "diameter": 0.001, "wall_thickness": 0.0001, "youngs_modulus": 4e5}' \
+  ', {"node": 4, "type": "flow", "flow": 0}, {"node": 5, "type": "flow", "flow": 0}' >"$WORK/cut_closed.json"
+expect_error "05 a detached closed vessel: refused, naming it" 2 \
+  "1 of the network's 2 connected parts has no pressure to refer to" -- \
+  "$HEMOSOLVE" "$WORK/cut_closed.json" --out "$WORK/cc" --quiet
+"$HEMOSOLVE" "$WORK/flows_only.json" --out "$WORK/fo" --steady --pressure-at 1=10mmHg --quiet 2>"$WORK/err" \
+  && "$PY" -c "
+import json, sys
+s = json.load(open(sys.argv[1]))
+q = {v['id']: v['mean_flow'] for v in s['vessels']}
+assert abs(q[0] - 1e-7) < 1e-18 and abs(q[1] - 5e-8) < 1e-18 and abs(q[2] - 5e-8) < 1e-18, q" "$WORK/fo/summary.json" \
+  && pass "05 --steady --pressure-at 1=10mmHg: the balanced flows solved" || fail "05 --pressure-at: $(cat "$WORK/err")"
+
 # 13g: --steady --red-cells transport where a part carries nothing (a detached vessel with a
 # pressure and a closed end; a ring with one pressure) settles at once.
 branch '{"node": 3, "type": "pressure", "pressure": 1000}' 1e-7 \
