@@ -263,12 +263,26 @@ void SteadySystem::check_node_form(const std::vector<NodeBoundary>& boundaries) 
       throw InputError(node_name(b.node) + ": its outlet has no resistance");
     has_boundary[static_cast<std::size_t>(b.node)] = 1;
   }
+  // Every dead end at once, the first named in full: a measured network's fragments end in
+  // many, and finding them one run at a time is what a user should not have to do.
+  std::vector<std::size_t> dead_ends;
   for (std::size_t i = 0; i < nodes; ++i)
-    if (degree[i] == 1 && !has_boundary[i])
-      throw InputError("vessel " + std::to_string(net.id[static_cast<std::size_t>(some_vessel[i])]) + " ends at " +
-                       node_name(static_cast<std::int64_t>(i)) +
-                       ", which no other vessel meets and which has no boundary condition (a dead end; a "
-                       "closed one is {\"node\": " + std::to_string(net.node_id[i]) + ", \"type\": \"flow\", \"flow\": 0})");
+    if (degree[i] == 1 && !has_boundary[i]) dead_ends.push_back(i);
+  if (!dead_ends.empty()) {
+    const std::size_t i = dead_ends.front(), shown = 5;
+    std::string others;
+    for (std::size_t k = 1; k < dead_ends.size() && k <= shown; ++k)
+      others += (k > 1 ? ", " : "") + std::to_string(net.node_id[dead_ends[k]]);
+    if (dead_ends.size() > shown + 1) others += " and " + std::to_string(dead_ends.size() - shown - 1) + " more";
+    throw InputError("vessel " + std::to_string(net.id[static_cast<std::size_t>(some_vessel[i])]) + " ends at " +
+                     node_name(static_cast<std::int64_t>(i)) +
+                     ", which no other vessel meets and which has no boundary condition (a dead end; a "
+                     "closed one is {\"node\": " + std::to_string(net.node_id[i]) + ", \"type\": \"flow\", \"flow\": 0})" +
+                     (dead_ends.size() > 1 ? "; " + std::to_string(dead_ends.size() - 1) + " more dead end" +
+                                                 (dead_ends.size() > 2 ? "s" : "") + ", at node" +
+                                                 (dead_ends.size() > 2 ? "s " : " ") + others
+                                           : std::string()));
+  }
   // Each connected part needs a pressure to refer to: a prescribed one or an outlet's. All
   // parts without one are named at once: a measured network has many fragments.
   if (const std::string refusal = pressure_reference_refusal(net, boundaries); !refusal.empty())

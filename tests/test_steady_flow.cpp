@@ -320,6 +320,15 @@ TEST(SteadyFlowAtNodes, RefusesNetworksWithoutAPressureReference) {
   dead.add_node(4);
   dead.add_vessel(5, 2, 4, 0.01, 1e-3, 1e-4, 2e5, 0);
   expect_refusal(dead, "vessel 5 ends at node 4, which no other vessel meets and which has no boundary condition");
+  {  // Every dead end in the one line: a measured network's fragments end in many.
+    Network many = dead;
+    for (int k = 0; k < 7; ++k) {
+      const auto end = many.add_node(10 + k);
+      many.add_vessel(10 + k, 1, end, 0.01, 1e-3, 1e-4, 2e5, 0);
+    }
+    expect_refusal(many, "vessel 5 ends at node 4");
+    expect_refusal(many, "; 7 more dead ends, at nodes 10, 11, 12, 13, 14 and 2 more");
+  }
   dead.boundaries.push_back(flow_boundary(4, 0.0));  // closed: accepted, and it carries nothing
   const SteadyFlow closed = solve_steady_flow(dead, std::vector<double>(6, 1e9), 0.0);
   EXPECT_NEAR(closed.flow[5], 0.0, 1e-24);
