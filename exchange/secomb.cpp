@@ -306,7 +306,8 @@ std::vector<BoundaryNode> read_boundary_nodes(Lines& lines, std::size_t& solute_
       lines.fail(node + ": " + range_message("the flow", b.value, ranges::flow_sample.min / m3s_per_nl_min,
                                              ranges::flow_sample.max / m3s_per_nl_min, "nl/min"));
     // NetFlow ignores the hematocrit of an outflow; where blood may enter it is a condition.
-    const bool may_enter = b.type == 0 || b.value > 0;
+    // An inflow is one whose flow in m^3/s is positive: 1e-320 nl/min is 0 m^3/s.
+    const bool may_enter = b.type == 0 || b.value * m3s_per_nl_min > 0;
     if (may_enter && !ranges::hematocrit.contains(b.hematocrit))
       lines.fail(node + ": " + range_message("the hematocrit", b.hematocrit, ranges::hematocrit.min,
                                              ranges::hematocrit.max, "(discharge, inflowing blood)"));
@@ -489,7 +490,7 @@ Network read_secomb(const std::string& path, const ImportOptions& options) {
     } else {
       b.type = BoundaryType::flow;
       b.waveform = Waveform::constant_value(bn.value * m3s_per_nl_min);
-      if (bn.value > 0) {
+      if (bn.value * m3s_per_nl_min > 0) {  // as the network holds it (below 3e-310 nl/min, 0)
         b.hematocrit = bn.hematocrit;
         inflows.push_back(b.node);
         ++inflow_count;

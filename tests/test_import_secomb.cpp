@@ -191,6 +191,22 @@ TEST(ImportSecomb, OutflowSignAndHematocrit) {
   EXPECT_FALSE(has_note(imported, "solute"));
 }
 
+// A flow too small for m^3/s (1e-320 nl/min is 0 there) is no inflow: no hematocrit, and
+// generations not counted from it, so that vexport secomb's file (flow 0) reads back the same
+// (found by tests/fuzz/fuzz_import_secomb.cpp; reproducer in tests/fuzz/regressions).
+TEST(ImportSecomb, AFlowThatUnderflowsIsNoInflow) {
+  const std::string text = header(3) + segments_3 + nodes_4 +
+                           "2 Total number of boundary nodes\nNode Bctype Press/Flow HD\n"
+                           "1 2 6.01e-320 0.45\n"
+                           "4 0 15.0 0.3\n";
+  TempFile file(text);
+  const Network net = import(file.path).net;
+  ASSERT_EQ(net.boundaries.size(), 2u);
+  EXPECT_EQ(net.boundaries[0].waveform.mean, 0.0);
+  EXPECT_TRUE(std::isnan(net.boundaries[0].hematocrit));
+  EXPECT_EQ(net.generation, (std::vector<std::int32_t>{0, 1, 0}));  // from both ends, as without inflow
+}
+
 TEST(ImportSecomb, SkippedTypesUnusedNodesAndResults) {
   // Segment 13 (type 3) is skipped as NetFlow skips it, and node 5 that only it joins is
   // left out; nonzero flow columns are NetFlow's results and are noted, not used.
