@@ -5,6 +5,7 @@
 // ids, connections, generations and classes, numbers and coordinates within its 9 digits
 // (docs/import.md). A refusal is InputError, nothing else.
 #include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 
@@ -19,21 +20,36 @@ namespace {
 
 const std::string format = GRAPH_FORMAT;
 
+// The export writes the edges grouped by their source node (Boost's compressed sparse row
+// graph sorts them), so vessels come back in that order: they are matched by id.
 std::string peer_difference(const Network& a, const Network& b) {
   constexpr double rel = 5e-9;
   if (a.vessel_count() != b.vessel_count()) return "vessel counts differ";
-  for (const std::string& d :
-       {same("vessel ids", a.id, b.id), same("node ids", a.node_id, b.node_id), same("from", a.from, b.from),
-        same("to", a.to, b.to), same("generation", a.generation, b.generation),
-        same("class", a.vessel_class, b.vessel_class), reals("x", a.x, b.x, rel), reals("y", a.y, b.y, rel),
-        reals("z", a.z, b.z, rel), reals("length", a.length, b.length, rel),
-        reals("diameter", a.diameter, b.diameter, rel),
-        reals("wall_thickness", a.wall_thickness, b.wall_thickness, rel),
-        reals("youngs_modulus", a.youngs_modulus, b.youngs_modulus, rel)})
+  for (const std::string& d : {same("node ids", a.node_id, b.node_id), reals("x", a.x, b.x, rel),
+                               reals("y", a.y, b.y, rel), reals("z", a.z, b.z, rel)})
     if (!d.empty()) return d;
-  for (std::size_t v = 0; v < a.vessel_count(); ++v)
-    if (!close_enough(a.diameter_at_to(v), b.diameter_at_to(v), rel))
-      return "vessel " + std::to_string(a.id[v]) + ": distal diameter differs";
+  std::map<std::int64_t, std::size_t> index;
+  for (std::size_t w = 0; w < b.vessel_count(); ++w) index.emplace(b.id[w], w);
+  for (std::size_t v = 0; v < a.vessel_count(); ++v) {
+    const std::string which = "vessel " + std::to_string(a.id[v]) + ": ";
+    const auto at = index.find(a.id[v]);
+    if (at == index.end()) return which + "not read back";
+    const std::size_t w = at->second;
+    const auto end_id = [](const Network& n, std::int32_t node) { return n.node_id[static_cast<std::size_t>(node)]; };
+    if (end_id(a, a.from[v]) != end_id(b, b.from[w]) || end_id(a, a.to[v]) != end_id(b, b.to[w]))
+      return which + "other nodes";
+    if (a.generation[v] != b.generation[w]) return which + "another generation";
+    if (a.vessel_class[v] != b.vessel_class[w]) return which + "another class";
+    const double pairs[][2] = {{a.length[v], b.length[w]},
+                               {a.diameter[v], b.diameter[w]},
+                               {a.diameter_at_to(v), b.diameter_at_to(w)},
+                               {a.wall_thickness[v], b.wall_thickness[w]},
+                               {a.youngs_modulus[v], b.youngs_modulus[w]}};
+    const char* names[] = {"length", "diameter", "distal diameter", "wall thickness", "Young's modulus"};
+    for (std::size_t k = 0; k < 5; ++k)
+      if (!close_enough(pairs[k][0], pairs[k][1], rel))
+        return which + names[k] + " " + std::to_string(pairs[k][0]) + " against " + std::to_string(pairs[k][1]);
+  }
   return "";
 }
 

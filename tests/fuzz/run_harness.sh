@@ -33,6 +33,8 @@ if ((${#regressions[@]})); then
   fi
 fi
 
+# HEMOTREE_FUZZ_RUNS=N stops after N executions (SECONDS still caps the time).
+[ -n "${HEMOTREE_FUZZ_RUNS:-}" ] && options+=(-runs="$HEMOTREE_FUZZ_RUNS")
 OMP_NUM_THREADS=1 "$harness" "${options[@]}" -max_total_time="$seconds" -artifact_prefix="$artifacts/" \
   "$corpus" "$here/corpus/$name" >"$log" 2>&1
 status=$?
