@@ -105,14 +105,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     }
   }
 
-  // The steady solve's rule (docs/network-format.md): a part with flow boundaries only has no
-  // pressure level, and a run from rest over it was called complete (hostile-inputs 05), or
-  // failed deep in the 0D solve. Refused here, before the steady solve is even tried.
-  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
-  if (const std::string refusal = pressure_reference_refusal(net, boundaries); !refusal.empty())
-    throw InputError(refusal);
   period_ = driving_waveform(net).period;
-  run_outlets_ = run_outlets(boundaries);
+  run_outlets_ = run_outlets(run_boundaries(net));
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_);
   lumped_.set_passes(options.lumped_passes);
@@ -139,6 +133,11 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   }
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
   boundaries_ = build_boundaries(net, first_element_, elements_per_vessel_, zero_d_);
+  // The steady solve's rule (docs/network-format.md), once the boundaries' own form is checked:
+  // a part with flow boundaries only has no pressure level, and a run from rest over it was
+  // called complete (hostile-inputs 05), or failed deep in the 0D solve.
+  if (const std::string refusal = pressure_reference_refusal(net, boundaries_.list); !refusal.empty())
+    throw InputError(refusal);
   if (steady) {
     // A pressure boundary counts as "in" or "out" by its steady flow.
     std::vector<double> inflow(net.node_count(), 0.0);
