@@ -11,6 +11,8 @@
 #include <limits>
 #include <utility>
 
+#include <omp.h>
+
 namespace hemotree {
 
 class ParallelErrors {
@@ -40,5 +42,21 @@ class ParallelErrors {
   std::int64_t index_ = std::numeric_limits<std::int64_t>::max();
   std::exception_ptr error_;
 };
+
+// body(first, last) over [0, count) in contiguous blocks, one per thread (the split of
+// schedule(static)), each under one guard: the loop inside a block stays a plain loop, as fast
+// as unguarded (a guard per iteration cost 6 % in the 0D vessels' assembly). The exception
+// of the lowest block wins, within it the first thrown: the lowest index, for any threads.
+template <class Body>
+void parallel_blocks(std::int64_t count, int threads, Body&& body) {
+  ParallelErrors errors;
+#pragma omp parallel num_threads(threads) if (threads > 1)
+  {
+    const std::int64_t parts = omp_get_num_threads(), me = omp_get_thread_num();
+    const std::int64_t first = count * me / parts, last = count * (me + 1) / parts;
+    errors.guard(first, [&] { body(first, last); });
+  }
+  errors.rethrow();
+}
 
 }  // namespace hemotree

@@ -79,15 +79,13 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     solver.sample_all(0.5, area_, q_, &p_, false);
     solver.sample_all(0.0, area_end_, q_end_, &p_end_, false);
     solver.sample_all(1.0, area_out_, q_out_, &p_out_end_, false);
-    const auto count = static_cast<std::int64_t>(one_d.size());
-    ParallelErrors errors;
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-    for (std::int64_t j = 0; j < count; ++j) errors.guard(j, [&] {
-      const auto v = static_cast<std::size_t>(one_d[static_cast<std::size_t>(j)]);
-      centre(v, area_[v], q_[v], p_[v], solver.mean_flow(v));
-      ends(v, p_end_[v], q_end_[v] / area_end_[v], p_out_end_[v], q_out_[v] / area_out_[v]);
+    parallel_blocks(static_cast<std::int64_t>(one_d.size()), threads, [&](std::int64_t first, std::int64_t last) {
+      for (auto j = static_cast<std::size_t>(first); j < static_cast<std::size_t>(last); ++j) {
+        const auto v = static_cast<std::size_t>(one_d[j]);
+        centre(v, area_[v], q_[v], p_[v], solver.mean_flow(v));
+        ends(v, p_end_[v], q_end_[v] / area_end_[v], p_out_end_[v], q_out_[v] / area_out_[v]);
+      }
     });
-    errors.rethrow();
   }
   // The 0D vessels straight from their state, all three points in one pass (their flow is
   // one along the vessel: its mean).

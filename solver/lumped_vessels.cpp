@@ -278,17 +278,11 @@ void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
 }
 
 void LumpedVessels::update_resistances() {
-  const auto vessels = static_cast<std::int64_t>(vessels_.size());
-  ParallelErrors errors;
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t i = 0; i < vessels; ++i) {
-    errors.guard(i, [&] {
-      const auto e = static_cast<std::size_t>(i);
+  parallel_blocks(static_cast<std::int64_t>(vessels_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
+    for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e)
       resistance_[e] = resistance(e, pressure_[static_cast<std::size_t>(a_[e])],
                                   pressure_[static_cast<std::size_t>(b_[e])], capacity_a_[e], capacity_b_[e]);
-    });
-  }
-  errors.rethrow();
+  });
 }
 
 double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const {
@@ -440,14 +434,10 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
     const auto i = static_cast<std::size_t>(k);
     return extrapolated ? 2 * pressure_[i] - previous_pressure_[i] : predicted_[i];
   };
-  ParallelErrors errors;
-#pragma omp parallel num_threads(threads_) if (threads_ > 1)
-  {
-    // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
-    // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
-#pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < vessels_i; ++i) errors.guard(i, [&] {
-      const auto e = static_cast<std::size_t>(i);
+  // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
+  // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
+  parallel_blocks(vessels_i, threads_, [&](std::int64_t first, std::int64_t last) {
+    for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
       const double pa = at(a_[e]), pb = at(b_[e]);
       double r;
       if (extrapolated) {
@@ -461,7 +451,10 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
                                                         : density_ * edge_length_[e] / (s * s);
       conductance_[e] = 1 / (r + 1.5 * inertance / dt);
       history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
-    });
+    }
+  });
+#pragma omp parallel num_threads(threads_) if (threads_ > 1)
+  {
     // BDF2 for a node's volume, V(p) linearised at p*:
     // (3 (V* + C* (p - p*)) - 4 V^n + V^(n-1)) / (2 dt) = inflows at t1.
 #pragma omp for schedule(static)
@@ -478,7 +471,6 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
       rhs_[k] = rhs;
     }
   }
-  errors.rethrow();
   for_each_source(coupled_inflow, 1.0, [&](std::size_t k, double inflow) { rhs_[k] += inflow; });
 }
 

@@ -138,23 +138,22 @@ class LumpedVessels {
   template <class F>
   void for_each_sample(F&& f, int threads) const {
     const auto vessels = static_cast<std::int64_t>(vessels_.size());
-    ParallelErrors errors;  // f may throw (the caller's statistics)
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-    for (std::int64_t i = 0; i < vessels; ++i) errors.guard(i, [&] {
-      const auto e = static_cast<std::size_t>(i);
-      Sample s;
-      s.flow = flow_[e];
-      s.pressure_in = pressure_at(static_cast<std::int32_t>(i), 0.0);
-      s.pressure_centre = pressure_at(static_cast<std::int32_t>(i), 0.5);
-      s.pressure_out = pressure_at(static_cast<std::int32_t>(i), 1.0);
-      const double root_in = lumen_root(e, s.pressure_in, 0.0), root_centre = lumen_root(e, s.pressure_centre, 0.5),
-                   root_out = lumen_root(e, s.pressure_out, 1.0);
-      s.area_in = root_in * root_in;
-      s.area_centre = root_centre * root_centre;
-      s.area_out = root_out * root_out;
-      f(static_cast<std::size_t>(vessels_[e]), s);
+    parallel_blocks(vessels, threads, [&](std::int64_t first, std::int64_t last) {  // f may throw (the caller's)
+      for (std::int64_t i = first; i < last; ++i) {
+        const auto e = static_cast<std::size_t>(i);
+        Sample s;
+        s.flow = flow_[e];
+        s.pressure_in = pressure_at(static_cast<std::int32_t>(i), 0.0);
+        s.pressure_centre = pressure_at(static_cast<std::int32_t>(i), 0.5);
+        s.pressure_out = pressure_at(static_cast<std::int32_t>(i), 1.0);
+        const double root_in = lumen_root(e, s.pressure_in, 0.0), root_centre = lumen_root(e, s.pressure_centre, 0.5),
+                     root_out = lumen_root(e, s.pressure_out, 1.0);
+        s.area_in = root_in * root_in;
+        s.area_centre = root_centre * root_centre;
+        s.area_out = root_out * root_out;
+        f(static_cast<std::size_t>(vessels_[e]), s);
+      }
     });
-    errors.rethrow();
   }
   // A tapered 0D vessel's volume, half at each of its nodes' pressures as the nodes hold it [m^3].
   double tapered_volume(std::int32_t index) const;

@@ -940,55 +940,55 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
   // Junctions are independent: each writes only its own ends' fluxes.
   const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
   std::int64_t failed_junction = -1;
-  // (errors, above: a junction of many vessels allocates its scratch)
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t jj = 0; jj < junctions; ++jj) errors.guard(jj, [&] {
-    const auto j = static_cast<std::size_t>(jj);
-    // Left uninitialised: only the first `count` entries are used (zeroing all 16 was 5 % of a step).
-    // A node of more than 16 vessels (measured networks) takes its scratch from the heap.
-    constexpr std::size_t on_stack = 16;
-    std::array<const VesselLaw*, on_stack> laws_stack;
-    std::array<double, on_stack> ja_stack, jq_stack;
-    std::array<int, on_stack> sign_stack;
-    std::array<EndState, on_stack> out_stack;
-    const auto first = boundaries_.junction_offset[j], last = boundaries_.junction_offset[j + 1];
-    const auto count = static_cast<std::size_t>(last - first);
-    std::vector<const VesselLaw*> laws_heap;
-    std::vector<double> ja_heap, jq_heap;
-    std::vector<int> sign_heap;
-    std::vector<EndState> out_heap;
-    const VesselLaw** laws = laws_stack.data();
-    double *ja = ja_stack.data(), *jq = jq_stack.data();
-    int* sign = sign_stack.data();
-    EndState* out = out_stack.data();
-    if (count > on_stack) {
-      laws_heap.resize(count);
-      ja_heap.resize(count);
-      jq_heap.resize(count);
-      sign_heap.resize(count);
-      out_heap.resize(count);
-      laws = laws_heap.data();
-      ja = ja_heap.data();
-      jq = jq_heap.data();
-      sign = sign_heap.data();
-      out = out_heap.data();
-    }
-    for (std::size_t i = 0; i < count; ++i) {
-      const VesselEnd& end = boundaries_.junction_ends[static_cast<std::size_t>(first) + i];
-      laws[i] = &end_law(static_cast<std::size_t>(end.vessel), end.distal);
-      trace(end, ja[i], jq[i]);
-      sign[i] = end.distal ? 1 : -1;
-      out[i] = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
-    }
-    if (!junction_state({laws, count}, {ja, count}, {jq, count}, {sign, count}, {out, count})) {
+  // A junction of many vessels allocates its scratch (an exception must not leave the region).
+  parallel_blocks(junctions, threads_, [&](std::int64_t first_junction, std::int64_t last_junction) {
+    for (std::int64_t jj = first_junction; jj < last_junction; ++jj) {
+      const auto j = static_cast<std::size_t>(jj);
+      // Left uninitialised: only the first `count` entries are used (zeroing all 16 was 5 % of a step).
+      // A node of more than 16 vessels (measured networks) takes its scratch from the heap.
+      constexpr std::size_t on_stack = 16;
+      std::array<const VesselLaw*, on_stack> laws_stack;
+      std::array<double, on_stack> ja_stack, jq_stack;
+      std::array<int, on_stack> sign_stack;
+      std::array<EndState, on_stack> out_stack;
+      const auto first = boundaries_.junction_offset[j], last = boundaries_.junction_offset[j + 1];
+      const auto count = static_cast<std::size_t>(last - first);
+      std::vector<const VesselLaw*> laws_heap;
+      std::vector<double> ja_heap, jq_heap;
+      std::vector<int> sign_heap;
+      std::vector<EndState> out_heap;
+      const VesselLaw** laws = laws_stack.data();
+      double *ja = ja_stack.data(), *jq = jq_stack.data();
+      int* sign = sign_stack.data();
+      EndState* out = out_stack.data();
+      if (count > on_stack) {
+        laws_heap.resize(count);
+        ja_heap.resize(count);
+        jq_heap.resize(count);
+        sign_heap.resize(count);
+        out_heap.resize(count);
+        laws = laws_heap.data();
+        ja = ja_heap.data();
+        jq = jq_heap.data();
+        sign = sign_heap.data();
+        out = out_heap.data();
+      }
+      for (std::size_t i = 0; i < count; ++i) {
+        const VesselEnd& end = boundaries_.junction_ends[static_cast<std::size_t>(first) + i];
+        laws[i] = &end_law(static_cast<std::size_t>(end.vessel), end.distal);
+        trace(end, ja[i], jq[i]);
+        sign[i] = end.distal ? 1 : -1;
+        out[i] = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
+      }
+      if (!junction_state({laws, count}, {ja, count}, {jq, count}, {sign, count}, {out, count})) {
 #pragma omp critical
-      failed_junction = failed_junction < 0 ? jj : std::min(failed_junction, jj);
-      return;
+        failed_junction = failed_junction < 0 ? jj : std::min(failed_junction, jj);
+        continue;
+      }
+      for (std::size_t i = 0; i < count; ++i)
+        set_end_flux(boundaries_.junction_ends[static_cast<std::size_t>(first) + i], out[i]);
     }
-    for (std::size_t i = 0; i < count; ++i)
-      set_end_flux(boundaries_.junction_ends[static_cast<std::size_t>(first) + i], out[i]);
   });
-  errors.rethrow();
   if (failed_junction >= 0) {
     const auto first = boundaries_.junction_offset[static_cast<std::size_t>(failed_junction)];
     throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);
