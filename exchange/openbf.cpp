@@ -24,6 +24,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include "cli/errors.hpp"
@@ -211,21 +212,59 @@ std::string read_capped(const std::string& path, const std::string& named, const
   return text;
 }
 
+// What a document holds, as the parser's events tell it: whether it has any content, where it
+// starts and where its last event lies (to see that the parser moves on).
+struct DocumentScan : YAML::EventHandler {
+  bool content = false;
+  YAML::Mark first_content, last;
+  void seen(const YAML::Mark& m, bool is_content) {
+    last = m;
+    if (is_content && !content) first_content = m;
+    content |= is_content;
+  }
+  void OnDocumentStart(const YAML::Mark& m) override { seen(m, false); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& m, YAML::anchor_t) override { seen(m, false); }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { seen(m, true); }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string&) override { seen(m, true); }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    seen(m, true);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    seen(m, true);
+  }
+  void OnMapEnd() override {}
+};
+
 // The model: one YAML document. A second one (after "---") would be dropped, so it is refused.
+// The documents are walked by the parser's events rather than YAML::LoadAll: yaml-cpp 0.7 makes
+// no progress on a ',' where a document should start (",a"), returning one more empty document
+// at the same place for ever, and LoadAll then allocated until memory ran out (fuzzing found it).
 YAML::Node load_yaml(const std::string& path) {
   const std::string text = read_capped(path, path, "an openBF model", model_cap);
-  std::vector<YAML::Node> documents;
+  YAML::Node model;
   try {
-    documents = YAML::LoadAll(text);
+    model = YAML::Load(text);
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    int previous = -1;  // where the last document's last event lay
+    for (std::size_t k = 0;; ++k) {
+      DocumentScan scan;
+      if (!parser.HandleNextDocument(scan)) break;
+      if (k > 0 && scan.content)
+        Source{path}.fail(scan.first_content, "a second YAML document (after \"---\"); an openBF model is one "
+                                      "document, and hemotree reads nothing it would drop");
+      if (k > 0 && scan.last.pos <= previous)
+        Source{path}.fail(scan.last, "not valid YAML: the parser makes no progress here (a ',' or a ']' "
+                                     "where a document should start?)");
+      previous = scan.last.pos;
+    }
   } catch (const YAML::Exception& e) {
     // yaml-cpp's own message carries "yaml-cpp: error at line L, column C: "; keep its reason.
     Source{path}.fail(e.mark, "not valid YAML: " + e.msg);
   }
-  for (std::size_t k = 1; k < documents.size(); ++k)
-    if (!documents[k].IsNull())
-      Source{path}.fail(documents[k].Mark(), "a second YAML document (after \"---\"); an openBF model is one "
-                                             "document, and hemotree reads nothing it would drop");
-  return documents.empty() ? YAML::Node() : documents.front();
+  return model;
 }
 
 // --- one vessel, as openBF reads it --------------------------------------------------------
