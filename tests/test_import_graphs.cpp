@@ -227,6 +227,26 @@ TEST_F(ImportGraphs, HemotreeGraphmlRoundTrip) {
   EXPECT_FALSE(noted("not imported"));
 }
 
+// Fuzzing found a diameter a hair below a class boundary (9.999999999999999e-06 m) written as
+// "1e-05" with the class of the unrounded one: hemotree's reader refused its own export. The
+// class written is the written diameter's.
+TEST_F(ImportGraphs, HemotreeGraphmlClassIsTheWrittenDiameters) {
+  Network original;
+  original.add_node(0, 0, 0, 0);
+  original.add_node(1, 1e-3, 0, 0);
+  original.add_vessel(0, 0, 1, 1e-3, std::nextafter(arteriole_min_diameter, 0.0), 1e-6, 3e5, 0);
+  ASSERT_NE(classify(original.diameter[0]), classify(arteriole_min_diameter));
+  const std::string path = scratch_path("boundary.graphml").string();
+  {
+    OutputStream out(path);
+    write_graphml(original, out);
+    out.commit();
+  }
+  const Network back = read_graphml(path, options());
+  EXPECT_EQ(back.diameter[0], arteriole_min_diameter);
+  EXPECT_EQ(back.vessel_class[0], classify(arteriole_min_diameter));
+}
+
 const std::string node_link = R"({"directed": true, "multigraph": true, "graph": {"units": "um"},
  "nodes": [{"id": 0, "x": 0, "y": 0}, {"id": 1, "x": 30, "y": 40}, {"id": 2, "x": 30, "y": 100}],
  "links": [
