@@ -386,6 +386,7 @@ void FlowTransport::save(CheckpointWriter& out) const {
   out.put(applied_hematocrit_);  // the factors themselves are the solver's (its checkpoint)
   out.put(static_cast<std::uint64_t>(advances_));
   out.put(last_time_);
+  out.put(face_volume_);  // the last step's flow directions: which node a 0D probe reads (cell_at)
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const TracerTransport& t = tracers_[k];
     out.put(std::vector<double>(t.concentration().begin(), t.concentration().end()));
@@ -408,6 +409,11 @@ void FlowTransport::restore(CheckpointReader& in) {
     in.fail("red-cell viscosities of another network");
   advances_ = static_cast<std::size_t>(in.get_u64());
   last_time_ = in.get_double();
+  // Without them a probe in a 0D vessel read the other node until the next transport step
+  // (4 samples after a resume differed from the uninterrupted run's).
+  std::vector<double> faces = in.get_vector();
+  if (faces.size() != face_volume_.size()) in.fail("red-cell faces of another network or another transport grid");
+  face_volume_ = std::move(faces);
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const std::vector<double> c = in.get_vector(), last = in.get_vector(), totals = in.get_vector(),
                               curve = in.get_vector();

@@ -112,7 +112,8 @@ class FlowTransport {
   std::vector<double> inflow_hematocrit_;  // per boundary (NaN: what last left there)
   // The boundaries' volumes at the last advance (the solver's own sums, never cleared).
   Eigen::VectorXd boundary_mark_;
-  std::vector<double> face_volume_, now_;  // scratch
+  std::vector<double> face_volume_;  // the last step's, per face (checkpointed: cell_at reads its signs)
+  std::vector<double> now_;          // scratch
   std::optional<RedCellTransport> red_cells_;
   std::size_t advances_ = 0;
   // The cycle in progress, per vessel: red cells and blood through its faces, extremes.

@@ -60,6 +60,10 @@ assert a["tracers"] == b["tracers"], (a["tracers"], b["tracers"])
 for x, y in zip(a["vessels"], b["vessels"]):
     assert x == y, (x, y)
 PY
+# probes.csv too: probe 6 is a 0D vessel, whose hematocrit is its upstream node's by the last
+# transport step's flow (a resumed run read the other node until its first step).
+cmp "$WORK/run/probes.csv" "$WORK/part/probes.csv" && pass "a resumed transport's probes.csv: the same bytes" \
+  || fail "a resumed transport's probes.csv differs"
 expect_error "a checkpoint without transport" 2 "written by a run with other options" -- \
   "$HEMOSOLVE" "$WORK/diamond.json" --cycles 4 --resume "$WORK/stopped" --quiet
 # Tracers: a plasma bolus at the inlet and a red-cell step into vessel 1, with the red cells
