@@ -40,7 +40,12 @@ std::string peer_difference(const Network& a, const Network& b) {
     if (end_id(a, a.from[v]) != end_id(b, b.from[w]) || end_id(a, a.to[v]) != end_id(b, b.to[w]))
       return which + "other nodes";
     if (a.generation[v] != b.generation[w]) return which + "another generation";
-    if (a.vessel_class[v] != b.vessel_class[w]) return which + "another class";
+    // The export writes the class of the diameter it writes (9 digits, 6d663c2, finding 7): a
+    // diameter within 1e-8 of a class boundary may come back in the class across it.
+    bool near_boundary = false;
+    for (const double bound : {artery_min_diameter, small_artery_min_diameter, arteriole_min_diameter})
+      near_boundary = near_boundary || std::abs(a.diameter[v] - bound) <= 1e-8 * bound;
+    if (a.vessel_class[v] != b.vessel_class[w] && !near_boundary) return which + "another class";
     const double pairs[][2] = {{a.length[v], b.length[w]},
                                {a.diameter[v], b.diameter[w]},
                                {a.diameter_at_to(v), b.diameter_at_to(w)},
@@ -70,15 +75,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   });
   if (!net) return 0;
   check_vnet_round_trip(*net, format);
-
-  // Finding 7 (reported; formats/export_graph.cpp is not this harness's): the export writes
-  // diameters with 9 significant digits and each vessel's class from the unrounded diameter,
-  // so a diameter just below a class boundary (9.999999999999999e-06 m) is written "1e-05"
-  // with class "capillary", and read_graphml refuses its own export (the class does not match
-  // the diameter). Until the export writes what reads back, such networks skip this step.
-  for (const double d : net->diameter)
-    for (const double bound : {artery_min_diameter, small_artery_min_diameter, arteriole_min_diameter})
-      if (d != bound && std::abs(d - bound) <= 1e-8 * bound) return 0;
 
   // hemotree's GraphML export: written whatever the network, read back the same.
   const auto written = scratch() / "exported.graphml";
