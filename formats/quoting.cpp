@@ -1,5 +1,7 @@
 #include "formats/quoting.hpp"
 
+#include <cstdio>
+
 #include <nlohmann/json.hpp>
 
 namespace hemotree {
@@ -18,6 +20,21 @@ std::string csv_field(std::string_view text) {
     quoted += c;
   }
   return quoted + '"';
+}
+
+std::string printable(std::string_view text) {
+  std::string shown;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f) {
+      shown += c;
+    } else {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
+      shown += escaped;
+    }
+  }
+  return shown;
 }
 
 }  // namespace hemotree

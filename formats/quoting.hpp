@@ -15,4 +15,7 @@ std::string json_quoted(std::string_view text);
 // text as one CSV field: unchanged when nothing in it needs quoting.
 std::string csv_field(std::string_view text);
 
+// text for an error message, which is one line: control and non-ASCII bytes shown as \xNN.
+std::string printable(std::string_view text);
+
 }  // namespace hemotree

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli/errors.hpp"
+#include "formats/quoting.hpp"
 
 namespace hemotree {
 
@@ -29,22 +30,6 @@ double TracerSpec::mean_over(double t0, double t1) const {
 }
 
 namespace {
-
-// The spec as typed, its control and non-ASCII bytes shown as \xNN: an error is one line.
-std::string printable(const std::string& text) {
-  std::string shown;
-  for (const char c : text) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (byte >= 0x20 && byte < 0x7f) {
-      shown += c;
-    } else {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
-      shown += escaped;
-    }
-  }
-  return shown;
-}
 
 [[noreturn]] void refuse(const std::string& spec, const std::string& what) {
   throw InputError("--tracer '" + printable(spec) + "': " + what);

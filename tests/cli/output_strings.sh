@@ -198,11 +198,6 @@ for spec in 1 1:0 1:1 2:0.25 1:5e-1 01 '+1' ' 1' '1 ' $'1\n' $'\n1:5' $'\t1:0.5'
     fi
   elif [ $status -eq 2 ] && [ "$lines" -eq 1 ]; then
     pass "--probe $(shown "$spec"): refused, exit 2, one line"
-  elif [ $status -eq 2 ] && [[ $spec == *$'\n'* ]]; then
-    # Known defect (reported, solver/probes.cpp is not this test's): parse_probe's two
-    # refusals quote the spec raw, so a newline in it splits the message; the tracer's
-    # refusal escapes it (printable in solver/tracer_spec.cpp). Counted once fixed.
-    echo "KNOWN DEFECT: --probe $(shown "$spec"): refused on $lines lines (the spec's newline printed raw)"
   else
     fail "--probe $(shown "$spec"): exit $status, $lines lines: $(head -c 300 "$WORK/err")"
   fi
