@@ -7,7 +7,7 @@
 #include <string_view>
 #include <unistd.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/interrupt.hpp"
 #include "formats/json_pull.hpp"
 #include "formats/output_stream.hpp"

@@ -9,7 +9,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

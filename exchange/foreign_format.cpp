@@ -9,7 +9,7 @@
 #include <string>
 #include <string_view>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
 #include "generator/growth_rules.hpp"
 

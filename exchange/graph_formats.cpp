@@ -22,7 +22,7 @@
 #include <boost/property_tree/xml_parser.hpp>
 #include <nlohmann/json.hpp>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/topology.hpp"
 

@@ -18,7 +18,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
 
 namespace hemotree {

@@ -5,7 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "exchange/openbf.hpp"

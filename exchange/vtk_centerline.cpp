@@ -24,7 +24,7 @@
 #include <boost/property_tree/xml_parser.hpp>
 #include <zlib.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/topology.hpp"
 

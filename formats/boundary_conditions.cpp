@@ -7,7 +7,7 @@
 #include <numbers>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
 
 namespace hemotree {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/exports.hpp"
 
 namespace hemotree {

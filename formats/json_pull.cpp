@@ -10,7 +10,7 @@
 #include <limits>
 #include <system_error>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

@@ -25,7 +25,7 @@ struct JsonError : std::runtime_error {
 };
 
 // Notes: columns count bytes, not UTF-8 characters; the in-memory constructor keeps a view,
-// so the text must outlive the parser; a failed read throws IoError (cli/errors.hpp); nesting
+// so the text must outlive the parser; a failed read throws IoError (core/errors.hpp); nesting
 // is capped at max_depth levels (RFC 8259 s. 9 allows a limit), so hostile input cannot
 // exhaust memory; numbers too small for a double become +-0; after a JsonError the parser
 // is not to be used again. Before the first next(), token() is end_of_input at 1:1.

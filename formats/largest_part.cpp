@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/connected_parts.hpp"
 #include "formats/topology.hpp"
 

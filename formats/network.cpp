@@ -5,7 +5,7 @@
 #include <string>
 #include <numbers>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/json_pull.hpp"
 #include "formats/network_io.hpp"

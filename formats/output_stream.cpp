@@ -12,7 +12,7 @@
 #include <string_view>
 #include <unistd.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

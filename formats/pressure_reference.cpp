@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
 
 namespace hemotree {

@@ -6,7 +6,7 @@
 
 #include <boost/graph/breadth_first_search.hpp>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

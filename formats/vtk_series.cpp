@@ -8,7 +8,7 @@
 #include <system_error>
 #include <utility>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/output_stream.hpp"
 
 namespace hemotree {

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

@@ -6,7 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/progress.hpp"
 #include "cli/tool.hpp"
 #include "cli/units.hpp"

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string_view>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

@@ -12,7 +12,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

@@ -4,7 +4,7 @@
 #include <limits>
 #include <numbers>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/rheology.hpp"
 
 namespace hemotree {

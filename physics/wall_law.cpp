@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

@@ -22,7 +22,7 @@
 #include <numeric>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

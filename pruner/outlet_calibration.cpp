@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/units.hpp"
 #include "formats/topology.hpp"
 #include "physics/wall_law.hpp"

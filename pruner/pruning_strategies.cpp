@@ -14,7 +14,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/topology.hpp"
 #include "generator/tree_growth.hpp"
 

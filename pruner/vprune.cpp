@@ -10,7 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "formats/exports.hpp"

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <utility>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/phase_separation.hpp"
 #include "physics/rheology.hpp"
 #include "solver/legendre_basis.hpp"

@@ -14,7 +14,7 @@
 #include <CLI/CLI.hpp>
 #include <omp.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/interrupt.hpp"
 #include "cli/tool.hpp"
 #include "cli/units.hpp"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 #include <Eigen/Eigenvalues>
 

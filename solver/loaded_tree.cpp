@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "network_flow/nodal_system.hpp"
 #include "solver/network_boundaries.hpp"
 #include "solver/steady_flow.hpp"

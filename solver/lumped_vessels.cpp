@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "core/parallel_errors.hpp"
 #include "physics/poiseuille.hpp"
 #include "solver/network_boundaries.hpp"

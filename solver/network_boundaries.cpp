@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

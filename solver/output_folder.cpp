@@ -12,7 +12,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

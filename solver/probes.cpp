@@ -1,6 +1,6 @@
 #include "solver/probes.hpp"
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/output_stream.hpp"
 #include "formats/quoting.hpp"
 

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/tool.hpp"
 #include "formats/vtk_series.hpp"
 #include "solver/run_report.hpp"

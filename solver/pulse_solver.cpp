@@ -10,7 +10,7 @@
 
 #include <omp.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "core/parallel_errors.hpp"
 #include "formats/connected_parts.hpp"
 #include "physics/poiseuille.hpp"

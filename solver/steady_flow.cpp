@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/connected_parts.hpp"
 #include "formats/topology.hpp"
 #include "network_flow/flow_network.hpp"

@@ -6,7 +6,7 @@
 #include <limits>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/phase_separation.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/rheology.hpp"

@@ -6,7 +6,7 @@
 #include <limits>
 #include <numbers>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/tool.hpp"
 #include "cli/units.hpp"
 #include "physics/rheology.hpp"

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/quoting.hpp"
 
 namespace hemotree {

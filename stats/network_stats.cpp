@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/connected_parts.hpp"
 
 namespace hemotree {

@@ -4,7 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/tool.hpp"
 #include "formats/network_io.hpp"
 #include "stats/network_stats.hpp"

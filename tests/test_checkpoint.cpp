@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "network_builders.hpp"
 #include "solver/checkpoint.hpp"
 #include "solver/pulse_solver.hpp"

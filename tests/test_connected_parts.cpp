@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/connected_parts.hpp"
 #include "formats/largest_part.hpp"
 #include "formats/network_io.hpp"

@@ -18,7 +18,7 @@
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/graphml.hpp>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/exports.hpp"
 #include "tests/xml_reader.hpp"
 

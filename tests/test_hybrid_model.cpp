@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "solver/pulse_solver.hpp"
 #include "tests/network_builders.hpp"
 

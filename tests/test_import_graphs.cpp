@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "exchange/graph_formats.hpp"
 #include "formats/exports.hpp"
 #include "formats/output_stream.hpp"

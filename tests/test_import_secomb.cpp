@@ -13,7 +13,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "exchange/secomb.hpp"
 #include "tests/shared_networks.hpp"
 #include "formats/network_io.hpp"

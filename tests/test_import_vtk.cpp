@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "exchange/vtk_centerline.hpp"
 #include "scratch_path.hpp"
 

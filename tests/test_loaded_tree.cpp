@@ -2,7 +2,7 @@
 // injected currents and shunts, through vessels, R outlets and RCR outlets' capacitor nodes.
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "solver/loaded_tree.hpp"
 #include "tests/network_builders.hpp"
 

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/json_pull.hpp"
 #include "formats/network_io.hpp"
 #include "formats/topology.hpp"

@@ -16,7 +16,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "exchange/foreign_format.hpp"
 #include "exchange/secomb.hpp"
 #include "solver/cycle_statistics.hpp"

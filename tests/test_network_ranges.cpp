@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/json_pull.hpp"
 #include "formats/network_io.hpp"

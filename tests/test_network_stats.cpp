@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "stats/network_stats.hpp"
 
 namespace hemotree {

@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "solver/output_folder.hpp"
 #include "solver/run_estimate.hpp"
 

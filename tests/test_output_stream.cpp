@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/output_stream.hpp"
 
 using namespace hemotree;

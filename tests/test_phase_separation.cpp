@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/phase_separation.hpp"
 
 using namespace hemotree;

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/topology.hpp"
 #include "generator/growth_rules.hpp"
 #include "generator/tree_growth.hpp"

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/interrupt.hpp"
 #include "network_builders.hpp"
 #include "solver/pulsatile_run.hpp"

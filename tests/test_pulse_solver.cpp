@@ -27,7 +27,7 @@
 #include <omp.h>
 #endif
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "solver/legendre_basis.hpp"
 #include "solver/pulse_solver.hpp"
 #include "solver/solution_breakdown.hpp"

@@ -10,7 +10,7 @@
 #include <numbers>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/phase_separation.hpp"
 #include "tests/transport_grids.hpp"
 #include "transport/red_cell_transport.hpp"

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/boundary_conditions.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/rheology.hpp"

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/network_io.hpp"
 #include "formats/pressure_reference.hpp"
 #include "physics/rheology.hpp"

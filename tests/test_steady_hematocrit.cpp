@@ -16,7 +16,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "exchange/secomb.hpp"
 #include "tests/shared_networks.hpp"
 #include "network_builders.hpp"

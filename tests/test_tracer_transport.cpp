@@ -12,7 +12,7 @@
 #include <numbers>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/phase_separation.hpp"
 #include "tests/transport_grids.hpp"
 #include "transport/indicator_curves.hpp"

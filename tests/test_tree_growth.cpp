@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/topology.hpp"
 #include "generator/fractal_length.hpp"
 #include "generator/growth_rules.hpp"

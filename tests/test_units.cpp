@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "cli/units.hpp"
 #include "formats/network.hpp"
 

@@ -14,7 +14,7 @@
 
 #include <unistd.h>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/vtk_series.hpp"
 #include "tests/xml_reader.hpp"
 

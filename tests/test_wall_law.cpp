@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/wall_law.hpp"
 
 using namespace hemotree;

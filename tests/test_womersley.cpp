@@ -9,7 +9,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/womersley.hpp"
 
 using namespace hemotree;

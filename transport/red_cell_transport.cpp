@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "physics/phase_separation.hpp"
 
 namespace hemotree {

@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 
 namespace hemotree {
 

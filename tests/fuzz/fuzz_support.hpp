@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli/errors.hpp"
+#include "core/errors.hpp"
 #include "formats/json_pull.hpp"
 
 namespace hemotree::fuzz {

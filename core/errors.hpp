@@ -1,4 +1,6 @@
-// Errors a user can act on. Every tool catches them in main and prints one line.
+// Errors a user can act on, raised by any layer (formats up to the tools) and caught by each
+// tool's run_tool (cli/tool.hpp), which prints one line. In the core room, below every layer:
+// a reader or a law must not include a command-line header to refuse a value.
 #pragma once
 
 #include <stdexcept>
