@@ -131,4 +131,32 @@ void fill_missing_walls(Network& net, const ImportOptions& options) {
                            "; --youngs-modulus sets one");
 }
 
+namespace {
+void ascii_strings(nlohmann::json& j) {
+  if (j.is_string()) {
+    std::string s = j.get<std::string>();
+    for (char& c : s)
+      if (static_cast<unsigned char>(c) >= 0x80) c = '?';
+    j = s;
+  } else if (j.is_structured()) {
+    for (auto& item : j) ascii_strings(item);
+  }
+}
+}  // namespace
+
+void stamp_import_provenance(Network& net, const std::string& format, const std::string& source,
+                             const nlohmann::json& parameters) {
+  if (!net.provenance.is_object()) net.provenance = nlohmann::json::object();
+  net.provenance["tool"] = "vimport";
+  net.provenance["version"] = HEMOTREE_VERSION;
+  net.provenance["format"] = format;
+  net.provenance["source"] = source;
+  if (!parameters.empty()) net.provenance["parameters"] = parameters;
+  try {
+    (void)net.provenance.dump();
+  } catch (const nlohmann::json::exception&) {
+    ascii_strings(net.provenance);
+  }
+}
+
 }  // namespace hemotree

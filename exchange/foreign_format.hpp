@@ -43,4 +43,10 @@ void refuse_deep_xml(const std::string& path, std::string_view xml);
 // toolkit's tables, and notes what it did (one line each, with the count of vessels).
 void fill_missing_walls(Network& net, const ImportOptions& options);
 
+// The provenance vimport writes on an imported network: "tool", "version", "format" and
+// "source" (and "parameters" where given) over what the reader put there; where a string is
+// not UTF-8 (a file name need not be, JSON text must be), its bytes outside ASCII become '?'.
+void stamp_import_provenance(Network& net, const std::string& format, const std::string& source,
+                             const nlohmann::json& parameters = nlohmann::json::object());
+
 }  // namespace hemotree

@@ -34,27 +34,6 @@ double parse_mean_cell_volume(std::string text) {
   return 1e-18 * parse_number(text, "--mean-cell-volume [fl]", Interval{r.min * 1e18, r.max * 1e18});
 }
 
-// A file name need not be valid UTF-8, and JSON text must be: where the provenance does not
-// serialize, bytes outside ASCII in its strings become '?'.
-void ascii_strings(nlohmann::json& j) {
-  if (j.is_string()) {
-    std::string s = j.get<std::string>();
-    for (char& c : s)
-      if (static_cast<unsigned char>(c) >= 0x80) c = '?';
-    j = s;
-  } else if (j.is_structured()) {
-    for (auto& item : j) ascii_strings(item);
-  }
-}
-
-void make_provenance_writable(nlohmann::json& provenance) {
-  try {
-    (void)provenance.dump();
-  } catch (const nlohmann::json::exception&) {
-    ascii_strings(provenance);
-  }
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -191,13 +170,7 @@ int main(int argc, char** argv) {
     }
 
     // ---- provenance and output -------------------------------------------------------------
-    if (!net.provenance.is_object()) net.provenance = nlohmann::json::object();
-    net.provenance["tool"] = "vimport";
-    net.provenance["version"] = HEMOTREE_VERSION;
-    net.provenance["format"] = format;
-    net.provenance["source"] = input;
-    if (!parameters.empty()) net.provenance["parameters"] = parameters;
-    make_provenance_writable(net.provenance);
+    stamp_import_provenance(net, format, input, parameters);
 
     OutputStream out(output);
     write_network(net, out);

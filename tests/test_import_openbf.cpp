@@ -654,7 +654,7 @@ TEST_F(OpenbfTest, TheCircleOfWillisClosesLoopsAndAdan56HasItsOwnExternalPressur
 // returning one empty document after another at the same place: YAML::LoadAll then allocated
 // until memory ran out. The model's documents are walked by their events and refused there.
 TEST_F(OpenbfTest, RefusesYamlWhoseParserMakesNoProgress) {
-  for (const std::string text : {std::string(",a"), std::string("[1]\n,"), std::string("project_name: x\n---\n,")}) {
+  for (const std::string& text : {std::string(",a"), std::string("[1]\n,"), std::string("project_name: x\n---\n,")}) {
     const std::string message = refusal(file("stall.yaml", text));
     EXPECT_TRUE(message.find("not valid YAML") != std::string::npos ||
                 message.find("second YAML document") != std::string::npos)

@@ -11,54 +11,12 @@
 
 #include "formats/network_io.hpp"
 #include "fuzz_support.hpp"
+#include "network_difference.hpp"
 
 using namespace hemotree;
 using hemotree::fuzz::finding;
 
 namespace {
-
-// Same double: bit for bit (exact), or as the writer's 9 significant digits allow.
-bool same_real(double a, double b, bool exact) {
-  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b);
-  if (exact) return a == b;
-  return std::abs(a - b) <= 1e-8 * std::max(std::abs(a), std::abs(b));
-}
-
-std::string first_difference(const Network& a, const Network& b, bool exact) {
-  auto reals = [&](const char* name, const std::vector<double>& u,
-                   const std::vector<double>& v) -> std::string {
-    if (u.size() != v.size()) return std::string(name) + ": sizes differ";
-    for (std::size_t i = 0; i < u.size(); ++i)
-      if (!same_real(u[i], v[i], exact))
-        return std::string(name) + "[" + std::to_string(i) + "]: " + std::to_string(u[i]) + " against " +
-               std::to_string(v[i]);
-    return "";
-  };
-  auto equal = [](const char* name, const auto& u, const auto& v) -> std::string {
-    return u == v ? "" : std::string(name) + " differs";
-  };
-  for (const std::string& d :
-       {equal("node ids", a.node_id, b.node_id), reals("x", a.x, b.x), reals("y", a.y, b.y),
-        reals("z", a.z, b.z), equal("vessel ids", a.id, b.id), equal("from", a.from, b.from),
-        equal("to", a.to, b.to), reals("length", a.length, b.length),
-        reals("diameter", a.diameter, b.diameter), reals("wall_thickness", a.wall_thickness, b.wall_thickness),
-        reals("youngs_modulus", a.youngs_modulus, b.youngs_modulus),
-        equal("generation", a.generation, b.generation), equal("class", a.vessel_class, b.vessel_class),
-        reals("beta", a.beta, b.beta), reals("reference_pressure", a.reference_pressure, b.reference_pressure),
-        equal("provenance", a.provenance, b.provenance), equal("extra members", a.extra, b.extra)})
-    if (!d.empty()) return d;
-  // Blood, inlet and outlets travel as nlohmann JSON, which keeps every double exactly.
-  if (a.blood.has_value() != b.blood.has_value()) return "blood present in one only";
-  if (a.blood && to_json(*a.blood) != to_json(*b.blood)) return "blood differs";
-  if (a.inlet.has_value() != b.inlet.has_value()) return "inlet present in one only";
-  if (a.inlet && (to_json(*a.inlet) != to_json(*b.inlet) || a.inlet->vessel != b.inlet->vessel))
-    return "inlet differs";
-  if (a.outlets.size() != b.outlets.size()) return "outlet counts differ";
-  for (std::size_t k = 0; k < a.outlets.size(); ++k)
-    if (a.outlets[k].vessel != b.outlets[k].vessel || to_json(a.outlets[k]) != to_json(b.outlets[k]))
-      return "outlet " + std::to_string(k) + " differs";
-  return "";
-}
 
 std::string shown(const fuzz::Refusal& r) { return r.kind + " \"" + r.message + "\""; }
 
@@ -115,7 +73,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
               std::to_string(buffer) + " bytes " + shown(stream_error));
     return 0;
   }
-  if (const std::string d = first_difference(*in_memory, *streamed, true); !d.empty())
+  if (const std::string d = fuzz::vnet_difference(*in_memory, *streamed, 0.0); !d.empty())
     finding("in memory and streamed through " + std::to_string(buffer) + " bytes read different networks: " + d);
 
   // Round trip: what the reader accepts the writer writes, the reader reads back the same
@@ -126,7 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   auto& again = again_result.first;
   auto& again_error = again_result.second;
   if (!again) finding("the reader refuses what write_network wrote: " + shown(again_error));
-  if (const std::string d = first_difference(*in_memory, *again, false); !d.empty())
+  if (const std::string d = fuzz::vnet_difference(*in_memory, *again, 1e-8); !d.empty())  // the writer's 9 digits
     finding("written and read back, the network changed: " + d);
   if (write_to_text(*again, file) != first) finding("a second write gives different bytes");
   return 0;
