@@ -16,17 +16,6 @@
 
 namespace hemotree {
 
-const char* to_string(RunStatus status) {
-  switch (status) {
-    case RunStatus::complete: return "complete";
-    case RunStatus::not_periodic: return "not periodic";
-    case RunStatus::interrupted: return "interrupted";
-    case RunStatus::broken_down: return "broken down";
-    case RunStatus::too_long: return "too long";
-  }
-  return "unknown";
-}
-
 namespace {
 double seconds_since_epoch_start() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();

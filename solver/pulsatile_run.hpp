@@ -42,8 +42,9 @@ struct RunPlan {
   std::size_t transport_every = 1;  // solver steps between red-cell transport steps
 };
 
+// How the time loop ended; what a run reports of it, with the checks on its numbers, is a
+// RunOutcome (solver/run_outcome.hpp), which alone has words and exit statuses.
 enum class RunStatus { complete, not_periodic, interrupted, broken_down, too_long };
-const char* to_string(RunStatus status);
 
 class PulsatileRun {
  public:
