@@ -15,7 +15,8 @@ BUILD_DIR=${HEMOTREE_BUILD_DIR:-$HEMOTREE_ROOT/build}
 JOBS=${HEMOTREE_JOBS:-$(nproc)}
 
 packages=(build-essential cmake ninja-build libboost-graph-dev libeigen3-dev
-          nlohmann-json3-dev libgtest-dev libcli11-dev libyaml-cpp-dev zlib1g-dev python3-matplotlib)
+          nlohmann-json3-dev libgtest-dev libcli11-dev libyaml-cpp-dev zlib1g-dev python3-matplotlib
+          python3-numpy python3-pandas)
 
 say() { echo "hemotree: $*" >&2; }
 
