@@ -23,139 +23,24 @@ interpolated, periodically, onto the reference samples. The measures (the data R
   max |Q_ref|), the extremes taken over each series' own samples.
 Exit status: 0 all locations within the thresholds, 1 some location beyond them, 2 unusable
 input (no probes.csv, a probe missing, less than one cycle), 77 reference not found
-(CTest's SKIP_RETURN_CODE).
+(CTest's SKIP_RETURN_CODE). The cases, the reference lookup and the measures are those of
+python/hemotree_boileau.py (scripts/validation-report uses the same); probes.csv is read by
+python/hemotree_io.py.
 """
 import argparse
-import csv
-import json
 import math
-import os
-import re
 import sys
 from pathlib import Path
 
 PROJECT = Path(__file__).resolve().parent.parent.parent
+sys.dont_write_bytecode = True  # no __pycache__ left in python/
+sys.path.insert(0, str(PROJECT / "python"))
+# The cases, the reference lookup and the measures: shared with scripts/validation-report.
+from hemotree_boileau import (CASES, KPA, ML, InputProblem, compare_location,  # noqa: E402
+                              probe_column, probe_flag, read_probes, read_table, reference_dir)
+import hemotree_io  # noqa: E402
+
 SKIP = 77
-
-# Per case, the compared locations: (label, vessel id, x along the vessel [0, 1], FV file,
-# matching 3D file). The vessel ids are those make-cases gives (examples/boileau2015):
-# cca: 1 the carotid; ibif: 1 the aorta, 2 and 3 the iliacs.
-CASES = {
-    "cca": [("carotid midpoint", 1, 0.5, "FV_carotid.dat", "B3D_commoncarotid.txt")],
-    "ibif": [("aorta midpoint", 1, 0.5, "FV_aorta-bif.dat", "B3D_AortaMid.txt"),
-             ("aorta at the junction", 1, 1.0, "FV_aorta_bif-bif.dat", "B3D_Junction.txt"),
-             ("iliac midpoint", 2, 0.5, "FV_iliac-bif.dat", "B3D_IliacMid.txt")],
-    "uta": [],
-}
-KPA, ML = 1e3, 1e-6   # reference units to SI: kPa -> Pa, ml/s -> m^3/s
-
-
-class InputProblem(Exception):
-    pass
-
-
-def probe_flag(vessel, x):
-    return f"{vessel}:{x:g}"
-
-
-def reference_dir(arg):
-    """The boileau2015 folder and where its location came from."""
-    if arg:
-        return Path(arg), "--reference-dir"
-    env = os.environ.get("HEMOTREE_VALIDATION_DIR")
-    if env:
-        path = Path(env)
-        if (path / "boileau2015").is_dir():
-            path = path / "boileau2015"
-        return path, "HEMOTREE_VALIDATION_DIR"
-    return PROJECT.parent / "shared" / "validation" / "boileau2015", "default"
-
-
-def read_table(path):
-    import numpy as np
-    rows = [line.split() for line in open(path) if line.strip() and not line.startswith("#")]
-    return np.array([[float(v) for v in r] for r in rows])
-
-
-def read_probes(run_dir):
-    """(time array, {(kind, vessel, x): column array}) from RUN_DIR/probes.csv."""
-    import numpy as np
-    path = Path(run_dir) / "probes.csv"
-    if not path.is_file():
-        raise InputProblem(f"{path} not found")
-    with open(path, newline="") as f:
-        lines = [line for line in f if line.strip() and not line.startswith("#")]
-    reader = csv.reader(lines)
-    try:
-        header = [h.strip() for h in next(reader)]
-    except StopIteration:
-        raise InputProblem(f"{path}: empty")
-    if not header or not header[0].startswith("t"):
-        raise InputProblem(f"{path}: the first column must be the time `t [s]`, not {header[:1]}")
-    columns = {}
-    pattern = re.compile(r"^(p|Q|A|u)\s+vessel\s+(-?\d+)\s+x\s+([-+0-9.eE]+)\s*(\[.*\])?$")
-    for k, name in enumerate(header[1:], start=1):
-        m = pattern.match(name)
-        if m:
-            columns[(m.group(1), int(m.group(2)), float(m.group(3)))] = k
-    try:
-        data = np.array([[float(v) for v in row] for row in reader if row])
-    except ValueError as e:
-        raise InputProblem(f"{path}: {e}")
-    if data.ndim != 2 or data.shape[0] < 3 or data.shape[1] != len(header):
-        raise InputProblem(f"{path}: expected rows of {len(header)} numbers under the header")
-    return path, data[:, 0], {key: data[:, k] for key, k in columns.items()}
-
-
-def probe_column(probes, kind, vessel, x, path):
-    for (k, v, px), column in probes.items():
-        if k == kind and v == vessel and abs(px - x) < 1e-6:
-            return column
-    have = sorted({probe_flag(v, px) for (_, v, px) in probes})
-    raise InputProblem(f"{path}: no column `{kind} vessel {vessel} x {x:g}` "
-                       f"(probes there: {', '.join(have) or 'none'}; run hemosolve with "
-                       f"--probe {probe_flag(vessel, x)})")
-
-
-def last_cycle(t, period, what):
-    """Indices of the samples in (t_end - T, t_end], checking they cover a whole cycle."""
-    import numpy as np
-    steps = np.diff(t)
-    if np.any(steps <= 0):
-        raise InputProblem(f"{what}: times must increase")
-    dt = float(np.median(steps))
-    start = t[-1] - period
-    if t[0] > start + 1.5 * dt:
-        raise InputProblem(f"{what}: {t[-1] - t[0]:.4g} s of samples, less than a full cycle "
-                           f"of {period:g} s")
-    return np.nonzero(t > start + 0.5 * dt)[0]
-
-
-def periodic_interp(phase_at, t, values, period):
-    import numpy as np
-    return np.interp(phase_at, np.mod(t, period), values, period=period)
-
-
-def compare_location(t_ours, p_ours, q_ours, ref, period, where):
-    import numpy as np
-    i = last_cycle(t_ours, period, where)
-    j = last_cycle(ref[:, 0], period, "reference")
-    t_ref = ref[j, 0]
-    p_ref, q_ref = ref[j, 1] * KPA, ref[j, 2] * ML
-    phase = np.mod(t_ref, period)
-    p = periodic_interp(phase, t_ours[i], p_ours[i], period)
-    q = periodic_interp(phase, t_ours[i], q_ours[i], period)
-    q_scale = float(np.max(np.abs(q_ref)))
-    m = {
-        "eps_P": float(np.mean(np.abs(p - p_ref) / p_ref)),
-        "eps_Q": float(np.mean(np.abs(q - q_ref)) / q_scale),
-        "max_P": float((p_ours[i].max() - p_ref.max()) / p_ref.max()),
-        "min_P": float((p_ours[i].min() - p_ref.min()) / p_ref.min()),
-        "max_Q": float((q_ours[i].max() - q_ref.max()) / q_scale),
-    }
-    curves = {"phase_ref": phase, "p_ref": p_ref, "q_ref": q_ref,
-              "phase_ours": np.mod(t_ours[i], period), "p_ours": p_ours[i], "q_ours": q_ours[i]}
-    return m, curves
 
 
 def plot(out, case, results, ref_dir, period):
@@ -234,8 +119,8 @@ def main(argv):
     try:
         case_file = Path(args.case_file or PROJECT / "examples" / "boileau2015" / f"{args.case}.json")
         try:
-            period = float(json.load(open(case_file))["inlet"]["waveform"]["period"])
-        except (OSError, ValueError, KeyError, TypeError) as e:
+            period = float(hemotree_io.read_network(case_file).inlet["waveform"]["period"])
+        except (OSError, ValueError, KeyError, TypeError, hemotree_io.MissingDependency) as e:
             raise InputProblem(f"{case_file}: cannot read inlet.waveform.period ({e})")
         if not (period > 0 and math.isfinite(period)):
             raise InputProblem(f"{case_file}: the period must be positive")
