@@ -1,6 +1,13 @@
-"""Figures of red cells and tracers carried by a hemosolve run (docs/transport.md), drawn by
-scripts/plot-results into DIR/figures when the run has them:
+"""Figures shared by the scripts (scripts/plot-results, scripts/plot-tree-stats): drawn from
+what hemotree_io reads, never reading files of their own but probes.csv (through hemotree_io).
+matplotlib is imported where a figure is drawn, so that importing this module costs nothing.
 
+Per-generation statistics of a tree (`vstats --json`), like the paper's Figure 4 (a, c, d):
+  plot_tree_stats          vessels by class and per generation, diameter quartiles; several
+                           trees (seeds) overlaid, the first drawn full, the others faint
+
+Red cells and tracers carried by a hemosolve run (docs/transport.md), drawn by
+scripts/plot-results into DIR/figures when the run has them (plot_all):
   hematocrit-vs-diameter   each vessel's cycle-mean discharge and tube hematocrit against its
                            diameter, with the binned medians, the feed's hematocrit and the
                            Fahraeus law's tube hematocrit at it (Pries et al. 1992)
@@ -10,9 +17,64 @@ scripts/plot-results into DIR/figures when the run has them:
   curves-NAME              tracer NAME's concentration against time at every probe
                            (probes.csv: indicator-dilution curves)
 """
-import csv
 import math
 from pathlib import Path
+
+import hemotree_io
+
+TREE_STATS_CLASSES = [("small_artery", "small arteries", "tab:green"),
+                      ("arteriole", "arterioles", "tab:blue"),
+                      ("capillary", "capillaries", "tab:red")]
+
+
+def plot_tree_stats(runs, stem):
+    """Writes STEM.png and STEM.svg: per-generation statistics of one or more trees (RUNS:
+    `vstats --json` dicts, hemotree_io.read_network_stats), the first in full, the others
+    faint. The numbers come from vstats; nothing is recomputed."""
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
+    ax_class, ax_total, ax_diam = axes
+    for i, stats in enumerate(runs):
+        gens = stats["generations"]
+        g = [row["generation"] for row in gens]
+        alpha = 1.0 if i == 0 else 0.35
+        for key, label, colour in TREE_STATS_CLASSES:
+            ax_class.semilogy(g, [row["classes"][key] for row in gens], color=colour,
+                              alpha=alpha, label=label if i == 0 else None)
+        ax_total.semilogy(g, [row["vessels"] for row in gens], color="tab:green",
+                          alpha=alpha, label="vessels per generation" if i == 0 else None)
+    peak = max(row["vessels"] for stats in runs for row in stats["generations"])
+    g_line = [k for k in range(64) if 2.0**k <= 10 * peak]
+    ax_total.semilogy(g_line, [2.0**k for k in g_line], color="grey",
+                      linestyle="--", label="$2^g$ (full binary growth)")
+
+    # Diameter quartiles of the first run, as boxes without whiskers beyond min/max.
+    gens = runs[0]["generations"]
+    boxes = [{"med": r["diameter"]["median"] * 1e6, "q1": r["diameter"]["q1"] * 1e6,
+              "q3": r["diameter"]["q3"] * 1e6, "whislo": r["diameter"]["min"] * 1e6,
+              "whishi": r["diameter"]["max"] * 1e6, "label": str(r["generation"])}
+             for r in gens if r["vessels"] > 0]
+    ax_diam.bxp(boxes, showfliers=False)
+    ax_diam.set_yscale("log")
+    ax_diam.set_xticks(range(1, len(boxes) + 1, 5))
+    ax_diam.set_xticklabels([b["label"] for b in boxes][::5])
+
+    ax_class.set(xlabel="generation", ylabel="vessels", title="(a) vessels by class",
+                 ylim=(0.5, None))
+    ax_class.legend()
+    ax_total.set(xlabel="generation", ylabel="vessels",
+                 title="(c) vessels per generation", ylim=(0.5, None))
+    ax_total.legend()
+    ax_diam.set(xlabel="generation", ylabel="diameter [um]",
+                title="(d) diameter quartiles, min and max")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    fig.suptitle(f"{runs[0]['vessels']:,} vessels" +
+                 (f" (first of {len(runs)} trees; others faint)" if len(runs) > 1 else ""))
+    fig.tight_layout()
+    for ext in ("png", "svg"):
+        fig.savefig(f"{stem}.{ext}", dpi=120)
+
 
 UM_PER_M = 1e6
 
@@ -152,20 +214,19 @@ def plot_curves(run, name, out, written, save, note):
     if not path.is_file():
         note(f"no {path} (--probe); skipping {stem}")
         return
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    if len(rows) < 2:
+    probes = hemotree_io.read_probes(path)
+    if len(probes) < 1:
         return
-    header = rows[0]
+    header = list(probes.columns)
     columns = [j for j, h in enumerate(header) if h.startswith(f"c_{name} vessel ")]
     if not columns:
         note(f"no c_{name} column in {path}; skipping {stem}")
         return
-    t = [float(r[0]) for r in rows[1:]]
+    t = probes.iloc[:, 0].to_numpy(dtype=float)
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for j in columns:
         label = header[j][len(f"c_{name} "):]
-        ax.plot(t, [float(r[j]) for r in rows[1:]], lw=1.5, label=label)
+        ax.plot(t, probes.iloc[:, j].to_numpy(dtype=float), lw=1.5, label=label)
     ax.set_xlabel("t [s]")
     unit = header[columns[0]]
     ax.set_ylabel(f"{name} concentration {unit[unit.find('['):] if '[' in unit else ''}")
