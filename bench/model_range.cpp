@@ -13,7 +13,7 @@
 #include <numbers>
 #include <vector>
 
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 
 using namespace hemotree;
 

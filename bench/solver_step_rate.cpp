@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "formats/network_io.hpp"
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 #include "solver/run_estimate.hpp"
 
 using namespace hemotree;

@@ -135,4 +135,40 @@ std::vector<NodeBoundary> node_boundaries(const Network& net) {
   return all;
 }
 
+std::vector<NodeBoundary> run_boundaries(const Network& net) {
+  node_boundaries(net);  // refuses two conditions at one node, and an inlet of no vessel
+  std::vector<NodeBoundary> list;
+  list.reserve(net.outlets.size() + 1 + net.boundaries.size());
+  for (const Outlet& o : net.outlets) list.push_back(as_node_boundary(net, o));
+  if (net.inlet) list.push_back(as_node_boundary(net, *net.inlet));
+  list.insert(list.end(), net.boundaries.begin(), net.boundaries.end());
+  return list;
+}
+
+std::vector<Outlet> run_outlets(const std::vector<NodeBoundary>& boundaries) {
+  std::vector<Outlet> outlets;
+  for (const NodeBoundary& b : boundaries)
+    if (b.is_outlet()) outlets.push_back(b.outlet);
+  return outlets;
+}
+
+Waveform driving_waveform(const Network& net) {
+  const std::vector<NodeBoundary> list = run_boundaries(net);
+  const NodeBoundary* first = nullptr;
+  for (const NodeBoundary& b : list) {
+    if (b.is_outlet() || b.waveform.shape == Waveform::Shape::constant) continue;
+    if (!first) {
+      first = &b;
+    } else if (std::abs(b.waveform.period - first->waveform.period) > 1e-9 * first->waveform.period) {
+      auto name = [&](const NodeBoundary& x) { return "node " + std::to_string(net.node_id[static_cast<std::size_t>(x.node)]); };
+      throw InputError("the boundary waveforms at " + name(*first) + " and " + name(b) + " have different periods (" +
+                       std::to_string(first->waveform.period) + " s and " + std::to_string(b.waveform.period) +
+                       " s): a pulsatile run needs one period for all");
+    }
+  }
+  if (first) return first->waveform;
+  if (net.inlet) return net.inlet->waveform;
+  return Waveform::constant_value(0.0);  // period 1 s
+}
+
 }  // namespace hemotree

@@ -7,7 +7,7 @@
 #include "cli/units.hpp"
 #include "formats/topology.hpp"
 #include "physics/wall_law.hpp"
-#include "solver/steady_flow.hpp"
+#include "steady/steady_flow.hpp"
 
 namespace hemotree {
 

@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
 

@@ -10,7 +10,7 @@
 #include "core/errors.hpp"
 #include "physics/phase_separation.hpp"
 #include "physics/rheology.hpp"
-#include "solver/legendre_basis.hpp"
+#include "pulse/legendre_basis.hpp"
 
 namespace hemotree {
 

@@ -22,8 +22,8 @@
 
 #include "formats/network.hpp"
 #include "physics/rheology.hpp"
-#include "solver/checkpoint.hpp"
-#include "solver/pulse_solver.hpp"
+#include "formats/checkpoint_file.hpp"
+#include "pulse/pulse_solver.hpp"
 #include "solver/tracer_spec.hpp"
 #include "transport/indicator_curves.hpp"
 #include "transport/red_cell_transport.hpp"

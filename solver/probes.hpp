@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "formats/network.hpp"
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
 

@@ -12,7 +12,7 @@
 #include "cli/tool.hpp"
 #include "formats/vtk_series.hpp"
 #include "solver/run_report.hpp"
-#include "solver/solution_breakdown.hpp"
+#include "pulse/solution_breakdown.hpp"
 
 namespace hemotree {
 

@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "cli/interrupt.hpp"
-#include "solver/checkpoint.hpp"
+#include "formats/checkpoint_file.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/flow_transport.hpp"
 #include "solver/probes.hpp"
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
 

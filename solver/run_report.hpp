@@ -14,7 +14,7 @@
 #include "formats/network.hpp"
 #include "formats/vtk_series.hpp"
 #include "solver/cycle_statistics.hpp"
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 #include "solver/vessel_table.hpp"
 
 namespace hemotree {

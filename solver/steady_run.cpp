@@ -13,7 +13,7 @@
 #include "solver/output_folder.hpp"
 #include "physics/phase_separation.hpp"
 #include "solver/run_report.hpp"
-#include "solver/steady_hematocrit.hpp"
+#include "steady/steady_hematocrit.hpp"
 
 namespace hemotree {
 

@@ -13,7 +13,7 @@
 
 #include "formats/network.hpp"
 #include "solver/cycle_statistics.hpp"
-#include "solver/steady_flow.hpp"
+#include "steady/steady_flow.hpp"
 #include "solver/vessel_table.hpp"
 
 namespace hemotree {
@@ -41,7 +41,7 @@ struct SteadyRunRequest {
   std::span<const std::uint8_t> vtk_keep;
   bool quiet = false;
   // Red cells: fixed (the blood's hematocrit everywhere) or phase separation at diverging
-  // bifurcations, the flows and hematocrits solved together (solver/steady_hematocrit.hpp).
+  // bifurcations, the flows and hematocrits solved together (steady/steady_hematocrit.hpp).
   bool phase_separation = false;
 };
 

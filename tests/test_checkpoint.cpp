@@ -12,8 +12,8 @@
 
 #include "core/errors.hpp"
 #include "network_builders.hpp"
-#include "solver/checkpoint.hpp"
-#include "solver/pulse_solver.hpp"
+#include "formats/checkpoint_file.hpp"
+#include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
 namespace {

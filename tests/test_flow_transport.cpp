@@ -16,9 +16,9 @@
 #include "physics/phase_separation.hpp"
 #include "physics/rheology.hpp"
 #include "solver/flow_transport.hpp"
-#include "solver/pulse_solver.hpp"
-#include "solver/steady_flow.hpp"
-#include "solver/steady_hematocrit.hpp"
+#include "pulse/pulse_solver.hpp"
+#include "steady/steady_flow.hpp"
+#include "steady/steady_hematocrit.hpp"
 #include "tests/network_builders.hpp"
 
 namespace hemotree {

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;

@@ -1,9 +1,9 @@
-// The loaded resistive tree (solver/loaded_tree) against hand calculations: the potentials of
+// The loaded resistive tree (steady/loaded_tree) against hand calculations: the potentials of
 // injected currents and shunts, through vessels, R outlets and RCR outlets' capacitor nodes.
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
-#include "solver/loaded_tree.hpp"
+#include "steady/loaded_tree.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;

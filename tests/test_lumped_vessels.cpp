@@ -1,4 +1,4 @@
-// The 0D vessels (solver/lumped_vessels) against circuits solved exactly: one vessel between
+// The 0D vessels (pulse/lumped_vessels) against circuits solved exactly: one vessel between
 // an imposed inflow and a resistance outlet is, for small pressure changes, two capacitors
 // C/2 joined by R (and L), with R_out to p_out. The linear ODE of that circuit is solved
 // exactly through its eigenvectors, independently of the scheme; BDF2 must follow it to its
@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "physics/viscosity_table.hpp"
-#include "solver/lumped_vessels.hpp"
+#include "pulse/lumped_vessels.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;

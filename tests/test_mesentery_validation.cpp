@@ -21,7 +21,7 @@
 
 #include "exchange/secomb.hpp"
 #include "tests/shared_networks.hpp"
-#include "solver/steady_flow.hpp"
+#include "steady/steady_flow.hpp"
 
 using namespace hemotree;
 namespace fs = std::filesystem;

@@ -20,8 +20,8 @@
 #include "exchange/foreign_format.hpp"
 #include "exchange/secomb.hpp"
 #include "solver/cycle_statistics.hpp"
-#include "solver/pulse_solver.hpp"
-#include "solver/steady_flow.hpp"
+#include "pulse/pulse_solver.hpp"
+#include "steady/steady_flow.hpp"
 #include "tests/network_builders.hpp"
 #include "tests/shared_networks.hpp"
 

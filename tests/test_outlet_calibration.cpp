@@ -10,7 +10,7 @@
 #include "physics/wall_law.hpp"
 #include "pruner/outlet_calibration.hpp"
 #include "pruner/pruning_strategies.hpp"
-#include "solver/steady_flow.hpp"
+#include "steady/steady_flow.hpp"
 
 using namespace hemotree;
 

@@ -1,4 +1,4 @@
-// Verification of the spectral/hp DG solver of pulsatile flow (solver/pulse_solver.hpp)
+// Verification of the spectral/hp DG solver of pulsatile flow (pulse/pulse_solver.hpp)
 // against exact solutions of the 1D model it discretizes: spectral convergence in p on a
 // smooth travelling pulse, the steady flow of a viscous compliant tube, the wave speed and
 // the non-reflecting outlet of the Boileau et al. (2015) single-pulse test, mass
@@ -28,11 +28,11 @@
 #endif
 
 #include "core/errors.hpp"
-#include "solver/legendre_basis.hpp"
-#include "solver/pulse_solver.hpp"
-#include "solver/solution_breakdown.hpp"
-#include "solver/stability_limit.hpp"
-#include "solver/vessel_equations.hpp"
+#include "pulse/legendre_basis.hpp"
+#include "pulse/pulse_solver.hpp"
+#include "pulse/solution_breakdown.hpp"
+#include "pulse/stability_limit.hpp"
+#include "physics/vessel_law.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;
@@ -879,7 +879,7 @@ TEST(PulseSolverVerification, DefaultStepIsStableForEveryDegree) {
       o.elements = elements;
       const double courant = PulseSolver(net, o).dt() * c0 / (length / elements);  // dt c / h
       double growth = 0;
-      // The spectrum and amplification of solver/stability_limit, themselves checked
+      // The spectrum and amplification of pulse/stability_limit, themselves checked
       // against closed forms and published limits in test_stability_limit.cpp.
       const TimeScheme waves = scheme == TimeScheme::runge_kutta4 ? scheme : TimeScheme::adams_bashforth2;
       for (const auto lambda : dg_advection_spectrum(p))

@@ -1,4 +1,4 @@
-// The Riemann problems of the 1D model (solver/riemann.hpp) on their own: the upwind flux
+// The Riemann problems of the 1D model (pulse/riemann.hpp) on their own: the upwind flux
 // between elements, the prescribed inflow, the resistance and reflection outlets and the
 // junctions, each against the equations it claims to solve, on many random states.
 #include <array>
@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "solver/riemann.hpp"
-#include "solver/vessel_equations.hpp"
+#include "pulse/riemann.hpp"
+#include "physics/vessel_law.hpp"
 
 using namespace hemotree;
 

@@ -1,12 +1,12 @@
-// The Courant limits of the DG operator under each time scheme (solver/stability_limit) and
-// the automatic degree per vessel built on them (solver/degree_choice).
+// The Courant limits of the DG operator under each time scheme (pulse/stability_limit) and
+// the automatic degree per vessel built on them (pulse/degree_choice).
 #include <cmath>
 #include <numbers>
 
 #include <gtest/gtest.h>
 
-#include "solver/degree_choice.hpp"
-#include "solver/stability_limit.hpp"
+#include "pulse/degree_choice.hpp"
+#include "pulse/stability_limit.hpp"
 
 using namespace hemotree;
 

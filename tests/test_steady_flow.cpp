@@ -11,8 +11,8 @@
 #include "formats/network_io.hpp"
 #include "formats/pressure_reference.hpp"
 #include "physics/rheology.hpp"
-#include "solver/loaded_tree.hpp"
-#include "solver/steady_flow.hpp"
+#include "steady/loaded_tree.hpp"
+#include "steady/steady_flow.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;

@@ -1,4 +1,4 @@
-// The steady red-cell distribution (solver/steady_hematocrit.hpp): hematocrits from given
+// The steady red-cell distribution (steady/steady_hematocrit.hpp): hematocrits from given
 // flows against the laws applied by hand, red-cell conservation at every node of a looped
 // network fed at several hematocrits, symmetry, and the coupled flow-hematocrit iteration
 // checked for self-consistency (its flows solve Kirchhoff's laws with the viscosities of its
@@ -22,7 +22,7 @@
 #include "network_builders.hpp"
 #include "physics/phase_separation.hpp"
 #include "physics/rheology.hpp"
-#include "solver/steady_hematocrit.hpp"
+#include "steady/steady_hematocrit.hpp"
 
 using namespace hemotree;
 using test_networks::flow_boundary;

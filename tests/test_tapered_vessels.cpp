@@ -1,7 +1,7 @@
 // Tapered vessels (Network::distal_diameter) in the 1D and 0D models.
 //
 // The 1D model of a tapered vessel carries the taper's source terms in its momentum equation
-// (solver/vessel_equations.hpp, docs/solver.md §1a). Checks, each against an independent
+// (physics/vessel_law.hpp, docs/solver.md §1a). Checks, each against an independent
 // calculation:
 // (a) the rest state (Q = 0, A = pi D(x)^2 / 4, one pressure all along) stays at rest to
 //     round-off, in a lone vessel and across a junction, for a given beta, thin and thick walls;
@@ -28,11 +28,11 @@
 #include "physics/poiseuille.hpp"
 #include "physics/rheology.hpp"
 #include "physics/wall_law.hpp"
-#include "solver/legendre_basis.hpp"
-#include "solver/lumped_vessels.hpp"
+#include "pulse/legendre_basis.hpp"
+#include "pulse/lumped_vessels.hpp"
 #include "solver/probes.hpp"
-#include "solver/pulse_solver.hpp"
-#include "solver/vessel_equations.hpp"
+#include "pulse/pulse_solver.hpp"
+#include "physics/vessel_law.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;

@@ -15,7 +15,7 @@
 #include "generator/growth_rules.hpp"
 #include "generator/tree_growth.hpp"
 #include "generator/venous_mirror.hpp"
-#include "solver/steady_flow.hpp"
+#include "steady/steady_flow.hpp"
 
 using namespace hemotree;
 

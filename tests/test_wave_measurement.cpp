@@ -10,7 +10,7 @@
 
 #include "physics/womersley.hpp"
 #include "solver/cycle_statistics.hpp"
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;

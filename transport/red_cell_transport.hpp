@@ -16,7 +16,7 @@
 // Phase separation is applied at a node cell with no boundary where this step's flow enters
 // through one vessel and leaves through two (the law's own case, with the feed's hematocrit
 // of the step before); blood is mixed by flux everywhere else, and at a node of more than
-// three vessels too (NetFlow's dishem.cpp rule; solver/steady_hematocrit.hpp does the same).
+// three vessels too (NetFlow's dishem.cpp rule; steady/steady_hematocrit.hpp does the same).
 #pragma once
 
 #include <cstdint>

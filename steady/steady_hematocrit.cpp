@@ -1,4 +1,4 @@
-#include "solver/steady_hematocrit.hpp"
+#include "steady/steady_hematocrit.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "physics/poiseuille.hpp"
-#include "solver/loaded_tree.hpp"
-#include "solver/pulse_solver.hpp"
+#include "steady/loaded_tree.hpp"
+#include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
 

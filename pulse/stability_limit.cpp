@@ -1,4 +1,4 @@
-#include "solver/stability_limit.hpp"
+#include "pulse/stability_limit.hpp"
 
 #include <algorithm>
 #include <map>
@@ -8,7 +8,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "solver/legendre_basis.hpp"
+#include "pulse/legendre_basis.hpp"
 
 namespace hemotree {
 

@@ -40,8 +40,8 @@
 #include "formats/network.hpp"
 #include "network_flow/nodal_system.hpp"
 #include "physics/viscosity_table.hpp"
-#include "solver/checkpoint.hpp"
-#include "solver/vessel_equations.hpp"
+#include "formats/checkpoint_file.hpp"
+#include "physics/vessel_law.hpp"
 
 namespace hemotree {
 
@@ -71,7 +71,7 @@ class LumpedVessels {
   // Its node for a network node, or -1 where no 0D vessel ends.
   std::int32_t node_of(std::int64_t network_node) const { return node_of_[static_cast<std::size_t>(network_node)]; }
   // The boundary flows and pressures at its nodes, by their places in run_boundaries(net)
-  // (solver/network_boundaries.hpp): predict() takes their values in these orders.
+  // (pulse/network_boundaries.hpp): predict() takes their values in these orders.
   const std::vector<std::int32_t>& inflow_boundaries() const { return inflow_boundary_; }
   const std::vector<std::int32_t>& held_boundaries() const { return held_boundary_; }
   // Per boundary of run_boundaries: whether its flow counts as "in" (else "out") in
@@ -103,7 +103,7 @@ class LumpedVessels {
   void predict(double dt, std::span<const double> coupled_inflow, double inlet_flow);
   // The pressure of a node at a fraction s in [0, 1] of the step being taken (linear
   // between the start and the prediction), and its impedance: a coupled end whose inflow
-  // departs from the predicted by dQ sees p + s Z dQ (solver/pulse_solver.cpp).
+  // departs from the predicted by dQ sees p + s Z dQ (pulse/pulse_solver.cpp).
   double pressure_during_step(std::int32_t node, double s) const {
     const auto i = static_cast<std::size_t>(node);
     return pressure_[i] + s * (predicted_[i] - pressure_[i]);

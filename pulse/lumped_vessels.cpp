@@ -1,4 +1,4 @@
-#include "solver/lumped_vessels.hpp"
+#include "pulse/lumped_vessels.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,8 +10,8 @@
 #include "core/errors.hpp"
 #include "core/parallel_errors.hpp"
 #include "physics/poiseuille.hpp"
-#include "solver/network_boundaries.hpp"
-#include "solver/solution_breakdown.hpp"
+#include "pulse/network_boundaries.hpp"
+#include "pulse/solution_breakdown.hpp"
 
 namespace hemotree {
 
@@ -55,7 +55,7 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
   shunt_pressure_.assign(network_nodes_, 0.0);
   volume_b_.assign(network_nodes_, 0.0);
 
-  // Boundary conditions at nodes of 0D vessels (solver/network_boundaries.hpp's order):
+  // Boundary conditions at nodes of 0D vessels (pulse/network_boundaries.hpp's order):
   // outlets are shunts, or R1 to a capacitor node with R2 and C; flows are currents into
   // their nodes; a pressure holds its node through a shunt far stiffer than the node's
   // vessel (predict() sizes it), a Dirichlet condition to 1e-10 of the vessel's drop.

@@ -7,7 +7,7 @@
 #include <complex>
 #include <vector>
 
-#include "solver/time_scheme.hpp"
+#include "pulse/time_scheme.hpp"
 
 namespace hemotree {
 

@@ -1,4 +1,4 @@
-#include "solver/steady_flow.hpp"
+#include "steady/steady_flow.hpp"
 
 #include <algorithm>
 #include <limits>

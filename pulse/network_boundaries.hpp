@@ -5,7 +5,7 @@
 //
 // Boundary conditions sit at nodes where exactly one vessel ends, at either of its ends: the
 // 1D equations are symmetric under x -> -x, Q -> -Q, so a condition written for one end
-// (solver/riemann.hpp) acts at the other on the mirrored trace (A, -Q), its flow negated.
+// (pulse/riemann.hpp) acts at the other on the mirrored trace (A, -Q), its flow negated.
 #pragma once
 
 #include <cstdint>
@@ -13,23 +13,10 @@
 #include <vector>
 
 #include "formats/network.hpp"
-#include "solver/riemann.hpp"
-#include "solver/vessel_equations.hpp"
+#include "pulse/riemann.hpp"
+#include "physics/vessel_law.hpp"
 
 namespace hemotree {
-
-// The network's boundary conditions as the pulsatile run takes them, in one fixed order: the
-// tree form's outlets (in net.outlets' order), its inlet, then net.boundaries. "Outlet k"
-// everywhere in the run (capacitors, TreeLoads) is the k-th outlet of this list: for a tree,
-// net.outlets[k]. Throws InputError where node_boundaries does (two at one node).
-std::vector<NodeBoundary> run_boundaries(const Network& net);
-// The outlets of run_boundaries, in its order.
-std::vector<Outlet> run_outlets(const std::vector<NodeBoundary>& boundaries);
-
-// The waveform that sets the run's period and pulse: the tree form's inlet, else the first
-// time-varying flow or pressure of run_boundaries, else a constant of period 1 s. Throws
-// InputError (naming both nodes) where two time-varying boundaries have different periods.
-Waveform driving_waveform(const Network& net);
 
 // One end of a vessel: its distal end (the `to` node, right trace of its last element) or
 // its proximal end (`from` node, left trace of its first element).
@@ -83,7 +70,7 @@ struct NetworkBoundaries {
 
 // Vessel v's elements are first_element[v] .. first_element[v] + elements_per_vessel - 1;
 // zero_d[v]: vessel v is 0D (no elements: its ends, and boundaries there, belong to
-// solver/lumped_vessels).
+// pulse/lumped_vessels).
 NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::int32_t>& first_element,
                                    int elements_per_vessel, const std::vector<bool>& zero_d);
 

@@ -4,7 +4,7 @@
 // characteristics, second-order Adams-Bashforth (or classical Runge-Kutta) in time.
 // The state of all elements lives in flat matrices (one row per element), and each stage
 // of the right-hand side acts on all of them at once.
-// Vessels far shorter than the pulse's wavelength may be 0D instead (solver/lumped_vessels,
+// Vessels far shorter than the pulse's wavelength may be 0D instead (pulse/lumped_vessels,
 // implicit): then a step is one 0D step with several explicit 1D substeps inside it.
 #pragma once
 
@@ -17,14 +17,14 @@
 
 #include "formats/network.hpp"
 #include "physics/viscosity_table.hpp"
-#include "solver/degree_choice.hpp"
-#include "solver/legendre_basis.hpp"
-#include "solver/lumped_vessels.hpp"
-#include "solver/network_boundaries.hpp"
-#include "solver/checkpoint.hpp"
-#include "solver/steady_flow.hpp"
-#include "solver/time_scheme.hpp"
-#include "solver/vessel_equations.hpp"
+#include "pulse/degree_choice.hpp"
+#include "pulse/legendre_basis.hpp"
+#include "pulse/lumped_vessels.hpp"
+#include "pulse/network_boundaries.hpp"
+#include "formats/checkpoint_file.hpp"
+#include "steady/steady_flow.hpp"
+#include "pulse/time_scheme.hpp"
+#include "physics/vessel_law.hpp"
 
 namespace hemotree {
 
@@ -127,7 +127,7 @@ class PulseSolver {
   void sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
                   std::vector<double>* pressure = nullptr, bool zero_d = true) const;
   const LumpedVessels& lumped() const { return lumped_; }
-  // The run's boundary conditions (solver/network_boundaries.hpp: run_boundaries), and per
+  // The run's boundary conditions (pulse/network_boundaries.hpp: run_boundaries), and per
   // boundary whether its flow counts as "in"; the period of its waveforms.
   const std::vector<NodeBoundary>& boundary_list() const { return boundaries_.list; }
   const std::vector<unsigned char>& boundary_entering() const { return boundaries_.entering; }

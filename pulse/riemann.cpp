@@ -1,4 +1,4 @@
-#include "solver/riemann.hpp"
+#include "pulse/riemann.hpp"
 
 #include <array>
 #include <cmath>

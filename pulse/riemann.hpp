@@ -12,7 +12,7 @@
 
 #include <span>
 
-#include "solver/vessel_equations.hpp"
+#include "physics/vessel_law.hpp"
 
 namespace hemotree {
 
@@ -36,7 +36,7 @@ EndState inflow_state(const VesselLaw& law, double a, double q, double q_in);
 // (An RCR outlet is this with R = R1 and p_beyond the capacitor pressure.)
 EndState resistance_state(const VesselLaw& law, double a, double q, double r, double p_beyond);
 
-// An end at a node of 0D vessels (solver/lumped_vessels): the end's total pressure
+// An end at a node of 0D vessels (pulse/lumped_vessels): the end's total pressure
 // p(A*) + rho u*^2 / 2, as at a junction, equals the node's p_node + r Q_in (the node's total
 // pressure, where Q_in is the flow from the end into the node and r the node's response to
 // it). distal: which end.

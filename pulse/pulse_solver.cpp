@@ -1,4 +1,4 @@
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 
 #include <algorithm>
 #include <array>
@@ -15,9 +15,9 @@
 #include "formats/connected_parts.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/wall_law.hpp"
-#include "solver/solution_breakdown.hpp"
-#include "solver/stability_limit.hpp"
-#include "solver/steady_flow.hpp"
+#include "pulse/solution_breakdown.hpp"
+#include "pulse/stability_limit.hpp"
+#include "steady/steady_flow.hpp"
 
 namespace hemotree {
 

@@ -1,10 +1,10 @@
-// PulseSolver's state written to a checkpoint and read back bit for bit (solver/checkpoint.hpp):
+// PulseSolver's state written to a checkpoint and read back bit for bit (formats/checkpoint_file.hpp):
 // what evolves (solution, multistep history, junction guesses, compliance balance marks,
 // viscosity factors, time); the rest is rebuilt from the network and the options.
 #include <string>
 #include <vector>
 
-#include "solver/pulse_solver.hpp"
+#include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
 

@@ -1,4 +1,4 @@
-#include "solver/loaded_tree.hpp"
+#include "steady/loaded_tree.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -6,8 +6,8 @@
 
 #include "core/errors.hpp"
 #include "network_flow/nodal_system.hpp"
-#include "solver/network_boundaries.hpp"
-#include "solver/steady_flow.hpp"
+#include "formats/network.hpp"
+#include "steady/steady_flow.hpp"
 
 namespace hemotree {
 

@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "physics/viscosity_table.hpp"
-#include "solver/time_scheme.hpp"
-#include "solver/vessel_equations.hpp"
+#include "pulse/time_scheme.hpp"
+#include "physics/vessel_law.hpp"
 
 namespace hemotree {
 

@@ -1,4 +1,4 @@
-#include "solver/checkpoint.hpp"
+#include "formats/checkpoint_file.hpp"
 
 #include <algorithm>
 #include <cerrno>

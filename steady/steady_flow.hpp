@@ -10,7 +10,7 @@
 
 #include "formats/network.hpp"
 #include "physics/viscosity_table.hpp"
-#include "solver/vessel_equations.hpp"
+#include "physics/vessel_law.hpp"
 
 namespace hemotree {
 

@@ -1,4 +1,4 @@
-#include "solver/legendre_basis.hpp"
+#include "pulse/legendre_basis.hpp"
 
 #include <algorithm>
 #include <cmath>

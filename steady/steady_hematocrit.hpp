@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "formats/network.hpp"
-#include "solver/steady_flow.hpp"
+#include "steady/steady_flow.hpp"
 
 namespace hemotree {
 

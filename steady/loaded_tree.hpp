@@ -2,7 +2,7 @@
 // (Poiseuille resistances) and outlets (R to ground; RCR as R1 to a capacitor node and R2 to
 // ground, at the outlet's node), prescribed flows open (the inlet), prescribed pressures
 // held (potential 0), and at every node and every capacitor node a conductance to ground
-// and an injected current. The boundaries are solver/network_boundaries.hpp's run_boundaries.
+// and an injected current. The boundaries are pulse/network_boundaries.hpp's run_boundaries.
 // Its potentials are what the slow drift of the network's compliances towards the periodic
 // state needs (PulseSolver::balance_compliances): pressure shifts in Pa for volume rates in
 // m^3/s. Outflow pressures are zero: the tree is the network's response to disturbances.

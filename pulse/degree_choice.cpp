@@ -1,10 +1,10 @@
-#include "solver/degree_choice.hpp"
+#include "pulse/degree_choice.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "solver/stability_limit.hpp"
+#include "pulse/stability_limit.hpp"
 
 namespace hemotree {
 
