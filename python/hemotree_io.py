@@ -191,48 +191,65 @@ def _read_header(f):
 
 
 def _check_fields(path, start, count):
-    """FormatError unless every row after byte START holds COUNT fields (pandas would fill a
-    short row with NaN, and drop a first row's extra fields). Each line's commas are counted
-    with numpy, a block at a time; a file with quotes is read row by row instead."""
+    """The number of rows after byte START; FormatError unless each holds COUNT fields
+    (pandas would fill a short row with NaN, and drop a first row's extra fields). Each
+    line's commas are counted with numpy, a block at a time (about 1 s for a 440 MB file);
+    a file with quotes is read row by row instead."""
     import numpy as np
-    carry = 0  # the commas of a line that an earlier block began
+    rows = carry = 0  # carry: the commas of a line that an earlier block began
+    last = b"\n"
     with open(path, "rb") as f:
         f.seek(start)
         while True:
-            block = f.read(1 << 22)
+            block = f.read(1 << 24)
             if not block:
                 break
             if b'"' in block:
                 return _find_bad_row(path, start, count)
             text = np.frombuffer(block, dtype=np.uint8)
-            commas = np.cumsum(text == ord(","), dtype=np.int64)
+            commas = np.flatnonzero(text == ord(","))
             ends = np.flatnonzero(text == ord("\n"))
             if len(ends):
-                per_line = np.diff(commas[ends], prepend=0)
+                upto = np.searchsorted(commas, ends)  # commas before each line end
+                per_line = np.diff(upto, prepend=0)
                 per_line[0] += carry
                 if np.any(per_line != count - 1):
                     return _find_bad_row(path, start, count)
-                carry = int(commas[-1] - commas[ends[-1]])
+                carry = len(commas) - int(upto[-1])
+                rows += len(ends)
             else:
-                carry += int(commas[-1])
+                carry += len(commas)
             last = block[-1:]
-    if start < path.stat().st_size and last != b"\n" and carry != count - 1:
-        _find_bad_row(path, start, count)  # a last row without its line end
+    if last != b"\n":  # a last row without its line end
+        if carry != count - 1:
+            return _find_bad_row(path, start, count)
+        rows += 1
+    return rows
 
 
 def _find_bad_row(path, start, count):
+    """The number of rows after byte START, read by the csv module; FormatError naming the
+    first row that does not hold COUNT fields."""
+    rows = 0
     with open(path, "rb") as f:
         f.seek(start)
         for row in csv.reader(io.TextIOWrapper(f, encoding="utf-8", newline="")):
             if len(row) != count:
                 raise FormatError(f"{path}: a row of {len(row)} fields under {count} names")
+            rows += 1
+    return rows
 
 
 def _read_table(path, text_columns=(), columns=None):
     """A CSV file of a header and rows of numbers (TEXT_COLUMNS: words) as a DataFrame with
     the header's names (duplicates kept), numbers as float64 or int64, words as categories;
-    an empty file (no header) as an empty DataFrame."""
+    an empty file (no header) as an empty DataFrame.
+
+    Read by pandas in chunks into columns allocated once: at its peak the memory of the
+    table and one chunk (pandas' own whole-file read takes about four times the table)."""
     pd = _pandas()
+    import numpy as np
+    from pandas.api.types import union_categoricals
     with open(path, "rb") as f:
         names = _read_header(f)
         start = f.tell()
@@ -242,41 +259,63 @@ def _read_table(path, text_columns=(), columns=None):
             raise FormatError(f"{path}: no column {', '.join(missing)} (a hemosolve --out folder?)")
     if not names:
         return pd.DataFrame()
-    _check_fields(path, start, len(names))
+    rows = _check_fields(path, start, len(names))
     words = [k for k, n in enumerate(names) if n in text_columns]
     use = list(range(len(names))) if columns is None else [k for k, n in enumerate(names) if n in columns]
+    numbers = {}  # position -> the column's values (int64 while every one is a whole number)
+    labels = {k: [] for k in use if k in words}  # position -> its chunks' categoricals
+    done = 0
     with open(path, "rb") as f:
         f.seek(start)
+        chunks = pd.read_csv(f, header=None, names=range(len(names)), usecols=use,
+                             dtype={k: "category" for k in words}, keep_default_na=False,
+                             na_values={k: [""] for k in range(len(names)) if k not in words},
+                             float_precision="round_trip", skip_blank_lines=False,
+                             index_col=False, chunksize=1 << 16) if rows else []
         try:
-            frame = pd.read_csv(f, header=None, names=range(len(names)), usecols=use,
-                                dtype={k: "category" for k in words}, keep_default_na=False,
-                                na_values={k: [""] for k in range(len(names)) if k not in words},
-                                float_precision="round_trip", skip_blank_lines=False,
-                                index_col=False)
-        except pd.errors.EmptyDataError:  # a header without rows
-            frame = pd.DataFrame({k: pd.Series([], dtype="category" if k in words else float)
-                                  for k in use})
+            for chunk in chunks:
+                n = len(chunk)
+                for k in chunk.columns:
+                    if k in labels:
+                        labels[k].append(chunk[k].array)
+                        continue
+                    values = chunk[k].to_numpy()
+                    if values.dtype.kind not in "if":  # texts pandas does not take for numbers
+                        values = np.array([_number(x, path) for x in values], dtype=float)
+                    column = numbers.get(k)
+                    if column is None:
+                        column = numbers[k] = np.empty(rows, dtype=values.dtype)
+                    elif column.dtype.kind == "i" and values.dtype.kind != "i":
+                        column = numbers[k] = column.astype(float)  # a null or a fraction
+                    column[done:done + n] = values
+                done += n
         except pd.errors.ParserError as e:
-            _find_bad_row(path, start, len(names))
-            raise FormatError(f"{path}: {str(e).strip()}") from None
-    for k in frame.columns:
-        if frame[k].dtype == object:  # texts pandas does not take for numbers: float's verdict
-            try:
-                frame[k] = [float(x) if isinstance(x, str) else x for x in frame[k]]
-            except ValueError:
-                bad = next(x for x in frame[k] if isinstance(x, str) and not _is_number(x))
-                raise FormatError(f"{path}: {bad!r} is not a number") from None
-    frame.columns = [names[k] for k in frame.columns]
+            raise FormatError(f"{path}: {' '.join(str(e).split())}") from None
+    if done != rows:
+        raise FormatError(f"{path}: {done} rows read of {rows}")
+    data = {}
+    for k in use:
+        if k in labels:
+            data[k] = union_categoricals(labels[k]) if labels[k] else pd.Categorical([])
+        else:
+            data[k] = numbers.get(k, np.empty(0))
+    frame = pd.DataFrame(data, copy=False)
+    frame.columns = [names[k] for k in use]
     frame.attrs["path"] = str(path)
     return frame
 
 
-def _is_number(text):
+def _number(x, path):
+    """float's verdict on a field pandas did not read as a number (NaN stays NaN; pandas
+    reads True and False as booleans, which are not numbers either)."""
+    if not isinstance(x, str):
+        if isinstance(x, float):
+            return x
+        raise FormatError(f"{path}: {str(x)!r} is not a number")
     try:
-        float(text)
+        return float(x)
     except ValueError:
-        return False
-    return True
+        raise FormatError(f"{path}: {x!r} is not a number") from None
 
 
 def read_vessels(path, columns=None):
