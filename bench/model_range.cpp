@@ -13,6 +13,7 @@
 #include <numbers>
 #include <vector>
 
+#include "physics/poiseuille.hpp"
 #include "pulse/pulse_solver.hpp"
 
 using namespace hemotree;

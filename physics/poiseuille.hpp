@@ -7,9 +7,15 @@
 
 namespace hemotree {
 
+// The friction coefficient k = 2 pi alpha/(alpha - 1) of the velocity profile whose
+// momentum-flux factor is alpha: the 1D friction is -k mu Q / A per unit length (8 pi mu u for
+// the parabolic profile, alpha = 4/3), and the steady resistance k mu l / A^2 below.
+inline double friction_coefficient(double alpha) { return 2 * std::numbers::pi * alpha / (alpha - 1); }
+
 // Friction f = -2 pi mu alpha/(alpha - 1) u per unit length gives, in steady flow,
 // dp/dx = -2 pi mu alpha/(alpha - 1) Q / A^2, so R = 2 pi mu alpha/(alpha - 1) l / A^2;
-// alpha = 4/3 (Poiseuille) gives R = 128 mu l / (pi D^4).
+// alpha = 4/3 (Poiseuille) gives R = 128 mu l / (pi D^4). (k mu l / A^2 written out, in the
+// order of operations whose bits the steady runs and vprune's outlets were recorded with.)
 inline double poiseuille_resistance(double viscosity, double length, double diameter,
                                     double alpha) {
   const double area = std::numbers::pi / 4 * diameter * diameter;
@@ -23,7 +29,7 @@ inline double poiseuille_resistance(double viscosity, double length, double diam
 // d0 = d1 gives poiseuille_resistance.
 inline double tapered_poiseuille_resistance(double viscosity, double length, double d0, double d1, double alpha) {
   constexpr double pi = std::numbers::pi;
-  const double k = 2 * pi * alpha / (alpha - 1);
+  const double k = friction_coefficient(alpha);
   return k * viscosity * 16 / (pi * pi) * length * (d0 * d0 + d0 * d1 + d1 * d1) / (3 * d0 * d0 * d0 * d1 * d1 * d1);
 }
 

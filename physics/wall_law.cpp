@@ -1,5 +1,5 @@
-// Tube laws p = p_ref + beta (sqrt(A) - sqrt(A_ref)) for thin- and thick-walled vessels,
-// after Causin et al. (2017) as given in the source paper (eqs. wall and h_undeformed).
+// The tube law's beta, p_ref and A_ref for thin- and thick-walled vessels, after Causin et
+// al. (2017) as given in the source paper (eqs. wall and h_undeformed).
 #include "physics/wall_law.hpp"
 
 #include <cmath>
@@ -42,30 +42,6 @@ void check_material(const WallProperties& wall, double external_pressure,
 }
 
 }  // namespace
-
-// --- The tube law and what follows from it --------------------------------------------------
-
-double TubeLaw::pressure(double area) const {
-  return reference_pressure + beta * (std::sqrt(area) - std::sqrt(reference_area));
-}
-
-// The exact inverse on p >= p_ref - beta sqrt(A_ref), the pressure at which the linear law
-// reaches sqrt(A) = 0. Below it the law has no root; the lumen is taken as collapsed
-// (A = 0, the continuous extension) rather than returning the square of a negative root,
-// which would be a spurious, re-opening area.
-double TubeLaw::area(double pressure) const {
-  const double root = std::sqrt(reference_area) + (pressure - reference_pressure) / beta;
-  return root > 0 ? root * root : 0.0;
-}
-
-double TubeLaw::compliance_per_length(double area) const {
-  return 2 * std::sqrt(area) / beta;
-}
-
-// c^2 = (A / rho) dp/dA with dp/dA = beta / (2 sqrt(A)).
-double TubeLaw::wave_speed(double area, double density) const {
-  return std::sqrt(beta * std::sqrt(area) / (2 * density));
-}
 
 // --- Choice of model ------------------------------------------------------------------------
 

@@ -1,24 +1,15 @@
-// The tube law p = p_ref + beta (sqrt(A) - sqrt(A_ref)) of a vessel, with beta and p_ref
-// from the thin- or thick-walled models of Causin et al. (the paper's eqs. wall and
-// h_undeformed), chosen per vessel by its wall thickness to diameter ratio.
+// The wall models that give a vessel's tube law p = p_ref + beta (sqrt(A) - sqrt(A_ref))
+// (physics/tube_law.hpp) from its wall: beta and p_ref from the thin- or thick-walled models
+// of Causin et al. (the paper's eqs. wall and h_undeformed), chosen per vessel by its wall
+// thickness to diameter ratio. The laws they return carry no blood yet (density 0): the
+// solvers that need its wave speed or fluxes set density and alpha.
 #pragma once
+
+#include "physics/tube_law.hpp"
 
 namespace hemotree {
 
 enum class WallModel { thin, thick };
-
-struct TubeLaw {
-  double beta = 0;                // [Pa/m]
-  double reference_pressure = 0;  // p_ref [Pa]
-  double reference_area = 0;      // A_ref [m^2]
-
-  double pressure(double area) const;
-  // The inverse of pressure(); 0 (collapsed lumen) below p_ref - beta sqrt(A_ref), where the
-  // linear law has no root.
-  double area(double pressure) const;
-  double compliance_per_length(double area) const;  // dA/dp = 2 sqrt(A) / beta [m^2/Pa]
-  double wave_speed(double area, double density) const;  // c = sqrt(A/rho dp/dA)
-};
 
 struct WallProperties {
   double diameter = 0;          // lumen diameter at zero transmural pressure [m]

@@ -64,9 +64,11 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
   // Compliance beyond each vessel's distal node: dV/dp = 2 l sqrt(A_ref) / beta per vessel.
   std::vector<double> compliance_beyond(n, 0.0);
   std::vector<TubeLaw> laws(n);
-  for (std::size_t v = 0; v < n; ++v)
+  for (std::size_t v = 0; v < n; ++v) {
     laws[v] = tube_law({full.diameter[v], full.wall_thickness[v], full.youngs_modulus[v]},
                        p.external_pressure, p.thick_wall_ratio);
+    laws[v].density = blood.density;
+  }
   const std::vector<std::int32_t> order = breadth_first_order(children, root);
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
     const auto v = static_cast<std::size_t>(*it);
@@ -102,7 +104,7 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
       // reflection; R1 + R2 is the removed subtree's resistance, C its compliance.
       const TubeLaw& law = laws[f];
       const double area = law.reference_area;
-      const double impedance = blood.density * law.wave_speed(area, blood.density) / area;
+      const double impedance = blood.density * law.wave_speed(area) / area;
       o.type = OutletType::rcr;
       o.r1 = std::min(impedance, beyond[f].resistance);
       o.r2 = beyond[f].resistance - o.r1;

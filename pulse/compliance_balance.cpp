@@ -56,10 +56,10 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       if (area > 0)
         resistance[v] = poiseuille_resistance(viscosity_(area), net_.length[v], std::sqrt(4 / std::numbers::pi * area), blood_.alpha);
     }
-  // Each vessel's volume and dA/dp = 2 sqrt(A) / beta at its mean area, now.
+  // Each vessel's volume and dA/dp at its mean area, now.
   const std::vector<double> volume = vessel_volumes();
   std::vector<double> area_per_pressure(n);
-  for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = 2 * std::sqrt(volume[v] / net_.length[v]) / laws_[v].beta;
+  for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = laws_[v].compliance_per_length(volume[v] / net_.length[v]);
   // A tapered vessel's dA/dp changes along it: each element's at its mean area and centre
   // (a 0D one's, the mean of its ends'), and the vessel's the mean of those.
   std::vector<double> element_area_per_pressure;
@@ -71,13 +71,13 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       if (zero_d_[v]) {
         const std::int32_t e = lumped_.vessel_index(v);
         for (const double x : {0.0, 1.0}) {
-          const VesselLaw at = law_at(v, x);
-          sum += std::sqrt(std::max(at.area(lumped_.pressure_at(e, x)), 0.0)) / at.beta;  // 2 sqrt(A) / beta, halved
+          const TubeLaw at = law_at(v, x);
+          sum += at.compliance_per_length(at.area(lumped_.pressure_at(e, x))) / 2;  // the mean of the two ends'
         }
       } else {
         for (auto el = first_element_[v]; el < end_element(v); ++el) {
           const double x = (el - first_element_[v] + 0.5) / elements_per_vessel_;
-          const double c = 2 * std::sqrt(state_.area(el, 0)) / law_at(v, x).beta;
+          const double c = law_at(v, x).compliance_per_length(state_.area(el, 0));
           element_area_per_pressure[static_cast<std::size_t>(el)] = c;
           sum += c / elements_per_vessel_;
         }

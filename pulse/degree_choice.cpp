@@ -8,7 +8,7 @@
 
 namespace hemotree {
 
-double linear_profile_error(const VesselLaw& law, const ViscosityTable& viscosity, double p_in, double p_out) {
+double linear_profile_error(const TubeLaw& law, const ViscosityTable& viscosity, double p_in, double p_out) {
   const double mean = 0.5 * (p_in + p_out);
   if (p_in == p_out || mean <= 0) return 0;
   auto gradient = [&](double p) {

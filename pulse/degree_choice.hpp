@@ -17,7 +17,7 @@
 
 #include "physics/viscosity_table.hpp"
 #include "pulse/time_scheme.hpp"
-#include "physics/vessel_law.hpp"
+#include "physics/tube_law.hpp"
 
 namespace hemotree {
 
@@ -38,7 +38,7 @@ struct DegreeRule {
 // / ((p_in + p_out) / 2) with g = mu(A) / A^2 the friction gradient per unit flow at each
 // end's area. Zero in a rigid vessel or one without flow; about 0.1 in a 5.6 um capillary
 // with a 1000 Pa drop (dA/A = 6 %, Pries viscosity).
-double linear_profile_error(const VesselLaw& law, const ViscosityTable& viscosity, double p_in, double p_out);
+double linear_profile_error(const TubeLaw& law, const ViscosityTable& viscosity, double p_in, double p_out);
 
 // element_transit: h / c per vessel (element length over wave speed) [s]; linear_error:
 // linear_profile_error per vessel, or empty where the network has no steady flow (then no

@@ -15,7 +15,7 @@
 
 namespace hemotree {
 
-LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws, const ViscosityTable& viscosity,
+LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                              const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of,
                              std::span<const VesselTaper> tapers)
     : density_(blood.density), friction_k_(friction_coefficient(blood.alpha)), viscosity_(&viscosity) {
@@ -37,10 +37,10 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
     vessel_ids_.push_back(net.id[v]);
     a_.push_back(node(net.from[v]));
     b_.push_back(node(net.to[v]));
-    const VesselLaw& law = laws[v];
+    const TubeLaw& law = laws[v];
     edge_length_.push_back(net.length[v]);
-    edge_root_slope_.push_back(1 / law.beta);
-    edge_root_intercept_.push_back(std::sqrt(law.reference_area) - law.reference_pressure / law.beta);
+    edge_root_slope_.push_back(law.lumen_root_slope());
+    edge_root_intercept_.push_back(law.lumen_root_intercept());
     if (!taper_of.empty() && taper_of[v] >= 0) {
       if (taper_edge_.empty()) taper_edge_.assign(n, -1);  // sized for every vessel; shrunk below
       taper_edge_[vessels_.size() - 1] = static_cast<std::int32_t>(tapered_.size());
@@ -90,7 +90,7 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const VesselLaw> laws
       held_node_.push_back(static_cast<std::int32_t>(at));
       held_boundary_.push_back(boundary);
       held_entering_.push_back(1);
-      const VesselLaw& law = laws[v];
+      const TubeLaw& law = laws[v];
       held_reference_conductance_.push_back(law.reference_area * law.reference_area /
                                             (friction_k_ * viscosity(law.reference_area) * net.length[v]));
       shunt_pressure_[at] = bc.waveform.mean_value();
@@ -183,9 +183,9 @@ LumpedVessels::TaperedEdge LumpedVessels::describe_taper(const VesselTaper& tape
   TaperedEdge t;
   t.taper = taper;
   auto root = [&](double x, double& c, double& d) {
-    const VesselLaw law = taper.at(x);
-    d = 1 / law.beta;
-    c = std::sqrt(law.reference_area) - law.reference_pressure * d;
+    const TubeLaw law = taper.at(x);
+    d = law.lumen_root_slope();
+    c = law.lumen_root_intercept();
   };
   for (std::size_t i = 0; i < taper_rule_nodes.size(); ++i) {
     double c, d;
@@ -389,13 +389,13 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
   update_dynamic_pressures();
 }
 
-void LumpedVessels::start_at_rest(std::span<const VesselLaw> laws) {
+void LumpedVessels::start_at_rest(std::span<const TubeLaw> laws) {
   if (empty()) return;
   // Each node at the mean reference pressure of its vessels, no flow; capacitors at p_out.
   std::vector<double> sum(network_nodes_, 0.0), count(network_nodes_, 0.0);
   for (std::size_t e = 0; e < vessels_.size(); ++e)
     for (const std::int32_t k : {a_[e], b_[e]}) {
-      const VesselLaw& law = laws[static_cast<std::size_t>(vessels_[e])];
+      const TubeLaw& law = laws[static_cast<std::size_t>(vessels_[e])];
       // A tapered vessel rests at its measured lumen (vessel_equations.hpp), at that pressure.
       sum[static_cast<std::size_t>(k)] += tapered(e) ? law.pressure(tapered_[static_cast<std::size_t>(taper_edge_[e])].taper.rest_area(0))
                                                      : law.reference_pressure;

@@ -41,7 +41,7 @@
 #include "network_flow/nodal_system.hpp"
 #include "physics/viscosity_table.hpp"
 #include "formats/checkpoint_file.hpp"
-#include "physics/vessel_law.hpp"
+#include "physics/vessel_taper.hpp"
 
 namespace hemotree {
 
@@ -54,7 +54,7 @@ class LumpedVessels {
   // vessel (docs/solver.md §10) holds int A(p, x) dx, still a quadratic in p; its resistance
   // is int k mu(A) / A^2 dx along the rigid taper's pressure profile, its inertance
   // rho int dx / A.
-  LumpedVessels(const Network& net, std::span<const VesselLaw> laws, const ViscosityTable& viscosity,
+  LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                 const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of = {},
                 std::span<const VesselTaper> tapers = {});
   // Solves a step takes (1: the extrapolated linearisation alone), and the threads of its
@@ -82,7 +82,7 @@ class LumpedVessels {
   // solution; rest: reference pressures), vessels at the given flows; capacitors at
   // p - R1 Q of their vessel's end (R1 edges and outlets follow from the pressures).
   void start(const std::vector<double>& network_node_pressure, const std::vector<double>& vessel_flow);
-  void start_at_rest(std::span<const VesselLaw> laws);
+  void start_at_rest(std::span<const TubeLaw> laws);
 
   // The nodes where 1D vessel ends meet 0D vessels (each once).
   void set_coupling_nodes(std::vector<std::int32_t> nodes);
@@ -212,8 +212,7 @@ class LumpedVessels {
   // The same at fraction x along it (a tapered vessel's law changes along it).
   double lumen_root(std::size_t e, double p, double x) const {
     if (taper_edge_.empty() || taper_edge_[e] < 0) return lumen_root(e, p);
-    const VesselLaw law = tapered_[static_cast<std::size_t>(taper_edge_[e])].taper.at(x);
-    return std::sqrt(law.reference_area) + (p - law.reference_pressure) / law.beta;
+    return tapered_[static_cast<std::size_t>(taper_edge_[e])].taper.at(x).lumen_root(p);
   }
   // A tapered 0D vessel: its law along it, its volume V(p) = a p^2 + b p + c at a uniform p,
   // and at the rule's points u_i of the rigid taper's resistance (physics/poiseuille.hpp)

@@ -14,7 +14,6 @@
 
 #include "formats/network.hpp"
 #include "pulse/riemann.hpp"
-#include "physics/vessel_law.hpp"
 
 namespace hemotree {
 

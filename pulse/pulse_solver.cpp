@@ -243,7 +243,7 @@ void PulseSolver::choose_models(const SolverOptions& options) {
     const VesselLaw& law = laws_[v];
     const double area = law.reference_area, length = net_.length[v];
     double transit = length / law.wave_speed(area);
-    double compliance = length * 2 * std::sqrt(area) / law.beta;
+    double compliance = law.compliance(length, area);
     double resistance = friction_k_ * viscosity_(area) * length / (area * area);
     if (is_tapered(v)) {
       // The same integrals along the vessel: int dx / c, int dA/dp dx, int k mu / A^2 dx.
@@ -253,7 +253,7 @@ void PulseSolver::choose_models(const SolverOptions& options) {
         const VesselLaw at = taper.at(taper_rule_nodes[i]);
         const double a = taper.rest_area(taper_rule_nodes[i]);
         transit += taper_rule_weights[i] * length / at.wave_speed(a);
-        compliance += taper_rule_weights[i] * length * 2 * std::sqrt(a) / at.beta;
+        compliance += at.compliance(taper_rule_weights[i] * length, a);
       }
       resistance = tapered_poiseuille_resistance(
           [&](double d) { return viscosity_(std::numbers::pi / 4 * d * d); }, length, taper.d0, taper.d1, blood_.alpha);
@@ -433,7 +433,7 @@ void PulseSolver::compute_rest_correction() {
     const auto r = static_cast<Eigen::Index>(row);
     for (Eigen::Index q = 0; q < basis.points; ++q) {
       const double root = std::sqrt(a_q(q));
-      flux(q) = taper_beta_(r, q) * a_q(q) * root / (3 * rho);
+      flux(q) = TubeLaw::pressure_flux(taper_beta_(r, q) / (3 * rho), a_q(q));  // as evaluate's
       source(q) = a_q(q) * (taper_g1_(r, q) * root + taper_g0_(r, q));
     }
     const int k = el - first_element_[v];
@@ -730,8 +730,8 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
 
   // Volume term: (F(U), dphi/dx) for both equations.
   flux_q.array() = alpha * flow_q.array().square() / area_q.array() +
-                   (element_beta_.segment(first, count).array() / (3 * rho)).replicate(1, area_q.cols()) *
-                       area_q.array() * area_q.array().sqrt();
+                   TubeLaw::pressure_flux(
+                       (element_beta_.segment(first, count).array() / (3 * rho)).replicate(1, area_q.cols()), area_q.array());
   // Tapered elements: beta varies between the points.
   const auto tapered_begin = std::lower_bound(tapered_elements_.begin(), tapered_elements_.end(), first);
   const auto tapered_end = std::lower_bound(tapered_begin, tapered_elements_.end(), first + count);
@@ -739,7 +739,7 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
     const Eigen::Index el = *it - first, row = it - tapered_elements_.begin();
     for (Eigen::Index q = 0; q < points; ++q) {
       const double a = area_q(el, q), u = flow_q(el, q);
-      flux_q(el, q) = alpha * u * u / a + taper_beta_(row, q) / (3 * rho) * a * std::sqrt(a);
+      flux_q(el, q) = alpha * u * u / a + TubeLaw::pressure_flux(taper_beta_(row, q) / (3 * rho), a);
     }
   }
   rate.area.block(first, 0, count, modes).noalias() = flow_q.lazyProduct(basis.weak_derivative.transpose());

@@ -24,7 +24,7 @@
 #include "formats/checkpoint_file.hpp"
 #include "steady/steady_flow.hpp"
 #include "pulse/time_scheme.hpp"
-#include "physics/vessel_law.hpp"
+#include "physics/vessel_taper.hpp"
 
 namespace hemotree {
 

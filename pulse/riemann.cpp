@@ -8,7 +8,7 @@
 
 namespace hemotree {
 
-void upwind_flux(const VesselLaw& law, double a_l, double q_l, double a_r, double q_r,
+void upwind_flux(const TubeLaw& law, double a_l, double q_l, double a_r, double q_r,
                  double& flux_area, double& flux_flow) {
   const double a = 0.5 * (a_l + a_r), q = 0.5 * (q_l + q_r);
   const double u = q / a, c = law.wave_speed(a);
@@ -26,22 +26,22 @@ void upwind_flux(const VesselLaw& law, double a_l, double q_l, double a_r, doubl
               0.5 * (abs21 * da + abs22 * dq);
 }
 
-double incoming_speed(const VesselLaw& law, double a, double q, bool distal) {
+double incoming_speed(const TubeLaw& law, double a, double q, bool distal) {
   return distal ? law.lambda_backward(a, q) : law.lambda_forward(a, q);
 }
 
-EndState inflow_state(const VesselLaw& law, double a, double q, double q_in) {
+EndState inflow_state(const TubeLaw& law, double a, double q, double q_in) {
   return {a + (q_in - q) / incoming_speed(law, a, q, false), q_in};
 }
 
-EndState resistance_state(const VesselLaw& law, double a, double q, double r, double p_beyond) {
+EndState resistance_state(const TubeLaw& law, double a, double q, double r, double p_beyond) {
   // Q* = q + mu (A* - a); solve g(A*) = p(A*) - r Q*(A*) - p_beyond = 0 by Newton.
   const double mu = incoming_speed(law, a, q, true);
   double x = a;
   for (int it = 0; it < 50; ++it) {
     const double qs = q + mu * (x - a);
     const double g = law.pressure(x) - r * qs - p_beyond;
-    const double dg = law.beta / (2 * std::sqrt(x)) - r * mu;
+    const double dg = law.pressure_slope(x) - r * mu;
     const double step = g / dg;
     x -= step;
     if (x <= 0) x = 0.5 * (x + step);  // stay in the physical range
@@ -50,14 +50,14 @@ EndState resistance_state(const VesselLaw& law, double a, double q, double r, do
   return {x, q + mu * (x - a)};
 }
 
-EndState pressure_state(const VesselLaw& law, double a, double q, double p_node, bool distal, double r) {
+EndState pressure_state(const TubeLaw& law, double a, double q, double p_node, bool distal, double r) {
   // Q* = q + mu (A* - a); solve p(A*) + rho (Q*/A*)^2 / 2 - r Q_in = p_node by Newton, as at a junction.
   const double mu = incoming_speed(law, a, q, distal), sign = distal ? 1.0 : -1.0;
   double x = a;
   for (int it = 0; it < 50; ++it) {
     const double qs = q + mu * (x - a), u = qs / x;
-    const double g = law.pressure(x) + 0.5 * law.density * u * u - r * sign * qs - p_node;
-    const double dg = law.beta / (2 * std::sqrt(x)) + law.density * u * (mu - u) / x - r * sign * mu;
+    const double g = law.total_pressure(x, qs) - r * sign * qs - p_node;
+    const double dg = law.pressure_slope(x) + law.density * u * (mu - u) / x - r * sign * mu;
     const double step = g / dg;
     x -= step;
     if (x <= 0) x = 0.5 * (x + step);  // stay in the physical range
@@ -66,7 +66,7 @@ EndState pressure_state(const VesselLaw& law, double a, double q, double p_node,
   return {x, q + mu * (x - a)};
 }
 
-EndState reflection_state(const VesselLaw& law, double a, double q, double a0, double q0, double rt) {
+EndState reflection_state(const TubeLaw& law, double a, double q, double a0, double q0, double rt) {
   // Outgoing: Q* - q = mu_in (A* - a) (linearised at the trace).
   // Incoming, measured from rest: w_in = -rt w_out with w_k = l_k(U0) . (U* - U0),
   // l_out(U0) = (-lambda_in0, 1), l_in(U0) = (-lambda_out0, 1).
@@ -82,7 +82,7 @@ EndState reflection_state(const VesselLaw& law, double a, double q, double a0, d
   return {a0 + d(0), q0 + d(1)};
 }
 
-bool junction_state(std::span<const VesselLaw* const> laws, std::span<const double> a,
+bool junction_state(std::span<const TubeLaw* const> laws, std::span<const double> a,
                     std::span<const double> q, std::span<const int> sign,
                     std::span<EndState> out) {
   const std::size_t n = laws.size();
@@ -106,12 +106,12 @@ bool junction_state(std::span<const VesselLaw* const> laws, std::span<const doub
     // is an arrowhead (row 0 full, then a diagonal and column 0): eliminated in O(n).
     double pt0 = 0, mass = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      // The tube law written out: one square root per end and iteration.
-      const VesselLaw& law = *laws[i];
+      // The tube law in sqrt(A): one square root per end and iteration.
+      const TubeLaw& law = *laws[i];
       const double qs = q[i] + mu[i] * (x[i] - a[i]);
       const double u = qs / x[i], root = std::sqrt(x[i]);
-      const double pt = law.reference_pressure + law.beta * (root - root_reference[i]) + 0.5 * law.density * u * u;
-      dpt[i] = law.beta / (2 * root) + law.density * u * (mu[i] - u) / x[i];
+      const double pt = law.pressure_of_root(root, root_reference[i]) + 0.5 * law.density * u * u;
+      dpt[i] = law.pressure_slope_of_root(root) + law.density * u * (mu[i] - u) / x[i];
       mass += sign[i] * qs;
       if (i == 0) pt0 = pt;
       f[i] = pt;

@@ -12,7 +12,7 @@
 
 #include <span>
 
-#include "physics/vessel_law.hpp"
+#include "physics/tube_law.hpp"
 
 namespace hemotree {
 
@@ -22,36 +22,36 @@ struct EndState {
 
 // Upwind flux between a left state (a_l, q_l) and a right state: the Roe-type flux
 // F* = (F_l + F_r)/2 - |H|(U_r - U_l)/2 with the Jacobian at the mean state.
-void upwind_flux(const VesselLaw& law, double a_l, double q_l, double a_r, double q_r,
+void upwind_flux(const TubeLaw& law, double a_l, double q_l, double a_r, double q_r,
                  double& flux_area, double& flux_flow);
 
 // The speed lambda_in of the characteristic entering a vessel at an end: forward speed at
 // the proximal end, backward at the distal end.
-double incoming_speed(const VesselLaw& law, double a, double q, bool distal);
+double incoming_speed(const TubeLaw& law, double a, double q, bool distal);
 
 // Prescribed inflow q_in at a vessel's proximal end.
-EndState inflow_state(const VesselLaw& law, double a, double q, double q_in);
+EndState inflow_state(const TubeLaw& law, double a, double q, double q_in);
 
 // Distal end into a resistance R to the pressure p_beyond: p(A*) - R Q* = p_beyond.
 // (An RCR outlet is this with R = R1 and p_beyond the capacitor pressure.)
-EndState resistance_state(const VesselLaw& law, double a, double q, double r, double p_beyond);
+EndState resistance_state(const TubeLaw& law, double a, double q, double r, double p_beyond);
 
 // An end at a node of 0D vessels (pulse/lumped_vessels): the end's total pressure
 // p(A*) + rho u*^2 / 2, as at a junction, equals the node's p_node + r Q_in (the node's total
 // pressure, where Q_in is the flow from the end into the node and r the node's response to
 // it). distal: which end.
-EndState pressure_state(const VesselLaw& law, double a, double q, double p_node, bool distal, double r = 0);
+EndState pressure_state(const TubeLaw& law, double a, double q, double p_node, bool distal, double r = 0);
 
 // Distal end with reflection coefficient rt of the wave leaving the vessel, measured from
 // the rest state (a0, q0): rt = 0 lets waves leave without reflection.
-EndState reflection_state(const VesselLaw& law, double a, double q, double a0, double q0, double rt);
+EndState reflection_state(const TubeLaw& law, double a, double q, double a0, double q0, double rt);
 
 // A junction of n vessel ends: traces (a, q) in, end states out; sign +1 for a vessel
 // whose distal end meets the node (its flow enters the node), -1 for a proximal end.
 // Newton on the areas: sum sign Q* = 0 and equal total pressure p + rho u^2 / 2.
 // Returns false if Newton did not converge. out's areas, where positive, are taken as the
 // first guess (the previous step's solution saves an iteration or two).
-bool junction_state(std::span<const VesselLaw* const> laws, std::span<const double> a,
+bool junction_state(std::span<const TubeLaw* const> laws, std::span<const double> a,
                     std::span<const double> q, std::span<const int> sign,
                     std::span<EndState> out);
 

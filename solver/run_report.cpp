@@ -25,7 +25,7 @@ double analysis_frequency(const Waveform& w) {
 
 WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_t v, double omega) {
   // At the vessel's middle: a tapered vessel's reference state changes along it.
-  const VesselLaw law = solver.law_at(v, 0.5);
+  const TubeLaw law = solver.law_at(v, 0.5);
   const double d = net.is_tapered(v) ? 0.5 * (net.diameter[v] + net.distal_diameter[v]) : net.diameter[v];
   WaveTheory t;
   t.pwv_elastic = law.wave_speed(law.reference_area);

@@ -331,7 +331,7 @@ SteadyFlow solve_steady_flow(const Network& net) {
   return solve_steady_flow(net, vessel_resistances(net, blood), net.inlet ? net.inlet->waveform.mean_value() : 0.0);
 }
 
-SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const VesselLaw> laws,
+SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, double inlet_flow,
                                        std::vector<double>* resistance) {
   std::vector<double> r = vessel_resistances(net, blood);

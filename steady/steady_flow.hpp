@@ -10,7 +10,7 @@
 
 #include "formats/network.hpp"
 #include "physics/viscosity_table.hpp"
-#include "physics/vessel_law.hpp"
+#include "physics/tube_law.hpp"
 
 namespace hemotree {
 
@@ -74,7 +74,7 @@ SteadyFlow solve_steady_flow(const Network& net);
 // given, receives the final ones. Throws InputError where solve_steady_flow does, or where a
 // lumen collapses.
 // blood: the run's (its rheology may differ from the file's).
-SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const VesselLaw> laws,
+SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, double inlet_flow,
                                        std::vector<double>* resistance = nullptr);
 

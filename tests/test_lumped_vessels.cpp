@@ -13,6 +13,7 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include "physics/poiseuille.hpp"
 #include "physics/viscosity_table.hpp"
 #include "pulse/lumped_vessels.hpp"
 #include "tests/network_builders.hpp"
@@ -27,7 +28,7 @@ constexpr double pi = std::numbers::pi;
 // One vessel (node 0 -> node 1) with an R outlet; the law from beta directly.
 struct OneVessel {
   Network net;
-  std::vector<VesselLaw> laws;
+  std::vector<TubeLaw> laws;
   double length = 0.01, diameter = 1e-3, beta = 0, p0 = 1e4, r_out = 0;
   double compliance = 0, resistance = 0, inertance = 0;  // of the vessel, at p0
 
@@ -40,7 +41,7 @@ struct OneVessel {
     net = chain(1, length, diameter, beta, p0, blood);
     net.outlets.push_back(resistance_outlet(0, r_out, p0));
     net.inlet = Inlet{0, Waveform{}};  // its flow is given to predict() here
-    VesselLaw law;
+    TubeLaw law;
     law.beta = beta;
     law.reference_area = area;
     law.reference_pressure = p0;
@@ -161,7 +162,7 @@ TEST(LumpedVessels, ConserveMassToRoundOff) {
   net.outlets.push_back(rcr_outlet(1, 1e8, 1e-10, 1e9, 1e3));
   net.outlets.push_back(resistance_outlet(2, 2e9, 1e3));
   net.inlet = Inlet{0, Waveform{}};
-  std::vector<VesselLaw> laws(3);
+  std::vector<TubeLaw> laws(3);
   for (std::size_t v = 0; v < 3; ++v) {
     laws[v].beta = beta;
     laws[v].reference_area = pi / 4 * net.diameter[v] * net.diameter[v];
@@ -194,7 +195,7 @@ TEST(LumpedVessels, PlaceTheInteriorPressureOnTheSteadyProfile) {
   const double beta = 2.5e4 / std::sqrt(area);  // beta sqrt(A) = 25 kPa: the drop narrows the radius 4 %
   Network net = chain(1, length, d, beta, 3000, blood);
   net.outlets.push_back(resistance_outlet(0, 1e15, 2000));
-  std::vector<VesselLaw> laws(1);
+  std::vector<TubeLaw> laws(1);
   laws[0].beta = beta;
   laws[0].reference_area = area;
   laws[0].reference_pressure = 3000;

@@ -339,7 +339,7 @@ TEST(NetworkGraphsPulsatile, RatMesenteryRunsAndMatchesItsSteadyState) {
   EXPECT_LT(std::abs(cycle.conservation_error), 1e-9);
   // Against the distended steady state (the run's start): the run holds it.
   const ViscosityTable viscosity(blood);
-  std::vector<VesselLaw> laws;
+  std::vector<TubeLaw> laws;
   for (std::size_t v = 0; v < net.vessel_count(); ++v) laws.push_back(solver.law(v));
   const SteadyFlow distended = solve_distended_steady_flow(net, blood, laws, viscosity, 0.0);
   const SteadyFlow rigid = solve_steady_flow(net, vessel_resistances(net, blood), 0.0);

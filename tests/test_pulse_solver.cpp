@@ -32,7 +32,8 @@
 #include "pulse/pulse_solver.hpp"
 #include "pulse/solution_breakdown.hpp"
 #include "pulse/stability_limit.hpp"
-#include "physics/vessel_law.hpp"
+#include "physics/poiseuille.hpp"
+#include "physics/vessel_taper.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;
@@ -169,7 +170,7 @@ namespace {
 //   dp/dx = -k mu Q / (A^2 (1 - alpha u^2/c^2)),  u = Q/A, c^2 = beta sqrt(A)/(2 rho).
 // Integrated upstream from the outlet, where the resistance gives p(L) = p_out + R Q, by RK4
 // with 20000 steps (error ~ 1e-15 relative).
-double steady_inlet_pressure(const VesselLaw& law, double length, double viscosity, double q,
+double steady_inlet_pressure(const TubeLaw& law, double length, double viscosity, double q,
                              double outlet_pressure) {
   const double k = friction_coefficient(law.alpha);
   auto slope = [&](double p) {
@@ -239,7 +240,7 @@ TEST(PulseSolverVerification, SteadyFlowInACompliantTubeMatchesTheSteadyModel) {
   net.outlets.push_back(resistance_outlet(0, r_out, p_out));
   const SteadyRun run = run_to_steady_state(net, q, 1.0, high_degree());
 
-  VesselLaw law;
+  TubeLaw law;
   law.beta = net.beta[0];
   law.reference_area = area;
   law.reference_pressure = p_out;
@@ -268,7 +269,7 @@ TEST(PulseSolverVerification, SteadyFlowThroughAnRCROutlet) {
   Network net = chain(1, length, diameter, beta_for_wave_speed(5.0, area), p_out, newtonian(viscosity));
   net.outlets.push_back(rcr_outlet(0, r1, 1e-13, r2, p_out));  // R2 C = 2 ms
   const SteadyRun run = run_to_steady_state(net, q, 1.0, high_degree());
-  VesselLaw law;
+  TubeLaw law;
   law.beta = net.beta[0];
   law.reference_area = area;
   law.reference_pressure = p_out;

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "pulse/riemann.hpp"
-#include "physics/vessel_law.hpp"
+#include "physics/tube_law.hpp"
 
 using namespace hemotree;
 
@@ -31,9 +31,9 @@ class Random {
   std::mt19937_64 engine_;
 };
 
-VesselLaw make_law(double beta, double reference_area, double reference_pressure,
+TubeLaw make_law(double beta, double reference_area, double reference_pressure,
                    double alpha = 4.0 / 3.0, double density = 1050.0) {
-  VesselLaw law;
+  TubeLaw law;
   law.beta = beta;
   law.reference_area = reference_area;
   law.reference_pressure = reference_pressure;
@@ -43,7 +43,7 @@ VesselLaw make_law(double beta, double reference_area, double reference_pressure
 }
 
 // A random vessel from capillaries to the aorta: wave speeds of about 1 to 15 m/s.
-VesselLaw random_law(Random& r) {
+TubeLaw random_law(Random& r) {
   const double diameter = std::exp(r.uniform(std::log(10e-6), std::log(3e-2)));
   const double area = 3.14159265358979323846 / 4 * diameter * diameter;
   const double c = r.uniform(1.0, 15.0);
@@ -54,7 +54,7 @@ VesselLaw random_law(Random& r) {
 }
 
 // A subsonic trace of the law: area within +-30 % of A_ref, |u| below c / 4.
-void random_trace(Random& r, const VesselLaw& law, double& a, double& q) {
+void random_trace(Random& r, const TubeLaw& law, double& a, double& q) {
   a = law.reference_area * r.uniform(0.7, 1.3);
   q = a * law.wave_speed(a) * r.uniform(-0.25, 0.25);
 }
@@ -68,7 +68,7 @@ double relative(double x, double y) { return std::abs(x - y) / std::max(std::abs
 TEST(UpwindFlux, IsConsistentWithThePhysicalFlux) {
   Random r(1);
   for (int trial = 0; trial < 1000; ++trial) {
-    const VesselLaw law = random_law(r);
+    const TubeLaw law = random_law(r);
     double a, q;
     random_trace(r, law, a, q);
     double fa, fq;
@@ -84,7 +84,7 @@ TEST(UpwindFlux, IsConsistentWithThePhysicalFlux) {
 TEST(UpwindFlux, TakesTheUpwindSideOfAWave) {
   Random r(2);
   for (int trial = 0; trial < 200; ++trial) {
-    const VesselLaw law = random_law(r);
+    const TubeLaw law = random_law(r);
     double a, q;
     random_trace(r, law, a, q);
     const double lf = law.lambda_forward(a, q), lb = law.lambda_backward(a, q);
@@ -115,7 +115,7 @@ TEST(UpwindFlux, TakesTheUpwindSideOfAWave) {
 TEST(InflowState, PrescribesTheFlowAndKeepsTheOutgoingCharacteristic) {
   Random r(3);
   for (int trial = 0; trial < 1000; ++trial) {
-    const VesselLaw law = random_law(r);
+    const TubeLaw law = random_law(r);
     double a, q;
     random_trace(r, law, a, q);
     const double q_in = a * law.wave_speed(a) * r.uniform(-0.25, 0.25);
@@ -134,7 +134,7 @@ TEST(InflowState, PrescribesTheFlowAndKeepsTheOutgoingCharacteristic) {
 TEST(ResistanceState, SolvesTheOutletLawAndKeepsTheOutgoingCharacteristic) {
   Random r(4);
   for (int trial = 0; trial < 1000; ++trial) {
-    const VesselLaw law = random_law(r);
+    const TubeLaw law = random_law(r);
     double a, q;
     random_trace(r, law, a, q);
     // Resistances from 0 (an open end at p_beyond) to 100 times the characteristic impedance.
@@ -154,7 +154,7 @@ TEST(ResistanceState, SolvesTheOutletLawAndKeepsTheOutgoingCharacteristic) {
 }
 
 TEST(ResistanceState, ZeroResistanceFixesThePressure) {
-  const VesselLaw law = make_law(4.5e6, 3.14e-4, 1e4);
+  const TubeLaw law = make_law(4.5e6, 3.14e-4, 1e4);
   const EndState u = resistance_state(law, 3.2e-4, 1e-5, 0.0, 1.2e4);
   EXPECT_NEAR(law.pressure(u.area), 1.2e4, 1e-9);
 }
@@ -162,7 +162,7 @@ TEST(ResistanceState, ZeroResistanceFixesThePressure) {
 TEST(ReflectionState, NonReflectingOutletHasNoIncomingWave) {
   Random r(5);
   for (int trial = 0; trial < 1000; ++trial) {
-    const VesselLaw law = random_law(r);
+    const TubeLaw law = random_law(r);
     double a0, q0, a, q;
     random_trace(r, law, a0, q0);  // the rest state
     random_trace(r, law, a, q);    // the trace
@@ -182,7 +182,7 @@ TEST(ReflectionState, NonReflectingOutletHasNoIncomingWave) {
 // sees the incident and the reflected wave, (1 + rt) times the incident's. rt = 1 closes the
 // end (no flow at rest), rt = -1 opens it (the rest pressure).
 TEST(ReflectionState, CoefficientReflectsThePressureWave) {
-  const VesselLaw law = make_law(4.5e6, 3.14e-4, 1e4);
+  const TubeLaw law = make_law(4.5e6, 3.14e-4, 1e4);
   const double a0 = 3.3e-4, q0 = 0;  // at rest
   const double lf = law.lambda_forward(a0, q0);
   for (double rt : {-1.0, -0.5, 0.0, 0.3, 1.0}) {
@@ -203,8 +203,8 @@ TEST(ReflectionState, CoefficientReflectsThePressureWave) {
 namespace {
 
 struct JunctionCase {
-  std::vector<VesselLaw> laws;
-  std::vector<const VesselLaw*> law_ptr;
+  std::vector<TubeLaw> laws;
+  std::vector<const TubeLaw*> law_ptr;
   std::vector<double> a, q;
   std::vector<int> sign;
   std::vector<EndState> out;
@@ -230,7 +230,7 @@ JunctionCase random_junction(Random& r, std::size_t n) {
     const double wave_speed = r.uniform(4.0, 8.0);
     const double beta = 2 * 1050.0 * wave_speed * wave_speed / std::sqrt(area);
     c.laws[i] = make_law(beta, area, pressure + r.uniform(-2e3, 2e3), r.uniform(0, 1) < 0.5 ? 4.0 / 3.0 : 1.1);
-    const VesselLaw& law = c.laws[i];
+    const TubeLaw& law = c.laws[i];
     // A trace near the law's area at the common pressure, +-10 % in area.
     c.a[i] = law.area(pressure) * r.uniform(0.9, 1.1);
     c.q[i] = c.a[i] * law.wave_speed(c.a[i]) * r.uniform(-0.1, 0.1);
@@ -276,8 +276,8 @@ TEST(JunctionState, ConservesMassAndTotalPressureOnRandomStates) {
 }
 
 TEST(JunctionState, RefusesFewerThanTwoEnds) {
-  const VesselLaw law = make_law(4.5e6, 3.14e-4, 1e4);
-  const VesselLaw* laws[] = {&law};
+  const TubeLaw law = make_law(4.5e6, 3.14e-4, 1e4);
+  const TubeLaw* laws[] = {&law};
   const double a[] = {3.3e-4}, q[] = {2e-5};
   const int sign[] = {1};
   std::array<EndState, 1> out;
@@ -286,8 +286,8 @@ TEST(JunctionState, RefusesFewerThanTwoEnds) {
 
 // Two ends of the same vessel with a continuous state: the junction changes nothing.
 TEST(JunctionState, ContinuousStateThroughTwoEqualVesselsIsUnchanged) {
-  const VesselLaw law = make_law(4.5e6, 3.14e-4, 1e4);
-  const VesselLaw* laws[] = {&law, &law};
+  const TubeLaw law = make_law(4.5e6, 3.14e-4, 1e4);
+  const TubeLaw* laws[] = {&law, &law};
   const double a[] = {3.3e-4, 3.3e-4}, q[] = {2e-5, 2e-5};
   const int sign[] = {1, -1};
   std::array<EndState, 2> out;

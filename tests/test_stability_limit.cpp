@@ -99,7 +99,7 @@ TEST(LinearProfileError, FollowsTheFrictionGradientAlongTheVessel) {
   blood.rheology = Rheology::newtonian;
   blood.newtonian_viscosity = 3.5e-3;
   const ViscosityTable mu(blood);
-  VesselLaw law;
+  TubeLaw law;
   law.reference_area = std::numbers::pi / 4 * 5.6e-6 * 5.6e-6;
   law.reference_pressure = 1333.2;
   law.density = 1050;
@@ -110,7 +110,7 @@ TEST(LinearProfileError, FollowsTheFrictionGradientAlongTheVessel) {
   EXPECT_NEAR(expected, 0.0358, 0.0005);  // dA/A = 4.5 % over the vessel
   EXPECT_NEAR(linear_profile_error(law, mu, p_out, p_in), expected, 1e-12 * expected);
   EXPECT_EQ(linear_profile_error(law, mu, p_in, p_in), 0.0);
-  VesselLaw stiffer = law;
+  TubeLaw stiffer = law;
   stiffer.beta *= 10;
   EXPECT_LT(linear_profile_error(stiffer, mu, p_in, p_out), 0.11 * expected);
 }

@@ -71,12 +71,12 @@ TEST(SteadyFlow, DistendedTubeResistsAtTheLumenOfItsMeanPressure) {
   const double a_ref = std::numbers::pi / 4 * 1e-6;
   net.beta[0] = test_networks::beta_for_wave_speed(3.0, a_ref);  // soft: c = 3 m/s
   net.outlets.push_back(resistance_outlet(0, 1e9, 1333.0));
-  VesselLaw law;
+  TubeLaw law;
   law.beta = net.beta[0];
   law.reference_area = a_ref;
   law.reference_pressure = 1333.0;
   law.density = test_networks::rho;
-  const std::vector<VesselLaw> laws{law};
+  const std::vector<TubeLaw> laws{law};
   const ViscosityTable mu(*net.blood);
   const double q = 5e-6;
   std::vector<double> r;

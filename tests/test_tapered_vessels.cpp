@@ -1,7 +1,7 @@
 // Tapered vessels (Network::distal_diameter) in the 1D and 0D models.
 //
 // The 1D model of a tapered vessel carries the taper's source terms in its momentum equation
-// (physics/vessel_law.hpp, docs/solver.md §1a). Checks, each against an independent
+// (physics/vessel_taper.hpp, docs/solver.md §1a). Checks, each against an independent
 // calculation:
 // (a) the rest state (Q = 0, A = pi D(x)^2 / 4, one pressure all along) stays at rest to
 //     round-off, in a lone vessel and across a junction, for a given beta, thin and thick walls;
@@ -32,7 +32,7 @@
 #include "pulse/lumped_vessels.hpp"
 #include "solver/probes.hpp"
 #include "pulse/pulse_solver.hpp"
-#include "physics/vessel_law.hpp"
+#include "physics/vessel_taper.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;
@@ -177,7 +177,7 @@ std::vector<double> steady_profile(const PulseSolver& s, double length, double v
   const double rho_ = s.blood().density, alpha = s.blood().alpha, k = friction_coefficient(alpha);
   auto slope = [&](double x, double p) {  // x in metres
     const double f = x / length, dx = 1e-6;
-    const VesselLaw law = s.law_at(0, f);
+    const TubeLaw law = s.law_at(0, f);
     const double a = law.area(p), a_p = 2 * std::sqrt(a) / law.beta;
     const double a_x = (s.law_at(0, f + dx / length).area(p) - s.law_at(0, f - dx / length).area(p)) / (2 * dx);
     return (-k * viscosity * q / (rho_ * a) + alpha * q * q * a_x / (a * a)) / (a / rho_ - alpha * q * q * a_p / (a * a));
@@ -404,7 +404,7 @@ TEST(TaperedVessels, LumpedTaperedVesselAgainstQuadrature) {
   taper.wall = {d0, h, e};
   taper.model = WallModel::thin;
   taper.external_pressure = p_ext;
-  const std::vector<VesselLaw> laws = {taper.at(0)};
+  const std::vector<TubeLaw> laws = {taper.at(0)};
   const ViscosityTable viscosity(blood);
   const std::vector<std::int32_t> taper_of = {0};
   const std::vector<VesselTaper> tapers = {taper};

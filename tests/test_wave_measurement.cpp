@@ -66,7 +66,7 @@ TEST(WallShearStress, SteadyPoiseuilleFlowInATube) {
   const CycleSummary s = run_cycles(net, o, 2, 2.0);
   for (std::size_t v = 0; v < 2; ++v) {
     // The lumen at the centre, from the measured mean pressure through the tube law.
-    VesselLaw law;
+    TubeLaw law;
     law.beta = net.beta[v];
     law.reference_area = a;
     law.reference_pressure = 2000.0;

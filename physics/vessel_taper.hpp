@@ -1,53 +1,22 @@
-// The 1D model of one vessel in conservative form, U = (A, Q):
+// A tapered vessel (Network::distal_diameter): the tube law along it and the source term its
+// taper adds. The 1D model of one vessel in conservative form, U = (A, Q):
 //   dA/dt + dQ/dx = 0
 //   dQ/dt + d/dx(alpha Q^2/A + beta A^(3/2) / (3 rho)) = -k mu Q / (rho A),  k = 2 pi alpha/(alpha - 1)
-// with the tube law p = p_ref + beta (sqrt(A) - sqrt(A_ref)) (beta, A_ref constant along the
-// vessel, so (A/rho) dp/dx is the x-derivative of beta A^(3/2)/(3 rho); a tapered vessel's
-// vary, and what the flux then misses is a source term: VesselTaper below). It is the paper's
-// system (eq. govEq) with Q = A u: smooth solutions are the same, and in (A, Q) the system is a
+// with the tube law p = p_ref + beta (sqrt(A) - sqrt(A_ref)) (physics/tube_law.hpp; k:
+// physics/poiseuille.hpp). Where beta and A_ref are constant along the vessel, (A/rho) dp/dx is
+// the x-derivative of beta A^(3/2)/(3 rho); a tapered vessel's vary, and what the flux then
+// misses is a source term (VesselTaper::source_coefficients). It is the paper's system (eq.
+// govEq) with Q = A u: smooth solutions are the same, and in (A, Q) the system is a
 // conservation law for any alpha, so mass is conserved exactly at every interface.
 #pragma once
 
 #include <cmath>
 #include <numbers>
 
+#include "physics/tube_law.hpp"
 #include "physics/wall_law.hpp"
 
 namespace hemotree {
-
-// What a vessel's equations need to know about it.
-struct VesselLaw {
-  double beta = 0;            // [Pa/m]
-  double reference_area = 0;  // [m^2]
-  double reference_pressure = 0;
-  double density = 0;
-  double alpha = 4.0 / 3.0;
-
-  double pressure(double a) const { return reference_pressure + beta * (std::sqrt(a) - std::sqrt(reference_area)); }
-  // The area at which the tube law gives pressure p.
-  double area(double p) const {
-    const double s = std::sqrt(reference_area) + (p - reference_pressure) / beta;
-    return s * s;
-  }
-  double wave_speed(double a) const { return std::sqrt(beta * std::sqrt(a) / (2 * density)); }
-  double flux_area(double, double q) const { return q; }
-  double flux_flow(double a, double q) const {
-    return alpha * q * q / a + beta * a * std::sqrt(a) / (3 * density);
-  }
-  // Characteristic speeds lambda = alpha u +- sqrt(c^2 + alpha (alpha - 1) u^2).
-  double lambda_forward(double a, double q) const {
-    const double u = q / a, c = wave_speed(a);
-    return alpha * u + std::sqrt(c * c + alpha * (alpha - 1) * u * u);
-  }
-  double lambda_backward(double a, double q) const {
-    const double u = q / a, c = wave_speed(a);
-    return alpha * u - std::sqrt(c * c + alpha * (alpha - 1) * u * u);
-  }
-  double total_pressure(double a, double q) const {
-    const double u = q / a;
-    return pressure(a) + 0.5 * density * u * u;
-  }
-};
 
 // A tapered vessel (Network::distal_diameter): its reference lumen diameter D(s) is linear in
 // the fraction s in [0, 1] from `from`, and so is its radius (openBF's Rp, Rd). The wall keeps
@@ -69,23 +38,19 @@ struct VesselTaper {
 
   double diameter(double s) const { return d0 + (d1 - d0) * s; }
   // The tube law at fraction s.
-  VesselLaw at(double s) const {
+  TubeLaw at(double s) const {
     const double d = diameter(s);
-    VesselLaw law;
-    law.density = density;
-    law.alpha = alpha;
+    TubeLaw law;
     if (given_beta) {
       law.beta = beta0 * (d0 / d) * (d0 / d);
       law.reference_area = std::numbers::pi / 4 * d * d;
       law.reference_pressure = reference_pressure;
-      return law;
+    } else {
+      const WallProperties w{d, wall.wall_thickness, wall.youngs_modulus};
+      law = model == WallModel::thin ? thin_wall_tube_law(w, external_pressure) : thick_wall_tube_law(w, external_pressure);
     }
-    const WallProperties w{d, wall.wall_thickness, wall.youngs_modulus};
-    const TubeLaw t = model == WallModel::thin ? thin_wall_tube_law(w, external_pressure)
-                                               : thick_wall_tube_law(w, external_pressure);
-    law.beta = t.beta;
-    law.reference_area = t.reference_area;
-    law.reference_pressure = t.reference_pressure;
+    law.density = density;
+    law.alpha = alpha;
     return law;
   }
   // The lumen at rest, where the pressure is the same all along.
@@ -101,9 +66,9 @@ struct VesselTaper {
   void source_coefficients(double s, double& g1, double& g0) const {
     constexpr double ds = 1e-3;
     auto parts = [&](double at, double& beta, double& c) {
-      const VesselLaw law = this->at(at);
+      const TubeLaw law = this->at(at);
       beta = law.beta;
-      c = law.reference_pressure - law.beta * std::sqrt(law.reference_area);
+      c = law.pressure_of_root(0, std::sqrt(law.reference_area));  // p where sqrt(A) = 0
     };
     double b[4], c[4];
     const double offsets[4] = {-2, -1, 1, 2};
@@ -116,11 +81,8 @@ struct VesselTaper {
   }
 };
 
-// The friction coefficient k = 2 pi alpha/(alpha - 1): friction -k mu Q / A per unit length
-// (8 pi mu u A / A for the parabolic profile, alpha = 4/3).
-inline double friction_coefficient(double alpha) {
-  constexpr double pi = 3.14159265358979323846;
-  return 2 * pi * alpha / (alpha - 1);
-}
+// The one law under the name the pulse solver still uses (pulse/pulse_solver.*) until its
+// split into the DG rate, stepping and sampling files lands (issue 22); then the name goes.
+using VesselLaw = TubeLaw;
 
 }  // namespace hemotree
