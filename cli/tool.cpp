@@ -1,6 +1,8 @@
 #include "cli/tool.hpp"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <new>
 #include <string>
@@ -9,8 +11,6 @@
 
 #include "core/errors.hpp"
 #include "cli/interrupt.hpp"
-#include "formats/json_pull.hpp"
-#include "formats/output_stream.hpp"
 
 namespace hemotree {
 
@@ -24,6 +24,14 @@ void say(const std::string& kind, const std::string& message) {
 
 void warn(const std::string& message) { say("warning: ", message); }
 void note(const std::string& message) { say("", message); }
+
+std::string standard_output_error() {
+  std::cout.flush();
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || std::cout.fail())
+    return errno != 0 ? std::strerror(errno) : "an earlier write failed";
+  return "";
+}
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
 

@@ -17,6 +17,11 @@ int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& b
 void warn(const std::string& message);
 void note(const std::string& message);
 
+// Flushes standard output (and std::cout) and returns "" when everything written to it
+// reached its destination, else the reason. A tool that printed to standard output outside
+// an OutputStream (help, version, a table) calls it before exiting 0.
+std::string standard_output_error();
+
 // True when stderr is a terminal: progress lines are shown only then.
 bool stderr_is_terminal();
 

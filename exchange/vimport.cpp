@@ -8,7 +8,7 @@
 
 #include "core/errors.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "exchange/graph_formats.hpp"
 #include "exchange/openbf.hpp"
 #include "exchange/secomb.hpp"

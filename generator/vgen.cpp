@@ -9,7 +9,7 @@
 #include "core/errors.hpp"
 #include "cli/progress.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/exports.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/network_io.hpp"

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "core/errors.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/topology.hpp"
 #include "physics/wall_law.hpp"
 #include "steady/steady_flow.hpp"

@@ -17,7 +17,7 @@
 #include "core/errors.hpp"
 #include "cli/interrupt.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/network_io.hpp"
 #include "formats/pressure_reference.hpp"
 #include "formats/topology.hpp"
