@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "cli/interrupt.hpp"
 
 namespace hemotree {
@@ -49,6 +50,10 @@ int checked_success(int status) {
 }  // namespace
 
 int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+  return run_tool(app, argc, argv, SettingWords{}, body);
+}
+
+int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, const std::function<int()>& body) {
   tool_name = app.get_name();
   try {
     app.parse(argc, argv);
@@ -77,6 +82,9 @@ int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& b
     return checked_success(body());
   } catch (const InterruptedExit& e) {
     return e.status;
+  } catch (const SettingError& e) {
+    say("error: ", e.in_words(words));
+    return 2;
   } catch (const InputError& e) {
     say("error: ", e.what());
     return 2;
