@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/setting_error.hpp"
 #include "formats/network_io.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "solver/run_estimate.hpp"
@@ -53,7 +54,7 @@ int main(int argc, char** argv) {
   const double period = net.inlet->waveform.period;
   std::printf("vessels %zu, elements %zu, degree %s, threads %d, dt %.3g s (%s)\n",
               net.vessel_count(), solver.element_count(), degree.c_str(), options.threads, solver.dt(),
-              solver.dt_reason().c_str());
+              in_words(solver.dt_reason()).c_str());
   std::printf("median %.1f steps/s over %d batches of %d steps (min %.1f, max %.1f)\n", rate,
               batches, steps, rates.front(), rates.back());
   std::printf("wall time per %.3g s cycle: %.3g s (%.3g h)\n", period, period / solver.dt() / rate,

@@ -1,6 +1,8 @@
 #include "cli/tool.hpp"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <new>
 #include <string>
@@ -8,9 +10,8 @@
 #include <unistd.h>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "cli/interrupt.hpp"
-#include "formats/json_pull.hpp"
-#include "formats/output_stream.hpp"
 
 namespace hemotree {
 
@@ -24,6 +25,14 @@ void say(const std::string& kind, const std::string& message) {
 
 void warn(const std::string& message) { say("warning: ", message); }
 void note(const std::string& message) { say("", message); }
+
+std::string standard_output_error() {
+  std::cout.flush();
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || std::cout.fail())
+    return errno != 0 ? std::strerror(errno) : "an earlier write failed";
+  return "";
+}
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
 
@@ -41,6 +50,10 @@ int checked_success(int status) {
 }  // namespace
 
 int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+  return run_tool(app, argc, argv, SettingWords{}, body);
+}
+
+int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, const std::function<int()>& body) {
   tool_name = app.get_name();
   try {
     app.parse(argc, argv);
@@ -69,6 +82,9 @@ int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& b
     return checked_success(body());
   } catch (const InterruptedExit& e) {
     return e.status;
+  } catch (const SettingError& e) {
+    say("error: ", e.in_words(words));
+    return 2;
   } catch (const InputError& e) {
     say("error: ", e.what());
     return 2;

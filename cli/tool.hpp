@@ -7,15 +7,26 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/setting_error.hpp"
+
 namespace hemotree {
 
 // Parses the command line with app, then runs body. Exit status: 0 success, 2 bad input
 // (flags, values, file contents), 1 input/output failure, 70 internal error.
+// A library's message that names settings (core/setting_error.hpp) is shown in words, the
+// tool's flags (cli/setting_words.hpp).
+int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, const std::function<int()>& body);
+// The same for a tool whose libraries name no setting of its own.
 int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
 
 // "vgen: warning: ..." / "vgen: ..." on stderr.
 void warn(const std::string& message);
 void note(const std::string& message);
+
+// Flushes standard output (and std::cout) and returns "" when everything written to it
+// reached its destination, else the reason. A tool that printed to standard output outside
+// an OutputStream (help, version, a table) calls it before exiting 0.
+std::string standard_output_error();
 
 // True when stderr is a terminal: progress lines are shown only then.
 bool stderr_is_terminal();

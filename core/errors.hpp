@@ -13,6 +13,12 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Malformed or unexpected JSON (formats/json_pull.hpp); what() is
+// "<source>:<line>:<column>: <message>". Exit status 2.
+struct JsonError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 // The environment failed us: cannot open, read or write a file. Exit status 1.
 struct IoError : std::runtime_error {
   using std::runtime_error::runtime_error;

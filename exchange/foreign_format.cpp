@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/field_ranges.hpp"
 #include "generator/growth_rules.hpp"
 
@@ -120,15 +121,15 @@ void fill_missing_walls(Network& net, const ImportOptions& options) {
   if (walls > 0)
     options.note(options.wall_ratio
                      ? "wall thickness h = " + format_number(*options.wall_ratio) + " D for " + count(walls) +
-                           " (--wall-ratio)"
-                     : "wall thickness from hemotree's per-class wall law (vgen --print-rules) for " +
-                           count(walls) + "; --wall-ratio sets h/D");
+                           " (" + placeholder("wall_ratio") + ")"
+                     : "wall thickness from hemotree's per-class wall law (vgen " + placeholder("print_rules") + ") for " +
+                           count(walls) + "; " + placeholder("wall_ratio") + " sets h/D");
   if (moduli > 0)
     options.note(options.youngs_modulus
                      ? "Young's modulus " + format_number(*options.youngs_modulus) + " Pa for " + count(moduli) +
-                           " (--youngs-modulus)"
-                     : "Young's modulus from hemotree's E(D) table (vgen --print-rules) for " + count(moduli) +
-                           "; --youngs-modulus sets one");
+                           " (" + placeholder("youngs_modulus") + ")"
+                     : "Young's modulus from hemotree's E(D) table (vgen " + placeholder("print_rules") + ") for " +
+                           count(moduli) + "; " + placeholder("youngs_modulus") + " sets one");
 }
 
 namespace {

@@ -20,7 +20,8 @@ struct ImportOptions {
   // whose file gives none; unset: the toolkit's per-class wall law (default_rules().wall).
   std::optional<double> wall_ratio;
   // Receives one line per assumption ("vessel wall thickness from h = 0.1 D for 1130
-  // vessels"); vimport prints them on stderr.
+  // vessels"), which names settings through placeholders (core/setting_error.hpp); vimport
+  // words them as its flags and prints the lines on stderr.
   std::function<void(const std::string&)> note = [](const std::string&) {};
 };
 

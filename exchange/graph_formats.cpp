@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/topology.hpp"
 
@@ -117,7 +118,7 @@ struct RawGraph {
   std::set<std::string> ignored_node, ignored_edge, ignored_graph;  // attribute names
 
   [[noreturn]] void fail(const std::string& where, const std::string& what) const {
-    throw InputError(path + ": " + where + ": " + what);
+    throw_input_error(path + ": " + where + ": " + what);
   }
   double number(const std::string& where, const std::string& name, const Value& v) const {
     if (!v.number) fail(where, "\"" + name + "\" must be a number (got \"" + v.text + "\")");
@@ -449,7 +450,8 @@ Network build_network(RawGraph& g, const ImportOptions& options, const GraphOpti
     unit_from = format_number(u) + " m, as given";
   }
   if (!(u > 0) || !std::isfinite(u)) g.fail("the length unit", "must be a positive number of metres");
-  const std::string hint = u == 1 ? " (lengths read in metres: a \"unit\" graph attribute or vimport --unit sets another)"
+  const std::string hint = u == 1 ? " (lengths read in metres: a \"unit\" graph attribute or vimport " + placeholder("unit") +
+                                        " sets another)"
                                   : " (lengths read in units of " + format_number(u) + " m)";
 
   Network net;

@@ -28,6 +28,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/field_ranges.hpp"
 
 namespace hemotree {
@@ -852,7 +853,7 @@ Network read_openbf(const std::string& path, const ImportOptions& options, Openb
   // What was assumed, one line each.
   // Where openBF's code and its documentation part, one line each: what was built, and how to
   // get the other reading (docs/import.md).
-  const std::string reading_note = as_coded ? " (openBF's code; --as-documented for its documentation's reading)"
+  const std::string reading_note = as_coded ? " (openBF's code; " + placeholder("as_documented") + " for its documentation's reading)"
                                             : " (openBF's documentation; its code differs: vimport's default)";
   if (tapers > 0)
     options.note(plural(tapers, "tapered vessel") + " (Rp != Rd): " +
@@ -886,12 +887,13 @@ Network read_openbf(const std::string& path, const ImportOptions& options, Openb
                                            : std::string()));
   if (ratio_walls > 0)
     options.note("wall thickness h = " + format_number(*options.wall_ratio) + " D for " + plural(ratio_walls, "vessel") +
-                 " without h0 (--wall-ratio)");
+                 " without h0 (" + placeholder("wall_ratio") + ")");
   if (open_ends > 0)
     options.note(plural(open_ends, "outlet") + " without outlet keys: openBF's default, non-reflecting (Rt = 0)");
   options.note("tube laws: openBF's thin wall, each vessel's beta = 4 E h0 / (3 sqrt(pi) R^2) at its reference_pressure, "
                "openBF's external pressure Pext = " + format_number(external_pressure) +
-               " Pa; hemosolve's --thick-wall-ratio and --external-pressure do not change them");
+               " Pa; hemosolve's " + placeholder("thick_wall_ratio") + " and " + placeholder("external_pressure") +
+               " do not change them");
   options.note(as_coded ? "momentum flux: alpha = 1 (blood momentum_flux_coefficient), as openBF's code has it; the "
                          "friction and the wall shear stress from the profile (blood alpha " + three_digits(blood.alpha) + ")" +
                              reading_note

@@ -7,7 +7,7 @@
 
 #include "core/errors.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "exchange/openbf.hpp"
 #include "exchange/secomb.hpp"
 #include "formats/network_io.hpp"

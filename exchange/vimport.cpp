@@ -7,8 +7,9 @@
 #include <CLI/CLI.hpp>
 
 #include "core/errors.hpp"
+#include "cli/setting_words.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "exchange/graph_formats.hpp"
 #include "exchange/openbf.hpp"
 #include "exchange/secomb.hpp"
@@ -74,7 +75,7 @@ int main(int argc, char** argv) {
                "it; the notes name each difference)");
   app.set_version_flag("--version", std::string("vimport ") + HEMOTREE_VERSION);
 
-  return run_tool(app, argc, argv, [&] {
+  return run_tool(app, argc, argv, vimport_words(), [&] {
     // ---- every flag, before any work ---------------------------------------------------
     if (format != "secomb" && format != "openbf" && format != "vtk" && format != "graphml" && format != "networkx")
       throw InputError("FORMAT must be secomb, openbf, vtk, graphml or networkx (got '" + format + "')");
@@ -84,7 +85,7 @@ int main(int argc, char** argv) {
       throw InputError("--unit applies to FORMAT vtk, graphml and networkx only (" + format + " files have their units)");
 
     ImportOptions options;
-    options.note = [](const std::string& line) { note("note: " + line); };
+    options.note = [](const std::string& line) { note("note: " + in_words(line, vimport_words())); };
     nlohmann::json parameters = nlohmann::json::object();
     if (as_documented) parameters["as_documented"] = true;
     if (!youngs_text.empty()) {

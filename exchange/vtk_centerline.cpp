@@ -25,6 +25,7 @@
 #include <zlib.h>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/topology.hpp"
 
@@ -277,7 +278,7 @@ struct XmlFile {
   std::string appended;  // the bytes after AppendedData's '_'
   bool appended_raw = false;
   [[noreturn]] void fail(const std::string& element, const std::string& what) const {
-    throw InputError(path + ": " + element + ": " + what);
+    throw_input_error(path + ": " + element + ": " + what);
   }
 };
 
@@ -470,7 +471,7 @@ Centerlines read_xml(const std::string& path, std::string text, const Centerline
   if (!radius)
     f.fail(at + "/PointData", "no DataArray Name=\"" + options.radius_array + "\" (point data arrays: " +
                                   join(c.point_arrays) + "; cell data arrays: " + join(c.cell_arrays) +
-                                  "); vimport --radius-array names another");
+                                  "); vimport " + placeholder("radius_array") + " names another");
   c.radius = read_data_array(f, *radius, at + "/PointData/DataArray[Name=" + options.radius_array + "]", points, 1);
   if (const ptree* groups = cell_data ? named_array(*cell_data, "GroupIds") : nullptr)
     c.group_ids = read_data_array(f, *groups, at + "/CellData/DataArray[Name=GroupIds]", lines, 1);
@@ -580,7 +581,7 @@ class LegacyReader {
         fail_file("LINES: point id " + std::to_string(id) + " outside [0, " + std::to_string(c.point_count()) + ")");
     if (!have_radius)
       fail_file("no point data array \"" + options.radius_array + "\" (point data arrays: " + join(c.point_arrays) +
-           "; cell data arrays: " + join(c.cell_arrays) + "); vimport --radius-array names another");
+           "; cell data arrays: " + join(c.cell_arrays) + "); vimport " + placeholder("radius_array") + " names another");
     return c;
   }
 
@@ -635,9 +636,9 @@ class LegacyReader {
   }
 
   [[noreturn]] void fail(const std::string& what) const {
-    throw InputError(path_ + ":" + std::to_string(line_) + ": " + what);
+    throw_input_error(path_ + ":" + std::to_string(line_) + ": " + what);
   }
-  [[noreturn]] void fail_file(const std::string& what) const { throw InputError(path_ + ": " + what); }
+  [[noreturn]] void fail_file(const std::string& what) const { throw_input_error(path_ + ": " + what); }
   void skip_blank() {
     while (pos_ < text_.size() && is_space(text_[pos_])) {
       if (text_[pos_] == '\n') ++line_;
@@ -941,7 +942,7 @@ Network build_network(const std::string& path, const Centerlines& c, const Impor
   }
 
   const std::string unit_hint = "; the file's lengths were read as " + format_number(u) +
-                                " m each (vimport --unit sets the unit, e.g. --unit mm)";
+                                " m each (vimport " + placeholder("unit") + " sets the unit, e.g. " + placeholder("unit") + " mm)";
   static const char* const axis_name[3] = {"x", "y", "z"};
   for (std::size_t k = 0; k < chains.size(); ++k) {
     const auto& p = chains[k].points;
@@ -954,12 +955,12 @@ Network build_network(const std::string& path, const Centerlines& c, const Impor
     const double diameter = 2 * u * radius_integral / length;
     const std::string where = path + ": vessel " + std::to_string(k) + " (polyline " + std::to_string(chains[k].cell) +
                               ", point " + std::to_string(p.front()) + " to point " + std::to_string(p.back()) + "): ";
-    if (!ranges::length.contains(u * length)) throw InputError(where + out_of_range("length", ranges::length, u * length) + unit_hint);
-    if (!ranges::diameter.contains(diameter)) throw InputError(where + out_of_range("diameter", ranges::diameter, diameter) + unit_hint);
+    if (!ranges::length.contains(u * length)) throw SettingError("unit", where + out_of_range("length", ranges::length, u * length) + unit_hint);
+    if (!ranges::diameter.contains(diameter)) throw SettingError("unit", where + out_of_range("diameter", ranges::diameter, diameter) + unit_hint);
     for (std::size_t end : {p.front(), p.back()})
       for (int d = 0; d < 3; ++d)
         if (!ranges::coordinate.contains(u * c.xyz[3 * end + d]))
-          throw InputError(where + out_of_range(axis_name[d], ranges::coordinate, u * c.xyz[3 * end + d]) + unit_hint);
+          throw SettingError("unit", where + out_of_range(axis_name[d], ranges::coordinate, u * c.xyz[3 * end + d]) + unit_hint);
     net.add_vessel(static_cast<std::int64_t>(k), node_of[p.front()], node_of[p.back()], u * length, diameter,
                    std::nan(""), std::nan(""), 0);
   }

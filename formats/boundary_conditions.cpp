@@ -32,15 +32,6 @@ std::string_view to_string(BoundaryType type) {
   return "";
 }
 
-double Blood::pries_diameter_scale() const { return std::cbrt(human_mean_cell_volume / mean_cell_volume); }
-double Blood::phase_separation_diameter_scale() const {
-  return std::cbrt(phase_separation_mean_cell_volume / mean_cell_volume);
-}
-
-std::string_view to_string(Rheology rheology) {
-  return rheology == Rheology::pries ? "pries" : "newtonian";
-}
-
 // ---- the inflow waveform --------------------------------------------------------------
 
 double Waveform::peak() const {

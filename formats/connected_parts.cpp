@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <utility>
 
+#include "core/setting_error.hpp"
+
 namespace hemotree {
 
 ConnectedParts connected_parts(const Network& net, std::span<const NodeBoundary> boundaries) {
@@ -95,10 +97,11 @@ std::string pressure_reference_refusal(const Network& net, std::span<const NodeB
                                 ? "1 of the network's " + std::to_string(total) + " connected parts has no pressure to refer to"
                                 : std::to_string(floating.size()) + " of the network's " + std::to_string(total) +
                                       " connected parts have no pressure to refer to";
-  const std::string remedy = floating.size() == 1 ? " (give a node a pressure or an outlet; where the flows balance, "
-                                                    "hemosolve --pressure-at NODE=PRESSURE fixes the level): "
+  const std::string pressure_at = "hemosolve " + placeholder("pressure_at") + " NODE=PRESSURE";
+  const std::string remedy = floating.size() == 1 ? " (give a node a pressure or an outlet; where the flows balance, " +
+                                                        pressure_at + " fixes the level): "
                                                   : " (give a node of each a pressure or an outlet; where a part's flows "
-                                                    "balance, hemosolve --pressure-at NODE=PRESSURE fixes its level): ";
+                                                    "balance, " + pressure_at + " fixes its level): ";
   return which + remedy + why;
 }
 

@@ -72,8 +72,9 @@ ConnectedParts connected_parts(const Network& net);
 
 // Empty where every part has a pressure to refer to (a prescribed pressure or an outlet of any
 // kind); else one line naming every part that has none, largest first, with its boundary
-// nodes and the balance of its flows, and what would give it one. The steady solve and the
-// pulsatile run refuse with it alike.
+// nodes and the balance of its flows, and what would give it one (naming the setting
+// pressure_at: core/setting_error.hpp). The steady solve and the pulsatile run refuse with it
+// alike.
 std::string pressure_reference_refusal(const Network& net, std::span<const NodeBoundary> boundaries);
 
 // "the part with vessel 12 (340 vessels)"

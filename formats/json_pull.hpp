@@ -17,12 +17,9 @@
 
 #include <nlohmann/json.hpp>
 
-namespace hemotree {
+#include "core/errors.hpp"  // JsonError
 
-// Malformed or unexpected input; what() is "<source>:<line>:<column>: <message>".
-struct JsonError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+namespace hemotree {
 
 // Notes: columns count bytes, not UTF-8 characters; the in-memory constructor keeps a view,
 // so the text must outlive the parser; a failed read throws IoError (core/errors.hpp); nesting

@@ -7,7 +7,6 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
-#include <iostream>
 #include <limits>
 #include <string_view>
 #include <unistd.h>
@@ -98,14 +97,6 @@ std::size_t remove_stale_partials(const std::string& path) {
     if (fs::remove(it->path(), ignored)) ++removed;
   }
   return removed;
-}
-
-std::string standard_output_error() {
-  std::cout.flush();
-  errno = 0;
-  if (std::fflush(stdout) != 0 || std::ferror(stdout) || std::cout.fail())
-    return errno != 0 ? errno_text() : "an earlier write failed";
-  return "";
 }
 
 OutputStream::OutputStream(const std::string& path, Temporary temporary) : buffer_(buffer_size) {

@@ -9,7 +9,8 @@
 // - where the file system has no O_TMPFILE (NFS, old overlayfs), into NAME.partial-HOST-PID,
 //   removed on failure, on SIGINT, SIGTERM and SIGHUP, and, after a SIGKILL, by the next
 //   writer of NAME once no process PID runs on HOST;
-// - standard output is checked for write errors (full disk, closed pipe).
+// - standard output is checked for write errors (full disk, closed pipe); what a tool
+//   prints outside an OutputStream, run_tool checks (cli/tool.hpp).
 #pragma once
 
 #include <cstdio>
@@ -64,11 +65,6 @@ std::string partial_path(const std::string& path);
 // Removes path.partial-HOST-PID (this host) and path.partial-PID (the older form) files whose
 // process no longer runs: what a writer killed by SIGKILL left. Returns how many it removed.
 std::size_t remove_stale_partials(const std::string& path);
-
-// Flushes standard output (and std::cout) and returns "" when everything written to it
-// reached its destination, else the reason. A tool that printed to standard output outside
-// an OutputStream (help, version) calls it before exiting 0.
-std::string standard_output_error();
 
 // Formats a real number with 9 significant digits (the precision of the network format).
 // Returns the number of characters written to out (at most 24).

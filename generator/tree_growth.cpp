@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 
 namespace hemotree {
 
@@ -58,8 +59,8 @@ Network grow_tree(const GrowthRules& rules, const GrowthParameters& p,
     const Daughters daughters = murray_daughters(d, kappa, range.murray_exponent);
     if (!branches(rules.stop, d, daughters, p.min_diameter)) continue;
     if (net.vessel_count() + 2 > max_grown_vessels)
-      throw InputError("the tree grows beyond " + std::to_string(max_grown_vessels) +
-                       " vessels, the most a network holds: raise --min-diameter");
+      throw SettingError("min_diameter", "the tree grows beyond " + std::to_string(max_grown_vessels) +
+                                             " vessels, the most a network holds: raise " + placeholder("min_diameter"));
     const std::int32_t node = net.to[v];
     const std::int32_t generation = net.generation[v] + 1;
     add(node, daughters.first, generation);

@@ -3,8 +3,8 @@
 
 #include <cstdint>
 #include <functional>
-#include <random>
 
+#include "core/uniform_source.hpp"  // the tree's random draws
 #include "formats/network.hpp"
 #include "generator/growth_rules.hpp"
 
@@ -14,19 +14,6 @@ struct GrowthParameters {
   double root_diameter = 1e-3;  // [m]
   double min_diameter = 7e-6;   // [m]
   std::uint64_t seed = 1;
-};
-
-// A uniform draw in [0, 1) from the 53 high bits of std::mt19937_64, whose sequence the
-// C++ standard fixes: the same seed gives the same tree with every standard library
-// (std::uniform_real_distribution's algorithm, by contrast, is left to the implementation).
-class UniformSource {
- public:
-  explicit UniformSource(std::uint64_t seed) : engine_(seed) {}
-  double operator()() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-  double between(double lo, double hi) { return lo + (hi - lo) * (*this)(); }
-
- private:
-  std::mt19937_64 engine_;
 };
 
 // The most vessels a grown tree may have: node and vessel indices are 32-bit, and a tree of

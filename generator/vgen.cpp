@@ -8,8 +8,9 @@
 
 #include "core/errors.hpp"
 #include "cli/progress.hpp"
+#include "cli/setting_words.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/exports.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/network_io.hpp"
@@ -94,7 +95,7 @@ int main(int argc, char** argv) {
       ->group("Venous mirror");
   app.set_version_flag("--version", std::string("vgen ") + HEMOTREE_VERSION);
 
-  const int status = run_tool(app, argc, argv, [&] {
+  const int status = run_tool(app, argc, argv, vgen_words(), [&] {
     const GrowthRules rules = rules_path.empty() ? default_rules() : read_rules(rules_path);
     if (print_rules) {
       OutputStream out(output);

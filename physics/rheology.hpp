@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "formats/boundary_conditions.hpp"
+#include "physics/blood.hpp"
 
 namespace hemotree {
 

@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "formats/boundary_conditions.hpp"
+#include "physics/blood.hpp"
 
 namespace hemotree {
 

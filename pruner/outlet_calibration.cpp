@@ -4,7 +4,7 @@
 #include <string>
 
 #include "core/errors.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/topology.hpp"
 #include "physics/wall_law.hpp"
 #include "steady/steady_flow.hpp"
@@ -127,23 +127,24 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
 
 std::string unphysiological_pressure_warning(const OutletReport& report,
                                              const OutletParameters& p, double mean_inflow,
-                                             double root_diameter) {
+                                             double root_diameter, const SettingWords& words) {
+  const auto named = [&](const char* setting) { return in_words(placeholder(setting), words); };
   constexpr double lowest = 0.0, highest = 300 * pascal_per_mmhg, typical = 100 * pascal_per_mmhg;
   const double inlet = report.steady_inlet_pressure_full;
   if (inlet >= lowest && inlet <= highest) return "";
   std::string text = "the steady inlet pressure is " + format_quantity(inlet, "mmHg") +
                      ", outside the physiological 0 to 300 mmHg: ";
   if (inlet < lowest)
-    return text + "--venous-pressure (" + format_quantity(p.venous_pressure, "mmHg") +
+    return text + named("venous_pressure") + " (" + format_quantity(p.venous_pressure, "mmHg") +
            ") is likely too low";
   // The capillary outlets always take `drop` on average; the rest is Poiseuille, nearly
   // linear in the flow.
   const double fixed = p.venous_pressure + p.capillary_pressure_drop;
   if (fixed > highest)
-    return text + "--venous-pressure (" + format_quantity(p.venous_pressure, "mmHg") +
-           ") and --capillary-drop (" + format_quantity(p.capillary_pressure_drop, "mmHg") +
+    return text + named("venous_pressure") + " (" + format_quantity(p.venous_pressure, "mmHg") + ") and " +
+           named("capillary_drop") + " (" + format_quantity(p.capillary_pressure_drop, "mmHg") +
            ") alone exceed it";
-  text += "--mean-flow (" + format_quantity(mean_inflow, "ml/min") +
+  text += named("mean_flow") + " (" + format_quantity(mean_inflow, "ml/min") +
           ") is likely too large for a tree whose root is " +
           format_quantity(root_diameter, "um") + " wide";
   if (inlet > fixed && typical > fixed)

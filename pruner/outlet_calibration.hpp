@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/setting_error.hpp"
 #include "formats/network.hpp"
 #include "pruner/pruning_strategies.hpp"
 
@@ -46,11 +47,13 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
 
 // Steady arterial pressures lie within 0 to 300 mmHg. When the full tree's steady inlet
 // pressure leaves that range, a warning naming the value in mmHg and the likely cause: an
-// inflow (vprune's --mean-flow) meant for a tree of another size, with the inflow that gives
+// inflow (the setting mean_flow) meant for a tree of another size, with the inflow that gives
 // about 100 mmHg (the drop down the tree is nearly proportional to it: within 2 %, since the
-// capillary outlets' resistance follows the flow); "" when it is in range.
+// capillary outlets' resistance follows the flow); "" when it is in range. The settings
+// (mean_flow, venous_pressure, capillary_drop) are named in words (vprune: its flags).
 std::string unphysiological_pressure_warning(const OutletReport& report,
                                              const OutletParameters& parameters,
-                                             double mean_inflow, double root_diameter);
+                                             double mean_inflow, double root_diameter,
+                                             const SettingWords& words = {});
 
 }  // namespace hemotree

@@ -15,8 +15,8 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/uniform_source.hpp"
 #include "formats/topology.hpp"
-#include "generator/tree_growth.hpp"
 
 namespace hemotree {
 

@@ -11,8 +11,9 @@
 #include <CLI/CLI.hpp>
 
 #include "core/errors.hpp"
+#include "cli/setting_words.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/exports.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/network_io.hpp"
@@ -190,7 +191,7 @@ int main(int argc, char** argv) {
       ->group("Blood and outlets");
   app.set_version_flag("--version", std::string("vprune ") + HEMOTREE_VERSION);
 
-  const int status = run_tool(app, argc, argv, [&] {
+  const int status = run_tool(app, argc, argv, vprune_words(), [&] {
     // ---- every flag, before any work ---------------------------------------------------
     const auto format = parse_export_format(format_name);
     if (!format) throw InputError("--format: unknown format '" + format_name + "'");
@@ -361,7 +362,7 @@ int main(int argc, char** argv) {
          " capillary; steady inlet pressure " + format_quantity(pruned_p, "mmHg") +
          " (full tree " + format_quantity(full_p, "mmHg") + ")");
     if (const std::string w = unphysiological_pressure_warning(
-            report, outlets, full.inlet->waveform.mean_value(), full.diameter[root]);
+            report, outlets, full.inlet->waveform.mean_value(), full.diameter[root], vprune_words());
         !w.empty())
       warn(w);
 

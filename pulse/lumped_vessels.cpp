@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "core/parallel_errors.hpp"
 #include "physics/poiseuille.hpp"
 #include "pulse/network_boundaries.hpp"
@@ -98,8 +99,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
     }
     const Outlet& o = bc.outlet;
     if (o.type == OutletType::reflection)
-      throw InputError("vessel " + std::to_string(net.id[v]) +
-                       ": a reflection outlet needs a 1D vessel (--model 1d, or auto, keeps it 1D)");
+      throw SettingError("model", "vessel " + std::to_string(net.id[v]) + ": a reflection outlet needs a 1D vessel (" +
+                                      placeholder("model") + " 1d, or auto, keeps it 1D)");
     outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(at), -1});
     if (o.type == OutletType::rcr && o.c > 0) {
       capacitor_of_outlet_[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(outlet_of_capacitor_.size());

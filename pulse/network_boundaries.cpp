@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 
 namespace hemotree {
 
@@ -50,8 +51,9 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
     if (i < net.outlets.size() && !ends.empty())
       throw InputError(name(static_cast<std::size_t>(net.outlets[i].vessel)) +
                        " has an outlet but other vessels continue from its end");
-    throw InputError("hemosolve's pulsatile run takes boundary conditions where one vessel ends; " + node_name(node) +
-                     " joins " + std::to_string(ends.size()) + " vessels; --steady takes any");
+    throw SettingError("steady", "hemosolve's pulsatile run takes boundary conditions where one vessel ends; " +
+                                     node_name(node) + " joins " + std::to_string(ends.size()) + " vessels; " +
+                                     placeholder("steady") + " takes any");
   };
   for (std::size_t node = 0; node < at_node.size(); ++node) {
     const auto& ends = at_node[node];

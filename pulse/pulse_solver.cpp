@@ -11,6 +11,7 @@
 #include <omp.h>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "core/parallel_errors.hpp"
 #include "formats/connected_parts.hpp"
 #include "physics/poiseuille.hpp"
@@ -53,9 +54,9 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     : net_(net), blood_(effective_blood(net, options)), viscosity_(blood_),
       scheme_(options.scheme) {
   if (options.degree < 0 && options.degree != SolverOptions::automatic)
-    throw InputError("--degree must be at least 0");
-  if (options.elements < 1) throw InputError("--elements must be at least 1");
-  if (options.threads < 1) throw InputError("--threads must be at least 1");
+    throw SettingError("degree", placeholder("degree") + " must be at least 0");
+  if (options.elements < 1) throw SettingError("elements", placeholder("elements") + " must be at least 1");
+  if (options.threads < 1) throw SettingError("threads", placeholder("threads") + " must be at least 1");
   threads_ = options.threads;
   friction_k_ = friction_coefficient(blood_.alpha);
   const std::size_t n = net.vessel_count();
@@ -137,7 +138,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   // a part with flow boundaries only has no pressure level, and a run from rest over it was
   // called complete (hostile-inputs 05), or failed deep in the 0D solve.
   if (const std::string refusal = pressure_reference_refusal(net, boundaries_.list); !refusal.empty())
-    throw InputError(refusal);
+    throw SettingError("pressure_at", refusal);
   if (steady) {
     // A pressure boundary counts as "in" or "out" by its steady flow.
     std::vector<double> inflow(net.node_count(), 0.0);
@@ -202,14 +203,14 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     // 16 % of the inflow and was called complete). The 1D substeps keep their own limit.
     stable_dt_ = target;
     std::ostringstream limit;
-    limit << "--lumped-step " << options.lumped_step << " of the period: BDF2 is stable at any step but follows "
+    limit << placeholder("lumped_step") << " " << options.lumped_step << " of the period: BDF2 is stable at any step but follows "
              "the pulse only at steps like it";
     stable_dt_reason_ = limit.str();
   }
   set_time_step(dt_);
   if (options.dt > 0) {
     set_time_step(options.dt);
-    dt_reason_ = "given by --dt";
+    dt_reason_ = "given by " + placeholder("dt");
   }
   // The coupled ends' first linearisation needs their end states.
   if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);

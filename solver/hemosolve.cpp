@@ -16,8 +16,9 @@
 
 #include "core/errors.hpp"
 #include "cli/interrupt.hpp"
+#include "cli/setting_words.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/network_io.hpp"
 #include "formats/pressure_reference.hpp"
 #include "formats/topology.hpp"
@@ -227,7 +228,7 @@ int main(int argc, char** argv) {
                                      "--probe", "--frames", "--dt", "--start", "--transport-step", "--tracer"})
     steady_flag->excludes(app.get_option(pulsatile_only));
 
-  return run_tool(app, argc, argv, [&] {
+  return run_tool(app, argc, argv, hemosolve_words(), [&] {
     // ---- every flag, before any work -------------------------------------------------
     if (out_dir.empty() && resume_dir.empty()) throw InputError("--out DIR is required (or --resume DIR)");
     if (!resume_dir.empty() && !out_dir.empty() &&
@@ -374,19 +375,19 @@ int main(int argc, char** argv) {
         beyond_limit ? "--dt " + format_quantity(options.dt, "s") + " is " + format_rounded(options.dt / run.stable_dt()) +
                            " times the " + (run.lumped_count() > 0 ? "0D step's accuracy limit " : "stability limit ") +
                            format_quantity(run.stable_dt(), "s") + " (" +
-                           run.stable_dt_reason() + ")"
+                           in_words(run.stable_dt_reason(), hemosolve_words()) + ")"
                      : std::string();
     if (beyond_limit && !force)
       throw InputError(over_limit + "; the solution would blow up or be wrong: use a --dt of at most the limit, or "
                        "--force to run it anyway");
     const double steps_wanted = std::ceil(period / run.dt() - 1e-9);
     if (!(steps_wanted <= most_steps_per_cycle))
-      throw InputError("a time step of " + format_quantity(run.dt(), "s") + " (" + run.dt_reason() + ") needs " +
+      throw InputError("a time step of " + format_quantity(run.dt(), "s") + " (" + in_words(run.dt_reason(), hemosolve_words()) + ") needs " +
                        format_rounded(steps_wanted) + " steps per cycle: no run can finish; check that vessel's "
                        "wall and length, and the inlet's flow");
     const auto steps_per_cycle = static_cast<std::size_t>(steps_wanted);
     const double dt = period / static_cast<double>(steps_per_cycle);  // a whole number per cycle
-    const std::string dt_reason = run.dt_reason();
+    const std::string dt_reason = in_words(run.dt_reason(), hemosolve_words());
     run.set_time_step(dt);  // slightly smaller, so that cycles end exactly on a step
     if (static_cast<std::size_t>(frames) > steps_per_cycle)
       throw InputError("--frames " + std::to_string(frames) + " exceeds the " + std::to_string(steps_per_cycle) +
@@ -574,7 +575,7 @@ int main(int argc, char** argv) {
         if (!b.is_outlet()) run_info["boundaries"].back()["hematocrit"] = b.entering_hematocrit(run.blood());
       }
     }
-    if (status == RunStatus::broken_down) run_info["error"] = pulsatile.breakdown();
+    if (status == RunStatus::broken_down) run_info["error"] = in_words(pulsatile.breakdown(), hemosolve_words());
     if (status == RunStatus::interrupted)
       run_info["error"] = std::string("interrupted by ") + InterruptRequests::name(pulsatile.signal()) +
                           "; resume with --resume " + out_dir;
@@ -591,7 +592,7 @@ int main(int argc, char** argv) {
     // Nothing computed, nothing kept: DIR stays as it was.
     if (status == RunStatus::broken_down && last.vessels.empty()) {
       folder.discard();
-      throw InputError(pulsatile.breakdown());
+      throw InputError(in_words(pulsatile.breakdown(), hemosolve_words()));
     }
     const std::filesystem::path dir = folder.staging();
     if (status == RunStatus::interrupted || checkpoint_every > 0) pulsatile.write_checkpoint();
@@ -616,7 +617,7 @@ int main(int argc, char** argv) {
            "; --resume " + out_dir + " continues");
       return exit_status(outcome, pulsatile.signal());
     }
-    if (status == RunStatus::broken_down) throw InputError(pulsatile.breakdown());
+    if (status == RunStatus::broken_down) throw InputError(in_words(pulsatile.breakdown(), hemosolve_words()));
     if (!failure.empty()) throw InputError("the results are wrong and marked failed in summary.json: " + failure);
     if (!quiet) {
       std::ostringstream m;

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 
 namespace hemotree {
 
@@ -86,7 +87,7 @@ OutputFolder::OutputFolder(const fs::path& dir) {
   if (!shown.has_filename()) shown = shown.parent_path();
   std::error_code ec;
   if (fs::exists(final_, ec) && (!fs::is_directory(final_, ec) || !is_results_folder(final_)))
-    throw InputError("--out " + dir.string() + ": exists and is not a hemosolve results folder (no summary.json); "
+    throw SettingError("out", placeholder("out") + " " + dir.string() + ": exists and is not a hemosolve results folder (no summary.json); "
                      "choose a new or empty folder");
 
   // The lock: its file must exist to be locked, and so must the folder it lies in.
@@ -103,7 +104,7 @@ OutputFolder::OutputFolder(const fs::path& dir) {
         ::close(lock_fd_);
         lock_fd_ = -1;
         if (error == EWOULDBLOCK)
-          throw InputError("--out " + shown.string() + ": " + who + " is writing " + shown.string() +
+          throw SettingError("out", placeholder("out") + " " + shown.string() + ": " + who + " is writing " + shown.string() +
                            ".partial; wait for it or choose another folder");
         throw IoError("cannot lock " + lock_.string() + ": " + std::strerror(error));
       }
@@ -121,7 +122,7 @@ OutputFolder::OutputFolder(const fs::path& dir) {
         ::ftruncate(lock_fd_, static_cast<off_t>(owner.size())) != 0)
       throw IoError("cannot write " + lock_.string() + ": " + std::strerror(errno));
     if (fs::exists(staging_, ec) && (!fs::is_directory(staging_, ec) || !is_results_folder(staging_)))
-      throw InputError("--out " + shown.string() + ": " + staging_.string() + " exists and was not made by hemosolve; move it away");
+      throw SettingError("out", placeholder("out") + " " + shown.string() + ": " + staging_.string() + " exists and was not made by hemosolve; move it away");
   } catch (...) {
     release();
     throw;

@@ -1,6 +1,7 @@
 #include "solver/probes.hpp"
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/output_stream.hpp"
 #include "formats/quoting.hpp"
 
@@ -19,11 +20,11 @@ Probe parse_probe(const std::string& text, const Network& net) {
       if (used != x.size()) throw std::invalid_argument("");
     }
   } catch (const std::exception&) {
-    throw InputError("--probe: '" + printable(text) + "' is not ID or ID:x");
+    throw SettingError("probe", placeholder("probe") + ": '" + printable(text) + "' is not ID or ID:x");
   }
-  if (!(p.x >= 0 && p.x <= 1)) throw InputError("--probe: x must lie in [0, 1] in '" + printable(text) + "'");
+  if (!(p.x >= 0 && p.x <= 1)) throw SettingError("probe", placeholder("probe") + ": x must lie in [0, 1] in '" + printable(text) + "'");
   const std::int64_t index = net.index_of(p.id);
-  if (index < 0) throw InputError("--probe: no vessel " + std::to_string(p.id));
+  if (index < 0) throw SettingError("probe", placeholder("probe") + ": no vessel " + std::to_string(p.id));
   p.vessel = static_cast<std::size_t>(index);
   return p;
 }

@@ -291,7 +291,7 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
     }
   } catch (const SolutionBreakdown& e) {
     if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
-    breakdown_ = e.what();
+    breakdown_ = e.message();
     return RunStatus::broken_down;
   }
   if (plan_.until_periodic && !periodic()) return RunStatus::not_periodic;

@@ -75,7 +75,7 @@ class PulsatileRun {
   bool has_change() const { return !previous_.vessels.empty(); }
   const PeriodicityChange& change() const { return change_; }
   int signal() const { return signal_; }                    // after an interrupt
-  const std::string& breakdown() const { return breakdown_; }  // after a breakdown
+  const std::string& breakdown() const { return breakdown_; }  // after a breakdown; settings as placeholders
   // Wall time per step measured over the first steps this process ran [s]; 0 before.
   double measured_step() const { return measured_step_; }
   const ProbeRecorder& probes() const { return probes_; }

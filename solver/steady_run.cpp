@@ -8,7 +8,7 @@
 
 #include "core/errors.hpp"
 #include "cli/tool.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "physics/rheology.hpp"
 #include "solver/output_folder.hpp"
 #include "physics/phase_separation.hpp"

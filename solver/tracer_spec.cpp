@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/quoting.hpp"
 
 namespace hemotree {
@@ -32,7 +33,7 @@ double TracerSpec::mean_over(double t0, double t1) const {
 namespace {
 
 [[noreturn]] void refuse(const std::string& spec, const std::string& what) {
-  throw InputError("--tracer '" + printable(spec) + "': " + what);
+  throw SettingError("tracer", placeholder("tracer") + " '" + printable(spec) + "': " + what);
 }
 
 double number(const std::string& spec, const std::string& key, const std::string& value, bool time) {

@@ -5,7 +5,7 @@
 #include <sstream>
 #include <vector>
 
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/topology.hpp"
 #include "physics/phase_separation.hpp"
 

@@ -123,7 +123,7 @@ std::string format(const char* pattern, Args... args) {
 }
 
 // The connected parts, largest first: all of them up to a screenful, then what the rest hold.
-void print_parts(const NetworkStats& stats, std::ostream& out) {
+void print_parts(const NetworkStats& stats, std::ostream& out, const SettingWords& words) {
   constexpr std::size_t shown = 20;
   const auto& parts = stats.parts_by_size;
   if (parts.empty()) return;
@@ -146,8 +146,9 @@ void print_parts(const NetworkStats& stats, std::ostream& out) {
       nodes += parts[k].nodes;
       boundary_nodes += parts[k].boundary_nodes;
     }
-    out << format("%-22s %10zu %10zu %15zu  (--json lists them all)\n",
-                  ("  " + std::to_string(parts.size() - shown) + " more").c_str(), vessels, nodes, boundary_nodes);
+    out << format("%-22s %10zu %10zu %15zu  (%s lists them all)\n",
+                  ("  " + std::to_string(parts.size() - shown) + " more").c_str(), vessels, nodes, boundary_nodes,
+                  in_words(placeholder("json"), words).c_str());
   }
 }
 
@@ -286,7 +287,7 @@ nlohmann::json to_json(const NetworkStats& stats) {
   return out;
 }
 
-void print_table(const NetworkStats& stats, std::ostream& out) {
+void print_table(const NetworkStats& stats, std::ostream& out, const SettingWords& words) {
   const double m3_per_ml = 1e-6;
   const double um_per_m = 1e6;
   const auto percent = [&](std::size_t count) {
@@ -327,7 +328,7 @@ void print_table(const NetworkStats& stats, std::ostream& out) {
                   stats.capillary_generation_min, stats.capillary_generation_max,
                   stats.capillary_generation_max - stats.capillary_generation_min + 1);
 
-  print_parts(stats, out);
+  print_parts(stats, out, words);
 
   // Class columns in VesselClass order, abbreviated so a row fits 110 characters.
   out << '\n'

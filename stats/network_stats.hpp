@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/setting_error.hpp"
 #include "formats/network.hpp"
 
 namespace hemotree {
@@ -62,6 +63,8 @@ struct NetworkStats {
 
 NetworkStats compute_stats(const Network& net);
 nlohmann::json to_json(const NetworkStats& stats);
-void print_table(const NetworkStats& stats, std::ostream& out);
+// The statistics as a table; where it points to a setting (the JSON form, for parts left out)
+// it names it in words (core/setting_error.hpp: vstats's are its flags).
+void print_table(const NetworkStats& stats, std::ostream& out, const SettingWords& words = {});
 
 }  // namespace hemotree

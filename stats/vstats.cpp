@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/errors.hpp"
+#include "cli/setting_words.hpp"
 #include "cli/tool.hpp"
 #include "formats/network_io.hpp"
 #include "stats/network_stats.hpp"
@@ -25,7 +26,7 @@ int main(int argc, char** argv) {
     if (json)
       std::cout << hemotree::to_json(stats).dump(2) << '\n';
     else
-      hemotree::print_table(stats, std::cout);
+      hemotree::print_table(stats, std::cout, hemotree::vstats_words());
     // A full disk or a closed pipe must not pass for success.
     std::cout.flush();
     if (!std::cout) throw hemotree::IoError("cannot write to standard output");

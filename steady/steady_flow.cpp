@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/connected_parts.hpp"
 #include "formats/topology.hpp"
 #include "network_flow/flow_network.hpp"
@@ -286,7 +287,7 @@ void SteadySystem::check_node_form(const std::vector<NodeBoundary>& boundaries) 
   // Each connected part needs a pressure to refer to: a prescribed one or an outlet's. All
   // parts without one are named at once: a measured network has many fragments.
   if (const std::string refusal = pressure_reference_refusal(net, boundaries); !refusal.empty())
-    throw InputError(refusal);
+    throw SettingError("pressure_at", refusal);
 }
 
 SteadyFlow SteadySystem::solve(const std::vector<double>& resistance, double inlet_flow) {

@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "cli/setting_words.hpp"
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "exchange/graph_formats.hpp"
 #include "formats/exports.hpp"
 #include "formats/output_stream.hpp"
@@ -44,7 +46,9 @@ class ImportGraphs : public ::testing::Test {
     try {
       read(path, options(), GraphOptions{});
     } catch (const InputError& e) {
-      const std::string m = e.what();
+      // As vimport shows it: a setting the message names, in its flag's words.
+      const auto* setting = dynamic_cast<const SettingError*>(&e);
+      const std::string m = setting ? setting->in_words(vimport_words()) : e.what();
       return m.rfind(path, 0) == 0 ? m.substr(path.size()) : m;
     }
     return "no error";

@@ -15,7 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "cli/setting_words.hpp"
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "exchange/vtk_centerline.hpp"
 #include "scratch_path.hpp"
 
@@ -246,7 +248,9 @@ class ImportVtk : public ::testing::Test {
     try {
       read(name, text);
     } catch (const InputError& e) {
-      const std::string m = e.what();
+      // As vimport shows it: a setting the message names, in its flag's words.
+      const auto* setting = dynamic_cast<const SettingError*>(&e);
+      const std::string m = setting ? setting->in_words(vimport_words()) : e.what();
       const std::string path = scratch_path(name).string();
       return m.rfind(path, 0) == 0 ? m.substr(path.size()) : m;  // without the file's name
     }
@@ -354,8 +358,9 @@ TEST_F(ImportVtk, UnitDefaultsToMetres) {
   try {
     read_vtk_centerline(path, ImportOptions{});
     ADD_FAILURE() << "no error";
-  } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), path + ": vessel 0 (polyline 0, point 0 to point 2): \"diameter\" must lie in "
+  } catch (const SettingError& e) {
+    EXPECT_EQ(e.setting(), "unit");
+    EXPECT_EQ(e.in_words(vimport_words()), path + ": vessel 0 (polyline 0, point 0 to point 2): \"diameter\" must lie in "
                                             "[2e-6, 0.5] m (got 1.92); the file's lengths were read as 1 m each "
                                             "(vimport --unit sets the unit, e.g. --unit mm)");
   }

@@ -16,7 +16,9 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/setting_words.hpp"
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "exchange/foreign_format.hpp"
 #include "exchange/secomb.hpp"
 #include "solver/cycle_statistics.hpp"
@@ -257,6 +259,8 @@ TEST(NetworkGraphsPulsatile, RefusesWhatItCannotRun) {
   auto message = [](const Network& net, ModelChoice model = ModelChoice::one_d) {
     try {
       PulseSolver solver(net, options_for(model));
+    } catch (const SettingError& e) {  // as hemosolve shows it
+      return e.in_words(hemosolve_words());
     } catch (const InputError& e) {
       return std::string(e.what());
     }

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/setting_words.hpp"
 #include "core/errors.hpp"
 #include "stats/network_stats.hpp"
 
@@ -355,7 +356,7 @@ TEST(NetworkStats, ConnectedPartsLargestFirst) {
   EXPECT_FALSE(fed.flows_balance);
   EXPECT_DOUBLE_EQ(fed.net_inflow, 1e-9);
   std::ostringstream table;
-  print_table(s, table);
+  print_table(s, table, vstats_words());
   const std::string text = table.str();
   EXPECT_NE(text.find("  with vessel 97"), std::string::npos) << text;  // the twentieth
   EXPECT_EQ(text.find("  with vessel 98"), std::string::npos) << text;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/setting_words.hpp"
 #include "formats/network_io.hpp"
 #include "formats/topology.hpp"
 #include "generator/growth_rules.hpp"
@@ -159,7 +160,7 @@ TEST(OutletCalibration, AnUnphysiologicalPressureIsNamedWithItsLikelyCauseAndRem
   const OutletReport report = calibrated(default_flow);
   EXPECT_NEAR(report.steady_inlet_pressure_full / 133.322, 81142.2, 0.5);
   const std::string warning =
-      unphysiological_pressure_warning(report, OutletParameters{}, default_flow, 60e-6);
+      unphysiological_pressure_warning(report, OutletParameters{}, default_flow, 60e-6, vprune_words());
   EXPECT_NE(warning.find("81142.2 mmHg"), std::string::npos) << warning;
   EXPECT_NE(warning.find("--mean-flow (1.74 ml/min) is likely too large"), std::string::npos) << warning;
   EXPECT_NE(warning.find("60 um"), std::string::npos) << warning;
@@ -179,6 +180,9 @@ TEST(OutletCalibration, AnUnphysiologicalPressureIsNamedWithItsLikelyCauseAndRem
   negative.venous_pressure = -50 * 133.322;
   OutletReport low = remedied;
   low.steady_inlet_pressure_full = -20 * 133.322;
-  EXPECT_NE(unphysiological_pressure_warning(low, negative, 1e-9, 60e-6).find("--venous-pressure (-50 mmHg)"),
+  EXPECT_NE(unphysiological_pressure_warning(low, negative, 1e-9, 60e-6, vprune_words()).find("--venous-pressure (-50 mmHg)"),
+            std::string::npos);
+  // Without a tool's words, the settings' own names.
+  EXPECT_NE(unphysiological_pressure_warning(low, negative, 1e-9, 60e-6).find(": venous_pressure (-50 mmHg)"),
             std::string::npos);
 }

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "formats/boundary_conditions.hpp"
+#include "physics/blood.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/rheology.hpp"
 

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "formats/network.hpp"
 
 using namespace hemotree;

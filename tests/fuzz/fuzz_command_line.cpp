@@ -16,7 +16,7 @@
 #include <string_view>
 #include <vector>
 
-#include "cli/units.hpp"
+#include "core/units.hpp"
 #include "tool_runner.hpp"
 
 using namespace hemotree;

@@ -1,4 +1,4 @@
-#include "cli/units.hpp"
+#include "core/units.hpp"
 
 #include <array>
 #include <charconv>

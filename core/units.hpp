@@ -1,6 +1,7 @@
-// Quantities on the command line: plain SI numbers, or a number with the unit people use
+// Quantities as people write them: plain SI numbers, or a number with the unit people use
 // ("1mm", "7um", "10mmHg", "1.74ml/min"). Everything is converted to SI on entry, and every
-// value is checked against the range its flag accepts before any work is done.
+// value is checked against the range its setting accepts before any work is done. In the
+// core: the tools parse their flags with it, the libraries print quantities with it.
 #pragma once
 
 #include <cstdint>
@@ -14,7 +15,7 @@ enum class Dimension { length, pressure, flow, time, viscosity, dimensionless };
 // Throws InputError("<what>: ...") when the text is not a number with a unit of dim.
 double parse_quantity(std::string_view text, Dimension dim, std::string_view what);
 
-// The values a flag accepts, in SI; an open end excludes its bound.
+// The values a setting accepts, in SI; an open end excludes its bound.
 struct Interval {
   double min, max;
   bool min_open = false, max_open = false;
@@ -30,7 +31,7 @@ std::string describe(const Interval& range, std::string_view unit);
 double parse_quantity(std::string_view text, Dimension dim, std::string_view what,
                       const Interval& range, std::string_view unit);
 
-// A plain number (a flag without a unit, such as --alpha) within range.
+// A plain number (a setting without a unit, such as alpha) within range.
 double parse_number(std::string_view text, std::string_view what, const Interval& range);
 
 // A decimal integer in [min, max]: no sign, no exponent, no silent wrap of "-1" or

@@ -1,0 +1,16 @@
+#include "physics/blood.hpp"
+
+#include <cmath>
+
+namespace hemotree {
+
+double Blood::pries_diameter_scale() const { return std::cbrt(human_mean_cell_volume / mean_cell_volume); }
+double Blood::phase_separation_diameter_scale() const {
+  return std::cbrt(phase_separation_mean_cell_volume / mean_cell_volume);
+}
+
+std::string_view to_string(Rheology rheology) {
+  return rheology == Rheology::pries ? "pries" : "newtonian";
+}
+
+}  // namespace hemotree
