@@ -18,7 +18,9 @@ namespace {
 constexpr std::string_view magic = "hemotree checkpoint\n";
 // 2: the 0D vessels keep their previous pressures; 3: their volumes above c; 4: face volumes;
 // 5: sections framed by their length and checksummed, and the file checksummed.
-constexpr std::uint64_t format_version = 6;  // 6: the transport's last face volumes
+// 6: the transport's last face volumes; 7: the run's identity in a section of its own (a hash of the
+// whole network and the options that shape the state), so that no field is left out of it.
+constexpr std::uint64_t format_version = 7;
 constexpr std::size_t word = sizeof(std::uint64_t);
 constexpr std::size_t header = magic.size() + word;  // the magic line and the format
 

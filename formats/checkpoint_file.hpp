@@ -7,7 +7,7 @@
 // reading it as garbage, and checksums a file changed after it was written: a flipped bit
 // in a stored state would otherwise resume as a plausible run with wrong numbers.
 //
-// The file (format 5):
+// The file (format 7):
 //   "hemotree checkpoint\n", u64 format
 //   each section: u64 name length, name, u64 payload length, payload,
 //                 u64 checksum of the section (its name, length and payload)

@@ -9,7 +9,6 @@
 #include <iterator>
 
 #include "core/errors.hpp"
-#include "cli/tool.hpp"
 #include "formats/vtk_series.hpp"
 #include "solver/run_report.hpp"
 #include "pulse/solution_breakdown.hpp"
@@ -70,9 +69,10 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
 
 void PulsatileRun::snapshot() {
   CheckpointWriter out;
+  out.section("identity");
+  out.put(plan_.network_identity);
+  out.put(plan_.state_shaping);
   out.section("run");
-  out.put(plan_.fingerprint);
-  out.put(plan_.options);
   out.put(static_cast<std::uint64_t>(done_));
   out.put(static_cast<std::uint64_t>(balances_));
   put_summary(out, last_);
@@ -96,11 +96,12 @@ void PulsatileRun::snapshot() {
 
 void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
   CheckpointReader in(bytes, source);
-  in.section("run");
-  if (in.get_u64() != plan_.fingerprint) in.fail("written for another network (its fingerprint differs)");
+  in.section("identity");
+  if (in.get_u64() != plan_.network_identity) in.fail("written for another network (its fingerprint differs)");
   const std::string options = in.get_string();
-  if (options != plan_.options)
-    in.fail("written by a run with other options (there: " + options + "; here: " + plan_.options + ")");
+  if (options != plan_.state_shaping)
+    in.fail("written by a run with other options (there: " + options + "; here: " + plan_.state_shaping + ")");
+  in.section("run");
   done_ = static_cast<int>(in.get_u64());
   balances_ = static_cast<int>(in.get_u64());
   last_ = get_summary(in, net_.vessel_count());
@@ -188,15 +189,16 @@ bool PulsatileRun::has_last_cycle_frames() const {
 
 void PulsatileRun::write_checkpoint() const { write_checkpoint_file(folder_ / "checkpoint.bin", snapshot_); }
 
-void PulsatileRun::progress(std::size_t k, double started) {
+void PulsatileRun::progress(RunObserver& observer, std::size_t k, double started) {
   const double elapsed = seconds_since_epoch_start() - started;
   const double rate = static_cast<double>(k + 1) / std::max(elapsed, 1e-9);
   const double left = static_cast<double>(plan_.steps_per_cycle - k - 1) / rate;
-  std::fprintf(stderr, "\rhemosolve: cycle %d/%d  t = %.4f s  %.0f steps/s  %.0f s left in this cycle   ", done_ + 1,
-               planned(), solver_.time(), rate, left);
+  observer.live_progress(done_ + 1, planned(), solver_.time(), rate, left);
 }
 
-RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
+RunStatus PulsatileRun::run(RunObserver& observer) {
+  const bool live = observer.progress_style() == ProgressStyle::live;
+  const bool log = observer.progress_style() == ProgressStyle::log;
   const double period = solver_.period();
   // Statistics every 1e-4 of a period (or every step if that is longer): means and extrema
   // of the smooth pulse are then exact to ~1e-7, at a few per cent of the run's time. With
@@ -234,12 +236,12 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
         }
         if (solver_.steps() % plan_.sample_every == 0) probes_.sample(solver_);
         if (k % 256 == 0) {
-          if ((signal_ = interrupts.poll()) != 0) {
+          if ((signal_ = observer.poll_interrupt()) != 0) {
             // Back to the last cycle end: what the summary and the checkpoint describe.
-            if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
+            if (live) observer.clear_live_progress();
             return RunStatus::interrupted;
           }
-          if (plan_.live_progress) progress(k, started);
+          if (live) progress(observer, k, started);
         }
         // The cost model's estimate, checked against this machine once the first second or
         // thousand steps have gone by (a clock reading a step until then).
@@ -248,7 +250,7 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
           if (elapsed > 1 || k + 1 >= 1024 || k + 1 == plan_.steps_per_cycle) {
             measured_step_ = elapsed / static_cast<double>(k + 1);
             if (plan_.longest_cycle > 0 && measured_step_ * static_cast<double>(plan_.steps_per_cycle) > plan_.longest_cycle) {
-              if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
+              if (live) observer.clear_live_progress();
               return RunStatus::too_long;
             }
           }
@@ -275,8 +277,8 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
       ++done_;
       snapshot();
       if (plan_.checkpoint_every > 0 && done_ % plan_.checkpoint_every == 0) write_checkpoint();
-      if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
-      if (plan_.log_progress) {
+      if (live) observer.clear_live_progress();
+      if (log) {
         const double wall = seconds_since_epoch_start() - started;
         std::string line = "cycle " + std::to_string(done_) + "/" + std::to_string(planned()) + " done in " +
                            std::to_string(static_cast<long long>(std::lround(wall))) + " s";
@@ -286,11 +288,11 @@ RunStatus PulsatileRun::run(InterruptRequests& interrupts) {
                         static_cast<long long>(net_.id[change_.vessel]));
           line += text;
         }
-        note(line);
+        observer.note(line);
       }
     }
   } catch (const SolutionBreakdown& e) {
-    if (plan_.live_progress) std::fprintf(stderr, "\r\033[K");
+    if (live) observer.clear_live_progress();
     breakdown_ = e.message();
     return RunStatus::broken_down;
   }

@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "cli/interrupt.hpp"
 #include "formats/checkpoint_file.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/flow_transport.hpp"
 #include "solver/probes.hpp"
+#include "solver/run_observer.hpp"
 #include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
@@ -32,10 +32,9 @@ struct RunPlan {
   std::size_t steps_per_cycle = 1;
   std::size_t sample_every = 1;  // steps between probe samples
   int checkpoint_every = 0;     // cycles; 0: only in memory (written on an interrupt)
-  std::uint64_t fingerprint = 0;  // of the network
-  std::string options;          // those options, for a clear refusal of another run's checkpoint
-  bool live_progress = false;   // a line that redraws itself (stderr is a terminal)
-  bool log_progress = false;    // a plain line per cycle (stderr is a log)
+  // The run's identity (solver/run_identity.hpp): a checkpoint of another is refused.
+  std::uint64_t network_identity = 0;
+  std::string state_shaping;    // readable, for a clear refusal of another run's checkpoint
   // The run measures its own step over its first seconds and stops (too_long) when a cycle
   // would take longer than this [s]; 0: never (--force).
   double longest_cycle = 0;
@@ -58,7 +57,9 @@ class PulsatileRun {
   // from a killed run's staging folder (the run's folder), whose frames of that last cycle
   // are then this run's; a published run that already has its cycles is refused as it is.
   void resume(const std::string& checkpoint_bytes, const std::string& source);
-  RunStatus run(InterruptRequests& interrupts);
+  // Progress goes to the observer, as its progress_style() asks; its interrupt requests are
+  // polled every 256 steps and answered at the last cycle end.
+  RunStatus run(RunObserver& observer);
   // Whether run() has a cycle to compute (false after a resume at the run's end).
   bool cycles_left() const;
   // The frames a killed run left in the folder are this run's last cycle's, to be kept by
@@ -74,7 +75,7 @@ class PulsatileRun {
   double red_cell_change() const { return red_cell_change_; }
   bool has_change() const { return !previous_.vessels.empty(); }
   const PeriodicityChange& change() const { return change_; }
-  int signal() const { return signal_; }                    // after an interrupt
+  int signal() const { return signal_; }                    // after an interrupt (RunObserver::poll_interrupt's)
   const std::string& breakdown() const { return breakdown_; }  // after a breakdown; settings as placeholders
   // Wall time per step measured over the first steps this process ran [s]; 0 before.
   double measured_step() const { return measured_step_; }
@@ -88,7 +89,7 @@ class PulsatileRun {
   bool periodic() const;
   void check_run_end(const std::filesystem::path& source) const;
   bool has_last_cycle_frames() const;
-  void progress(std::size_t step_in_cycle, double started);
+  void progress(RunObserver& observer, std::size_t step_in_cycle, double started);
 
   const Network& net_;
   PulseSolver& solver_;

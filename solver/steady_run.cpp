@@ -7,7 +7,6 @@
 #include <numbers>
 
 #include "core/errors.hpp"
-#include "cli/tool.hpp"
 #include "core/units.hpp"
 #include "physics/rheology.hpp"
 #include "solver/output_folder.hpp"
@@ -92,7 +91,7 @@ VesselTable steady_results(const Network& net, const CycleSummary& cycle) {
   return table;
 }
 
-void run_steady(const Network& net, const SteadyRunRequest& request) {
+void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver& observer) {
   Blood blood = net.blood.value_or(Blood{});
   if (request.rheology_override >= 0) blood.rheology = static_cast<Rheology>(request.rheology_override);
   OutputFolder folder(request.out_dir);
@@ -148,8 +147,7 @@ void run_steady(const Network& net, const SteadyRunRequest& request) {
                      " passes (last change " + format_rounded(separated.change) +
                      "): phase separation may have no steady state here, or several; " +
                      request.out_dir.string() + " holds the last pass, marked \"not converged\"");
-  if (!request.quiet)
-    note("steady state of " + std::to_string(net.vessel_count()) + " vessels in " + format_quantity(wall, "s") +
+  observer.note("steady state of " + std::to_string(net.vessel_count()) + " vessels in " + format_quantity(wall, "s") +
          ": " + format_quantity(cycle.inlet_mean_flow, "nl/min") + " in through the boundaries; results in " +
          request.out_dir.string());
 }

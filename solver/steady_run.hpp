@@ -13,6 +13,7 @@
 
 #include "formats/network.hpp"
 #include "solver/cycle_statistics.hpp"
+#include "solver/run_observer.hpp"
 #include "steady/steady_flow.hpp"
 #include "solver/vessel_table.hpp"
 
@@ -39,7 +40,6 @@ struct SteadyRunRequest {
   int rheology_override = -1;      // -1: the file's; else static_cast<int>(Rheology)
   bool vtk = false;
   std::span<const std::uint8_t> vtk_keep;
-  bool quiet = false;
   // Red cells: fixed (the blood's hematocrit everywhere) or phase separation at diverging
   // bifurcations, the flows and hematocrits solved together (steady/steady_hematocrit.hpp).
   bool phase_separation = false;
@@ -49,6 +49,7 @@ struct SteadyRunRequest {
 // OutputFolder (never a half-written folder). InputError for a network it cannot solve. With
 // phase separation each vessel's discharge and tube hematocrit are reported too; an iteration
 // that does not converge writes its last state marked "not converged" and is InputError.
-void run_steady(const Network& net, const SteadyRunRequest& request);
+// The observer hears the one note of a steady run (its time and where its results are).
+void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver& observer);
 
 }  // namespace hemotree

@@ -20,6 +20,13 @@ namespace {
 
 using namespace test_networks;
 
+// The run's interrupt requests are the process's signals, as hemosolve's are.
+struct Interrupts : RunObserver {
+  InterruptRequests requests;
+  int poll_interrupt() override { return requests.poll(); }
+  int poll() { return requests.poll(); }
+};
+
 Network pulsed_vessel() {
   const double d = 3e-3, a = std::numbers::pi / 4 * d * d;
   Network net = chain(1, 0.2, d, beta_for_wave_speed(5.0, a), 1e4, newtonian(4e-3));
@@ -51,7 +58,7 @@ TEST(PulsatileRun, RunsItsCycles) {
   Fixture f;
   PulseSolver s(f.net, f.options);
   PulsatileRun run(f.net, s, {}, f.plan(s, 3), f.folder);
-  InterruptRequests interrupts;
+  Interrupts interrupts;
   EXPECT_EQ(run.run(interrupts), RunStatus::complete);
   EXPECT_EQ(run.cycles_done(), 3);
   EXPECT_NEAR(s.time(), 0.3, 1e-12);
@@ -65,7 +72,7 @@ TEST(PulsatileRun, StopsWhenItsOwnStepSaysACycleIsTooLong) {
   RunPlan plan = f.plan(s, 3);
   plan.longest_cycle = 1e-9;  // [s]: no machine does a cycle in a nanosecond
   PulsatileRun run(f.net, s, {}, plan, f.folder);
-  InterruptRequests interrupts;
+  Interrupts interrupts;
   EXPECT_EQ(run.run(interrupts), RunStatus::too_long);
   EXPECT_EQ(run.cycles_done(), 0);
 }
@@ -74,7 +81,7 @@ TEST(PulsatileRun, AnswersAnInterruptAtAStepsEnd) {
   Fixture f;
   PulseSolver s(f.net, f.options);
   PulsatileRun run(f.net, s, {}, f.plan(s, 3), f.folder);
-  InterruptRequests interrupts;
+  Interrupts interrupts;
   ::raise(SIGTERM);  // blocked: pending until polled, the process lives on
   EXPECT_EQ(run.run(interrupts), RunStatus::interrupted);
   EXPECT_EQ(run.signal(), SIGTERM);
@@ -86,7 +93,7 @@ TEST(PulsatileRun, ResumesFromItsCheckpointAsIfNeverStopped) {
   Fixture f;
   PulseSolver whole(f.net, f.options);
   PulsatileRun a(f.net, whole, {}, f.plan(whole, 4), f.folder);
-  InterruptRequests interrupts;
+  Interrupts interrupts;
   ASSERT_EQ(a.run(interrupts), RunStatus::complete);
 
   PulseSolver first(f.net, f.options);
@@ -111,7 +118,7 @@ TEST(PulsatileRun, RefusesItsCheckpointWithAnyByteChanged) {
   Fixture f;
   PulseSolver first(f.net, f.options);
   PulsatileRun a(f.net, first, {}, f.plan(first, 2), f.folder);
-  InterruptRequests interrupts;
+  Interrupts interrupts;
   ASSERT_EQ(a.run(interrupts), RunStatus::complete);
   a.write_checkpoint();
   const std::string bytes = read_checkpoint_file(f.folder / "checkpoint.bin");
@@ -141,7 +148,7 @@ TEST(PulsatileRun, ResumedAtItsEnd) {
   Fixture f;
   PulseSolver first(f.net, f.options);
   PulsatileRun a(f.net, first, {}, f.plan(first, 2), f.folder);
-  InterruptRequests interrupts;
+  Interrupts interrupts;
   ASSERT_EQ(a.run(interrupts), RunStatus::complete);
   a.write_checkpoint();
   const std::string bytes = read_checkpoint_file(f.folder / "checkpoint.bin");

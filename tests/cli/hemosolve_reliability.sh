@@ -233,6 +233,29 @@ json.dump(net, open(sys.argv[2], "w"))
 PY
 expect_error "resume with another network" 2 "another network" -- \
   "$HEMOSOLVE" "$WORK/other.json" "${ARGS[@]}" --resume "$WORK/whole" --quiet
+# The identity is the whole network at full precision (solver/run_identity.hpp): one field
+# 1e-12 away, or one the solver never reads, is another network.
+for change in 'net["vessels"][0]["reference_pressure"] *= 1 + 1e-12' 'net["nodes"][1]["x"] += 1e-6'; do
+  "$PY" - "$CCA" "$WORK/other.json" "$change" <<'PY'
+import json, sys
+net = json.load(open(sys.argv[1]))
+exec(sys.argv[3])
+json.dump(net, open(sys.argv[2], "w"))
+PY
+  expect_error "resume with one field changed: $change" 2 "written for another network" -- \
+    "$HEMOSOLVE" "$WORK/other.json" "${ARGS[@]}" --resume "$WORK/whole" --quiet
+done
+# A checkpoint of an earlier format is said to be one, not taken for another network's.
+cp -r "$WORK/whole" "$WORK/old-format"
+"$PY" - "$WORK/old-format/checkpoint.bin" <<'PY'
+import struct, sys
+data = bytearray(open(sys.argv[1], "rb").read())
+at = len(b"hemotree checkpoint\n")
+data[at:at + 8] = struct.pack("<Q", 6)
+open(sys.argv[1], "wb").write(data)
+PY
+expect_error "resume from a format 6 checkpoint" 2 "checkpoint format 6 of an earlier hemosolve" -- \
+  "$HEMOSOLVE" "$CCA" "${ARGS[@]}" --resume "$WORK/old-format" --quiet
 
 # What a tool prints to a full disk is an error, not a success.
 if [ -c /dev/full ]; then

@@ -1,0 +1,403 @@
+#include "solver/pulsatile_call.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "core/units.hpp"
+#include "core/errors.hpp"
+#include "formats/checkpoint_file.hpp"
+#include "pulse/pulse_solver.hpp"
+#include "solver/flow_transport.hpp"
+#include "solver/output_folder.hpp"
+#include "solver/pulsatile_run.hpp"
+#include "solver/run_estimate.hpp"
+#include "solver/run_identity.hpp"
+#include "solver/run_report.hpp"
+#include "solver/steady_run.hpp"
+#include "solver/transport_report.hpp"
+
+namespace hemotree {
+
+namespace {
+
+constexpr double one_day = 86400;
+// The scheme's own mass balance: round-off plus the junctions' Newton tolerance (1e-12 of
+// the flow; docs/solver.md). Far above both and far below any error that changes a result.
+constexpr double conservation_tolerance = 1e-8;
+// Steady or mean pressures outside this band are not physiological [mmHg].
+constexpr double physiological_low = 0, physiological_high = 300;
+
+std::string plural(std::size_t count, const std::string& noun) {
+  return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
+}
+
+// Warns when pressures leave the physiological band, with the likely cause.
+void warn_unphysiological(double low, double high, std::int64_t vessel, const Network& net, const char* what,
+                          RunObserver& observer) {
+  if (!std::isfinite(low) || !std::isfinite(high)) return;
+  if (low >= physiological_low * pascal_per_mmhg && high <= physiological_high * pascal_per_mmhg) return;
+  observer.warn(std::string(what) + " reach " + format_quantity(high, "mmHg") + " (lowest " +
+                format_quantity(low, "mmHg") + ", at vessel " + std::to_string(vessel) +
+                "), outside a physiological 0 to 300 mmHg: " +
+                (net.inlet ? "the inlet's mean flow (" + format_quantity(net.inlet->waveform.mean_value(), "ml/min") +
+                                 ") is likely wrong for this network's size (vprune --mean-flow sets it)"
+                           : std::string("the boundary flows and pressures are likely wrong for this network")));
+}
+
+// The checkpoint a resume continues from (empty without one); a killed run's checkpoint is
+// not overwritten by a fresh run unless forced.
+struct Checkpoint {
+  std::string bytes, source;
+};
+
+Checkpoint checkpoint_to_resume(const OutputFolder& folder, const RunConfiguration& config) {
+  Checkpoint c;
+  if (config.resume) {
+    const auto file = folder.latest_checkpoint();
+    if (!file)
+      throw InputError("--resume " + config.out_dir + ": no checkpoint.bin in it or in " + folder.staging().string() +
+                       " (a run writes one when interrupted, or every N cycles with --checkpoint-every N)");
+    c.bytes = read_checkpoint_file(*file);
+    c.source = file->string();
+  }
+  if (!config.resume && !config.force && folder.latest_checkpoint() &&
+      folder.latest_checkpoint()->parent_path() == folder.staging())
+    throw InputError(folder.staging().string() + " holds the checkpoint of a run that was killed: --resume " +
+                     config.out_dir + " continues it; --force (or removing that folder) starts afresh");
+  return c;
+}
+
+// The discretisation's size and cost, said before the run and refused above a day a cycle.
+struct Discretisation {
+  TimeStepDecision step;
+  std::map<int, std::size_t> degrees;  // elements per degree
+  std::size_t one_d = 0;
+};
+
+Discretisation decide_discretisation(const Network& net, PulseSolver& run, const RunConfiguration& config,
+                                     double period, RunObserver& observer) {
+  Discretisation d;
+  d.step = decide_time_step(run, config, period);
+  const std::size_t steps_per_cycle = d.step.cycle.steps_per_cycle;
+  const double dt = d.step.cycle.dt;
+  if (static_cast<std::size_t>(config.frames) > steps_per_cycle)
+    throw InputError("--frames " + std::to_string(config.frames) + " exceeds the " + std::to_string(steps_per_cycle) +
+                     " steps of a cycle");
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (!run.is_lumped(v)) d.degrees[run.degree(v)] += static_cast<std::size_t>(config.solver.elements);
+  std::vector<double> elements_of_degree(static_cast<std::size_t>(run.max_degree()) + 1, 0.0);
+  std::string degree_list;
+  for (const auto& [p, count] : d.degrees) {
+    elements_of_degree[static_cast<std::size_t>(p)] = static_cast<double>(count);
+    degree_list += (degree_list.empty() ? "" : ", ") + std::to_string(count) + " of degree " + std::to_string(p);
+  }
+  const int planned = config.planned_cycles(), threads = config.solver.threads;
+  const double lumped = static_cast<double>(run.lumped_count()), substeps = run.substeps();
+  const RunEstimate per_cycle =
+      estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), threads, substeps, lumped);
+  const RunEstimate whole =
+      estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned, threads, substeps, lumped);
+  if (per_cycle.seconds > one_day && !config.force)
+    throw InputError("one cycle would take about " + describe_duration(per_cycle.seconds) + " (" +
+                     format_rounded(static_cast<double>(steps_per_cycle)) + " steps of " + format_quantity(dt, "s") +
+                     ", set by the " + d.step.reason + "; " + plural(run.element_count(), "element") +
+                     "): refused, more than a day. Check that vessel's wall and length and the inlet's "
+                     "flow, use fewer --elements or a lower --degree, or --force to run it anyway");
+  d.one_d = net.vessel_count() - run.lumped_count();
+  observer.note(plural(d.one_d, "vessel") + " 1D, " + std::to_string(run.lumped_count()) + " 0D (--model " +
+                to_string(config.solver.model) + ")" +
+                (run.lumped_count() > 0 && d.one_d > 0
+                     ? "; " + std::to_string(run.substeps()) + " 1D substeps of " +
+                           format_quantity(run.substep(), "s") + " per step"
+                     : std::string()));
+  observer.note("time step " + format_quantity(dt, "s") + " (" + d.step.reason + "), " +
+                std::to_string(steps_per_cycle) + " steps per cycle, " + plural(run.element_count(), "element") +
+                (degree_list.empty() ? "" : ": ") + degree_list + "; estimated " +
+                describe_duration(per_cycle.seconds) + " per cycle, " + describe_duration(whole.seconds) +
+                (config.until_periodic ? " for at most " : " for ") + plural(planned, "cycle") + " on " +
+                plural(threads, "thread"));
+  if (whole.seconds > one_day && observer.hears_notes())
+    observer.warn("the whole run may take " + describe_duration(whole.seconds) +
+                  " (use --checkpoint-every N to be able to resume it)");
+  return d;
+}
+
+// A run is complete only when its numbers say so: the reason it is not, or empty.
+std::string check_results(const Network& net, const PulseSolver& run, const PulsatileRun& pulsatile,
+                          RunStatus status, const std::string& beyond_limit) {
+  if (status != RunStatus::complete && status != RunStatus::not_periodic) return {};
+  // A forced step beyond the limit runs, for whoever wants to see what it gives, but its
+  // numbers are outside the scheme's accuracy: never complete.
+  if (!beyond_limit.empty()) return beyond_limit + ", forced: the results are outside the scheme's accuracy";
+  const CycleSummary& last = pulsatile.last_cycle();
+  if (!(std::abs(last.conservation_error) < conservation_tolerance))
+    return "the scheme lost mass: (in - out - stored) / in = " + format_rounded(last.conservation_error) +
+           " over the last cycle, above " + format_rounded(conservation_tolerance);
+  // Each prescribed flow's mean against what went through it (a zero mean within 1e-6 of the flow in).
+  const std::vector<NodeBoundary>& list = run.boundary_list();
+  for (std::size_t i = 0; i < list.size() && i < last.boundary_mean_flow.size(); ++i) {
+    if (list[i].type != BoundaryType::flow) continue;
+    const double prescribed = list[i].waveform.mean_value(), got = last.boundary_mean_flow[i];
+    if (std::abs(got - prescribed) <= 1e-2 * std::abs(prescribed) + 1e-6 * std::abs(last.inlet_mean_flow)) continue;
+    const bool inlet = net.inlet && net.boundaries.empty();
+    return (inlet ? std::string("the inlet's mean flow")
+                  : "the mean flow into node " + std::to_string(net.node_id[static_cast<std::size_t>(list[i].node)])) +
+           " over the last cycle is " + format_quantity(got, "ml/min") + " where the waveform prescribes " +
+           format_quantity(prescribed, "ml/min") + ": the time step cannot follow the pulse";
+  }
+  return {};
+}
+
+RunOutcome outcome_of(RunStatus status, const std::string& failure) {
+  return !failure.empty()                     ? RunOutcome::failed
+         : status == RunStatus::broken_down  ? RunOutcome::broken_down
+         : status == RunStatus::interrupted  ? RunOutcome::interrupted
+         : status == RunStatus::not_periodic ? RunOutcome::not_periodic
+                                             : RunOutcome::complete;
+}
+
+// summary.json's "run": the configuration as run, the step and what came of it.
+nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunConfiguration& config,
+                        const Discretisation& d, const PulsatileRun& pulsatile, RunOutcome outcome, double wall) {
+  const SolverOptions& options = config.solver;
+  const bool steady_start = run.started_from_steady();
+  const Waveform driving = driving_waveform(net);
+  const std::size_t steps_per_cycle = d.step.cycle.steps_per_cycle;
+  nlohmann::json info = {{"tool", "hemosolve"}, {"version", HEMOTREE_VERSION},
+                         {"network", config.network_name},
+                         {"degree", options.degree == SolverOptions::automatic ? nlohmann::json("auto")
+                                                                               : nlohmann::json(options.degree)},
+                         {"elements_per_vessel", options.elements}, {"scheme", to_string(options.scheme)},
+                         {"model", to_string(options.model)},
+                         {"vessels_1d", d.one_d},
+                         {"vessels_0d", run.lumped_count()},
+                         {"substeps", run.substeps()},
+                         {"threads", options.threads},
+                         {"rheology", to_string(run.blood().rheology)},
+                         {"red_cells", to_string(config.red_cells)},
+                         {"mean_cell_volume", run.blood().mean_cell_volume},
+                         {"start", steady_start ? "steady" : "rest"},
+                         {"start_requested", options.steady_start ? "steady" : "rest"},
+                         {"balance_compliances", config.balance_compliances && steady_start},
+                         {"period", driving.period},
+                         {"pulse_frequency", pulse_frequency(driving)},
+                         {"analysis_frequency", analysis_frequency(driving)},
+                         {"time_step", d.step.cycle.dt}, {"time_step_limit", d.step.reason},
+                         {"steps_per_cycle", steps_per_cycle},
+                         {"status", to_string(outcome)},
+                         {"cycles", pulsatile.cycles_done()},
+                         {"steps", static_cast<std::uint64_t>(pulsatile.cycles_done()) * steps_per_cycle},
+                         {"compliance_balances", pulsatile.compliance_balances()},
+                         {"wall_time", wall}};
+  if (!steady_start && options.steady_start) info["steady_refusal"] = run.steady_refusal();
+  for (const auto& [p, count] : d.degrees) info["elements_of_degree"][std::to_string(p)] = count;
+  if (pulsatile.has_change()) {
+    info["periodic_change"] = pulsatile.change().change;
+    info["slowest_vessel"] = net.id[pulsatile.change().vessel];
+  }
+  const CycleSummary& last = pulsatile.last_cycle();
+  if (!last.boundary_mean_flow.empty()) {
+    // Each boundary's mean flow into the network over the last cycle (as --steady reports).
+    info["boundaries"] = nlohmann::json::array();
+    for (std::size_t i = 0; i < run.boundary_list().size(); ++i) {
+      const NodeBoundary& b = run.boundary_list()[i];
+      info["boundaries"].push_back({{"node", net.node_id[static_cast<std::size_t>(b.node)]},
+                                    {"type", to_string(b.type)},
+                                    {"flow", last.boundary_mean_flow[i]}});
+      if (!b.is_outlet()) info["boundaries"].back()["hematocrit"] = b.entering_hematocrit(run.blood());
+    }
+  }
+  return info;
+}
+
+// The notes and warnings of a run that ended with its numbers: its length, the red cells'
+// unrest, unphysiological pressures, a tracer the run never reached.
+void say_results(const Network& net, const PulseSolver& run, const RunConfiguration& config,
+                 const PulsatileRun& pulsatile, const FlowTransport* transport, double wall, RunObserver& observer) {
+  std::ostringstream m;
+  m << plural(pulsatile.cycles_done(), "cycle") << " in " << describe_duration(wall);
+  if (pulsatile.has_change())
+    m << "; last cycle-to-cycle change " << format_rounded(pulsatile.change().change) << " (vessel "
+      << net.id[pulsatile.change().vessel] << ")";
+  m << "; results in " << config.out_dir;
+  observer.note(m.str());
+  // The red cells' own unrest, said plainly: a network can oscillate by itself (docs/transport.md).
+  const RedCellCycle& cells = pulsatile.last_red_cells();
+  if (transport && transport->reports_red_cells() && !cells.discharge.empty())
+    observer.note(red_cell_line(net, cells, pulsatile.red_cell_change()));
+  const CycleSummary& last = pulsatile.last_cycle();
+  double low = INFINITY, high = -INFINITY;
+  std::size_t highest = 0;
+  for (std::size_t v = 0; v < last.vessels.size(); ++v) {
+    low = std::min(low, last.vessels[v].mean_pressure);
+    if (last.vessels[v].mean_pressure > high) high = last.vessels[(highest = v)].mean_pressure;
+  }
+  warn_unphysiological(low, high, net.id[highest], net, "mean pressures", observer);
+  // A tracer whose injection the run never reached has no curves: said, not left to be found.
+  for (std::size_t k = 0; transport && k < config.tracers.size(); ++k)
+    if (const TracerTransport& moved = transport->tracer(k); moved.entered() + moved.injected() == 0)
+      observer.warn("tracer " + config.tracers[k].name + " never entered the network (its injection starts at t = " +
+                    format_quantity(config.tracers[k].start, "s") + ", the run ended at t = " +
+                    format_quantity(run.time(), "s") + "): its arrival, peak and transit times are null");
+}
+
+}  // namespace
+
+void check_pulsatile(const Network& net, const RunConfiguration& config) {
+  if (!net.inlet && net.boundaries.empty())
+    throw InputError("the network has no \"inlet\": hemosolve needs one (vprune adds it), or \"boundaries\"");
+  // The common period of the time-varying boundary conditions (1 s where all are constant).
+  const double period = driving_waveform(net).period;
+  if (!Interval{0, period, true, false}.contains(config.sample_interval))
+    throw InputError("--sample-interval must lie in " + describe({0, period, true, false}, "s") + " (got " +
+                     format_quantity(config.sample_interval, "s") + ")");
+}
+
+RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunObserver& observer) {
+  check_configuration(config);
+  check_pulsatile(net, config);
+  const Waveform driving = driving_waveform(net);
+  const double period = driving.period;
+  OutputFolder folder(config.out_dir);
+  const Checkpoint checkpoint = checkpoint_to_resume(folder, config);
+  RunResult result;
+  auto interrupted_before_start = [&] {  // before the time loop nothing is written: just stop
+    if ((result.signal = observer.poll_interrupt()) == 0) return false;
+    observer.warn("interrupted by " + observer.signal_name(result.signal) + " before the first step: nothing written");
+    result.outcome = RunOutcome::interrupted;
+    result.started = false;
+    return true;
+  };
+  if (interrupted_before_start()) return result;
+
+  // ---- the discretisation, its step and its cost ---------------------------------------
+  PulseSolver run(net, config.solver);  // the steady solve: minutes on the full tree
+  if (interrupted_before_start()) return result;
+  const Discretisation d = decide_discretisation(net, run, config, period, observer);
+  const std::size_t steps_per_cycle = d.step.cycle.steps_per_cycle;
+  const double dt = d.step.cycle.dt;
+
+  // ---- what the run starts from, said as it is --------------------------------------------
+  if (config.solver.steady_start && !run.started_from_steady())
+    observer.warn("no steady solution to start from (" + run.steady_refusal() + "): starting from rest" +
+                  (config.balance_compliances ? std::string(", without the compliance balance (it needs the steady network)")
+                                              : std::string()));
+  warn_unphysiological(run.steady_pressure_min(), run.steady_pressure_max(), net.id[run.steady_pressure_max_vessel()],
+                       net, "steady pressures", observer);
+
+  // ---- the run ------------------------------------------------------------------------------
+  const RunIdentity identity = run_identity(net, config, dt, run.blood().rheology);
+  RunPlan plan;
+  plan.cycles = config.cycles;
+  plan.until_periodic = config.until_periodic;
+  plan.periodic_tolerance = config.periodic_tolerance;
+  plan.max_cycles = config.max_cycles;
+  plan.balance_compliances = config.balance_compliances;
+  plan.frames = config.frames;
+  plan.vtk_keep = config.vtk_keep;
+  plan.steps_per_cycle = steps_per_cycle;
+  plan.sample_every = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(config.sample_interval / dt)));
+  plan.checkpoint_every = config.checkpoint_every;
+  plan.network_identity = identity.network;
+  plan.state_shaping = identity.shaping;
+  plan.longest_cycle = config.force ? 0 : one_day;
+  std::optional<FlowTransport> transport;
+  if (config.carries_transport()) {
+    const bool red = config.red_cells == RedCells::transport;
+    const std::vector<TracerSpec>& tracers = config.tracers;
+    FlowTransportOptions carried;
+    carried.tracers = tracers;
+    transport.emplace(net, run, red ? carried : red_cells_fixed(carried));
+    plan.transport_every = std::max<std::size_t>(
+        1, static_cast<std::size_t>(std::llround(config.transport_step * static_cast<double>(steps_per_cycle))));
+    observer.note(std::string(red ? "red cells" : "") + (red && !tracers.empty() ? " and " : "") +
+                  (tracers.empty() ? "" : plural(tracers.size(), "tracer")) + " carried on " +
+                  plural(transport->cell_count(), "cell") + ", a transport step every " +
+                  plural(plan.transport_every, "flow step"));
+  }
+  PulsatileRun pulsatile(net, run, config.probes, plan, folder.staging(), transport ? &*transport : nullptr);
+  if (!checkpoint.bytes.empty()) {
+    pulsatile.resume(checkpoint.bytes, checkpoint.source);
+    observer.note("resuming from " + checkpoint.source + " after " + std::to_string(pulsatile.cycles_done()) +
+                  " cycles (t = " + format_quantity(run.time(), "s") + ")");
+  }
+  folder.open(pulsatile.keeps_frames());  // a resume at the run's end keeps the killed run's last frames
+  if (config.frames > 0) {
+    std::error_code ec;
+    std::filesystem::create_directories(folder.staging() / "frames", ec);
+    if (ec) throw IoError("cannot create " + (folder.staging() / "frames").string() + ": " + ec.message());
+  }
+  const auto started = std::chrono::steady_clock::now();
+  const RunStatus status = pulsatile.run(observer);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const CycleSummary& last = pulsatile.last_cycle();
+
+  const std::string failure = check_results(net, run, pulsatile, status, d.step.beyond_limit);
+  result.outcome = outcome_of(status, failure);
+  result.signal = pulsatile.signal();
+  nlohmann::json info = run_info(net, run, config, d, pulsatile, result.outcome, wall);
+  if (!failure.empty()) info["error"] = failure;
+  if (status == RunStatus::broken_down) info["error"] = in_words(pulsatile.breakdown(), config.words);
+  if (status == RunStatus::interrupted)
+    info["error"] = "interrupted by " + observer.signal_name(pulsatile.signal()) + "; resume with --resume " +
+                    config.out_dir;
+
+  if (status == RunStatus::too_long) {
+    folder.discard();
+    const double cycle = pulsatile.measured_step() * static_cast<double>(steps_per_cycle);
+    throw InputError("one cycle would take about " + describe_duration(cycle) + " (measured over its first steps: " +
+                     format_quantity(pulsatile.measured_step(), "s") + " a step, " +
+                     format_rounded(static_cast<double>(steps_per_cycle)) +
+                     " steps): stopped, more than a day. Use fewer --elements or a lower --degree, --threads, "
+                     "or --force to run it anyway");
+  }
+  // Nothing computed, nothing kept: DIR stays as it was.
+  if (status == RunStatus::broken_down && last.vessels.empty()) {
+    folder.discard();
+    throw InputError(in_words(pulsatile.breakdown(), config.words));
+  }
+  const std::filesystem::path dir = folder.staging();
+  if (status == RunStatus::interrupted || config.checkpoint_every > 0) pulsatile.write_checkpoint();
+  pulsatile.probes().write(dir / "probes.csv");
+  VesselTable results = last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(driving));
+  if (transport && !last.vessels.empty())
+    report_transport(net, *transport, pulsatile.last_red_cells(), pulsatile.red_cell_change(),
+                     static_cast<double>(plan.transport_every) * dt, results, info);
+  if (!last.vessels.empty()) info["statistics"] = group_statistics(net, results);
+  write_summary(dir / "summary.json", info, results, last);
+  write_vessel_table(dir / "vessels.csv", results);
+  if (config.vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
+  folder.publish();
+
+  result.error = status == RunStatus::broken_down ? in_words(pulsatile.breakdown(), config.words) : failure;
+  result.cycles_done = pulsatile.cycles_done();
+  result.has_change = pulsatile.has_change();
+  if (result.has_change) {
+    result.change = pulsatile.change().change;
+    result.slowest_vessel = net.id[pulsatile.change().vessel];
+  }
+  result.time_step = dt;
+  result.steps_per_cycle = steps_per_cycle;
+  result.last_cycle = last;
+  const bool with_numbers = result.outcome == RunOutcome::complete || result.outcome == RunOutcome::not_periodic;
+  if (with_numbers) say_results(net, run, config, pulsatile, transport ? &*transport : nullptr, wall, observer);
+  return result;
+}
+
+void run_steady(const Network& net, const RunConfiguration& config, RunObserver& observer) {
+  SteadyRunRequest request;
+  request.input = config.network_name;
+  request.out_dir = config.out_dir;
+  request.rheology_override = config.solver.rheology_override;
+  request.vtk = config.vtk;
+  request.vtk_keep = config.vtk_keep;
+  request.phase_separation = config.red_cells == RedCells::transport;
+  run_steady(net, request, observer);
+}
+
+}  // namespace hemotree

@@ -1,0 +1,79 @@
+// A pulsatile or steady run as one value: what a tool's options (or a test, a benchmark, a
+// binding) ask for, checked once, and the decisions taken from it before the time loop (the
+// time step a whole number of times per cycle). solver/pulsatile_call.hpp runs it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/setting_error.hpp"
+#include "pulse/pulse_solver.hpp"
+#include "solver/probes.hpp"
+#include "solver/tracer_spec.hpp"
+
+namespace hemotree {
+
+// Red cells: the blood's hematocrit in every vessel, or split at diverging bifurcations and
+// carried by the flow (docs/transport.md).
+enum class RedCells { fixed, transport };
+const char* to_string(RedCells cells);          // "fixed", "transport"
+const char* to_string(ModelChoice model);       // "auto", "1d", "0d"
+const char* to_string(TimeScheme scheme);       // "etd2", "ab2", "rk4"
+
+struct RunConfiguration {
+  std::string network_name;  // as the caller named it (summary.json's "network")
+  std::string out_dir;       // the results folder, written as OUT.partial until the run ends
+  SolverOptions solver;      // model, degrees, elements, scheme, step, wall, start, threads
+  // Cycles: this many, or until every vessel's mean pressure changes by less than
+  // periodic_tolerance (relative) from one cycle to the next, at most max_cycles.
+  int cycles = 1;
+  bool until_periodic = false;
+  double periodic_tolerance = 0;
+  int max_cycles = 50;
+  bool balance_compliances = true;
+  int checkpoint_every = 0;       // cycles; 0: a checkpoint only when interrupted
+  bool resume = false;            // continue from the latest checkpoint of out_dir
+  double sample_interval = 1e-3;  // between probe samples [s], in (0, the period]
+  std::vector<Probe> probes;
+  RedCells red_cells = RedCells::fixed;
+  std::vector<TracerSpec> tracers;
+  double transport_step = 5e-3;   // the transport's step as a fraction of the period, in (0, 0.5]
+  int frames = 0;                 // of the last cycle, as a ParaView time series
+  bool vtk = false;               // results.vtp
+  std::vector<std::uint8_t> vtk_keep;  // the vessels the VTK output shows (empty: all)
+  // Run even beyond the stability limit, a day per cycle, or over a killed run's checkpoint.
+  bool force = false;
+  // The caller's words for the settings that texts from the solver name (its time-step
+  // reason, a breakdown's advice): hemosolve's flags; empty, the settings' own names.
+  SettingWords words;
+
+  bool carries_transport() const { return red_cells == RedCells::transport || !tracers.empty(); }
+  int planned_cycles() const { return until_periodic ? max_cycles : cycles; }
+};
+
+// The configuration's own ranges, before any work (InputError naming the option as hemosolve
+// spells it: the command line is where a configuration is most often written).
+void check_configuration(const RunConfiguration& config);
+
+// A cycle of N steps of dt = T / N: the step no longer than the solver's, N = ceil(T / step)
+// (less 1e-9 of a step, so that a step that divides the period is kept), so that every
+// cycle ends exactly on a step. InputError when N is beyond any machine's reach.
+struct CycleStep {
+  std::size_t steps_per_cycle = 1;
+  double dt = 0;  // [s]
+};
+CycleStep decide_cycle_step(double period, double step, const std::string& reason);
+
+// The run's time step, decided here alone: the solver's (its stability limit, or the one
+// asked for), refused above the limit unless forced, rounded to a whole number per cycle and
+// set on the solver.
+struct TimeStepDecision {
+  CycleStep cycle;
+  std::string reason;        // what limits the step (the solver's words)
+  std::string beyond_limit;  // a forced step above the limit, said; empty otherwise
+};
+TimeStepDecision decide_time_step(PulseSolver& solver, const RunConfiguration& config, double period);
+
+}  // namespace hemotree
