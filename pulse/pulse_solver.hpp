@@ -94,6 +94,8 @@ class PulseSolver {
   double substep() const { return dt_ / substeps_; }
   bool is_lumped(std::size_t vessel) const { return zero_d_[vessel]; }
   std::size_t lumped_count() const { return lumped_.vessel_count(); }
+  // What sets the step; a setting it names is a placeholder (core/setting_error.hpp), for the
+  // caller to word: in_words(dt_reason(), words).
   const std::string& dt_reason() const { return dt_reason_; }
   // The largest step the run takes without --force, whatever --dt asked for, and what sets
   // it: the scheme's stability limit (cfl times it) with 1D vessels alone; with 0D vessels the

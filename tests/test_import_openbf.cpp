@@ -13,7 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/setting_words.hpp"
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "exchange/openbf.hpp"
 #include "tests/shared_networks.hpp"
 
@@ -121,7 +123,7 @@ double openbf_tube_beta(double e, double h, double r) {
 // As openBF's documentation reads the model.
 TEST_F(OpenbfTest, ReadsEveryKeyOfAHandWrittenModel) {
   file("tee_inlet.dat", inlet_table);
-  options_.note = [this](const std::string& s) { notes_.push_back(s); };
+  options_.note = [this](const std::string& s) { notes_.push_back(in_words(s, vimport_words())); };  // as vimport words them
   const Network net = read_openbf(file("tee.yaml", three_vessels), options_, OpenbfReading::documented);
 
   ASSERT_EQ(net.vessel_count(), 3u);
@@ -216,7 +218,7 @@ TEST_F(OpenbfTest, ReadsEveryKeyOfAHandWrittenModel) {
 // documented reading is one note naming --as-documented.
 TEST_F(OpenbfTest, ByDefaultBuildsTheModelOpenbfsCodeComputes) {
   file("tee_inlet.dat", inlet_table);
-  options_.note = [this](const std::string& s) { notes_.push_back(s); };
+  options_.note = [this](const std::string& s) { notes_.push_back(in_words(s, vimport_words())); };  // as vimport words them
   const Network net = read_openbf(file("tee.yaml", three_vessels), options_);
 
   EXPECT_FALSE(net.is_tapered(0));
@@ -259,7 +261,7 @@ TEST_F(OpenbfTest, TheSpacedGammaProfileIsReadOnlyAsDocumented) {
   std::string text = three_vessels;
   for (std::size_t at; (at = text.find("gamma_profile")) != std::string::npos;) text.replace(at, 13, "gamma profile");
   file("spaced.yaml", text);
-  options_.note = [this](const std::string& s) { notes_.push_back(s); };
+  options_.note = [this](const std::string& s) { notes_.push_back(in_words(s, vimport_words())); };  // as vimport words them
   EXPECT_DOUBLE_EQ(read_openbf(path("spaced.yaml"), options_).blood->alpha, 4.0 / 3.0);
   bool told = false;
   for (const std::string& n : notes_)
@@ -405,7 +407,7 @@ TEST_F(OpenbfTest, RefusesManyKeysAtTheFirstUnknownOne) {
 // (0.5 s, 1e-4): 3e-5 m^3/s apart, 30 % of the peak 1e-4.
 TEST_F(OpenbfTest, LeavesOutRowsThatGoBackInTimeWithANote) {
   file("tee_inlet.dat", "0 0\n0.5 1e-4\n0.4 8e-5\n0.6 6e-5\n1 0\n");
-  options_.note = [this](const std::string& s) { notes_.push_back(s); };
+  options_.note = [this](const std::string& s) { notes_.push_back(in_words(s, vimport_words())); };  // as vimport words them
   const Network net = read_openbf(file("tee.yaml", three_vessels), options_);
   EXPECT_EQ(net.inlet->waveform.time, (std::vector<double>{0, 0.5, 0.6}));
   std::string note;
