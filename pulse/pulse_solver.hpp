@@ -197,10 +197,21 @@ class PulseSolver {
   std::size_t balance_compliances(double period, const std::vector<double>* mean_pressure = nullptr);
 
  private:
+  // The DG rate dU/dt of the 1D vessels at time t (pulse/dg_rate.cpp), and its steps in order.
   void evaluate(double t, const PulseState& s, PulseState& rate);
+  void volume_terms(double t, const PulseState& s, PulseState& rate);  // (F, dphi/dx), S, traces
   // Returns the first element whose area is not positive and finite, or -1.
   Eigen::Index element_terms(const PulseState& s, PulseState& rate, const ModalBasis& basis, Eigen::Index first,
                              Eigen::Index count);
+  void interior_face_fluxes();                          // upwind F* between a vessel's elements
+  void prescribed_end_fluxes(double t);                 // F(U*) at given flows and pressures
+  void coupled_end_fluxes(double t, PulseState& rate);  // at nodes of 0D vessels; their inflows
+  void outlet_end_fluxes(const PulseState& s, PulseState& rate);  // R, RCR (dp_c/dt), reflection
+  void boundary_exchange(PulseState& rate) const;       // volumes in and out through the boundaries
+  void junction_fluxes(double t);                       // each junction's Riemann problem
+  void lift_to_rate(PulseState& rate) const;            // surface term, 1/J, source's projection
+  void trace(const VesselEnd& end, double& a, double& q) const;  // the inner trace at an end
+  void set_end_flux(const VesselEnd& end, const EndState& u);    // F(U*) there; U* kept
   void step_exponential(double h);
   void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
   void step_coupled();     // a 0D step around its 1D substeps
