@@ -9,6 +9,7 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -212,11 +213,18 @@ class PulseSolver {
   void lift_to_rate(PulseState& rate) const;            // surface term, 1/J, source's projection
   void trace(const VesselEnd& end, double& a, double& q) const;  // the inner trace at an end
   void set_end_flux(const VesselEnd& end, const EndState& u);    // F(U*) there; U* kept
-  void step_exponential(double h);
+  // The step from the stability limits, and the schemes (pulse_time_stepping.cpp).
+  void choose_time_step(const SolverOptions& options);
+  void step_exponential(double h);  // ETD2 in the friction, AB2 in the rest
   void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
   void step_coupled();     // a 0D step around its 1D substeps
+  // The constructor's steps (pulse_solver.cpp), after the tube laws and the models.
+  std::optional<SteadyFlow> solve_steady_flow();  // none where the network has none: why kept
+  // A pressure boundary counts as "in" or "out" by its steady flow (without one: as built).
+  void orient_pressure_boundaries(const std::optional<SteadyFlow>& steady);
+  void couple_lumped_ends();  // the 1D ends at 0D nodes: their nodes, slots, held inflows
+  void allocate_state();      // the state's and the point values' storage
   void choose_models(const SolverOptions& options);
-  void choose_time_step(const SolverOptions& options);
   void start_from_steady_flow(const SteadyFlow& steady);
   std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
   void start_at_rest();
@@ -226,6 +234,7 @@ class PulseSolver {
     return zero_d_[vessel] ? first_element_[vessel] : first_element_[vessel] + elements_per_vessel_;
   }
   std::vector<double> capacitor_pressures() const;  // per run outlet (NaN: none)
+  // A point of a 1D vessel: its element and xi in [-1, 1] there, and the modes' value (pulse_sampling.cpp).
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
   double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;
 
