@@ -81,8 +81,4 @@ struct VesselTaper {
   }
 };
 
-// The one law under the name the pulse solver still uses (pulse/pulse_solver.*) until its
-// split into the DG rate, stepping and sampling files lands (issue 22); then the name goes.
-using VesselLaw = TubeLaw;
-
 }  // namespace hemotree

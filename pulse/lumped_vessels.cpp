@@ -11,7 +11,6 @@
 #include "core/setting_error.hpp"
 #include "core/parallel_errors.hpp"
 #include "physics/poiseuille.hpp"
-#include "pulse/network_boundaries.hpp"
 #include "pulse/solution_breakdown.hpp"
 
 namespace hemotree {
@@ -56,75 +55,7 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   shunt_pressure_.assign(network_nodes_, 0.0);
   volume_b_.assign(network_nodes_, 0.0);
 
-  // Boundary conditions at nodes of 0D vessels (pulse/network_boundaries.hpp's order):
-  // outlets are shunts, or R1 to a capacitor node with R2 and C; flows are currents into
-  // their nodes; a pressure holds its node through a shunt far stiffer than the node's
-  // vessel (predict() sizes it), a Dirichlet condition to 1e-10 of the vessel's drop.
-  std::vector<std::int32_t> vessel_at(net.node_count(), -1), end_sign(net.node_count(), 0);
-  for (std::size_t e = 0; e < vessels_.size(); ++e) {
-    const auto v = static_cast<std::size_t>(vessels_[e]);
-    vessel_at[static_cast<std::size_t>(net.from[v])] = static_cast<std::int32_t>(v);
-    end_sign[static_cast<std::size_t>(net.from[v])] = -1;  // flow along it leaves the node
-    vessel_at[static_cast<std::size_t>(net.to[v])] = static_cast<std::int32_t>(v);
-    end_sign[static_cast<std::size_t>(net.to[v])] = 1;
-  }
-  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
-  std::size_t outlet_count = 0;
-  for (const NodeBoundary& b : boundaries) outlet_count += b.is_outlet() ? 1 : 0;
-  capacitor_of_outlet_.assign(outlet_count, -1);
-  std::int32_t k = -1;  // outlet index
-  for (std::size_t i = 0; i < boundaries.size(); ++i) {
-    const NodeBoundary& bc = boundaries[i];
-    if (bc.is_outlet()) ++k;
-    const auto network_node = static_cast<std::size_t>(bc.node);
-    if (node_of_[network_node] < 0) continue;
-    const auto at = static_cast<std::size_t>(node_of_[network_node]);
-    const auto v = static_cast<std::size_t>(vessel_at[network_node]);
-    const auto boundary = static_cast<std::int32_t>(i);
-    if (bc.type == BoundaryType::flow) {
-      inflow_node_.push_back(static_cast<std::int32_t>(at));
-      inflow_boundary_.push_back(boundary);
-      inflow_entering_.push_back(bc.waveform.mean_value() >= 0);
-      continue;
-    }
-    if (bc.type == BoundaryType::pressure) {
-      held_node_.push_back(static_cast<std::int32_t>(at));
-      held_boundary_.push_back(boundary);
-      held_entering_.push_back(1);
-      const TubeLaw& law = laws[v];
-      held_reference_conductance_.push_back(law.reference_area * law.reference_area /
-                                            (friction_k_ * viscosity(law.reference_area) * net.length[v]));
-      shunt_pressure_[at] = bc.waveform.mean_value();
-      continue;
-    }
-    const Outlet& o = bc.outlet;
-    if (o.type == OutletType::reflection)
-      throw SettingError("model", "vessel " + std::to_string(net.id[v]) + ": a reflection outlet needs a 1D vessel (" +
-                                      placeholder("model") + " 1d, or auto, keeps it 1D)");
-    outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(at), -1});
-    if (o.type == OutletType::rcr && o.c > 0) {
-      capacitor_of_outlet_[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(outlet_of_capacitor_.size());
-      const auto c = static_cast<std::int32_t>(nodes_++);
-      outlet_boundary_.back().r1_edge = static_cast<std::int32_t>(vessels_.size() + outlet_of_capacitor_.size());
-      outlet_of_capacitor_.push_back(k);
-      capacitor_vessel_edge_.push_back(index_of_vessel_[v]);
-      capacitor_edge_sign_.push_back(end_sign[network_node]);
-      a_.push_back(static_cast<std::int32_t>(at));
-      b_.push_back(c);
-      edge_fixed_resistance_.push_back(o.r1);
-      shunt_.push_back(1 / o.r2);
-      shunt_pressure_.push_back(o.p_out);
-      volume_b_.push_back(o.c);
-    } else {
-      shunt_[at] = 1 / o.resistance();
-      shunt_pressure_[at] = o.p_out;
-    }
-  }
-  if (!held_node_.empty()) {
-    held_.assign(nodes_, 0);
-    for (std::size_t j = 0; j < held_node_.size(); ++j) held_[static_cast<std::size_t>(held_node_[j])] = static_cast<std::int32_t>(j + 1);
-    held_out_.assign(held_node_.size(), 0.0);
-  }
+  add_boundary_rows(net, laws, viscosity);
 
   // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes:
   // (L / 2) (d^2 p^2 + 2 c d p + c^2).
@@ -147,6 +78,10 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
     }
   }
 
+  allocate_system();
+}
+
+void LumpedVessels::allocate_system() {
   system_ = NodalSystem(nodes_, a_, b_);
   const std::size_t edges = a_.size();
   volume_.assign(nodes_, 0.0);
@@ -611,11 +546,6 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * predicted_[k] - shunt_current_[k];
     boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * out;
   }
-}
-
-void LumpedVessels::set_entering(std::span<const unsigned char> entering) {
-  for (std::size_t j = 0; j < inflow_node_.size(); ++j) inflow_entering_[j] = entering[static_cast<std::size_t>(inflow_boundary_[j])];
-  for (std::size_t j = 0; j < held_node_.size(); ++j) held_entering_[j] = entering[static_cast<std::size_t>(held_boundary_[j])];
 }
 
 // ---- what the rest of the solver reads -------------------------------------------------------

@@ -251,6 +251,11 @@ class LumpedVessels {
   }
   // The flow out of the network through held node j in the step just completed.
   double held_outflow(std::size_t j) const { return held_out_[j]; }
+  // The constructor's steps: the boundary conditions' rows at 0D nodes (shunts, currents,
+  // held nodes, RCR capacitor nodes; pulse/lumped_boundary_rows.cpp), and the nodal system
+  // with the per-node and per-edge arrays and each node's incident edges.
+  void add_boundary_rows(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity);
+  void allocate_system();
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R

@@ -1,14 +1,18 @@
+// PulseSolver set up from a network and options: each vessel's tube law, the 1D/0D choice,
+// degrees and elements (blocks of rows by degree), the taper tables, the boundaries and the
+// 1D-0D coupling, the initial state (steady or at rest); and the transport's hooks (viscosity
+// factors, face volumes). Its other concepts have their own files: the DG rate (dg_rate.cpp),
+// the time step and schemes (pulse_time_stepping.cpp), the solution read out
+// (pulse_sampling.cpp), the checkpoint (pulse_solver_checkpoint.cpp) and the compliance
+// balance (compliance_balance.cpp).
 #include "pulse/pulse_solver.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <optional>
 #include <sstream>
-
-#include <omp.h>
 
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
@@ -16,8 +20,6 @@
 #include "formats/connected_parts.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/wall_law.hpp"
-#include "pulse/solution_breakdown.hpp"
-#include "pulse/stability_limit.hpp"
 #include "steady/steady_flow.hpp"
 
 namespace hemotree {
@@ -65,7 +67,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   laws_.resize(n);
   for (std::size_t v = 0; v < n; ++v) {
     const std::string name = "vessel " + std::to_string(net.id[v]);
-    VesselLaw& law = laws_[v];
+    TubeLaw& law = laws_[v];
     law.density = blood_.density;
     law.alpha = blood_.momentum_alpha();
     if (!net.beta.empty() && !std::isnan(net.beta[v])) {
@@ -113,25 +115,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   lumped_.set_passes(options.lumped_passes);
   lumped_.set_threads(threads_);
 
-  // The steady Poiseuille solution, where the network has one (not with reflection outlets):
-  // the degrees follow its pressure profiles, and the run starts from it.
-  std::optional<SteadyFlow> steady;
-  // (A network with node boundaries takes their means; a tree, its inlet's.)
-  try {
-    steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet ? net.inlet->waveform.mean_value() : 0.0,
-                                         &steady_resistance_);
-  } catch (const InputError& e) {
-    steady_refusal_ = e.what();
-  }
-  if (steady) {
-    const auto [low, high] = std::minmax_element(steady->node_pressure.begin(), steady->node_pressure.end());
-    steady_pressure_min_ = *low;
-    steady_pressure_max_ = *high;
-    const auto node = high - steady->node_pressure.begin();  // the inlet's node, as a rule
-    const auto entering = std::find(net.to.begin(), net.to.end(), node), leaving = std::find(net.from.begin(), net.from.end(), node);
-    steady_pressure_max_vessel_ = static_cast<std::size_t>(
-        entering != net.to.end() ? entering - net.to.begin() : leaving - net.from.begin());
-  }
+  const std::optional<SteadyFlow> steady = solve_steady_flow();
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
   boundaries_ = build_boundaries(net, first_element_, elements_per_vessel_, zero_d_);
   // The steady solve's rule (docs/network-format.md), once the boundaries' own form is checked:
@@ -139,46 +123,9 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   // called complete (hostile-inputs 05), or failed deep in the 0D solve.
   if (const std::string refusal = pressure_reference_refusal(net, boundaries_.list); !refusal.empty())
     throw SettingError("pressure_at", refusal);
-  if (steady) {
-    // A pressure boundary counts as "in" or "out" by its steady flow.
-    std::vector<double> inflow(net.node_count(), 0.0);
-    for (std::size_t v = 0; v < n; ++v) {
-      inflow[static_cast<std::size_t>(net.from[v])] += steady->flow[v];
-      inflow[static_cast<std::size_t>(net.to[v])] -= steady->flow[v];
-    }
-    for (std::size_t i = 0; i < boundaries_.list.size(); ++i)
-      if (boundaries_.list[i].type == BoundaryType::pressure)
-        boundaries_.entering[i] = inflow[static_cast<std::size_t>(boundaries_.list[i].node)] >= 0;
-  }
-  lumped_.set_entering(boundaries_.entering);
-  lumped_inflow_.assign(lumped_.inflow_boundaries().size(), 0.0);
-  lumped_held_.assign(lumped_.held_boundaries().size(), 0.0);
-  for (const auto& c : boundaries_.coupled) coupled_node_.push_back(lumped_.node_of(c.node));
-  {
-    std::vector<std::int32_t> nodes = coupled_node_;
-    std::sort(nodes.begin(), nodes.end());
-    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-    for (const std::int32_t node : coupled_node_)
-      coupled_slot_.push_back(static_cast<std::int32_t>(std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
-    coupled_inflow_.assign(nodes.size(), 0.0);
-    lumped_.set_coupling_nodes(std::move(nodes));
-  }
-  held_end_flow_.assign(boundaries_.coupled.size(), 0.0);
-  coupled_volume_ = coupled_inflow_;
-
-  const auto rows = static_cast<Eigen::Index>(element_vessel_.size());
-  Eigen::Index points = 0;
-  for (const DegreeBlock& b : blocks_) points = std::max<Eigen::Index>(points, bases_[b.degree].points);
-  const Eigen::Index modes = max_degree() + 1;
-  state_.area.setZero(rows, modes);
-  state_.flow.setZero(rows, modes);
-  state_.capacitor.setZero(static_cast<Eigen::Index>(boundaries_.capacitors));
-  state_.coupled.setZero(static_cast<Eigen::Index>(boundaries_.coupled.size()));
-  state_.boundary.setZero(static_cast<Eigen::Index>(boundaries_.list.size()));
-  area_q_.resize(rows, points);
-  flow_q_.resize(rows, points);
-  flux_q_.resize(rows, points);
-  source_q_.resize(rows, points);
+  orient_pressure_boundaries(steady);
+  couple_lumped_ends();
+  allocate_state();
 
   compute_rest_correction();
   started_from_steady_ = options.steady_start && steady;
@@ -216,11 +163,76 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);
 }
 
-void PulseSolver::set_time_step(double dt) {
-  dt_ = dt;
-  substeps_ = lumped_.empty() || !std::isfinite(stable_1d_)
-                  ? 1
-                  : static_cast<int>(std::max(1.0, std::ceil(dt / stable_1d_ - 1e-9)));
+std::optional<SteadyFlow> PulseSolver::solve_steady_flow() {
+  const Network& net = net_;
+  // The steady Poiseuille solution, where the network has one (not with reflection outlets):
+  // the degrees follow its pressure profiles, and the run starts from it.
+  std::optional<SteadyFlow> steady;
+  // (A network with node boundaries takes their means; a tree, its inlet's.)
+  try {
+    steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet ? net.inlet->waveform.mean_value() : 0.0,
+                                         &steady_resistance_);
+  } catch (const InputError& e) {
+    steady_refusal_ = e.what();
+  }
+  if (steady) {
+    const auto [low, high] = std::minmax_element(steady->node_pressure.begin(), steady->node_pressure.end());
+    steady_pressure_min_ = *low;
+    steady_pressure_max_ = *high;
+    const auto node = high - steady->node_pressure.begin();  // the inlet's node, as a rule
+    const auto entering = std::find(net.to.begin(), net.to.end(), node), leaving = std::find(net.from.begin(), net.from.end(), node);
+    steady_pressure_max_vessel_ = static_cast<std::size_t>(
+        entering != net.to.end() ? entering - net.to.begin() : leaving - net.from.begin());
+  }
+  return steady;
+}
+
+void PulseSolver::orient_pressure_boundaries(const std::optional<SteadyFlow>& steady) {
+  const Network& net = net_;
+  const std::size_t n = net.vessel_count();
+  if (steady) {
+    // A pressure boundary counts as "in" or "out" by its steady flow.
+    std::vector<double> inflow(net.node_count(), 0.0);
+    for (std::size_t v = 0; v < n; ++v) {
+      inflow[static_cast<std::size_t>(net.from[v])] += steady->flow[v];
+      inflow[static_cast<std::size_t>(net.to[v])] -= steady->flow[v];
+    }
+    for (std::size_t i = 0; i < boundaries_.list.size(); ++i)
+      if (boundaries_.list[i].type == BoundaryType::pressure)
+        boundaries_.entering[i] = inflow[static_cast<std::size_t>(boundaries_.list[i].node)] >= 0;
+  }
+}
+
+void PulseSolver::couple_lumped_ends() {
+  lumped_.set_entering(boundaries_.entering);
+  lumped_inflow_.assign(lumped_.inflow_boundaries().size(), 0.0);
+  lumped_held_.assign(lumped_.held_boundaries().size(), 0.0);
+  for (const auto& c : boundaries_.coupled) coupled_node_.push_back(lumped_.node_of(c.node));
+  std::vector<std::int32_t> nodes = coupled_node_;
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  for (const std::int32_t node : coupled_node_)
+    coupled_slot_.push_back(static_cast<std::int32_t>(std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
+  coupled_inflow_.assign(nodes.size(), 0.0);
+  lumped_.set_coupling_nodes(std::move(nodes));
+  held_end_flow_.assign(boundaries_.coupled.size(), 0.0);
+  coupled_volume_ = coupled_inflow_;
+}
+
+void PulseSolver::allocate_state() {
+  const auto rows = static_cast<Eigen::Index>(element_vessel_.size());
+  Eigen::Index points = 0;
+  for (const DegreeBlock& b : blocks_) points = std::max<Eigen::Index>(points, bases_[b.degree].points);
+  const Eigen::Index modes = max_degree() + 1;
+  state_.area.setZero(rows, modes);
+  state_.flow.setZero(rows, modes);
+  state_.capacitor.setZero(static_cast<Eigen::Index>(boundaries_.capacitors));
+  state_.coupled.setZero(static_cast<Eigen::Index>(boundaries_.coupled.size()));
+  state_.boundary.setZero(static_cast<Eigen::Index>(boundaries_.list.size()));
+  area_q_.resize(rows, points);
+  flow_q_.resize(rows, points);
+  flux_q_.resize(rows, points);
+  source_q_.resize(rows, points);
 }
 
 void PulseSolver::choose_models(const SolverOptions& options) {
@@ -241,7 +253,7 @@ void PulseSolver::choose_models(const SolverOptions& options) {
     reflecting[v] = reflecting_node[static_cast<std::size_t>(net_.from[v])] || reflecting_node[static_cast<std::size_t>(net_.to[v])];
   const double period = period_, omega = 2 * std::numbers::pi / period;
   for (std::size_t v = 0; v < n; ++v) {
-    const VesselLaw& law = laws_[v];
+    const TubeLaw& law = laws_[v];
     const double area = law.reference_area, length = net_.length[v];
     double transit = length / law.wave_speed(area);
     double compliance = law.compliance(length, area);
@@ -251,7 +263,7 @@ void PulseSolver::choose_models(const SolverOptions& options) {
       const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
       transit = compliance = 0;
       for (std::size_t i = 0; i < taper_rule_nodes.size(); ++i) {
-        const VesselLaw at = taper.at(taper_rule_nodes[i]);
+        const TubeLaw at = taper.at(taper_rule_nodes[i]);
         const double a = taper.rest_area(taper_rule_nodes[i]);
         transit += taper_rule_weights[i] * length / at.wave_speed(a);
         compliance += at.compliance(taper_rule_weights[i] * length, a);
@@ -362,7 +374,7 @@ void PulseSolver::build_taper_tables() {
   }
 }
 
-VesselLaw PulseSolver::law_at(std::size_t vessel, double x) const {
+TubeLaw PulseSolver::law_at(std::size_t vessel, double x) const {
   if (!is_tapered(vessel)) return laws_[vessel];
   return tapers_[static_cast<std::size_t>(taper_of_[vessel])].at(std::clamp(x, 0.0, 1.0));
 }
@@ -438,7 +450,7 @@ void PulseSolver::compute_rest_correction() {
       source(q) = a_q(q) * (taper_g1_(r, q) * root + taper_g0_(r, q));
     }
     const int k = el - first_element_[v];
-    const VesselLaw left = taper.at(static_cast<double>(k) / e), right = taper.at(static_cast<double>(k + 1) / e);
+    const TubeLaw left = taper.at(static_cast<double>(k) / e), right = taper.at(static_cast<double>(k + 1) / e);
     const double flux_left = left.flux_flow((basis.left * a).value(), 0.0);
     const double flux_right = right.flux_flow((basis.right * a).value(), 0.0);
     Eigen::VectorXd rate = basis.weak_derivative * flux -
@@ -488,542 +500,6 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
   }
 }
 
-// ---- time step ---------------------------------------------------------------------------
-
-void PulseSolver::choose_time_step(const SolverOptions& options) {
-  // Waves: dt <= cfl nu_max(p) h / lambda_max, with nu_max from the Bloch analysis of the DG
-  // operator (0.50 at p = 1 down to 0.0133 at p = 7 for AB2); friction (explicit schemes):
-  // dt <= safety / (k mu / (rho A)).
-  std::vector<double> courant(bases_.size(), 0.0);
-  for (const DegreeBlock& b : blocks_)
-    courant[static_cast<std::size_t>(b.degree)] =
-        options.cfl * courant_limit(b.degree, scheme_ == TimeScheme::runge_kutta4 ? TimeScheme::runge_kutta4
-                                                                                  : TimeScheme::adams_bashforth2);
-  double wave = std::numeric_limits<double>::infinity(), friction = wave;
-  std::size_t wave_vessel = 0, friction_vessel = 0;
-  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
-    if (zero_d_[v]) continue;
-    const VesselLaw& law = laws_[v];
-    const auto el = first_element_[v];
-    const double a = state_.area(el, 0), q = state_.flow(el, 0);
-    const double h = 2 * half_length_(el);
-    double lambda = std::max(std::abs(law.lambda_forward(a, q)), std::abs(law.lambda_backward(a, q)));
-    if (is_tapered(v)) {
-      // The speeds change along the vessel: the largest at the ends of its elements.
-      const int degree = vessel_degree_[v];
-      for (auto k = first_element_[v]; k < end_element(v); ++k) {
-        const int j = k - first_element_[v];
-        for (const int side : {0, 1}) {
-          const VesselLaw at = law_at(v, static_cast<double>(j + side) / elements_per_vessel_);
-          double ak = 0, qk = 0;
-          for (int m = 0; m <= degree; ++m) {
-            const double sign = side == 0 && m % 2 == 1 ? -1.0 : 1.0;  // P_m(-1) = (-1)^m
-            ak += sign * state_.area(k, m);
-            qk += sign * state_.flow(k, m);
-          }
-          lambda = std::max({lambda, std::abs(at.lambda_forward(ak, qk)), std::abs(at.lambda_backward(ak, qk))});
-        }
-      }
-    }
-    const double dt_wave = courant[static_cast<std::size_t>(vessel_degree_[v])] * h / lambda;
-    if (dt_wave < wave) {
-      wave = dt_wave;
-      wave_vessel = v;
-    }
-    const double rate = friction_k_ * viscosity_(a) / (blood_.density * a);
-    const double stability = scheme_ == TimeScheme::runge_kutta4 ? 2.78 : 1.0;
-    const double dt_friction = scheme_ == TimeScheme::exponential_ab2
-                                   ? std::numeric_limits<double>::infinity()
-                                   : options.friction_safety * stability / rate;
-    if (dt_friction < friction) {
-      friction = dt_friction;
-      friction_vessel = v;
-    }
-  }
-  // The capacitor of an RCR outlet relaxes at the rate (1/R1 + 1/R2)/C at most (R1 in
-  // series with the vessel's impedance is slower), and every scheme here steps it explicitly.
-  double capacitor = std::numeric_limits<double>::infinity();
-  std::size_t capacitor_vessel = 0;
-  for (const auto& o : boundaries_.outlets) {
-    if (o.capacitor < 0) continue;
-    const double rate = (1 / o.outlet.r1 + 1 / o.outlet.r2) / o.outlet.c;
-    const double stability = scheme_ == TimeScheme::runge_kutta4 ? 2.78 : 1.0;
-    const double dt_capacitor = options.friction_safety * stability / rate;
-    if (dt_capacitor < capacitor) {
-      capacitor = dt_capacitor;
-      capacitor_vessel = static_cast<std::size_t>(o.end.vessel);
-    }
-  }
-  std::ostringstream why;
-  dt_ = std::min({wave, friction, capacitor});
-  if (!std::isfinite(dt_)) why << "no 1D vessels";
-  else if (dt_ == wave) why << "wave speed (CFL) in vessel " << net_.id[wave_vessel];
-  else if (dt_ == friction) why << "friction stiffness in vessel " << net_.id[friction_vessel];
-  else why << "RCR outlet capacitor of vessel " << net_.id[capacitor_vessel];
-  dt_reason_ = why.str();
-}
-
-namespace {
-// e^z, phi1(z) = (e^z - 1)/z and phi2(z) = (e^z - 1 - z)/z^2, by series near 0 where the
-// formulas cancel.
-void phi_functions(double z, double& e, double& phi1, double& phi2) {
-  e = std::exp(z);
-  if (std::abs(z) < 1e-3) {
-    phi1 = 1 + z / 2 + z * z / 6 + z * z * z / 24;
-    phi2 = 0.5 + z / 6 + z * z / 24 + z * z * z / 120;
-    return;
-  }
-  phi1 = (e - 1) / z;
-  phi2 = (e - 1 - z) / (z * z);
-}
-}  // namespace
-
-void PulseSolver::step_exponential(double h) {
-  // ETD2 (Cox & Matthews 2002): Q+ = e^z Q + h (phi1(z) N + phi2(z) (N - N_prev)), z = -r h,
-  // with N = rate + r Q the non-stiff part; A and the capacitors (r = 0) take plain AB2.
-  // Both N are taken with this step's r (N_prev = rate_prev + r Q_prev): with the previous
-  // step's r the scheme falls to first order wherever the area, and so r, pulsates.
-  evaluate(time_, state_, rate_);
-  if (!have_previous_rate_) {
-    previous_rate_ = rate_;
-    previous_flow_ = state_.flow;
-    have_previous_rate_ = true;
-  }
-  const Eigen::Index elements = state_.flow.rows();
-  decay_.resize(elements);
-  next_flow_.resize(elements);
-  phi1_.resize(elements);
-  phi2_.resize(elements);
-  for (Eigen::Index el = 0; el < elements; ++el) phi_functions(-friction_rate_(el) * h, decay_(el), phi1_(el), phi2_(el));
-  // Column by column (the storage order), over each degree's block of rows.
-  for (const DegreeBlock& b : blocks_)
-    for (Eigen::Index j = 0; j <= b.degree; ++j) {
-      const auto r = friction_rate_.segment(b.first, b.count).array();
-      auto q = state_.flow.col(j).segment(b.first, b.count).array();
-      auto q_before = previous_flow_.col(j).segment(b.first, b.count).array();
-      const auto n_now = rate_.flow.col(j).segment(b.first, b.count).array() + r * q;
-      const auto n_before = previous_rate_.flow.col(j).segment(b.first, b.count).array() + r * q_before;
-      auto next = next_flow_.segment(b.first, b.count).array();  // scratch: no allocation per step
-      next = decay_.segment(b.first, b.count).array() * q +
-             h * (phi1_.segment(b.first, b.count).array() * n_now +
-                  phi2_.segment(b.first, b.count).array() * (n_now - n_before));
-      q_before = q;
-      q = next;
-    }
-  state_.area += h * (1.5 * rate_.area - 0.5 * previous_rate_.area);
-  state_.capacitor += h * (1.5 * rate_.capacitor - 0.5 * previous_rate_.capacitor);
-  state_.exchanged += h * (1.5 * rate_.exchanged - 0.5 * previous_rate_.exchanged);
-  state_.coupled += h * (1.5 * rate_.coupled - 0.5 * previous_rate_.coupled);
-  state_.boundary += h * (1.5 * rate_.boundary - 0.5 * previous_rate_.boundary);
-  state_.faces += h * (1.5 * rate_.faces - 0.5 * previous_rate_.faces);
-  std::swap(previous_rate_, rate_);
-}
-
-void PulseSolver::step() {
-  if (lumped_.empty()) {
-    step_1d(dt_);
-    time_ += dt_;
-  } else {
-    step_coupled();
-  }
-  ++steps_;
-}
-
-void PulseSolver::step_coupled() {
-  // The 0D vessels step first with the coupled ends' inflows held at their last values; the
-  // 1D ends then see each node's pressure move to the prediction, plus the node's own
-  // response to their departure from the held inflow: a Robin condition. Without it the
-  // coupling is explicit, and unstable once the step exceeds the node's C / Y; with the
-  // response of BDF2 (Z = (K^-1)_ii) it broke down at 4 substeps, with 3/2 Z, the backward
-  // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §10).
-  std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
-  for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
-    const VesselEnd& end = boundaries_.coupled[k].end;
-    const EndState& u = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
-    held_end_flow_[k] = end.distal ? u.flow : -u.flow;
-    coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
-  }
-  step_start_ = time_;
-  const double t1 = time_ + dt_;
-  // The boundary flows and pressures at the 0D vessels' nodes, at the step's end.
-  for (std::size_t j = 0; j < lumped_inflow_.size(); ++j)
-    lumped_inflow_[j] = boundaries_.list[static_cast<std::size_t>(lumped_.inflow_boundaries()[j])].waveform(t1);
-  for (std::size_t j = 0; j < lumped_held_.size(); ++j)
-    lumped_held_[j] = boundaries_.list[static_cast<std::size_t>(lumped_.held_boundaries()[j])].waveform(t1);
-  lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
-  // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
-  if (element_count() > 0) {
-    const Eigen::VectorXd before = state_.coupled;
-    const double h = dt_ / substeps_;
-    for (int k = 0; k < substeps_; ++k) {
-      step_1d(h);
-      time_ = step_start_ + (k + 1) * h;
-    }
-    std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
-    for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
-      coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
-          state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
-  }
-  // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
-  lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1),
-                   std::span<double>(state_.boundary.data(), static_cast<std::size_t>(state_.boundary.size())));
-  time_ = t1;
-}
-
-void PulseSolver::step_1d(double dt) {
-  if (scheme_ == TimeScheme::exponential_ab2) {
-    step_exponential(dt);
-  } else if (scheme_ == TimeScheme::runge_kutta4) {
-    // Classical fourth-order Runge-Kutta.
-    evaluate(time_, state_, stage_[0]);
-    PulseState y = state_;
-    y.add_scaled(0.5 * dt, stage_[0]);
-    evaluate(time_ + 0.5 * dt, y, stage_[1]);
-    y = state_;
-    y.add_scaled(0.5 * dt, stage_[1]);
-    evaluate(time_ + 0.5 * dt, y, stage_[2]);
-    y = state_;
-    y.add_scaled(dt, stage_[2]);
-    evaluate(time_ + dt, y, stage_[3]);
-    state_.add_scaled(dt / 6, stage_[0]);
-    state_.add_scaled(dt / 3, stage_[1]);
-    state_.add_scaled(dt / 3, stage_[2]);
-    state_.add_scaled(dt / 6, stage_[3]);
-  } else {
-    // Second-order Adams-Bashforth (the paper's); its first step is Heun's, second order too.
-    evaluate(time_, state_, rate_);
-    if (!have_previous_rate_) {
-      PulseState y = state_;
-      y.add_scaled(dt, rate_);
-      evaluate(time_ + dt, y, stage_[0]);
-      state_.add_scaled(0.5 * dt, rate_);
-      state_.add_scaled(0.5 * dt, stage_[0]);
-      have_previous_rate_ = true;
-    } else {
-      state_.add_scaled(1.5 * dt, rate_);
-      state_.add_scaled(-0.5 * dt, previous_rate_);
-    }
-    std::swap(previous_rate_, rate_);
-  }
-}
-
-// ---- the right-hand side -------------------------------------------------------------------
-
-
-// The element-local part of the right-hand side for elements [first, first + count): point
-// values, volume fluxes, friction, traces. Rows are independent, so blocks run in parallel
-// and give the same bits whatever the number of threads.
-Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, const ModalBasis& basis,
-                                        Eigen::Index first, Eigen::Index count) {
-  const double rho = blood_.density, alpha = blood_.momentum_alpha();
-  const Eigen::Index modes = basis.degree + 1, points = basis.points;
-  auto area_q = area_q_.block(first, 0, count, points);
-  auto flow_q = flow_q_.block(first, 0, count, points);
-  auto flux_q = flux_q_.block(first, 0, count, points);
-  auto source_q = source_q_.block(first, 0, count, points);
-  const auto area = s.area.block(first, 0, count, modes), flow = s.flow.block(first, 0, count, modes);
-  area_q.noalias() = area.lazyProduct(basis.at_points.transpose());
-  flow_q.noalias() = flow.lazyProduct(basis.at_points.transpose());
-  if (!(area_q.array() > 0).all() || !area_q.allFinite()) {
-    for (Eigen::Index el = 0; el < count; ++el)
-      if (!(area_q.row(el).array() > 0).all() || !area_q.row(el).allFinite()) return first + el;
-  }
-
-  // Volume term: (F(U), dphi/dx) for both equations.
-  flux_q.array() = alpha * flow_q.array().square() / area_q.array() +
-                   TubeLaw::pressure_flux(
-                       (element_beta_.segment(first, count).array() / (3 * rho)).replicate(1, area_q.cols()), area_q.array());
-  // Tapered elements: beta varies between the points.
-  const auto tapered_begin = std::lower_bound(tapered_elements_.begin(), tapered_elements_.end(), first);
-  const auto tapered_end = std::lower_bound(tapered_begin, tapered_elements_.end(), first + count);
-  for (auto it = tapered_begin; it != tapered_end; ++it) {
-    const Eigen::Index el = *it - first, row = it - tapered_elements_.begin();
-    for (Eigen::Index q = 0; q < points; ++q) {
-      const double a = area_q(el, q), u = flow_q(el, q);
-      flux_q(el, q) = alpha * u * u / a + TubeLaw::pressure_flux(taper_beta_(row, q) / (3 * rho), a);
-    }
-  }
-  rate.area.block(first, 0, count, modes).noalias() = flow_q.lazyProduct(basis.weak_derivative.transpose());
-  rate.flow.block(first, 0, count, modes).noalias() = flux_q.lazyProduct(basis.weak_derivative.transpose());
-
-  // Friction -r Q with r = k mu / (rho A) at each point, mu at the local diameter (Pries) or
-  // constant. Column by column: the storage order.
-  for (Eigen::Index q = 0; q < points; ++q)
-    for (Eigen::Index el = 0; el < count; ++el) {
-      const double a = area_q(el, q);
-      source_q(el, q) = friction_k_ * viscosity_(a) / (rho * a);
-    }
-  if (element_viscosity_factor_.size() > 0)
-    source_q = element_viscosity_factor_.segment(first, count).asDiagonal() * source_q;
-  // Each element's friction rate, r averaged over the element: the exponential scheme
-  // integrates -r Q exactly and leaves only the variation of r within the element explicit.
-  friction_rate_.segment(first, count).noalias() = source_q.lazyProduct(basis.rule.weights) / 2;
-  source_q.array() *= -flow_q.array();
-  // Tapered elements: the part of the pressure force that the flux does not hold,
-  // A (g1 sqrt(A) + g0) (vessel_equations.hpp, docs/solver.md §1a).
-  for (auto it = tapered_begin; it != tapered_end; ++it) {
-    const Eigen::Index el = *it - first, row = it - tapered_elements_.begin();
-    for (Eigen::Index q = 0; q < points; ++q) {
-      const double a = area_q(el, q);
-      source_q(el, q) += a * (taper_g1_(row, q) * std::sqrt(a) + taper_g0_(row, q));
-    }
-  }
-
-  // Traces at both ends of every element.
-  area_left_.segment(first, count).noalias() = area.lazyProduct(basis.left.transpose());
-  area_right_.segment(first, count).noalias() = area.lazyProduct(basis.right.transpose());
-  flow_left_.segment(first, count).noalias() = flow.lazyProduct(basis.left.transpose());
-  flow_right_.segment(first, count).noalias() = flow.lazyProduct(basis.right.transpose());
-  return -1;
-}
-
-void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
-  const Eigen::Index elements = s.area.rows();
-  // Every used mode of every rate is written below; the padding columns of lower degrees
-  // must stay zero, so the storage is cleared only when it is (re)allocated.
-  if (rate.area.rows() != elements || rate.area.cols() != s.area.cols() ||
-      rate.capacitor.size() != s.capacitor.size() || rate.coupled.size() != s.coupled.size() ||
-      rate.boundary.size() != s.boundary.size() || rate.faces.size() != s.faces.size())
-    rate.set_zero_like(s);
-  friction_rate_.resize(elements);
-  for (Eigen::VectorXd* v : {&area_left_, &area_right_, &flow_left_, &flow_right_, &flux_a_left_,
-                             &flux_a_right_, &flux_q_left_, &flux_q_right_})
-    v->resize(elements);
-
-  // Element terms: each degree's block split into one part per thread.
-  Eigen::Index bad = -1;
-  ParallelErrors errors;
-  for (const DegreeBlock& b : blocks_) {
-    const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
-#pragma omp parallel num_threads(threads_) if (threads_ > 1)
-    {
-      const int threads = omp_get_num_threads(), me = omp_get_thread_num();
-      const Eigen::Index first = b.first + b.count * me / threads, last = b.first + b.count * (me + 1) / threads;
-      errors.guard(first, [&] {
-        const Eigen::Index found = element_terms(s, rate, basis, first, last - first);
-        if (found >= 0) {
-#pragma omp critical
-          bad = bad < 0 ? found : std::min(bad, found);
-        }
-      });
-    }
-    errors.rethrow();
-  }
-  if (bad >= 0) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad])], t);
-
-  // Interfaces inside vessels: between consecutive elements of one vessel (a loop over the
-  // elements, not the vessels: a full tree's millions of 0D vessels have none).
-  if (elements_per_vessel_ > 1) {
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-    for (Eigen::Index el = 0; el < elements - 1; ++el) {
-      const std::int32_t v = element_vessel_[static_cast<std::size_t>(el)];
-      if (element_vessel_[static_cast<std::size_t>(el) + 1] != v) continue;
-      double fa, fq;
-      // In a tapered vessel, the law at the interface itself.
-      const VesselLaw& law = taper_row_.empty() || taper_row_[static_cast<std::size_t>(el)] < 0
-                                 ? laws_[static_cast<std::size_t>(v)]
-                                 : taper_right_law_[static_cast<std::size_t>(taper_row_[static_cast<std::size_t>(el)])];
-      upwind_flux(law, area_right_(el), flow_right_(el), area_left_(el + 1), flow_left_(el + 1), fa, fq);
-      flux_a_right_(el) = flux_a_left_(el + 1) = fa;
-      flux_q_right_(el) = flux_q_left_(el + 1) = fq;
-    }
-  }
-
-  // Vessel ends: the node supplies U*, the flux is F(U*).
-  auto set_end_flux = [&](const VesselEnd& end, const EndState& u) {
-    const VesselLaw& law = end_law(static_cast<std::size_t>(end.vessel), end.distal);
-    const double fa = u.flow, fq = law.flux_flow(u.area, u.flow);
-    if (end.distal) {
-      flux_a_right_(end.element) = fa;
-      flux_q_right_(end.element) = fq;
-    } else {
-      flux_a_left_(end.element) = fa;
-      flux_q_left_(end.element) = fq;
-    }
-    boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)] = u;
-  };
-  auto trace = [&](const VesselEnd& end, double& a, double& q) {
-    a = end.distal ? area_right_(end.element) : area_left_(end.element);
-    q = end.distal ? flow_right_(end.element) : flow_left_(end.element);
-  };
-
-  // Prescribed flows into the network: at a distal end on the mirrored trace (A, -Q).
-  for (const auto& f : boundaries_.flows) {
-    double a, q;
-    trace(f.end, a, q);
-    const double q_in = boundaries_.list[static_cast<std::size_t>(f.index)].waveform(t);
-    const VesselLaw& law = end_law(static_cast<std::size_t>(f.end.vessel), f.end.distal);
-    EndState u;
-    if (!f.end.distal) {
-      u = inflow_state(law, a, q, q_in);
-    } else {
-      u = inflow_state(law, a, -q, q_in);
-      u.flow = -u.flow;
-    }
-    set_end_flux(f.end, u);
-  }
-  // Prescribed pressures: the end's total pressure is the node's.
-  for (const auto& g : boundaries_.pressures) {
-    double a, q;
-    trace(g.end, a, q);
-    const double p = boundaries_.list[static_cast<std::size_t>(g.index)].waveform(t);
-    set_end_flux(g.end, pressure_state(end_law(static_cast<std::size_t>(g.end.vessel), g.end.distal), a, q, p, g.end.distal));
-  }
-  // Ends at nodes of 0D vessels: the node's pressure, moving through the 0D step.
-  for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
-    const auto& c = boundaries_.coupled[k];
-    double a, q;
-    trace(c.end, a, q);
-    // Total pressure p(t) + rho u^2 / 2 + r (Q_in - Q_held): the node's pressure at this point
-    // of the step, the kinetic energy of its 0D vessels, and its response, r = 3/2 Z
-    // (docs/solver.md §10).
-    const double s = dt_ > 0 ? std::clamp((t - step_start_) / dt_, 0.0, 1.0) : 0.0;
-    const std::int32_t node = coupled_node_[k];
-    const double r = 1.5 * lumped_.impedance(node);
-    const EndState u = pressure_state(end_law(static_cast<std::size_t>(c.end.vessel), c.end.distal), a, q,
-                                      lumped_.pressure_during_step(node, s) + lumped_.dynamic_pressure(node) -
-                                          r * held_end_flow_[k],
-                                      c.end.distal, r);
-    set_end_flux(c.end, u);
-    rate.coupled(static_cast<Eigen::Index>(k)) = c.end.distal ? u.flow : -u.flow;
-  }
-  const auto outlets = static_cast<std::int64_t>(boundaries_.outlets.size());
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t k = 0; k < outlets; ++k) {
-    const auto& o = boundaries_.outlets[static_cast<std::size_t>(k)];
-    double a, q;
-    trace(o.end, a, q);
-    const VesselLaw& law = end_law(static_cast<std::size_t>(o.end.vessel), o.end.distal);
-    // The distal end's conditions; at a proximal end on the mirrored state, the flow negated
-    // back after (sign: along the vessel, out of the network).
-    const double sign = o.end.distal ? 1.0 : -1.0;
-    q *= sign;
-    EndState u;
-    switch (o.outlet.type) {
-      case OutletType::resistance:
-        u = resistance_state(law, a, q, o.outlet.r, o.outlet.p_out);
-        break;
-      case OutletType::rcr:
-        if (o.capacitor < 0) {  // no compliance: R1 and R2 in series
-          u = resistance_state(law, a, q, o.outlet.r1 + o.outlet.r2, o.outlet.p_out);
-        } else {
-          const double pc = s.capacitor(o.capacitor);
-          u = resistance_state(law, a, q, o.outlet.r1, pc);
-          // C dp_c/dt = Q* - (p_c - p_out) / R2
-          rate.capacitor(o.capacitor) = (u.flow - (pc - o.outlet.p_out) / o.outlet.r2) / o.outlet.c;
-        }
-        break;
-      case OutletType::reflection:
-        u = reflection_state(law, a, q, o.rest_area, sign * o.rest_flow, o.outlet.reflection);
-        break;
-    }
-    u.flow *= sign;
-    set_end_flux(o.end, u);
-  }
-  // The volume fluxes the boundaries exchange, summed in a fixed order (the same bits
-  // whatever the threads); an end's flow is positive along the vessel.
-  auto leaving = [&](const VesselEnd& end) {
-    const double q = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)].flow;
-    return end.distal ? q : -q;
-  };
-  rate.exchanged.setZero();
-  for (const auto* given : {&boundaries_.flows, &boundaries_.pressures})
-    for (const auto& g : *given) {
-      const double in = -leaving(g.end);
-      rate.boundary(g.index) = in;
-      if (boundaries_.entering[static_cast<std::size_t>(g.index)]) rate.exchanged(0) += in;
-      else rate.exchanged(1) -= in;
-    }
-  for (const auto& o : boundaries_.outlets) {
-    rate.exchanged(1) += leaving(o.end);
-    rate.boundary(o.boundary) = -leaving(o.end);
-  }
-  // Junctions are independent: each writes only its own ends' fluxes.
-  const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
-  std::int64_t failed_junction = -1;
-  // A junction of many vessels allocates its scratch (an exception must not leave the region).
-  parallel_blocks(junctions, threads_, [&](std::int64_t first_junction, std::int64_t last_junction) {
-    for (std::int64_t jj = first_junction; jj < last_junction; ++jj) {
-      const auto j = static_cast<std::size_t>(jj);
-      // Left uninitialised: only the first `count` entries are used (zeroing all 16 was 5 % of a step).
-      // A node of more than 16 vessels (measured networks) takes its scratch from the heap.
-      constexpr std::size_t on_stack = 16;
-      std::array<const VesselLaw*, on_stack> laws_stack;
-      std::array<double, on_stack> ja_stack, jq_stack;
-      std::array<int, on_stack> sign_stack;
-      std::array<EndState, on_stack> out_stack;
-      const auto first = boundaries_.junction_offset[j], last = boundaries_.junction_offset[j + 1];
-      const auto count = static_cast<std::size_t>(last - first);
-      std::vector<const VesselLaw*> laws_heap;
-      std::vector<double> ja_heap, jq_heap;
-      std::vector<int> sign_heap;
-      std::vector<EndState> out_heap;
-      const VesselLaw** laws = laws_stack.data();
-      double *ja = ja_stack.data(), *jq = jq_stack.data();
-      int* sign = sign_stack.data();
-      EndState* out = out_stack.data();
-      if (count > on_stack) {
-        laws_heap.resize(count);
-        ja_heap.resize(count);
-        jq_heap.resize(count);
-        sign_heap.resize(count);
-        out_heap.resize(count);
-        laws = laws_heap.data();
-        ja = ja_heap.data();
-        jq = jq_heap.data();
-        sign = sign_heap.data();
-        out = out_heap.data();
-      }
-      for (std::size_t i = 0; i < count; ++i) {
-        const VesselEnd& end = boundaries_.junction_ends[static_cast<std::size_t>(first) + i];
-        laws[i] = &end_law(static_cast<std::size_t>(end.vessel), end.distal);
-        trace(end, ja[i], jq[i]);
-        sign[i] = end.distal ? 1 : -1;
-        out[i] = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
-      }
-      if (!junction_state({laws, count}, {ja, count}, {jq, count}, {sign, count}, {out, count})) {
-#pragma omp critical
-        failed_junction = failed_junction < 0 ? jj : std::min(failed_junction, jj);
-        continue;
-      }
-      for (std::size_t i = 0; i < count; ++i)
-        set_end_flux(boundaries_.junction_ends[static_cast<std::size_t>(first) + i], out[i]);
-    }
-  });
-  if (failed_junction >= 0) {
-    const auto first = boundaries_.junction_offset[static_cast<std::size_t>(failed_junction)];
-    throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);
-  }
-
-  // Surface term and scaling: dC/dt = (volume - M^-1 (phi(1) F*_R - phi(-1) F*_L)) / J + source.
-  for (const DegreeBlock& b : blocks_) {
-    const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
-    const auto right = basis.inverse_mass.cwiseProduct(basis.right);  // lifts of the end fluxes
-    const auto left = basis.inverse_mass.cwiseProduct(basis.left);
-    const Eigen::Index modes = b.degree + 1;
-#pragma omp parallel num_threads(threads_) if (threads_ > 1)
-    {
-      const int threads = omp_get_num_threads(), me = omp_get_thread_num();
-      const Eigen::Index first = b.first + b.count * me / threads,
-                         count = b.first + b.count * (me + 1) / threads - first;
-      auto ra = rate.area.block(first, 0, count, modes);
-      auto rq = rate.flow.block(first, 0, count, modes);
-      ra.noalias() -= flux_a_right_.segment(first, count) * right;
-      ra.noalias() += flux_a_left_.segment(first, count) * left;
-      rq.noalias() -= flux_q_right_.segment(first, count) * right;
-      rq.noalias() += flux_q_left_.segment(first, count) * left;
-      const auto inverse_jacobian = half_length_.segment(first, count).cwiseInverse().asDiagonal();
-      ra = inverse_jacobian * ra;
-      rq = inverse_jacobian * rq;
-      rq.noalias() += source_q_.block(first, 0, count, basis.points).lazyProduct(basis.projection.transpose());
-    }
-  }
-  // Tapered elements: less the rest state's residual (compute_rest_correction).
-  for (std::size_t row = 0; row < tapered_elements_.size(); ++row)
-    rate.flow.row(tapered_elements_[row]) -= taper_rest_.row(static_cast<Eigen::Index>(row));
-  if (rate.faces.size() > 0) rate.faces = flux_a_left_;
-}
-
 void PulseSolver::set_viscosity_factors(std::span<const double> per_vessel) {
   viscosity_factor_.assign(per_vessel.begin(), per_vessel.end());
   lumped_.set_viscosity_factors(viscosity_factor_);
@@ -1052,103 +528,6 @@ void PulseSolver::track_face_volumes() {
     if (s->area.rows() == elements) s->faces.setZero(elements);
   lumped_.track_passed_volumes();
   tracking_faces_ = true;
-}
-
-// ---- evaluation --------------------------------------------------------------------------
-
-void PulseSolver::locate(std::size_t vessel, double x, std::size_t& element, double& xi) const {
-  const auto first = first_element_[vessel], count = elements_per_vessel_;
-  const double s = std::clamp(x, 0.0, 1.0) * count;
-  const auto k = std::min(static_cast<std::int32_t>(s), count - 1);
-  element = static_cast<std::size_t>(first + k);
-  xi = 2 * (s - k) - 1;
-}
-
-double PulseSolver::evaluate_modes(const Eigen::MatrixXd& c, std::size_t element, double xi) const {
-  double value = 0;
-  const int degree = vessel_degree_[static_cast<std::size_t>(element_vessel_[element])];
-  for (int j = 0; j <= degree; ++j) value += c(static_cast<Eigen::Index>(element), j) * legendre(j, xi);
-  return value;
-}
-
-double PulseSolver::area_at(std::size_t vessel, double x) const {
-  if (zero_d_[vessel]) return law_at(vessel, x).area(pressure_at(vessel, x));
-  std::size_t el;
-  double xi;
-  locate(vessel, x, el, xi);
-  return evaluate_modes(state_.area, el, xi);
-}
-
-double PulseSolver::flow_at(std::size_t vessel, double x) const {
-  if (zero_d_[vessel]) return lumped_.flow(lumped_.vessel_index(vessel));
-  std::size_t el;
-  double xi;
-  locate(vessel, x, el, xi);
-  return evaluate_modes(state_.flow, el, xi);
-}
-
-double PulseSolver::pressure_at(std::size_t vessel, double x) const {
-  if (zero_d_[vessel]) return lumped_.pressure_at(lumped_.vessel_index(vessel), std::clamp(x, 0.0, 1.0));
-  return law_at(vessel, x).pressure(area_at(vessel, x));
-}
-
-double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
-  return viscosity(vessel, area_at(vessel, x));
-}
-
-void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
-                             std::vector<double>* pressure, bool zero_d) const {
-  const std::size_t n = net_.vessel_count();
-  area.resize(n);
-  flow.resize(n);
-  if (pressure) pressure->resize(n);
-  if (n == 0) return;
-  // The same element k and point xi in every vessel (locate's arithmetic).
-  const double s = std::clamp(x, 0.0, 1.0) * elements_per_vessel_;
-  const auto k = std::min(static_cast<std::int32_t>(s), elements_per_vessel_ - 1);
-  const double xi = 2 * (s - k) - 1;
-  std::array<double, 32> phi;  // degrees are at most 30
-  for (std::size_t j = 0; j <= static_cast<std::size_t>(max_degree()); ++j) phi[j] = legendre(static_cast<int>(j), xi);
-  // The 0D vessels from their own state, then the 1D ones (the first of each one's elements
-  // names it).
-  if (zero_d)
-    lumped_.sample(std::clamp(x, 0.0, 1.0), area, flow, pressure ? std::span<double>(*pressure) : std::span<double>(), threads_);
-  const auto one_d = static_cast<std::int64_t>(one_d_vessels_.size());
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::int64_t j = 0; j < one_d; ++j) {
-    const auto v = static_cast<std::size_t>(one_d_vessels_[static_cast<std::size_t>(j)]);
-    const Eigen::Index el = first_element_[v] + k;
-    double a = 0, q = 0;
-    for (int j = 0; j <= vessel_degree_[v]; ++j) {
-      a += state_.area(el, j) * phi[static_cast<std::size_t>(j)];
-      q += state_.flow(el, j) * phi[static_cast<std::size_t>(j)];
-    }
-    area[v] = a;
-    flow[v] = q;
-    if (pressure) (*pressure)[v] = is_tapered(v) ? law_at(v, x).pressure(a) : laws_[v].pressure(a);
-  }
-}
-
-double PulseSolver::mean_flow(std::size_t vessel) const {
-  if (zero_d_[vessel]) return lumped_.flow(lumped_.vessel_index(vessel));
-  double sum = 0;
-  for (auto el = first_element_[vessel]; el < end_element(vessel); ++el) sum += state_.flow(el, 0);
-  return sum / elements_per_vessel_;
-}
-
-double PulseSolver::network_volume() const {
-  // The 1D vessels' volumes and what the 0D scheme conserves (lumped_vessels.hpp).
-  double volume = lumped_.stored_volume();
-  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
-    for (auto el = first_element_[v]; el < end_element(v); ++el) volume += 2 * half_length_(el) * state_.area(el, 0);
-  return volume;
-}
-
-void PulseSolver::check_solution() const {
-  lumped_.check(time_);
-  for (Eigen::Index el = 0; el < state_.area.rows(); ++el)
-    if (!(state_.area(el, 0) > 0) || !state_.area.row(el).allFinite() || !state_.flow.row(el).allFinite())
-      throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], time_);
 }
 
 }  // namespace hemotree

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -153,12 +154,12 @@ class PulseSolver {
 
   // A vessel's tube law: at its `from` end (the whole vessel's unless it tapers), at one of
   // its ends, and at fraction x along it.
-  const VesselLaw& law(std::size_t vessel) const { return laws_[vessel]; }
-  const VesselLaw& end_law(std::size_t vessel, bool distal) const {
+  const TubeLaw& law(std::size_t vessel) const { return laws_[vessel]; }
+  const TubeLaw& end_law(std::size_t vessel, bool distal) const {
     return distal && !taper_of_.empty() && taper_of_[vessel] >= 0 ? distal_laws_[static_cast<std::size_t>(taper_of_[vessel])]
                                                                   : laws_[vessel];
   }
-  VesselLaw law_at(std::size_t vessel, double x) const;
+  TubeLaw law_at(std::size_t vessel, double x) const;
   bool is_tapered(std::size_t vessel) const { return !taper_of_.empty() && taper_of_[vessel] >= 0; }
   const Blood& blood() const { return blood_; }
   int degree(std::size_t vessel) const { return vessel_degree_[vessel]; }  // -1: 0D
@@ -199,15 +200,33 @@ class PulseSolver {
   std::size_t balance_compliances(double period, const std::vector<double>* mean_pressure = nullptr);
 
  private:
+  // The DG rate dU/dt of the 1D vessels at time t (pulse/dg_rate.cpp), and its steps in order.
   void evaluate(double t, const PulseState& s, PulseState& rate);
+  void volume_terms(double t, const PulseState& s, PulseState& rate);  // (F, dphi/dx), S, traces
   // Returns the first element whose area is not positive and finite, or -1.
   Eigen::Index element_terms(const PulseState& s, PulseState& rate, const ModalBasis& basis, Eigen::Index first,
                              Eigen::Index count);
-  void step_exponential(double h);
+  void interior_face_fluxes();                          // upwind F* between a vessel's elements
+  void prescribed_end_fluxes(double t);                 // F(U*) at given flows and pressures
+  void coupled_end_fluxes(double t, PulseState& rate);  // at nodes of 0D vessels; their inflows
+  void outlet_end_fluxes(const PulseState& s, PulseState& rate);  // R, RCR (dp_c/dt), reflection
+  void boundary_exchange(PulseState& rate) const;       // volumes in and out through the boundaries
+  void junction_fluxes(double t);                       // each junction's Riemann problem
+  void lift_to_rate(PulseState& rate) const;            // surface term, 1/J, source's projection
+  void trace(const VesselEnd& end, double& a, double& q) const;  // the inner trace at an end
+  void set_end_flux(const VesselEnd& end, const EndState& u);    // F(U*) there; U* kept
+  // The step from the stability limits, and the schemes (pulse_time_stepping.cpp).
+  void choose_time_step(const SolverOptions& options);
+  void step_exponential(double h);  // ETD2 in the friction, AB2 in the rest
   void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
   void step_coupled();     // a 0D step around its 1D substeps
+  // The constructor's steps (pulse_solver.cpp), after the tube laws and the models.
+  std::optional<SteadyFlow> solve_steady_flow();  // none where the network has none: why kept
+  // A pressure boundary counts as "in" or "out" by its steady flow (without one: as built).
+  void orient_pressure_boundaries(const std::optional<SteadyFlow>& steady);
+  void couple_lumped_ends();  // the 1D ends at 0D nodes: their nodes, slots, held inflows
+  void allocate_state();      // the state's and the point values' storage
   void choose_models(const SolverOptions& options);
-  void choose_time_step(const SolverOptions& options);
   void start_from_steady_flow(const SteadyFlow& steady);
   std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
   void start_at_rest();
@@ -217,6 +236,7 @@ class PulseSolver {
     return zero_d_[vessel] ? first_element_[vessel] : first_element_[vessel] + elements_per_vessel_;
   }
   std::vector<double> capacitor_pressures() const;  // per run outlet (NaN: none)
+  // A point of a 1D vessel: its element and xi in [-1, 1] there, and the modes' value (pulse_sampling.cpp).
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
   double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;
 
@@ -226,18 +246,18 @@ class PulseSolver {
   std::vector<double> lumped_inflow_, lumped_held_;  // the 0D nodes' boundary values at a step's end
   Blood blood_;
   ViscosityTable viscosity_;
-  std::vector<VesselLaw> laws_;            // per vessel (a tapered one's at its `from` end)
+  std::vector<TubeLaw> laws_;            // per vessel (a tapered one's at its `from` end)
   // Tapered vessels (none in most networks: then taper_of_ is empty and nothing below is
   // touched): per vessel its taper's index or -1; per taper its description and distal law.
   std::vector<std::int32_t> taper_of_;
   std::vector<VesselTaper> tapers_;
-  std::vector<VesselLaw> distal_laws_;
+  std::vector<TubeLaw> distal_laws_;
   // Per element of a tapered vessel (a row): beta and the source coefficients g1, g0 at its
   // quadrature points, the law at its right interface, and the rest-state correction of the
   // flow's rate (modes); taper_row_ per element (-1: untapered; empty without tapers).
   std::vector<std::int32_t> taper_row_, tapered_elements_;
   Eigen::MatrixXd taper_beta_, taper_g1_, taper_g0_, taper_rest_;
-  std::vector<VesselLaw> taper_right_law_;
+  std::vector<TubeLaw> taper_right_law_;
   void build_taper_tables();
   // The tapered elements' rates at the rest state: what the discrete operator leaves of an
   // exact balance (quadrature, differences), subtracted in every evaluation.

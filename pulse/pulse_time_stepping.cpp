@@ -1,0 +1,241 @@
+// The time step and the schemes that take it (docs/solver.md §5, §10): the step from the stability
+// limits (choose_time_step); ETD2 (exponential in the friction), AB2 and classical RK4 on the
+// 1D vessels' state, each a sequence of DG rates (pulse/dg_rate.cpp); and the 1D-0D step: one
+// implicit 0D step of the lumped vessels around the 1D substeps inside it (step_coupled).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <sstream>
+#include <utility>
+
+#include "pulse/pulse_solver.hpp"
+#include "pulse/stability_limit.hpp"
+
+namespace hemotree {
+
+void PulseSolver::set_time_step(double dt) {
+  dt_ = dt;
+  substeps_ = lumped_.empty() || !std::isfinite(stable_1d_)
+                  ? 1
+                  : static_cast<int>(std::max(1.0, std::ceil(dt / stable_1d_ - 1e-9)));
+}
+
+void PulseSolver::choose_time_step(const SolverOptions& options) {
+  // Waves: dt <= cfl nu_max(p) h / lambda_max, with nu_max from the Bloch analysis of the DG
+  // operator (0.50 at p = 1 down to 0.0133 at p = 7 for AB2); friction (explicit schemes):
+  // dt <= safety / (k mu / (rho A)).
+  std::vector<double> courant(bases_.size(), 0.0);
+  for (const DegreeBlock& b : blocks_)
+    courant[static_cast<std::size_t>(b.degree)] =
+        options.cfl * courant_limit(b.degree, scheme_ == TimeScheme::runge_kutta4 ? TimeScheme::runge_kutta4
+                                                                                  : TimeScheme::adams_bashforth2);
+  double wave = std::numeric_limits<double>::infinity(), friction = wave;
+  std::size_t wave_vessel = 0, friction_vessel = 0;
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    if (zero_d_[v]) continue;
+    const TubeLaw& law = laws_[v];
+    const auto el = first_element_[v];
+    const double a = state_.area(el, 0), q = state_.flow(el, 0);
+    const double h = 2 * half_length_(el);
+    double lambda = std::max(std::abs(law.lambda_forward(a, q)), std::abs(law.lambda_backward(a, q)));
+    if (is_tapered(v)) {
+      // The speeds change along the vessel: the largest at the ends of its elements.
+      const int degree = vessel_degree_[v];
+      for (auto k = first_element_[v]; k < end_element(v); ++k) {
+        const int j = k - first_element_[v];
+        for (const int side : {0, 1}) {
+          const TubeLaw at = law_at(v, static_cast<double>(j + side) / elements_per_vessel_);
+          double ak = 0, qk = 0;
+          for (int m = 0; m <= degree; ++m) {
+            const double sign = side == 0 && m % 2 == 1 ? -1.0 : 1.0;  // P_m(-1) = (-1)^m
+            ak += sign * state_.area(k, m);
+            qk += sign * state_.flow(k, m);
+          }
+          lambda = std::max({lambda, std::abs(at.lambda_forward(ak, qk)), std::abs(at.lambda_backward(ak, qk))});
+        }
+      }
+    }
+    const double dt_wave = courant[static_cast<std::size_t>(vessel_degree_[v])] * h / lambda;
+    if (dt_wave < wave) {
+      wave = dt_wave;
+      wave_vessel = v;
+    }
+    const double rate = friction_k_ * viscosity_(a) / (blood_.density * a);
+    const double stability = scheme_ == TimeScheme::runge_kutta4 ? 2.78 : 1.0;
+    const double dt_friction = scheme_ == TimeScheme::exponential_ab2
+                                   ? std::numeric_limits<double>::infinity()
+                                   : options.friction_safety * stability / rate;
+    if (dt_friction < friction) {
+      friction = dt_friction;
+      friction_vessel = v;
+    }
+  }
+  // The capacitor of an RCR outlet relaxes at the rate (1/R1 + 1/R2)/C at most (R1 in
+  // series with the vessel's impedance is slower), and every scheme here steps it explicitly.
+  double capacitor = std::numeric_limits<double>::infinity();
+  std::size_t capacitor_vessel = 0;
+  for (const auto& o : boundaries_.outlets) {
+    if (o.capacitor < 0) continue;
+    const double rate = (1 / o.outlet.r1 + 1 / o.outlet.r2) / o.outlet.c;
+    const double stability = scheme_ == TimeScheme::runge_kutta4 ? 2.78 : 1.0;
+    const double dt_capacitor = options.friction_safety * stability / rate;
+    if (dt_capacitor < capacitor) {
+      capacitor = dt_capacitor;
+      capacitor_vessel = static_cast<std::size_t>(o.end.vessel);
+    }
+  }
+  std::ostringstream why;
+  dt_ = std::min({wave, friction, capacitor});
+  if (!std::isfinite(dt_)) why << "no 1D vessels";
+  else if (dt_ == wave) why << "wave speed (CFL) in vessel " << net_.id[wave_vessel];
+  else if (dt_ == friction) why << "friction stiffness in vessel " << net_.id[friction_vessel];
+  else why << "RCR outlet capacitor of vessel " << net_.id[capacitor_vessel];
+  dt_reason_ = why.str();
+}
+
+namespace {
+// e^z, phi1(z) = (e^z - 1)/z and phi2(z) = (e^z - 1 - z)/z^2, by series near 0 where the
+// formulas cancel.
+void phi_functions(double z, double& e, double& phi1, double& phi2) {
+  e = std::exp(z);
+  if (std::abs(z) < 1e-3) {
+    phi1 = 1 + z / 2 + z * z / 6 + z * z * z / 24;
+    phi2 = 0.5 + z / 6 + z * z / 24 + z * z * z / 120;
+    return;
+  }
+  phi1 = (e - 1) / z;
+  phi2 = (e - 1 - z) / (z * z);
+}
+}  // namespace
+
+void PulseSolver::step_exponential(double h) {
+  // ETD2 (Cox & Matthews 2002): Q+ = e^z Q + h (phi1(z) N + phi2(z) (N - N_prev)), z = -r h,
+  // with N = rate + r Q the non-stiff part; A and the capacitors (r = 0) take plain AB2.
+  // Both N are taken with this step's r (N_prev = rate_prev + r Q_prev): with the previous
+  // step's r the scheme falls to first order wherever the area, and so r, pulsates.
+  evaluate(time_, state_, rate_);
+  if (!have_previous_rate_) {
+    previous_rate_ = rate_;
+    previous_flow_ = state_.flow;
+    have_previous_rate_ = true;
+  }
+  const Eigen::Index elements = state_.flow.rows();
+  decay_.resize(elements);
+  next_flow_.resize(elements);
+  phi1_.resize(elements);
+  phi2_.resize(elements);
+  for (Eigen::Index el = 0; el < elements; ++el) phi_functions(-friction_rate_(el) * h, decay_(el), phi1_(el), phi2_(el));
+  // Column by column (the storage order), over each degree's block of rows.
+  for (const DegreeBlock& b : blocks_)
+    for (Eigen::Index j = 0; j <= b.degree; ++j) {
+      const auto r = friction_rate_.segment(b.first, b.count).array();
+      auto q = state_.flow.col(j).segment(b.first, b.count).array();
+      auto q_before = previous_flow_.col(j).segment(b.first, b.count).array();
+      const auto n_now = rate_.flow.col(j).segment(b.first, b.count).array() + r * q;
+      const auto n_before = previous_rate_.flow.col(j).segment(b.first, b.count).array() + r * q_before;
+      auto next = next_flow_.segment(b.first, b.count).array();  // scratch: no allocation per step
+      next = decay_.segment(b.first, b.count).array() * q +
+             h * (phi1_.segment(b.first, b.count).array() * n_now +
+                  phi2_.segment(b.first, b.count).array() * (n_now - n_before));
+      q_before = q;
+      q = next;
+    }
+  state_.area += h * (1.5 * rate_.area - 0.5 * previous_rate_.area);
+  state_.capacitor += h * (1.5 * rate_.capacitor - 0.5 * previous_rate_.capacitor);
+  state_.exchanged += h * (1.5 * rate_.exchanged - 0.5 * previous_rate_.exchanged);
+  state_.coupled += h * (1.5 * rate_.coupled - 0.5 * previous_rate_.coupled);
+  state_.boundary += h * (1.5 * rate_.boundary - 0.5 * previous_rate_.boundary);
+  state_.faces += h * (1.5 * rate_.faces - 0.5 * previous_rate_.faces);
+  std::swap(previous_rate_, rate_);
+}
+
+void PulseSolver::step() {
+  if (lumped_.empty()) {
+    step_1d(dt_);
+    time_ += dt_;
+  } else {
+    step_coupled();
+  }
+  ++steps_;
+}
+
+void PulseSolver::step_coupled() {
+  // The 0D vessels step first with the coupled ends' inflows held at their last values; the
+  // 1D ends then see each node's pressure move to the prediction, plus the node's own
+  // response to their departure from the held inflow: a Robin condition. Without it the
+  // coupling is explicit, and unstable once the step exceeds the node's C / Y; with the
+  // response of BDF2 (Z = (K^-1)_ii) it broke down at 4 substeps, with 3/2 Z, the backward
+  // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §10).
+  std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
+  for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
+    const VesselEnd& end = boundaries_.coupled[k].end;
+    const EndState& u = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
+    held_end_flow_[k] = end.distal ? u.flow : -u.flow;
+    coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
+  }
+  step_start_ = time_;
+  const double t1 = time_ + dt_;
+  // The boundary flows and pressures at the 0D vessels' nodes, at the step's end.
+  for (std::size_t j = 0; j < lumped_inflow_.size(); ++j)
+    lumped_inflow_[j] = boundaries_.list[static_cast<std::size_t>(lumped_.inflow_boundaries()[j])].waveform(t1);
+  for (std::size_t j = 0; j < lumped_held_.size(); ++j)
+    lumped_held_[j] = boundaries_.list[static_cast<std::size_t>(lumped_.held_boundaries()[j])].waveform(t1);
+  lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
+  // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
+  if (element_count() > 0) {
+    const Eigen::VectorXd before = state_.coupled;
+    const double h = dt_ / substeps_;
+    for (int k = 0; k < substeps_; ++k) {
+      step_1d(h);
+      time_ = step_start_ + (k + 1) * h;
+    }
+    std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
+    for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
+      coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
+          state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
+  }
+  // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
+  lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1),
+                   std::span<double>(state_.boundary.data(), static_cast<std::size_t>(state_.boundary.size())));
+  time_ = t1;
+}
+
+void PulseSolver::step_1d(double dt) {
+  if (scheme_ == TimeScheme::exponential_ab2) {
+    step_exponential(dt);
+  } else if (scheme_ == TimeScheme::runge_kutta4) {
+    // Classical fourth-order Runge-Kutta.
+    evaluate(time_, state_, stage_[0]);
+    PulseState y = state_;
+    y.add_scaled(0.5 * dt, stage_[0]);
+    evaluate(time_ + 0.5 * dt, y, stage_[1]);
+    y = state_;
+    y.add_scaled(0.5 * dt, stage_[1]);
+    evaluate(time_ + 0.5 * dt, y, stage_[2]);
+    y = state_;
+    y.add_scaled(dt, stage_[2]);
+    evaluate(time_ + dt, y, stage_[3]);
+    state_.add_scaled(dt / 6, stage_[0]);
+    state_.add_scaled(dt / 3, stage_[1]);
+    state_.add_scaled(dt / 3, stage_[2]);
+    state_.add_scaled(dt / 6, stage_[3]);
+  } else {
+    // Second-order Adams-Bashforth (the paper's); its first step is Heun's, second order too.
+    evaluate(time_, state_, rate_);
+    if (!have_previous_rate_) {
+      PulseState y = state_;
+      y.add_scaled(dt, rate_);
+      evaluate(time_ + dt, y, stage_[0]);
+      state_.add_scaled(0.5 * dt, rate_);
+      state_.add_scaled(0.5 * dt, stage_[0]);
+      have_previous_rate_ = true;
+    } else {
+      state_.add_scaled(1.5 * dt, rate_);
+      state_.add_scaled(-0.5 * dt, previous_rate_);
+    }
+    std::swap(previous_rate_, rate_);
+  }
+}
+
+}  // namespace hemotree
