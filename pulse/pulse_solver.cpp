@@ -132,33 +132,6 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   if (started_from_steady_) start_from_steady_flow(*steady);
   else start_at_rest();
   choose_time_step(options);
-  stable_1d_ = dt_;
-  stable_dt_ = dt_;
-  stable_dt_reason_ = dt_reason_;
-  if (!lumped_.empty()) {
-    // The 0D step follows the pulse (it has no stability limit); the 1D vessels take as
-    // many substeps of at most their own limit as fit in it.
-    const double target = options.lumped_step * period_;
-    const double substeps = std::isfinite(stable_1d_) ? std::max(1.0, std::floor(target / stable_1d_)) : 1.0;
-    dt_ = std::isfinite(stable_1d_) ? std::min(target, substeps * stable_1d_) : target;
-    std::ostringstream why;
-    why << "0D step of " << options.lumped_step << " of the period";
-    if (std::isfinite(stable_1d_)) why << ", " << substeps << " 1D substeps set by the " << dt_reason_;
-    dt_reason_ = why.str();
-    // The implicit 0D step is stable at any length, but not accurate: BDF2 follows the pulse
-    // only at steps of about --lumped-step of the period (a --dt of one step a cycle stored
-    // 16 % of the inflow and was called complete). The 1D substeps keep their own limit.
-    stable_dt_ = target;
-    std::ostringstream limit;
-    limit << placeholder("lumped_step") << " " << options.lumped_step << " of the period: BDF2 is stable at any step but follows "
-             "the pulse only at steps like it";
-    stable_dt_reason_ = limit.str();
-  }
-  set_time_step(dt_);
-  if (options.dt > 0) {
-    set_time_step(options.dt);
-    dt_reason_ = "given by " + placeholder("dt");
-  }
   // The coupled ends' first linearisation needs their end states.
   if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);
 }

@@ -216,7 +216,8 @@ class PulseSolver {
   void trace(const VesselEnd& end, double& a, double& q) const;  // the inner trace at an end
   void set_end_flux(const VesselEnd& end, const EndState& u);    // F(U*) there; U* kept
   // The step from the stability limits, and the schemes (pulse_time_stepping.cpp).
-  void choose_time_step(const SolverOptions& options);
+  void choose_time_step(const SolverOptions& options);   // the step, its limit and their reasons
+  void choose_stable_step(const SolverOptions& options);  // the 1D vessels' stability limit
   void step_exponential(double h);  // ETD2 in the friction, AB2 in the rest
   void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
   void step_coupled();     // a 0D step around its 1D substeps

@@ -1,5 +1,6 @@
-// The time step and the schemes that take it (docs/solver.md §5, §10): the step from the stability
-// limits (choose_time_step); ETD2 (exponential in the friction), AB2 and classical RK4 on the
+// The time step and the schemes that take it (docs/solver.md §5, §10): the step, decided here
+// alone (choose_time_step: the 1D stability limits, the 0D step and the 1D substeps in it, or
+// the step given; the run room only shortens it to a whole number per cycle); ETD2 (exponential in the friction), AB2 and classical RK4 on the
 // 1D vessels' state, each a sequence of DG rates (pulse/dg_rate.cpp); and the 1D-0D step: one
 // implicit 0D step of the lumped vessels around the 1D substeps inside it (step_coupled).
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <sstream>
 #include <utility>
 
+#include "core/setting_error.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "pulse/stability_limit.hpp"
 
@@ -22,6 +24,37 @@ void PulseSolver::set_time_step(double dt) {
 }
 
 void PulseSolver::choose_time_step(const SolverOptions& options) {
+  choose_stable_step(options);
+  stable_1d_ = dt_;
+  stable_dt_ = dt_;
+  stable_dt_reason_ = dt_reason_;
+  if (!lumped_.empty()) {
+    // The 0D step follows the pulse (it has no stability limit); the 1D vessels take as
+    // many substeps of at most their own limit as fit in it.
+    const double target = options.lumped_step * period_;
+    const double substeps = std::isfinite(stable_1d_) ? std::max(1.0, std::floor(target / stable_1d_)) : 1.0;
+    dt_ = std::isfinite(stable_1d_) ? std::min(target, substeps * stable_1d_) : target;
+    std::ostringstream why;
+    why << "0D step of " << options.lumped_step << " of the period";
+    if (std::isfinite(stable_1d_)) why << ", " << substeps << " 1D substeps set by the " << dt_reason_;
+    dt_reason_ = why.str();
+    // The implicit 0D step is stable at any length, but not accurate: BDF2 follows the pulse
+    // only at steps of about --lumped-step of the period (a --dt of one step a cycle stored
+    // 16 % of the inflow and was called complete). The 1D substeps keep their own limit.
+    stable_dt_ = target;
+    std::ostringstream limit;
+    limit << placeholder("lumped_step") << " " << options.lumped_step << " of the period: BDF2 is stable at any step but follows "
+             "the pulse only at steps like it";
+    stable_dt_reason_ = limit.str();
+  }
+  set_time_step(dt_);
+  if (options.dt > 0) {
+    set_time_step(options.dt);
+    dt_reason_ = "given by " + placeholder("dt");
+  }
+}
+
+void PulseSolver::choose_stable_step(const SolverOptions& options) {
   // Waves: dt <= cfl nu_max(p) h / lambda_max, with nu_max from the Bloch analysis of the DG
   // operator (0.50 at p = 1 down to 0.0133 at p = 7 for AB2); friction (explicit schemes):
   // dt <= safety / (k mu / (rho A)).
