@@ -28,6 +28,7 @@
 namespace hemotree::openbf {
 
 constexpr double unset = std::numeric_limits<double>::quiet_NaN();
+
 // --- openBF's physics where the model leaves something out ---------------------------------
 
 // openBF's wall thickness where a vessel gives no h0: Avolio's (1980) fit as openBF writes it
@@ -64,6 +65,7 @@ constexpr FieldRange profile_range{0, 998, ""};
 
 // openBF's default profile exponent (vessel.jl: get(config, "gamma_profile", 2)): parabolic.
 constexpr double default_profile = 2;
+
 // --- the YAML file and its messages --------------------------------------------------------
 
 struct Entry {
@@ -211,7 +213,9 @@ struct VesselModel {
   std::string inlet_file;
   YAML::Mark inlet_mark;
 };
+
 inline bool has_outlet(const VesselModel& v) { return v.first_outlet_key != nullptr; }
+
 // One entry of "network": its keys checked and read; the openBF settings it ignores go into
 // `ignored`, and its entries into `keep`, which the VesselModel points into.
 VesselModel read_vessel(const Source& source, const YAML::Node& node, std::size_t position,
@@ -223,6 +227,7 @@ inline std::string three_digits(double value) {
   std::snprintf(text, sizeof text, "%.3g", value);
   return format_number(std::strtod(text, nullptr));
 }
+
 // openBF's inlet file as hemotree's periodic flow table; `named_by` says where the model names it.
 Waveform read_inlet_table(const std::string& path, const std::string& named_by, const ImportOptions& options);
 

@@ -68,6 +68,7 @@ std::vector<std::pair<double, double>> inlet_rows(const Waveform& w) {
   rows.emplace_back(w.period, rows.front().second);
   return rows;
 }
+
 // openBF's one external pressure: the reference pressure of the vessels whose tube law is
 // given by beta, else what an import from openBF recorded, else 0.
 double openbf_external_pressure(const Network& net) {
