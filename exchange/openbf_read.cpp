@@ -169,6 +169,19 @@ void check_nodes(const Source& source, const std::vector<VesselModel>& vessels, 
                                              " end there and none leaves it; openBF has no outlet shared by two vessels");
 }
 
+// openBF's blood: Newtonian, with the momentum-flux coefficient of its velocity profile.
+Blood openbf_blood(double density, double viscosity, double profile, bool as_coded) {
+  Blood blood;
+  blood.density = density;
+  blood.rheology = Rheology::newtonian;
+  blood.newtonian_viscosity = viscosity;
+  blood.alpha = alpha_of_profile(profile);
+  // openBF's code writes its momentum flux with alpha = 1 whatever the profile, which sets
+  // its friction only (docs/import.md).
+  if (as_coded) blood.momentum_flux_coefficient = 1;
+  return blood;
+}
+
 // What the reading assumed or chose, counted for its notes.
 struct Tally {
   std::size_t law_walls = 0, tapered_law_walls = 0, ratio_walls = 0, open_ends = 0, wk2 = 0, wk3_without_r2 = 0;
@@ -362,14 +375,7 @@ Network read_openbf(const std::string& path, const ImportOptions& options, Openb
   net.reserve(vessels.size(), node_index.size());
   for (auto& [id, index] : node_index) index = net.add_node(id);
 
-  Blood blood;
-  blood.density = density;
-  blood.rheology = Rheology::newtonian;
-  blood.newtonian_viscosity = viscosity;
-  blood.alpha = alpha_of_profile(profile);
-  // openBF's code writes its momentum flux with alpha = 1 whatever the profile, which sets
-  // its friction only (docs/import.md).
-  if (as_coded) blood.momentum_flux_coefficient = 1;
+  const Blood blood = openbf_blood(density, viscosity, profile, as_coded);
   net.blood = blood;
 
   Tally tally;
