@@ -1,4 +1,5 @@
-// openBF's YAML models, read into a Network and written from one. What each key means is
+// openBF's YAML models read into a Network (the file, a vessel's keys and the inlet table are
+// read in openbf_yaml.cpp, openbf_vessel.cpp, openbf_inlet.cpp). What each key means is
 // openBF's own reading of it (src/vessel.jl, network.jl, solver.jl, boundary_conditions.jl of
 // openBF 2.x), or, where that code departs from openBF's documentation (docs/src/man/config.md)
 // and on request, the documentation's; docs/import.md has the table and the differences.
