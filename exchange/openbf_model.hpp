@@ -187,11 +187,6 @@ YAML::Node load_yaml(const std::string& path);
 
 // --- one vessel, as openBF reads it --------------------------------------------------------
 
-// Settings of openBF's solver and output that do not change the model: ignored, and named in
-// one note.
-const std::set<std::string, std::less<>> ignored_vessel_keys = {"M", "to_save", "initial_pressure",
-                                                                "initial_flow", "inlet number"};
-
 struct VesselModel {
   YAML::Mark mark;
   std::string label;

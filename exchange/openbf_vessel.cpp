@@ -6,6 +6,11 @@ namespace hemotree::openbf {
 
 namespace {
 
+// Settings of openBF's solver and output that do not change the model: ignored, and named in
+// one note.
+const std::set<std::string, std::less<>> ignored_vessel_keys = {"M", "to_save", "initial_pressure",
+                                                                "initial_flow", "inlet number"};
+
 // The keys of a vessel that hemotree reads, refuses with a reason, or ignores.
 const std::set<std::string, std::less<>> vessel_keys = {
     "label", "sn", "tn", "L", "E", "R0", "Rp", "Rd", "h0", "Pext", "gamma_profile", "gamma profile",
