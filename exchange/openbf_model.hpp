@@ -178,6 +178,7 @@ class Fields {
 constexpr std::size_t model_cap = std::size_t{8} << 20;   // bytes
 constexpr std::size_t inlet_cap = std::size_t{64} << 20;  // bytes
 constexpr std::size_t line_cap = 4096;                    // bytes of one inlet-table line
+
 // The whole of a regular file of at most `cap` bytes. `named` names it in the IoError of a file
 // that cannot be read; `kind` says what the file should be ("an inlet table").
 std::string read_capped(const std::string& path, const std::string& named, const std::string& kind, std::size_t cap);
