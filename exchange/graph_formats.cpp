@@ -432,9 +432,14 @@ void check_range(const RawGraph& g, const std::string& where, const char* field,
   if (!range.contains(value)) g.fail(where, out_of_range(field, range, value) + hint);
 }
 
-Network build_network(RawGraph& g, const ImportOptions& options, const GraphOptions& graph_options) {
-  const std::string edge_word = g.format == "graphml" ? "edge" : "link";
-  // Units: the caller's, the file's, or metres.
+// The length unit: the caller's, the file's, or metres; `hint` closes a message about a length
+// out of range.
+struct LengthUnit {
+  double u;                     // metres per unit of the file
+  std::string unit_from, hint;  // where it came from, for the note
+};
+
+LengthUnit length_unit(const RawGraph& g, const GraphOptions& graph_options) {
   double u = 1;
   std::string unit_from = "metres, the default";
   if (g.unit) {
@@ -453,16 +458,14 @@ Network build_network(RawGraph& g, const ImportOptions& options, const GraphOpti
   const std::string hint = u == 1 ? " (lengths read in metres: a \"unit\" graph attribute or vimport " + placeholder("unit") +
                                         " sets another)"
                                   : " (lengths read in units of " + format_number(u) + " m)";
+  return {u, unit_from, hint};
+}
 
-  Network net;
-  // Node ids: "id" attributes when every node has one, else from the file's node ids.
+// Node ids: "id" attributes when every node has one, else from the file's node ids (their
+// numbers), else the file's order, its ids kept in provenance "node_names"; `node_how` says which.
+std::vector<std::int64_t> node_ids_of(const RawGraph& g, Network& net, std::string& node_how) {
   std::vector<std::string> node_keys;
   for (const auto& n : g.nodes) node_keys.push_back(n.key);
-  std::unordered_map<std::string, std::int32_t> index;
-  for (std::size_t i = 0; i < g.nodes.size(); ++i)
-    if (!index.emplace(g.nodes[i].key, static_cast<std::int32_t>(i)).second)
-      g.fail(g.nodes[i].where, "its id \"" + g.nodes[i].key + "\" appears twice");
-  std::string node_how;
   std::vector<std::int64_t> node_ids;
   const bool id_attributes =
       !g.nodes.empty() && std::all_of(g.nodes.begin(), g.nodes.end(), [](const RawNode& n) { return n.id.has_value(); });
@@ -482,6 +485,48 @@ Network build_network(RawGraph& g, const ImportOptions& options, const GraphOpti
     node_how = "numbered in the file's order (its ids are kept in provenance \"node_names\")";
     net.provenance["node_names"] = node_keys;
   }
+  return node_ids;
+}
+
+// Vessel ids: "id" attributes when every edge has one, else the file's edge ids or keys,
+// else the order of the file.
+void set_vessel_ids(const RawGraph& g, Network& net, std::string& vessel_how) {
+  const bool edge_id_attributes =
+      !g.edges.empty() && std::all_of(g.edges.begin(), g.edges.end(), [](const RawEdge& e) { return e.id.has_value(); });
+  std::vector<std::string> edge_keys;
+  for (const auto& e : g.edges)
+    if (e.key) edge_keys.push_back(*e.key);
+  if (edge_id_attributes) {
+    std::map<std::int64_t, std::size_t> seen;
+    for (std::size_t k = 0; k < g.edges.size(); ++k) {
+      if (const auto [it, fresh] = seen.emplace(*g.edges[k].id, k); !fresh)
+        g.fail(g.edges[k].where, "its \"id\" " + std::to_string(*g.edges[k].id) + " is also that of " +
+                                     g.edges[it->second].where);
+      net.id[k] = *g.edges[k].id;
+    }
+    vessel_how = "their \"id\" attributes";
+  } else if (auto ids = edge_keys.size() == g.edges.size() ? ids_from_keys(edge_keys, vessel_how) : std::nullopt) {
+    net.id = std::move(*ids);
+  } else {
+    for (std::size_t k = 0; k < g.edges.size(); ++k) net.id[k] = static_cast<std::int64_t>(k);
+    vessel_how = "numbered in the file's order";
+  }
+}
+
+Network build_network(RawGraph& g, const ImportOptions& options, const GraphOptions& graph_options) {
+  const std::string edge_word = g.format == "graphml" ? "edge" : "link";
+  const LengthUnit unit = length_unit(g, graph_options);
+  const double u = unit.u;
+  const std::string& unit_from = unit.unit_from;
+  const std::string& hint = unit.hint;
+
+  Network net;
+  std::unordered_map<std::string, std::int32_t> index;
+  for (std::size_t i = 0; i < g.nodes.size(); ++i)
+    if (!index.emplace(g.nodes[i].key, static_cast<std::int32_t>(i)).second)
+      g.fail(g.nodes[i].where, "its id \"" + g.nodes[i].key + "\" appears twice");
+  std::string node_how;
+  const std::vector<std::int64_t> node_ids = node_ids_of(g, net, node_how);
 
   // Coordinates: all nodes or none (z = 0 for a plane layout).
   const auto placed = [](const RawNode& n) { return !std::isnan(n.x) && !std::isnan(n.y); };
@@ -567,29 +612,8 @@ Network build_network(RawGraph& g, const ImportOptions& options, const GraphOpti
   }
   if (tapered > 0) net.distal_diameter = std::move(distal);
 
-  // Vessel ids: "id" attributes when every edge has one, else the file's edge ids or keys,
-  // else the order of the file.
   std::string vessel_how;
-  const bool edge_id_attributes =
-      !g.edges.empty() && std::all_of(g.edges.begin(), g.edges.end(), [](const RawEdge& e) { return e.id.has_value(); });
-  std::vector<std::string> edge_keys;
-  for (const auto& e : g.edges)
-    if (e.key) edge_keys.push_back(*e.key);
-  if (edge_id_attributes) {
-    std::map<std::int64_t, std::size_t> seen;
-    for (std::size_t k = 0; k < g.edges.size(); ++k) {
-      if (const auto [it, fresh] = seen.emplace(*g.edges[k].id, k); !fresh)
-        g.fail(g.edges[k].where, "its \"id\" " + std::to_string(*g.edges[k].id) + " is also that of " +
-                                     g.edges[it->second].where);
-      net.id[k] = *g.edges[k].id;
-    }
-    vessel_how = "their \"id\" attributes";
-  } else if (auto ids = edge_keys.size() == g.edges.size() ? ids_from_keys(edge_keys, vessel_how) : std::nullopt) {
-    net.id = std::move(*ids);
-  } else {
-    for (std::size_t k = 0; k < g.edges.size(); ++k) net.id[k] = static_cast<std::int64_t>(k);
-    vessel_how = "numbered in the file's order";
-  }
+  set_vessel_ids(g, net, vessel_how);
 
   if (!generations) net.generation = generations_from_inlets(net);  // breadth first from the inlets
   net.provenance["tool"] = "vimport";
