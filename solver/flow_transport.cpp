@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "physics/phase_separation.hpp"
 #include "physics/rheology.hpp"
 #include "pulse/legendre_basis.hpp"
@@ -183,11 +184,11 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
           given.push_back(static_cast<std::int32_t>(b));
       }
       if (given.empty())
-        throw InputError("--tracer " + spec.name + ": " +
-                         (spec.place == TracerSpec::Place::inlet
-                              ? std::string("the network has no flow or pressure boundary to give it through")
-                              : "node " + std::to_string(net.node_id[static_cast<std::size_t>(spec.at)]) +
-                                    " has no flow or pressure boundary (at=vessel:ID gives it inside the network)"));
+        throw SettingError("tracer", placeholder("tracer") + " " + spec.name + ": " +
+                           (spec.place == TracerSpec::Place::inlet
+                                ? std::string("the network has no flow or pressure boundary to give it through")
+                                : "node " + std::to_string(net.node_id[static_cast<std::size_t>(spec.at)]) +
+                                      " has no flow or pressure boundary (at=vessel:ID gives it inside the network)"));
     }
     tracer_boundaries_.push_back(std::move(given));
     tracer_face_.push_back(face);

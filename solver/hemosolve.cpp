@@ -19,16 +19,13 @@
 #include "core/errors.hpp"
 #include "formats/network_io.hpp"
 #include "formats/pressure_reference.hpp"
+#include "solver/outcome_lines.hpp"
 #include "solver/pulsatile_call.hpp"
 #include "solver/run_configuration.hpp"
 
 using namespace hemotree;
 
 namespace {
-
-std::string plural(std::size_t count, const std::string& noun) {
-  return std::to_string(count) + " " + noun + (count == 1 ? "" : "s");
-}
 
 // The run's words on stderr ("hemosolve: ...", notes silenced by --quiet), its progress as a
 // line redrawn on a terminal or a line per cycle in a log, and Ctrl-C and kill as requests.
@@ -55,37 +52,6 @@ class CommandLineObserver final : public RunObserver {
   InterruptRequests& interrupts_;
   bool quiet_;
 };
-
-// The option texts that name a choice, as values.
-void translate_choices(RunConfiguration& config, const std::string& scheme, const std::string& model,
-                       const std::string& start, const std::string& rheology, const std::string& degree_text) {
-  SolverOptions& options = config.solver;
-  if (scheme == "rk4") options.scheme = TimeScheme::runge_kutta4;
-  else if (scheme == "ab2") options.scheme = TimeScheme::adams_bashforth2;
-  else if (scheme == "etd2") options.scheme = TimeScheme::exponential_ab2;
-  else throw InputError("--scheme must be etd2, ab2 or rk4 (got '" + scheme + "')");
-  if (model == "auto") options.model = ModelChoice::automatic;
-  else if (model == "1d") options.model = ModelChoice::one_d;
-  else if (model == "0d") options.model = ModelChoice::zero_d;
-  else throw InputError("--model must be auto, 1d or 0d (got '" + model + "')");
-  if (start == "rest") options.steady_start = false;
-  else if (start != "steady") throw InputError("--start must be steady or rest (got '" + start + "')");
-  if (!rheology.empty()) {
-    if (rheology == "pries") options.rheology_override = static_cast<int>(Rheology::pries);
-    else if (rheology == "newtonian") options.rheology_override = static_cast<int>(Rheology::newtonian);
-    else throw InputError("--rheology must be pries or newtonian (got '" + rheology + "')");
-  }
-  if (degree_text != "auto") {
-    std::size_t used = 0;
-    try {
-      options.degree = std::stoi(degree_text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != degree_text.size() || options.degree < 0 || options.degree > 30)
-      throw InputError("--degree must be auto or a whole number in [0, 30] (got '" + degree_text + "')");
-  }
-}
 
 // --pressure-at NODE=PRESSURE: the pressure level of a part whose boundaries are flows only.
 void fix_pressures(Network& net, const std::vector<std::string>& texts, bool quiet) {
@@ -121,26 +87,10 @@ std::vector<std::uint8_t> vtk_vessels(const Network& net, const std::string& tex
 // The outcome said as the command line says it, and the exit status (solver/run_outcome.hpp).
 int finish(const RunResult& result, const RunConfiguration& config) {
   if (!result.started) return InterruptRequests::exit_status(result.signal);
-  const std::string& out_dir = config.out_dir;
-  if (result.outcome == RunOutcome::interrupted) {
-    warn(std::string("interrupted by ") + InterruptRequests::name(result.signal) + " after " +
-         plural(result.cycles_done, "cycle") + ": " + out_dir +
-         (result.cycles_done > 0 ? " holds the results of the last whole cycle and its checkpoint"
-                                 : " holds the checkpoint of the start (no cycle was completed)") +
-         "; --resume " + out_dir + " continues");
-    return exit_status(result.outcome, result.signal);
-  }
-  if (result.outcome == RunOutcome::broken_down) throw InputError(result.error);
-  if (result.outcome == RunOutcome::failed)
-    throw InputError("the results are wrong and marked failed in summary.json: " + result.error);
-  if (result.outcome == RunOutcome::not_periodic)
-    warn("not periodic within " + std::to_string(config.max_cycles) + " cycles (--max-cycles)" +
-         (result.has_change ? ": the last cycle changed by " + format_rounded(result.change) + " (vessel " +
-                                  std::to_string(result.slowest_vessel) + ")"
-                            : std::string()) +
-         ", above --until-periodic " + format_rounded(config.periodic_tolerance) + "; exit status " +
-         std::to_string(exit_status(result.outcome)));
-  return exit_status(result.outcome);
+  if (const std::string error = outcome_error(result); !error.empty()) throw InputError(error);
+  if (const std::string line = outcome_warning(result, config, InterruptRequests::name(result.signal)); !line.empty())
+    warn(line);
+  return exit_status(result.outcome, result.signal);
 }
 
 // The command line as given: numbers bound straight into the run's configuration, texts
@@ -289,8 +239,7 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
 int run_command_line(CommandLine& line, int cores) {
   RunConfiguration& config = line.config;
   SolverOptions& options = config.solver;
-  const std::string &out_dir = line.out_dir, &resume_dir = line.resume_dir, &red_cells = line.red_cells,
-                  &vtk_min_text = line.vtk_min_text;
+  const std::string &out_dir = line.out_dir, &resume_dir = line.resume_dir, &vtk_min_text = line.vtk_min_text;
   const bool quiet = line.quiet, vtk = config.vtk;
   const int frames = config.frames;
   config.words = hemosolve_words();
@@ -303,7 +252,11 @@ int run_command_line(CommandLine& line, int cores) {
   config.resume = !resume_dir.empty();
   config.until_periodic = line.until_periodic->count() > 0;
   check_configuration(config);
-  translate_choices(config, line.scheme, line.model, line.start, line.rheology, line.degree_text);
+  options.scheme = time_scheme_named(line.scheme);
+  options.model = model_named(line.model);
+  options.steady_start = steady_start_named(line.start);
+  if (!line.rheology.empty()) options.rheology_override = static_cast<int>(rheology_named(line.rheology));
+  options.degree = degree_named(line.degree_text);
   if (!line.dt_text.empty()) options.dt = parse_quantity(line.dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");
   if (options.threads < 1 || options.threads > cores)
     throw InputError("--threads must lie in [1, " + std::to_string(cores) + "] (got " +
@@ -324,14 +277,8 @@ int run_command_line(CommandLine& line, int cores) {
   }
   if ((vtk || frames > 0) && net.x.empty())
     throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
-  if (red_cells == "transport") config.red_cells = RedCells::transport;
-  else if (red_cells != "fixed") throw InputError("--red-cells must be fixed or transport (got '" + red_cells + "')");
-  for (const auto& text : line.tracer_texts)
-    config.tracers.push_back(parse_tracer(text, net, static_cast<int>(config.tracers.size()) + 1));
-  for (std::size_t i = 0; i < config.tracers.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (config.tracers[i].name == config.tracers[j].name)
-        throw InputError("--tracer: two tracers named " + config.tracers[i].name);
+  config.red_cells = red_cells_named(line.red_cells);
+  config.tracers = parse_tracers(line.tracer_texts, net);
   if (line.steady) {
     run_steady(net, config, observer);
     return 0;

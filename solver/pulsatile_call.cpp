@@ -10,6 +10,7 @@
 
 #include "core/units.hpp"
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/checkpoint_file.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "solver/flow_transport.hpp"
@@ -38,14 +39,15 @@ std::string plural(std::size_t count, const std::string& noun) {
 
 // Warns when pressures leave the physiological band, with the likely cause.
 void warn_unphysiological(double low, double high, std::int64_t vessel, const Network& net, const char* what,
-                          RunObserver& observer) {
+                          const SettingWords& words, RunObserver& observer) {
   if (!std::isfinite(low) || !std::isfinite(high)) return;
   if (low >= physiological_low * pascal_per_mmhg && high <= physiological_high * pascal_per_mmhg) return;
   observer.warn(std::string(what) + " reach " + format_quantity(high, "mmHg") + " (lowest " +
                 format_quantity(low, "mmHg") + ", at vessel " + std::to_string(vessel) +
                 "), outside a physiological 0 to 300 mmHg: " +
                 (net.inlet ? "the inlet's mean flow (" + format_quantity(net.inlet->waveform.mean_value(), "ml/min") +
-                                 ") is likely wrong for this network's size (vprune --mean-flow sets it)"
+                                 ") is likely wrong for this network's size (vprune " +
+                                 in_words(placeholder("mean_flow"), words) + " sets it)"
                            : std::string("the boundary flows and pressures are likely wrong for this network")));
 }
 
@@ -60,15 +62,17 @@ Checkpoint checkpoint_to_resume(const OutputFolder& folder, const RunConfigurati
   if (config.resume) {
     const auto file = folder.latest_checkpoint();
     if (!file)
-      throw InputError("--resume " + config.out_dir + ": no checkpoint.bin in it or in " + folder.staging().string() +
-                       " (a run writes one when interrupted, or every N cycles with --checkpoint-every N)");
+      throw SettingError("resume", placeholder("resume") + " " + config.out_dir + ": no checkpoint.bin in it or in " +
+                                       folder.staging().string() + " (a run writes one when interrupted, or every N "
+                                       "cycles with " + placeholder("checkpoint_every") + " N)");
     c.bytes = read_checkpoint_file(*file);
     c.source = file->string();
   }
   if (!config.resume && !config.force && folder.latest_checkpoint() &&
       folder.latest_checkpoint()->parent_path() == folder.staging())
-    throw InputError(folder.staging().string() + " holds the checkpoint of a run that was killed: --resume " +
-                     config.out_dir + " continues it; --force (or removing that folder) starts afresh");
+    throw SettingError("force", folder.staging().string() + " holds the checkpoint of a run that was killed: " +
+                                    placeholder("resume") + " " + config.out_dir + " continues it; " +
+                                    placeholder("force") + " (or removing that folder) starts afresh");
   return c;
 }
 
@@ -86,8 +90,8 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
   const std::size_t steps_per_cycle = d.step.cycle.steps_per_cycle;
   const double dt = d.step.cycle.dt;
   if (static_cast<std::size_t>(config.frames) > steps_per_cycle)
-    throw InputError("--frames " + std::to_string(config.frames) + " exceeds the " + std::to_string(steps_per_cycle) +
-                     " steps of a cycle");
+    throw SettingError("frames", placeholder("frames") + " " + std::to_string(config.frames) + " exceeds the " +
+                                     std::to_string(steps_per_cycle) + " steps of a cycle");
   for (std::size_t v = 0; v < net.vessel_count(); ++v)
     if (!run.is_lumped(v)) d.degrees[run.degree(v)] += static_cast<std::size_t>(config.solver.elements);
   std::vector<double> elements_of_degree(static_cast<std::size_t>(run.max_degree()) + 1, 0.0);
@@ -103,13 +107,15 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
   const RunEstimate whole =
       estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned, threads, substeps, lumped);
   if (per_cycle.seconds > one_day && !config.force)
-    throw InputError("one cycle would take about " + describe_duration(per_cycle.seconds) + " (" +
+    throw SettingError("force", "one cycle would take about " + describe_duration(per_cycle.seconds) + " (" +
                      format_rounded(static_cast<double>(steps_per_cycle)) + " steps of " + format_quantity(dt, "s") +
                      ", set by the " + d.step.reason + "; " + plural(run.element_count(), "element") +
                      "): refused, more than a day. Check that vessel's wall and length and the inlet's "
-                     "flow, use fewer --elements or a lower --degree, or --force to run it anyway");
+                     "flow, use fewer " + placeholder("elements") + " or a lower " + placeholder("degree") + ", or " +
+                     placeholder("force") + " to run it anyway");
   d.one_d = net.vessel_count() - run.lumped_count();
-  observer.note(plural(d.one_d, "vessel") + " 1D, " + std::to_string(run.lumped_count()) + " 0D (--model " +
+  observer.note(plural(d.one_d, "vessel") + " 1D, " + std::to_string(run.lumped_count()) + " 0D (" +
+                in_words(placeholder("model"), config.words) + " " +
                 to_string(config.solver.model) + ")" +
                 (run.lumped_count() > 0 && d.one_d > 0
                      ? "; " + std::to_string(run.substeps()) + " 1D substeps of " +
@@ -122,8 +128,8 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
                 (config.until_periodic ? " for at most " : " for ") + plural(planned, "cycle") + " on " +
                 plural(threads, "thread"));
   if (whole.seconds > one_day && observer.hears_notes())
-    observer.warn("the whole run may take " + describe_duration(whole.seconds) +
-                  " (use --checkpoint-every N to be able to resume it)");
+    observer.warn("the whole run may take " + describe_duration(whole.seconds) + " (use " +
+                  in_words(placeholder("checkpoint_every"), config.words) + " N to be able to resume it)");
   return d;
 }
 
@@ -202,7 +208,7 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
   }
   const CycleSummary& last = pulsatile.last_cycle();
   if (!last.boundary_mean_flow.empty()) {
-    // Each boundary's mean flow into the network over the last cycle (as --steady reports).
+    // Each boundary's mean flow into the network over the last cycle (as the steady run reports).
     info["boundaries"] = nlohmann::json::array();
     for (std::size_t i = 0; i < run.boundary_list().size(); ++i) {
       const NodeBoundary& b = run.boundary_list()[i];
@@ -237,7 +243,7 @@ void say_results(const Network& net, const PulseSolver& run, const RunConfigurat
     low = std::min(low, last.vessels[v].mean_pressure);
     if (last.vessels[v].mean_pressure > high) high = last.vessels[(highest = v)].mean_pressure;
   }
-  warn_unphysiological(low, high, net.id[highest], net, "mean pressures", observer);
+  warn_unphysiological(low, high, net.id[highest], net, "mean pressures", config.words, observer);
   // A tracer whose injection the run never reached has no curves: said, not left to be found.
   for (std::size_t k = 0; transport && k < config.tracers.size(); ++k)
     if (const TracerTransport& moved = transport->tracer(k); moved.entered() + moved.injected() == 0)
@@ -254,8 +260,9 @@ void check_pulsatile(const Network& net, const RunConfiguration& config) {
   // The common period of the time-varying boundary conditions (1 s where all are constant).
   const double period = driving_waveform(net).period;
   if (!Interval{0, period, true, false}.contains(config.sample_interval))
-    throw InputError("--sample-interval must lie in " + describe({0, period, true, false}, "s") + " (got " +
-                     format_quantity(config.sample_interval, "s") + ")");
+    throw SettingError("sample_interval", placeholder("sample_interval") + " must lie in " +
+                                              describe({0, period, true, false}, "s") + " (got " +
+                                              format_quantity(config.sample_interval, "s") + ")");
 }
 
 RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunObserver& observer) {
@@ -288,7 +295,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
                   (config.balance_compliances ? std::string(", without the compliance balance (it needs the steady network)")
                                               : std::string()));
   warn_unphysiological(run.steady_pressure_min(), run.steady_pressure_max(), net.id[run.steady_pressure_max_vessel()],
-                       net, "steady pressures", observer);
+                       net, "steady pressures", config.words, observer);
 
   // ---- the run ------------------------------------------------------------------------------
   const RunIdentity identity = run_identity(net, config, dt, run.blood().rheology);
@@ -344,22 +351,23 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   if (!failure.empty()) info["error"] = failure;
   if (status == RunStatus::broken_down) info["error"] = in_words(pulsatile.breakdown(), config.words);
   if (status == RunStatus::interrupted)
-    info["error"] = "interrupted by " + observer.signal_name(pulsatile.signal()) + "; resume with --resume " +
-                    config.out_dir;
+    info["error"] = "interrupted by " + observer.signal_name(pulsatile.signal()) + "; resume with " +
+                    in_words(placeholder("resume"), config.words) + " " + config.out_dir;
 
   if (status == RunStatus::too_long) {
     folder.discard();
     const double cycle = pulsatile.measured_step() * static_cast<double>(steps_per_cycle);
-    throw InputError("one cycle would take about " + describe_duration(cycle) + " (measured over its first steps: " +
+    throw SettingError("force", "one cycle would take about " + describe_duration(cycle) + " (measured over its first steps: " +
                      format_quantity(pulsatile.measured_step(), "s") + " a step, " +
                      format_rounded(static_cast<double>(steps_per_cycle)) +
-                     " steps): stopped, more than a day. Use fewer --elements or a lower --degree, --threads, "
-                     "or --force to run it anyway");
+                     " steps): stopped, more than a day. Use fewer " + placeholder("elements") + " or a lower " +
+                     placeholder("degree") + ", " + placeholder("threads") + ", or " + placeholder("force") +
+                     " to run it anyway");
   }
   // Nothing computed, nothing kept: DIR stays as it was.
   if (status == RunStatus::broken_down && last.vessels.empty()) {
     folder.discard();
-    throw InputError(in_words(pulsatile.breakdown(), config.words));
+    throw_input_error(pulsatile.breakdown());  // its placeholders worded by the catcher
   }
   const std::filesystem::path dir = folder.staging();
   if (status == RunStatus::interrupted || config.checkpoint_every > 0) pulsatile.write_checkpoint();

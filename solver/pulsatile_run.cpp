@@ -9,6 +9,7 @@
 #include <iterator>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "formats/vtk_series.hpp"
 #include "solver/run_report.hpp"
 #include "pulse/solution_breakdown.hpp"
@@ -146,21 +147,26 @@ bool PulsatileRun::cycles_left() const { return done_ < planned() && !periodic()
 // last checkpoint and publishing its folder left both in its staging folder.
 void PulsatileRun::check_run_end(const std::filesystem::path& source) const {
   const std::string cycles = std::to_string(done_) + (done_ == 1 ? " cycle" : " cycles");
-  const std::string raise = plan_.until_periodic ? "--max-cycles" : "--cycles";
+  const std::string raise = placeholder(plan_.until_periodic ? "max_cycles" : "cycles");
+  const std::string resume = placeholder("resume");
   if (source.parent_path() != folder_) {
     const std::string dir = source.parent_path().string();
     if (periodic())
-      throw InputError("--resume " + dir + ": the run is already periodic after its " + cycles +
-                       "; nothing is left to run");
-    throw InputError("--resume " + dir + ": the run already has its " + cycles + "; raise " + raise + " to continue");
+      throw SettingError("resume", resume + " " + dir + ": the run is already periodic after its " + cycles +
+                                       "; nothing is left to run");
+    throw SettingError("resume", resume + " " + dir + ": the run already has its " + cycles + "; raise " + raise +
+                                     " to continue");
   }
   if (done_ > planned())
-    throw InputError("--resume: " + source.string() + " is after cycle " + std::to_string(done_) + ", beyond " + raise +
-                     " " + std::to_string(planned()) + "; raise " + raise + " to continue");
+    throw SettingError("resume", resume + ": " + source.string() + " is after cycle " + std::to_string(done_) +
+                                     ", beyond " + raise + " " + std::to_string(planned()) + "; raise " + raise +
+                                     " to continue");
   if (!has_last_cycle_frames())
-    throw InputError("--resume: " + source.string() + " ends the run after its " + cycles +
-                     ", but the frames of that last cycle are not in " + (folder_ / "frames").string() + " as --frames " +
-                     std::to_string(plan_.frames) + " asks; raise " + raise + " to compute another cycle's");
+    throw SettingError("resume", resume + ": " + source.string() + " ends the run after its " + cycles +
+                                     ", but the frames of that last cycle are not in " +
+                                     (folder_ / "frames").string() + " as " + placeholder("frames") + " " +
+                                     std::to_string(plan_.frames) + " asks; raise " + raise +
+                                     " to compute another cycle's");
 }
 
 // The folder's frames/frames.pvd lists the frames of the cycle that ended at the

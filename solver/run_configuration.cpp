@@ -1,9 +1,13 @@
 #include "solver/run_configuration.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <exception>
 
 #include "core/units.hpp"
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
+#include "formats/quoting.hpp"
 
 namespace hemotree {
 
@@ -11,15 +15,18 @@ namespace {
 
 constexpr double most_steps_per_cycle = 1e12;  // beyond any machine's reach, and size_t's range is safe
 
-void check_count(long long value, long long low, long long high, const std::string& name) {
+// setting's value within [low, high]; said names the setting as the message does.
+void check_count(long long value, long long low, long long high, const std::string& setting,
+                 const std::string& said = {}) {
   if (value < low || value > high)
-    throw InputError(name + " must lie in [" + std::to_string(low) + ", " + std::to_string(high) + "] (got " +
-                     std::to_string(value) + ")");
+    throw SettingError(setting, (said.empty() ? placeholder(setting) : said) + " must lie in [" + std::to_string(low) +
+                                    ", " + std::to_string(high) + "] (got " + std::to_string(value) + ")");
 }
 
-void check_range(double value, const Interval& range, const std::string& name) {
+void check_range(double value, const Interval& range, const std::string& setting, const std::string& said = {}) {
   if (!range.contains(value))
-    throw InputError(name + " must lie in " + describe(range, "") + " (got " + format_rounded(value) + ")");
+    throw SettingError(setting, (said.empty() ? placeholder(setting) : said) + " must lie in " + describe(range, "") +
+                                    " (got " + format_rounded(value) + ")");
 }
 
 }  // namespace
@@ -44,28 +51,90 @@ const char* to_string(TimeScheme scheme) {
   return "etd2";
 }
 
+namespace {
+// A caller's text as a message shows it: as written, unless it holds a control character
+// (which a one-line message, and a placeholder's marks, must not carry).
+std::string shown(const std::string& text) {
+  const bool control = std::any_of(text.begin(), text.end(), [](char c) {
+    return static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+  });
+  return control ? printable(text) : text;
+}
+
+[[noreturn]] void refuse_choice(const char* setting, const char* choices, const std::string& name) {
+  throw SettingError(setting, placeholder(setting) + " must be " + choices + " (got '" + shown(name) + "')");
+}
+}  // namespace
+
+TimeScheme time_scheme_named(const std::string& name) {
+  if (name == "rk4") return TimeScheme::runge_kutta4;
+  if (name == "ab2") return TimeScheme::adams_bashforth2;
+  if (name == "etd2") return TimeScheme::exponential_ab2;
+  refuse_choice("scheme", "etd2, ab2 or rk4", name);
+}
+
+ModelChoice model_named(const std::string& name) {
+  if (name == "auto") return ModelChoice::automatic;
+  if (name == "1d") return ModelChoice::one_d;
+  if (name == "0d") return ModelChoice::zero_d;
+  refuse_choice("model", "auto, 1d or 0d", name);
+}
+
+bool steady_start_named(const std::string& name) {
+  if (name != "steady" && name != "rest") refuse_choice("start", "steady or rest", name);
+  return name == "steady";
+}
+
+Rheology rheology_named(const std::string& name) {
+  if (name == "pries") return Rheology::pries;
+  if (name == "newtonian") return Rheology::newtonian;
+  refuse_choice("rheology", "pries or newtonian", name);
+}
+
+int degree_named(const std::string& name) {
+  if (name == "auto") return SolverOptions::automatic;
+  std::size_t used = 0;
+  int degree = -1;
+  try {
+    degree = std::stoi(name, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != name.size() || degree < 0 || degree > 30)
+    refuse_choice("degree", "auto or a whole number in [0, 30]", name);
+  return degree;
+}
+
+RedCells red_cells_named(const std::string& name) {
+  if (name == "transport") return RedCells::transport;
+  if (name != "fixed") refuse_choice("red_cells", "fixed or transport", name);
+  return RedCells::fixed;
+}
+
 // In the order hemosolve has always checked them, so that its first complaint is the same.
 void check_configuration(const RunConfiguration& c) {
-  check_count(c.cycles, 1, 100000, "--cycles");
-  check_count(c.max_cycles, 1, 100000, "--max-cycles");
-  check_count(c.checkpoint_every, 0, 100000, "--checkpoint-every");
-  check_count(c.frames, 0, 10000, "--frames");
-  if (c.until_periodic) check_range(c.periodic_tolerance, {0, 1, true, true}, "--until-periodic");
+  check_count(c.cycles, 1, 100000, "cycles");
+  check_count(c.max_cycles, 1, 100000, "max_cycles");
+  check_count(c.checkpoint_every, 0, 100000, "checkpoint_every");
+  check_count(c.frames, 0, 10000, "frames");
+  if (c.until_periodic) check_range(c.periodic_tolerance, {0, 1, true, true}, "periodic_tolerance");
   const SolverOptions& s = c.solver;
-  check_range(s.lumped_transit, {0, 1}, "--lumped-transit");
-  check_range(s.lumped_rc, {0, INFINITY}, "--lumped-rc");
-  check_range(s.lumped_step, {0, 0.1, true, false}, "--lumped-step");
-  check_count(s.lumped_passes, 1, 10, "--lumped-passes");
-  check_range(s.cfl, {0, c.force ? 100.0 : 1.0, true, false}, c.force ? "--cfl (with --force)" : "--cfl");
-  if (s.degree != SolverOptions::automatic) check_count(s.degree, 0, 30, "--degree");
-  check_count(s.degree_rule.low, 0, 30, "--low-degree");
-  check_count(s.degree_rule.raise_to, 0, 30, "--raise-degree");
-  check_count(s.degree_rule.high, 0, 30, "--high-degree");
-  check_range(s.degree_rule.linear_error, {0, INFINITY}, "--linear-error");  // inf: never degree 2
-  check_count(s.elements, 1, 1000, "--elements");
-  check_range(s.thick_wall_ratio, {0, 10, true, false}, "--thick-wall-ratio");
+  check_range(s.lumped_transit, {0, 1}, "lumped_transit");
+  check_range(s.lumped_rc, {0, INFINITY}, "lumped_rc");
+  check_range(s.lumped_step, {0, 0.1, true, false}, "lumped_step");
+  check_count(s.lumped_passes, 1, 10, "lumped_passes");
+  check_range(s.cfl, {0, c.force ? 100.0 : 1.0, true, false}, "cfl",
+              c.force ? placeholder("cfl") + " (with " + placeholder("force") + ")" : placeholder("cfl"));
+  if (s.degree != SolverOptions::automatic) check_count(s.degree, 0, 30, "degree");
+  check_count(s.degree_rule.low, 0, 30, "low_degree");
+  check_count(s.degree_rule.raise_to, 0, 30, "raise_degree");
+  check_count(s.degree_rule.high, 0, 30, "high_degree");
+  check_range(s.degree_rule.linear_error, {0, INFINITY}, "linear_error");  // inf: never degree 2
+  check_count(s.elements, 1, 1000, "elements");
+  check_range(s.thick_wall_ratio, {0, 10, true, false}, "thick_wall_ratio");
   if (!(c.transport_step > 0 && c.transport_step <= 0.5))
-    throw InputError("--transport-step " + format_rounded(c.transport_step) + ": accepted range (0, 0.5] of the period");
+    throw SettingError("transport_step", placeholder("transport_step") + " " + format_rounded(c.transport_step) +
+                                             ": accepted range (0, 0.5] of the period");
 }
 
 CycleStep decide_cycle_step(double period, double step, const std::string& reason) {
@@ -83,13 +152,17 @@ CycleStep decide_cycle_step(double period, double step, const std::string& reaso
 TimeStepDecision decide_time_step(PulseSolver& solver, const RunConfiguration& config, double period) {
   const double asked = config.solver.dt;
   TimeStepDecision d;
+  // Named by placeholders: worded by the caller's words where kept, by the catcher's where thrown.
+  std::string beyond_limit;
   if (asked > 0 && asked > solver.stable_dt() * (1 + 1e-9))
-    d.beyond_limit = "--dt " + format_quantity(asked, "s") + " is " + format_rounded(asked / solver.stable_dt()) +
-                     " times the " + (solver.lumped_count() > 0 ? "0D step's accuracy limit " : "stability limit ") +
-                     format_quantity(solver.stable_dt(), "s") + " (" + in_words(solver.stable_dt_reason(), config.words) + ")";
-  if (!d.beyond_limit.empty() && !config.force)
-    throw InputError(d.beyond_limit + "; the solution would blow up or be wrong: use a --dt of at most the limit, or "
-                     "--force to run it anyway");
+    beyond_limit = placeholder("dt") + " " + format_quantity(asked, "s") + " is " +
+                   format_rounded(asked / solver.stable_dt()) + " times the " +
+                   (solver.lumped_count() > 0 ? "0D step's accuracy limit " : "stability limit ") +
+                   format_quantity(solver.stable_dt(), "s") + " (" + solver.stable_dt_reason() + ")";
+  if (!beyond_limit.empty() && !config.force)
+    throw SettingError("dt", beyond_limit + "; the solution would blow up or be wrong: use a " + placeholder("dt") +
+                                 " of at most the limit, or " + placeholder("force") + " to run it anyway");
+  d.beyond_limit = in_words(beyond_limit, config.words);
   d.reason = in_words(solver.dt_reason(), config.words);
   d.cycle = decide_cycle_step(period, solver.dt(), d.reason);
   solver.set_time_step(d.cycle.dt);  // slightly smaller, so that cycles end exactly on a step

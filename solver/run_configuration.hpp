@@ -22,6 +22,16 @@ const char* to_string(RedCells cells);          // "fixed", "transport"
 const char* to_string(ModelChoice model);       // "auto", "1d", "0d"
 const char* to_string(TimeScheme scheme);       // "etd2", "ab2", "rk4"
 
+// The choices from their names, as a caller writes them (a command line, a script): a
+// SettingError naming the setting (scheme, model, start, rheology, degree, red_cells) for any
+// other text.
+TimeScheme time_scheme_named(const std::string& name);
+ModelChoice model_named(const std::string& name);
+bool steady_start_named(const std::string& name);  // "steady" (true) or "rest"
+Rheology rheology_named(const std::string& name);  // "pries" or "newtonian"
+int degree_named(const std::string& name);         // "auto" (SolverOptions::automatic) or 0 to 30
+RedCells red_cells_named(const std::string& name);
+
 struct RunConfiguration {
   std::string network_name;  // as the caller named it (summary.json's "network")
   std::string out_dir;       // the results folder, written as OUT.partial until the run ends
@@ -45,16 +55,18 @@ struct RunConfiguration {
   std::vector<std::uint8_t> vtk_keep;  // the vessels the VTK output shows (empty: all)
   // Run even beyond the stability limit, a day per cycle, or over a killed run's checkpoint.
   bool force = false;
-  // The caller's words for the settings that texts from the solver name (its time-step
-  // reason, a breakdown's advice): hemosolve's flags; empty, the settings' own names.
+  // The caller's words for the settings that the run's kept texts name (summary.json's
+  // time-step reason and error, the notes and warnings to the observer): hemosolve's flags;
+  // empty, the settings' own names. What the run throws is a SettingError the catcher words.
   SettingWords words;
 
   bool carries_transport() const { return red_cells == RedCells::transport || !tracers.empty(); }
   int planned_cycles() const { return until_periodic ? max_cycles : cycles; }
 };
 
-// The configuration's own ranges, before any work (InputError naming the option as hemosolve
-// spells it: the command line is where a configuration is most often written).
+// The configuration's own ranges, before any work: a SettingError naming the setting by its
+// own name ("cycles", "max_cycles", "periodic_tolerance", "low_degree", "transport_step", ...),
+// which the caller words (hemosolve: its flags, cli/setting_words.cpp).
 void check_configuration(const RunConfiguration& config);
 
 // A cycle of N steps of dt = T / N: the step no longer than the solver's, N = ceil(T / step)

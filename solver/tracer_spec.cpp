@@ -140,4 +140,20 @@ TracerSpec parse_tracer(const std::string& spec, const Network& net, int ordinal
   return t;
 }
 
+namespace {
+[[noreturn]] void refuse_twice(const std::string& name) {
+  throw SettingError("tracer", placeholder("tracer") + ": two tracers named " + name);
+}
+}  // namespace
+
+std::vector<TracerSpec> parse_tracers(const std::vector<std::string>& specs, const Network& net) {
+  std::vector<TracerSpec> tracers;
+  for (const std::string& spec : specs) tracers.push_back(parse_tracer(spec, net, static_cast<int>(tracers.size()) + 1));
+  for (std::size_t i = 0; i < tracers.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (tracers[i].name == tracers[j].name)
+        refuse_twice(tracers[i].name);
+  return tracers;
+}
+
 }  // namespace hemotree

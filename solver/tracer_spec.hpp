@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "formats/network.hpp"
 #include "transport/tracer_transport.hpp"
@@ -39,6 +40,9 @@ struct TracerSpec {
 // Parses SPEC for the network (ids to indices); `ordinal` names it tracerN where no name is
 // given. InputError naming the key, the value and what is accepted.
 TracerSpec parse_tracer(const std::string& spec, const Network& net, int ordinal);
+
+// Each SPEC parsed (the k-th named tracerk where it names none), and a name given twice refused.
+std::vector<TracerSpec> parse_tracers(const std::vector<std::string>& specs, const Network& net);
 
 const char* to_string(TracerCarrier carrier);
 

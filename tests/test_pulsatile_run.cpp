@@ -12,6 +12,8 @@
 
 #include "core/errors.hpp"
 #include "cli/interrupt.hpp"
+#include "cli/setting_words.hpp"
+#include "core/setting_error.hpp"
 #include "network_builders.hpp"
 #include "solver/pulsatile_run.hpp"
 
@@ -160,10 +162,13 @@ TEST(PulsatileRun, ResumedAtItsEnd) {
   try {
     published.resume(bytes, (f.folder / "checkpoint.bin").string());
     FAIL() << "resumed a published run that has its cycles";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("the run already has its 2 cycles; raise --cycles to continue"),
+  } catch (const SettingError& e) {  // the setting by its name; hemosolve's user reads its flag
+    EXPECT_NE(std::string(e.what()).find("the run already has its 2 cycles; raise cycles to continue"),
               std::string::npos)
         << e.what();
+    EXPECT_NE(e.in_words(hemosolve_words()).find("the run already has its 2 cycles; raise --cycles to continue"),
+              std::string::npos)
+        << e.in_words(hemosolve_words());
   }
 
   PulseSolver s2(f.net, f.options);

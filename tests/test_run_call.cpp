@@ -8,8 +8,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "cli/setting_words.hpp"
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "network_builders.hpp"
+#include "solver/outcome_lines.hpp"
 #include "solver/pulsatile_call.hpp"
 
 namespace hemotree {
@@ -129,6 +132,68 @@ TEST(DecideCycleStep, RoundsTheStepDownToAWholeNumberPerCycle) {
   EXPECT_EQ(b.steps_per_cycle, 10u);
   // No machine runs 1e13 steps a cycle.
   EXPECT_THROW(decide_cycle_step(1.0, 1e-13, "a vessel's friction"), InputError);
+}
+
+// The run names its settings by their own names to a caller from code (no words), and by
+// hemosolve's flags through hemosolve's words: no library text carries a flag.
+SettingError refusal_of(const Network& net, const RunConfiguration& config) {
+  Recorder observer;
+  try {
+    run_pulsatile(net, config, observer);
+  } catch (const SettingError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "the run was not refused";
+  return SettingError("", "");
+}
+
+TEST(RunCall, NamesSettingsInTheCallersWords) {
+  const SeriesOfThree case_;
+  const Folder folder;
+  RunConfiguration config = two_cycles(folder);
+  config.solver.dt = SeriesOfThree::period / 4;  // far above the stability limit
+  SettingError e = refusal_of(case_.net, config);
+  EXPECT_EQ(e.setting(), "dt");
+  const std::string own(e.what()), flags = e.in_words(hemosolve_words());
+  EXPECT_EQ(own.rfind("dt 0.025 s is ", 0), 0u) << own;
+  EXPECT_NE(own.find("use a dt of at most the limit, or force to run it anyway"), std::string::npos) << own;
+  EXPECT_EQ(own.find("--"), std::string::npos) << own;
+  EXPECT_EQ(flags.rfind("--dt 0.025 s is ", 0), 0u) << flags;
+  EXPECT_NE(flags.find("use a --dt of at most the limit, or --force to run it anyway"), std::string::npos) << flags;
+
+  // A setting whose flag is not its name: the periodic tolerance is hemosolve's --until-periodic.
+  config = two_cycles(folder);
+  config.until_periodic = true;
+  config.periodic_tolerance = 2;
+  e = refusal_of(case_.net, config);
+  EXPECT_STREQ(e.what(), "periodic_tolerance must lie in (0, 1) (got 2)");
+  EXPECT_EQ(e.in_words(hemosolve_words()), "--until-periodic must lie in (0, 1) (got 2)");
+
+  config = two_cycles(folder);
+  config.cycles = 0;
+  e = refusal_of(case_.net, config);
+  EXPECT_STREQ(e.what(), "cycles must lie in [1, 100000] (got 0)");
+  EXPECT_EQ(e.in_words(hemosolve_words()), "--cycles must lie in [1, 100000] (got 0)");
+}
+
+// Texts the run keeps (the outcome's lines) are worded by the configuration's words.
+TEST(RunCall, SaysItsOutcomeInTheCallersWords) {
+  RunConfiguration config;
+  config.out_dir = "out";
+  config.max_cycles = 4;
+  config.periodic_tolerance = 1e-3;
+  RunResult result;
+  result.outcome = RunOutcome::not_periodic;
+  EXPECT_EQ(outcome_warning(result, config, ""),
+            "not periodic within 4 cycles (max_cycles), above periodic_tolerance 0.001; exit status 3");
+  config.words = hemosolve_words();
+  EXPECT_EQ(outcome_warning(result, config, ""),
+            "not periodic within 4 cycles (--max-cycles), above --until-periodic 0.001; exit status 3");
+  result.outcome = RunOutcome::interrupted;
+  result.cycles_done = 1;
+  EXPECT_EQ(outcome_warning(result, config, "SIGINT"),
+            "interrupted by SIGINT after 1 cycle: out holds the results of the last whole cycle and its "
+            "checkpoint; --resume out continues");
 }
 
 }  // namespace
