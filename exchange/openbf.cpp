@@ -810,7 +810,7 @@ Network read_openbf(const std::string& path, const ImportOptions& options, Openb
       if (v.outlet_kind == "reflection") fail("outlet", "\"outlet\": reflection with Windkessel keys (R1, R2, Cc)");
       if (std::isnan(v.r1)) fail("", "a Windkessel outlet needs \"R1\"");
       if (std::isnan(v.cc)) fail("", "a Windkessel outlet needs \"Cc\"");
-      o.type = OutletType::rcr;
+      o.type = BoundaryType::rcr;
       o.c = v.cc;
       o.p_out = std::isnan(v.pout) ? 0.0 : v.pout;
       if (!std::isnan(v.r2) && v.r2 != 0) {
@@ -833,7 +833,7 @@ Network read_openbf(const std::string& path, const ImportOptions& options, Openb
     } else {
       if (!std::isnan(v.pout)) fail("Pout", "\"Pout\" belongs to a Windkessel outlet (R1, R2, Cc)");
       if (v.outlet_kind == "wk2" || v.outlet_kind == "wk3") fail("outlet", "\"outlet\": " + v.outlet_kind + " without R1 and Cc");
-      o.type = OutletType::reflection;
+      o.type = BoundaryType::reflection;
       o.reflection = std::isnan(v.rt) ? 0.0 : v.rt;
       if (!has_outlet(v)) ++open_ends;
     }
@@ -1117,7 +1117,7 @@ void write_openbf(const Network& net, OutputStream& out, const std::string& inle
     y += "    gamma_profile: " + std::to_string(static_cast<long long>(whole)) + "\n";
     if (const Outlet* o = outlet_of[v]) {
       switch (o->type) {
-        case OutletType::rcr:
+        case BoundaryType::rcr:
           // openBF reads R1 = 0 as a reflection outlet and R2 = 0 as a two-element Windkessel.
           if (o->r1 == 0 || o->r2 == 0)
             throw InputError(vessel_name(v) + ": an RCR outlet with R" + (o->r1 == 0 ? "1" : "2") +
@@ -1125,11 +1125,14 @@ void write_openbf(const Network& net, OutputStream& out, const std::string& inle
           y += "    R1: " + yaml_real(o->r1) + "\n    R2: " + yaml_real(o->r2) + "\n    Cc: " + yaml_real(o->c) + "\n";
           if (o->p_out != 0) y += "    Pout: " + yaml_real(o->p_out) + "\n";
           break;
-        case OutletType::resistance:
+        case BoundaryType::resistance:
           throw InputError(vessel_name(v) + ": a resistance (R) outlet; openBF has Windkessels and reflection only");
-        case OutletType::reflection:
+        case BoundaryType::reflection:
           y += "    Rt: " + yaml_real(o->reflection) + "\n";
           break;
+        case BoundaryType::flow:
+        case BoundaryType::pressure:
+          break;  // not outlet models
       }
     }
     out << y;

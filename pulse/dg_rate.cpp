@@ -245,10 +245,10 @@ void PulseSolver::outlet_end_fluxes(const PulseState& s, PulseState& rate) {
     q *= sign;
     EndState u;
     switch (o.outlet.type) {
-      case OutletType::resistance:
+      case BoundaryType::resistance:
         u = resistance_state(law, a, q, o.outlet.r, o.outlet.p_out);
         break;
-      case OutletType::rcr:
+      case BoundaryType::rcr:
         if (o.capacitor < 0) {  // no compliance: R1 and R2 in series
           u = resistance_state(law, a, q, o.outlet.r1 + o.outlet.r2, o.outlet.p_out);
         } else {
@@ -258,9 +258,12 @@ void PulseSolver::outlet_end_fluxes(const PulseState& s, PulseState& rate) {
           rate.capacitor(o.capacitor) = (u.flow - (pc - o.outlet.p_out) / o.outlet.r2) / o.outlet.c;
         }
         break;
-      case OutletType::reflection:
+      case BoundaryType::reflection:
         u = reflection_state(law, a, q, o.rest_area, sign * o.rest_flow, o.outlet.reflection);
         break;
+      case BoundaryType::flow:
+      case BoundaryType::pressure:
+        break;  // prescribed ends, not outlets
     }
     u.flow *= sign;
     set_end_flux(o.end, u);

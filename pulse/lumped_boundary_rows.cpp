@@ -58,11 +58,11 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
       continue;
     }
     const Outlet& o = bc.outlet;
-    if (o.type == OutletType::reflection)
+    if (o.type == BoundaryType::reflection)
       throw SettingError("model", "vessel " + std::to_string(net.id[v]) + ": a reflection outlet needs a 1D vessel (" +
                                       placeholder("model") + " 1d, or auto, keeps it 1D)");
     outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(at), -1});
-    if (o.type == OutletType::rcr && o.c > 0) {
+    if (o.type == BoundaryType::rcr && o.c > 0) {
       capacitor_of_outlet_[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(outlet_of_capacitor_.size());
       const auto c = static_cast<std::int32_t>(nodes_++);
       outlet_boundary_.back().r1_edge = static_cast<std::int32_t>(vessels_.size() + outlet_of_capacitor_.size());

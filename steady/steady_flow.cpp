@@ -63,7 +63,7 @@ Reduction reduce(const Network& net, const std::vector<double>& resistance) {
     const auto v = static_cast<std::size_t>(o.vessel);
     if (children.offset[v + 1] != children.offset[v])
       throw InputError(name(v) + " has an outlet but is not terminal");
-    if (o.type == OutletType::reflection)
+    if (o.type == BoundaryType::reflection)
       throw InputError(name(v) + ": a reflection outlet has no steady resistance");
     outlet_of[v] = static_cast<std::int32_t>(k);
   }
@@ -115,7 +115,7 @@ std::vector<std::int32_t> steady_outlets(const Network& net) {
       throw InputError("outlet " + std::to_string(k) + ": no vessel of index " + std::to_string(o.vessel));
     const auto v = static_cast<std::size_t>(o.vessel);
     if (left[static_cast<std::size_t>(net.to[v])]) throw InputError(name(v) + " has an outlet but is not terminal");
-    if (o.type == OutletType::reflection)
+    if (o.type == BoundaryType::reflection)
       throw InputError(name(v) + ": a reflection outlet has no steady resistance");
     if (!(o.resistance() > 0)) throw InputError(name(v) + ": its outlet has no resistance");
     if (outlet_of[v] >= 0) throw InputError(name(v) + " has two outlets");
