@@ -1,7 +1,9 @@
 // Each boundary condition's 1D end state (pulse/boundaries/) against the equation its header
 // claims it imposes, at both ends where it may sit, with the characteristic leaving the
-// vessel kept: Q* - Q = lambda_in (A* - A) (pulse/riemann.hpp).
+// vessel kept: Q* - Q = lambda_in (A* - A) (pulse/riemann.hpp); and its steady row
+// (steady/boundaries/) in the nodal system.
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -13,6 +15,11 @@
 #include "pulse/boundaries/reflection_outlet.hpp"
 #include "pulse/boundaries/resistance_outlet.hpp"
 #include "pulse/riemann.hpp"
+#include "steady/boundaries/flow_inlet.hpp"
+#include "steady/boundaries/nodal_rows.hpp"
+#include "steady/boundaries/pressure_end.hpp"
+#include "steady/boundaries/rcr_outlet.hpp"
+#include "steady/boundaries/resistance_outlet.hpp"
 
 using namespace hemotree;
 
@@ -109,6 +116,44 @@ TEST(CoupledNode, TheEndsTotalPressureIsTheNodesPlusItsResponse) {
         << "distal " << distal;
     expect_outgoing_kept(law, trace_area, trace_flow, distal, u);
   }
+}
+
+// Three nodes' rows, empty.
+struct Rows {
+  std::vector<double> shunt = std::vector<double>(3, 0.0), inflow = std::vector<double>(3, 0.0),
+                      pressure = std::vector<double>(3, 0.0);
+  std::vector<unsigned char> prescribed = std::vector<unsigned char>(3, 0);
+  steady::NodalRows rows{shunt, inflow, pressure, prescribed};
+};
+
+TEST(SteadyRows, AFlowIsACurrentIntoItsNode) {
+  Rows r;
+  steady::FlowInlet{2e-6}.add_row(r.rows, 1);
+  steady::FlowInlet{-5e-7}.add_row(r.rows, 1);
+  EXPECT_DOUBLE_EQ(r.inflow[1], 2e-6 - 5e-7);
+  EXPECT_EQ(r.shunt, std::vector<double>(3, 0.0));
+  EXPECT_EQ(r.prescribed, std::vector<unsigned char>(3, 0));
+}
+
+TEST(SteadyRows, APressureIsPrescribed) {
+  Rows r;
+  steady::PressureEnd{1.2e4}.add_row(r.rows, 2);
+  EXPECT_EQ(r.prescribed, (std::vector<unsigned char>{0, 0, 1}));
+  EXPECT_EQ(r.pressure[2], 1.2e4);
+  EXPECT_EQ(r.inflow, std::vector<double>(3, 0.0));
+}
+
+TEST(SteadyRows, AnOutletIsAShuntToItsOutflowPressure) {
+  // Q = (p_i - p_out) / R: G_i = 1/R, b_i = p_out / R.
+  Rows r;
+  steady::ResistanceOutlet{4e8, 1.5e3}.add_row(r.rows, 0);
+  EXPECT_EQ(r.shunt[0], 1 / 4e8);
+  EXPECT_EQ(r.inflow[0], 1.5e3 / 4e8);
+  // An RCR's capacitor carries no steady flow: R1 + R2 in series.
+  Rows rcr;
+  steady::RcrOutlet{1e8, 3e8, 1.5e3}.add_row(rcr.rows, 0);
+  EXPECT_EQ(rcr.shunt, r.shunt);
+  EXPECT_EQ(rcr.inflow, r.inflow);
 }
 
 }  // namespace
