@@ -10,6 +10,7 @@
 #include "physics/tube_law.hpp"
 #include "pulse/boundaries/coupled_node.hpp"
 #include "pulse/boundaries/flow_inlet.hpp"
+#include "pulse/boundaries/lumped_rows.hpp"
 #include "pulse/boundaries/pressure_end.hpp"
 #include "pulse/boundaries/rcr_outlet.hpp"
 #include "pulse/boundaries/reflection_outlet.hpp"
@@ -86,6 +87,21 @@ TEST(RcrOutlet, R1ToTheCapacitorAndTheCapacitorsRate) {
   EXPECT_NEAR(law.pressure(series.area) - outlet.p_out, (outlet.r1 + outlet.r2) * series.flow,
               1e-9 * law.pressure(series.area));
   expect_outgoing_kept(law, trace_area, trace_flow, true, series);
+}
+
+TEST(LumpedRows, AnROutletIsAShuntAndAnRcrACapacitorNode) {
+  const ResistanceOutlet r{4e8, 1.5e3};
+  EXPECT_EQ(r.lumped_shunt().conductance, 1 / 4e8);
+  EXPECT_EQ(r.lumped_shunt().pressure, 1.5e3);
+  const RcrOutlet rcr{1e8, 2e-9, 3e8, 1.5e3};
+  const LumpedCapacitor cap = rcr.lumped_capacitor();
+  EXPECT_EQ(cap.edge_resistance, 1e8);
+  EXPECT_EQ(cap.shunt.conductance, 1 / 3e8);
+  EXPECT_EQ(cap.shunt.pressure, 1.5e3);
+  EXPECT_EQ(cap.compliance, 2e-9);
+  // With no compliance, R1 and R2 in series: the R outlet's shunt.
+  EXPECT_EQ(rcr.series_lumped_shunt().conductance, r.lumped_shunt().conductance);
+  EXPECT_EQ(rcr.series_lumped_shunt().pressure, r.lumped_shunt().pressure);
 }
 
 TEST(ReflectionOutlet, TheIncomingWaveIsMinusRtTimesTheOutgoing) {

@@ -12,6 +12,8 @@
 #pragma once
 
 #include "physics/tube_law.hpp"
+#include "pulse/boundaries/lumped_rows.hpp"
+#include "pulse/boundaries/resistance_outlet.hpp"
 #include "pulse/riemann.hpp"
 
 namespace hemotree {
@@ -30,6 +32,10 @@ struct RcrOutlet {
   EndState series_end_state(const TubeLaw& law, double a, double q) const {
     return resistance_state(law, a, q, r1 + r2, p_out);
   }
+  // Its 0D rows: R1 to a capacitor node of its own, or, with no compliance, a shunt
+  // 1/(R1 + R2) to p_out.
+  LumpedCapacitor lumped_capacitor() const { return {r1, {1 / r2, p_out}, c}; }
+  LumpedShunt series_lumped_shunt() const { return ResistanceOutlet{r1 + r2, p_out}.lumped_shunt(); }
 };
 
 }  // namespace hemotree

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "physics/tube_law.hpp"
+#include "pulse/boundaries/lumped_rows.hpp"
 #include "pulse/riemann.hpp"
 
 namespace hemotree {
@@ -21,6 +22,8 @@ struct ResistanceOutlet {
   EndState end_state(const TubeLaw& law, double a, double q) const {
     return resistance_state(law, a, q, resistance, p_out);
   }
+  // Its 0D row: a shunt 1/R to p_out.
+  LumpedShunt lumped_shunt() const { return {1 / resistance, p_out}; }
 };
 
 }  // namespace hemotree
