@@ -40,7 +40,7 @@ Network vessel(double length, double diameter, double wave_speed, const Blood& b
   // An outlet of the vessel's characteristic impedance, plus a resistance that sets ~40 mmHg.
   Outlet o;
   o.vessel = 0;
-  o.type = OutletType::resistance;
+  o.type = BoundaryType::resistance;
   o.r = blood.density * wave_speed / area + 1000 / mean_flow;
   o.p_out = 1000;
   net.outlets.push_back(o);

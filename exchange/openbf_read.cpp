@@ -210,7 +210,7 @@ Outlet openbf_outlet(const Source& source, const VesselModel& v, std::size_t k, 
     if (v.outlet_kind == "reflection") fail("outlet", "\"outlet\": reflection with Windkessel keys (R1, R2, Cc)");
     if (std::isnan(v.r1)) fail("", "a Windkessel outlet needs \"R1\"");
     if (std::isnan(v.cc)) fail("", "a Windkessel outlet needs \"Cc\"");
-    o.type = OutletType::rcr;
+    o.type = BoundaryType::rcr;
     o.c = v.cc;
     o.p_out = std::isnan(v.pout) ? 0.0 : v.pout;
     if (!std::isnan(v.r2) && v.r2 != 0) {
@@ -233,7 +233,7 @@ Outlet openbf_outlet(const Source& source, const VesselModel& v, std::size_t k, 
   } else {
     if (!std::isnan(v.pout)) fail("Pout", "\"Pout\" belongs to a Windkessel outlet (R1, R2, Cc)");
     if (v.outlet_kind == "wk2" || v.outlet_kind == "wk3") fail("outlet", "\"outlet\": " + v.outlet_kind + " without R1 and Cc");
-    o.type = OutletType::reflection;
+    o.type = BoundaryType::reflection;
     o.reflection = std::isnan(v.rt) ? 0.0 : v.rt;
     if (!has_outlet(v)) ++tally.open_ends;
   }

@@ -129,7 +129,7 @@ std::string vessel_yaml(const Network& net, std::size_t v, const std::vector<std
   y += "    gamma_profile: " + std::to_string(static_cast<long long>(whole)) + "\n";
   if (const Outlet* o = outlet_of[v]) {
     switch (o->type) {
-      case OutletType::rcr:
+      case BoundaryType::rcr:
         // openBF reads R1 = 0 as a reflection outlet and R2 = 0 as a two-element Windkessel.
         if (o->r1 == 0 || o->r2 == 0)
           throw InputError(vessel_name(v) + ": an RCR outlet with R" + (o->r1 == 0 ? "1" : "2") +
@@ -137,11 +137,14 @@ std::string vessel_yaml(const Network& net, std::size_t v, const std::vector<std
         y += "    R1: " + yaml_real(o->r1) + "\n    R2: " + yaml_real(o->r2) + "\n    Cc: " + yaml_real(o->c) + "\n";
         if (o->p_out != 0) y += "    Pout: " + yaml_real(o->p_out) + "\n";
         break;
-      case OutletType::resistance:
+      case BoundaryType::resistance:
         throw InputError(vessel_name(v) + ": a resistance (R) outlet; openBF has Windkessels and reflection only");
-      case OutletType::reflection:
+      case BoundaryType::reflection:
         y += "    Rt: " + yaml_real(o->reflection) + "\n";
         break;
+      case BoundaryType::flow:
+      case BoundaryType::pressure:
+        break;  // not outlet models
     }
   }
   return y;

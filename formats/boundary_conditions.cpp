@@ -12,15 +12,6 @@
 
 namespace hemotree {
 
-std::string_view to_string(OutletType type) {
-  switch (type) {
-    case OutletType::rcr: return "RCR";
-    case OutletType::resistance: return "R";
-    case OutletType::reflection: return "reflection";
-  }
-  return "";
-}
-
 std::string_view to_string(BoundaryType type) {
   switch (type) {
     case BoundaryType::flow: return "flow";
@@ -263,12 +254,15 @@ Inlet inlet_from_json(const nlohmann::json& j) {
 
 nlohmann::json to_json(const Outlet& o) {
   switch (o.type) {
-    case OutletType::rcr:
+    case BoundaryType::rcr:
       return {{"type", "RCR"}, {"R1", o.r1}, {"C", o.c}, {"R2", o.r2}, {"p_out", o.p_out}};
-    case OutletType::resistance:
+    case BoundaryType::resistance:
       return {{"type", "R"}, {"R", o.r}, {"p_out", o.p_out}};
-    case OutletType::reflection:
+    case BoundaryType::reflection:
       return {{"type", "reflection"}, {"coefficient", o.reflection}};
+    case BoundaryType::flow:
+    case BoundaryType::pressure:
+      break;  // not outlet models
   }
   return {};
 }
@@ -279,7 +273,7 @@ Outlet outlet_from_json(const nlohmann::json& j, const std::string& where) {
   Outlet o;
   const std::string type = j.at("type").get<std::string>();
   if (type == "RCR") {
-    o.type = OutletType::rcr;
+    o.type = BoundaryType::rcr;
     o.r1 = in_range(j, "R1", ranges::rcr_part, where);
     o.c = in_range(j, "C", ranges::compliance, where);
     o.r2 = in_range(j, "R2", ranges::rcr_part, where);
@@ -288,11 +282,11 @@ Outlet outlet_from_json(const nlohmann::json& j, const std::string& where) {
       throw InputError(where + ": RCR needs R1 + R2 >= " + format_number(ranges::resistance.min) +
                        " Pa s/m^3 (got " + format_number(o.r1 + o.r2) + ")");
   } else if (type == "R") {
-    o.type = OutletType::resistance;
+    o.type = BoundaryType::resistance;
     o.r = in_range(j, "R", ranges::resistance, where);
     o.p_out = in_range_or(j, "p_out", ranges::pressure, 0.0, where);
   } else if (type == "reflection") {
-    o.type = OutletType::reflection;
+    o.type = BoundaryType::reflection;
     o.reflection = in_range_or(j, "coefficient", ranges::reflection, 0.0, where);
   } else {
     throw InputError(where + ": unknown outlet type \"" + type + "\" (RCR, R or reflection)");

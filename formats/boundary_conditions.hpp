@@ -44,24 +44,31 @@ struct Inlet {
   Waveform waveform;
 };
 
-enum class OutletType { rcr, resistance, reflection };
+// The kind of a boundary condition: a prescribed flow into the network (negative: out of
+// it), a prescribed pressure, or one of the 0D outlet models (rcr, resistance, reflection)
+// to an outflow pressure. One enum for both file forms: an Outlet's type is one of the last
+// three.
+enum class BoundaryType { flow, pressure, rcr, resistance, reflection };
+
+inline bool is_outlet_model(BoundaryType type) {
+  return type == BoundaryType::rcr || type == BoundaryType::resistance || type == BoundaryType::reflection;
+}
 
 // The 0D model at the distal node of a terminal vessel.
 struct Outlet {
   std::int32_t vessel = -1;   // vessel index
-  OutletType type = OutletType::resistance;
+  BoundaryType type = BoundaryType::resistance;
   double r1 = 0, c = 0, r2 = 0;   // RCR: [Pa s/m^3], [m^3/Pa], [Pa s/m^3]
   double r = 0;                   // R: [Pa s/m^3]
   double p_out = 0;               // pressure beyond the outlet (venous) [Pa]
   double reflection = 0;          // reflection: coefficient in [-1, 1], 0 non-reflecting
 
-  double resistance() const { return type == OutletType::rcr ? r1 + r2 : r; }
+  double resistance() const { return type == BoundaryType::rcr ? r1 + r2 : r; }
 };
 
 // A boundary condition at a node (format version 2): a prescribed flow into the network
 // (negative: out of it), a prescribed pressure, or a 0D outlet model to its outflow
 // pressure. Vessels may meet at the node in any number and orientation.
-enum class BoundaryType { flow, pressure, rcr, resistance, reflection };
 
 struct NodeBoundary {
   std::int32_t node = -1;  // node index
@@ -71,7 +78,7 @@ struct NodeBoundary {
   // The discharge hematocrit of the blood entering here, NaN: the blood's.
   double hematocrit = std::numeric_limits<double>::quiet_NaN();
 
-  bool is_outlet() const { return type != BoundaryType::flow && type != BoundaryType::pressure; }
+  bool is_outlet() const { return is_outlet_model(type); }
   // The discharge hematocrit blood enters with here (the blood's where none is given); NaN
   // at an outlet, whose backflow returns what it took.
   double entering_hematocrit(const Blood& blood) const {
@@ -80,7 +87,6 @@ struct NodeBoundary {
   }
 };
 
-std::string_view to_string(OutletType type);
 std::string_view to_string(BoundaryType type);
 
 // The JSON forms of docs/network-format.md; the readers throw InputError naming the field.

@@ -104,9 +104,7 @@ double Network::volume(std::size_t v) const {
 NodeBoundary as_node_boundary(const Network& net, const Outlet& outlet) {
   NodeBoundary b;
   b.node = net.to[static_cast<std::size_t>(outlet.vessel)];
-  b.type = outlet.type == OutletType::rcr          ? BoundaryType::rcr
-           : outlet.type == OutletType::resistance ? BoundaryType::resistance
-                                                   : BoundaryType::reflection;
+  b.type = outlet.type;
   b.outlet = outlet;
   return b;
 }

@@ -43,7 +43,7 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
 
   // The full tree ends in its capillary outlets.
   Outlet leaf_outlet;
-  leaf_outlet.type = OutletType::resistance;
+  leaf_outlet.type = BoundaryType::resistance;
   leaf_outlet.r = report.capillary_resistance;
   leaf_outlet.p_out = p.venous_pressure;
   full.outlets.clear();
@@ -96,7 +96,7 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
     o.vessel = static_cast<std::int32_t>(k);
     o.p_out = p.venous_pressure;
     if (is_leaf(f)) {
-      o.type = OutletType::resistance;
+      o.type = BoundaryType::resistance;
       o.r = report.capillary_resistance;
       ++report.leaf;
     } else if (full.diameter[f] >= p.rcr_min_diameter) {
@@ -105,14 +105,14 @@ OutletReport calibrate_outlets(Network& full, const KeepMask& keep, Network& pru
       const TubeLaw& law = laws[f];
       const double area = law.reference_area;
       const double impedance = blood.density * law.wave_speed(area) / area;
-      o.type = OutletType::rcr;
+      o.type = BoundaryType::rcr;
       o.r1 = std::min(impedance, beyond[f].resistance);
       o.r2 = beyond[f].resistance - o.r1;
       o.c = compliance_beyond[f];
       report.r1_limited += impedance > beyond[f].resistance;
       ++report.rcr;
     } else {
-      o.type = OutletType::resistance;
+      o.type = BoundaryType::resistance;
       o.r = beyond[f].resistance;
       ++report.resistance;
     }

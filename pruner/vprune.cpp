@@ -85,11 +85,11 @@ void check_outlets(const Network& pruned) {
         throw InputError(where + out_of_range(field, range, value) +
                          " (--mean-flow or --capillary-drop out of proportion for this tree)");
     };
-    if (o.type == OutletType::rcr) {
+    if (o.type == BoundaryType::rcr) {
       check("R1", ranges::rcr_part, o.r1);
       check("R2", ranges::rcr_part, o.r2);
       check("C", ranges::compliance, o.c);
-    } else if (o.type == OutletType::resistance) {
+    } else if (o.type == BoundaryType::resistance) {
       check("R", ranges::resistance, o.r);
     }
   }

@@ -27,6 +27,12 @@
 
 #include "core/parallel_errors.hpp"
 #include "pulse/pulse_solver.hpp"
+#include "pulse/boundaries/coupled_node.hpp"
+#include "pulse/boundaries/flow_inlet.hpp"
+#include "pulse/boundaries/pressure_end.hpp"
+#include "pulse/boundaries/rcr_outlet.hpp"
+#include "pulse/boundaries/reflection_outlet.hpp"
+#include "pulse/boundaries/resistance_outlet.hpp"
 #include "pulse/riemann.hpp"
 #include "pulse/solution_breakdown.hpp"
 
@@ -186,48 +192,39 @@ void PulseSolver::trace(const VesselEnd& end, double& a, double& q) const {
 }
 
 void PulseSolver::prescribed_end_fluxes(double t) {
-  // Prescribed flows into the network: at a distal end on the mirrored trace (A, -Q).
+  // Prescribed flows into the network (pulse/boundaries/flow_inlet.hpp).
   for (const auto& f : boundaries_.flows) {
     double a, q;
     trace(f.end, a, q);
     const double q_in = boundaries_.list[static_cast<std::size_t>(f.index)].waveform(t);
     const TubeLaw& law = end_law(static_cast<std::size_t>(f.end.vessel), f.end.distal);
-    EndState u;
-    if (!f.end.distal) {
-      u = inflow_state(law, a, q, q_in);
-    } else {
-      u = inflow_state(law, a, -q, q_in);
-      u.flow = -u.flow;
-    }
-    set_end_flux(f.end, u);
+    set_end_flux(f.end, FlowInlet{q_in}.end_state(law, a, q, f.end.distal));
   }
-  // Prescribed pressures: the end's total pressure is the node's.
+  // Prescribed pressures (pulse/boundaries/pressure_end.hpp).
   for (const auto& g : boundaries_.pressures) {
     double a, q;
     trace(g.end, a, q);
     const double p = boundaries_.list[static_cast<std::size_t>(g.index)].waveform(t);
-    set_end_flux(g.end, pressure_state(end_law(static_cast<std::size_t>(g.end.vessel), g.end.distal), a, q, p, g.end.distal));
+    set_end_flux(g.end, PressureEnd{p}.end_state(end_law(static_cast<std::size_t>(g.end.vessel), g.end.distal), a, q,
+                                                 g.end.distal));
   }
 }
 
 void PulseSolver::coupled_end_fluxes(double t, PulseState& rate) {
-  // Ends at nodes of 0D vessels: the node's pressure, moving through the 0D step.
+  // Ends at nodes of 0D vessels: the node's pressure, moving through the 0D step
+  // (pulse/boundaries/coupled_node.hpp).
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
     const auto& c = boundaries_.coupled[k];
     double a, q;
     trace(c.end, a, q);
-    // Total pressure p(t) + rho u^2 / 2 + r (Q_in - Q_held): the node's pressure at this point
-    // of the step, the kinetic energy of its 0D vessels, and its response, r = 3/2 Z
-    // (docs/solver.md §10).
+    // The node's response r = 3/2 Z (docs/solver.md §10), its pressure at this point of the step.
     const double s = dt_ > 0 ? std::clamp((t - step_start_) / dt_, 0.0, 1.0) : 0.0;
     const std::int32_t node = coupled_node_[k];
     const double r = 1.5 * lumped_.impedance(node);
-    const EndState u = pressure_state(end_law(static_cast<std::size_t>(c.end.vessel), c.end.distal), a, q,
-                                      lumped_.pressure_during_step(node, s) + lumped_.dynamic_pressure(node) -
-                                          r * held_end_flow_[k],
-                                      c.end.distal, r);
+    const CoupledNode coupled{lumped_.pressure_during_step(node, s), lumped_.dynamic_pressure(node), r, held_end_flow_[k]};
+    const EndState u = coupled.end_state(end_law(static_cast<std::size_t>(c.end.vessel), c.end.distal), a, q, c.end.distal);
     set_end_flux(c.end, u);
-    rate.coupled(static_cast<Eigen::Index>(k)) = c.end.distal ? u.flow : -u.flow;
+    rate.coupled(static_cast<Eigen::Index>(k)) = CoupledNode::flow_into_node(u, c.end.distal);
   }
 }
 
@@ -244,23 +241,28 @@ void PulseSolver::outlet_end_fluxes(const PulseState& s, PulseState& rate) {
     const double sign = o.end.distal ? 1.0 : -1.0;
     q *= sign;
     EndState u;
+    // The outlet models (pulse/boundaries/*_outlet.hpp).
     switch (o.outlet.type) {
-      case OutletType::resistance:
-        u = resistance_state(law, a, q, o.outlet.r, o.outlet.p_out);
+      case BoundaryType::resistance:
+        u = ResistanceOutlet{o.outlet.r, o.outlet.p_out}.end_state(law, a, q);
         break;
-      case OutletType::rcr:
-        if (o.capacitor < 0) {  // no compliance: R1 and R2 in series
-          u = resistance_state(law, a, q, o.outlet.r1 + o.outlet.r2, o.outlet.p_out);
+      case BoundaryType::rcr: {
+        const RcrOutlet rcr{o.outlet.r1, o.outlet.c, o.outlet.r2, o.outlet.p_out};
+        if (o.capacitor < 0) {  // no compliance
+          u = rcr.series_end_state(law, a, q);
         } else {
           const double pc = s.capacitor(o.capacitor);
-          u = resistance_state(law, a, q, o.outlet.r1, pc);
-          // C dp_c/dt = Q* - (p_c - p_out) / R2
-          rate.capacitor(o.capacitor) = (u.flow - (pc - o.outlet.p_out) / o.outlet.r2) / o.outlet.c;
+          u = rcr.end_state(law, a, q, pc);
+          rate.capacitor(o.capacitor) = rcr.capacitor_rate(u.flow, pc);
         }
         break;
-      case OutletType::reflection:
-        u = reflection_state(law, a, q, o.rest_area, sign * o.rest_flow, o.outlet.reflection);
+      }
+      case BoundaryType::reflection:
+        u = ReflectionOutlet{o.outlet.reflection, o.rest_area, sign * o.rest_flow}.end_state(law, a, q);
         break;
+      case BoundaryType::flow:
+      case BoundaryType::pressure:
+        break;  // prescribed ends, not outlets
     }
     u.flow *= sign;
     set_end_flux(o.end, u);

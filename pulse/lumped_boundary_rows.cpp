@@ -9,6 +9,9 @@
 
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
+#include "pulse/boundaries/lumped_rows.hpp"
+#include "pulse/boundaries/rcr_outlet.hpp"
+#include "pulse/boundaries/resistance_outlet.hpp"
 #include "pulse/lumped_vessels.hpp"
 #include "pulse/network_boundaries.hpp"
 
@@ -58,11 +61,14 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
       continue;
     }
     const Outlet& o = bc.outlet;
-    if (o.type == OutletType::reflection)
+    if (o.type == BoundaryType::reflection)
       throw SettingError("model", "vessel " + std::to_string(net.id[v]) + ": a reflection outlet needs a 1D vessel (" +
                                       placeholder("model") + " 1d, or auto, keeps it 1D)");
     outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(at), -1});
-    if (o.type == OutletType::rcr && o.c > 0) {
+    // The outlet's rows (pulse/boundaries/resistance_outlet.hpp, rcr_outlet.hpp).
+    const RcrOutlet rcr{o.r1, o.c, o.r2, o.p_out};
+    if (o.type == BoundaryType::rcr && o.c > 0) {
+      const LumpedCapacitor rows = rcr.lumped_capacitor();
       capacitor_of_outlet_[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(outlet_of_capacitor_.size());
       const auto c = static_cast<std::int32_t>(nodes_++);
       outlet_boundary_.back().r1_edge = static_cast<std::int32_t>(vessels_.size() + outlet_of_capacitor_.size());
@@ -71,13 +77,15 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
       capacitor_edge_sign_.push_back(end_sign[network_node]);
       a_.push_back(static_cast<std::int32_t>(at));
       b_.push_back(c);
-      edge_fixed_resistance_.push_back(o.r1);
-      shunt_.push_back(1 / o.r2);
-      shunt_pressure_.push_back(o.p_out);
-      volume_b_.push_back(o.c);
+      edge_fixed_resistance_.push_back(rows.edge_resistance);
+      shunt_.push_back(rows.shunt.conductance);
+      shunt_pressure_.push_back(rows.shunt.pressure);
+      volume_b_.push_back(rows.compliance);
     } else {
-      shunt_[at] = 1 / o.resistance();
-      shunt_pressure_[at] = o.p_out;
+      const LumpedShunt row = o.type == BoundaryType::rcr ? rcr.series_lumped_shunt()
+                                                          : ResistanceOutlet{o.r, o.p_out}.lumped_shunt();
+      shunt_[at] = row.conductance;
+      shunt_pressure_[at] = row.pressure;
     }
   }
   if (!held_node_.empty()) {

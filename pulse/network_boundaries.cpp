@@ -86,7 +86,7 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
         o.boundary = bi;
         o.outlet = c.outlet;
         o.outlet.vessel = static_cast<std::int32_t>(v);
-        if (o.outlet.type == OutletType::rcr && o.outlet.c > 0)
+        if (o.outlet.type == BoundaryType::rcr && o.outlet.c > 0)
           o.capacitor = static_cast<std::int32_t>(b.capacitors++);
         b.outlets.push_back(o);
       }

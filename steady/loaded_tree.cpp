@@ -78,7 +78,7 @@ TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& 
     const Outlet& o = outlets[k];
     const std::int32_t distal = outlet_node[k];
     const auto d = static_cast<std::size_t>(distal);
-    if (o.type != OutletType::rcr) {
+    if (o.type != BoundaryType::rcr) {
       shunt[d] += 1 / o.r;
     } else if (o.r1 == 0) {
       shunt[d] += 1 / o.r2 + loads.capacitor_shunt[k];
@@ -112,7 +112,7 @@ TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& 
   for (std::size_t k = 0; k < outlets.size(); ++k) {
     const Outlet& o = outlets[k];
     if (capacitor_node[k] >= 0) p.capacitor[k] = current[static_cast<std::size_t>(capacitor_node[k])];
-    else if (o.type == OutletType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(outlet_node[k])];
+    else if (o.type == BoundaryType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(outlet_node[k])];
   }
   return p;
 }

@@ -16,6 +16,11 @@
 #include "network_flow/flow_network.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/rheology.hpp"
+#include "steady/boundaries/flow_inlet.hpp"
+#include "steady/boundaries/nodal_rows.hpp"
+#include "steady/boundaries/pressure_end.hpp"
+#include "steady/boundaries/rcr_outlet.hpp"
+#include "steady/boundaries/resistance_outlet.hpp"
 
 namespace hemotree {
 
@@ -63,7 +68,7 @@ Reduction reduce(const Network& net, const std::vector<double>& resistance) {
     const auto v = static_cast<std::size_t>(o.vessel);
     if (children.offset[v + 1] != children.offset[v])
       throw InputError(name(v) + " has an outlet but is not terminal");
-    if (o.type == OutletType::reflection)
+    if (o.type == BoundaryType::reflection)
       throw InputError(name(v) + ": a reflection outlet has no steady resistance");
     outlet_of[v] = static_cast<std::int32_t>(k);
   }
@@ -115,7 +120,7 @@ std::vector<std::int32_t> steady_outlets(const Network& net) {
       throw InputError("outlet " + std::to_string(k) + ": no vessel of index " + std::to_string(o.vessel));
     const auto v = static_cast<std::size_t>(o.vessel);
     if (left[static_cast<std::size_t>(net.to[v])]) throw InputError(name(v) + " has an outlet but is not terminal");
-    if (o.type == OutletType::reflection)
+    if (o.type == BoundaryType::reflection)
       throw InputError(name(v) + ": a reflection outlet has no steady resistance");
     if (!(o.resistance() > 0)) throw InputError(name(v) + ": its outlet has no resistance");
     if (outlet_of[v] >= 0) throw InputError(name(v) + " has two outlets");
@@ -170,22 +175,25 @@ SteadySystem::SteadySystem(const Network& net) : net_(net) {
     check_node_form(boundaries);
   }
   if (net.inlet) inlet_node_ = net.from[static_cast<std::size_t>(net.index_of(net.inlet->vessel))];
+  // Each condition's row (steady/boundaries/).
+  steady::NodalRows rows{shunt_, inflow_, pressure_, prescribed_};
   for (const NodeBoundary& b : boundaries) {
     const auto i = static_cast<std::size_t>(b.node);
     switch (b.type) {
       case BoundaryType::flow:
-        if (static_cast<std::int64_t>(i) != inlet_node_) inflow_[i] += b.waveform.mean_value();
+        if (static_cast<std::int64_t>(i) != inlet_node_) steady::FlowInlet{b.waveform.mean_value()}.add_row(rows, i);
         break;
       case BoundaryType::pressure:
-        prescribed_[i] = 1;
-        pressure_[i] = b.waveform.mean_value();
+        steady::PressureEnd{b.waveform.mean_value()}.add_row(rows, i);
         break;
       case BoundaryType::rcr:
-      case BoundaryType::resistance:
-        shunt_[i] += 1 / b.outlet.resistance();
-        inflow_[i] += b.outlet.p_out / b.outlet.resistance();
+      case BoundaryType::resistance:  // the outlet's parameters are of its own type
+        if (b.outlet.type == BoundaryType::rcr)
+          steady::RcrOutlet{b.outlet.r1, b.outlet.r2, b.outlet.p_out}.add_row(rows, i);
+        else
+          steady::ResistanceOutlet{b.outlet.r, b.outlet.p_out}.add_row(rows, i);
         break;
-      case BoundaryType::reflection: break;  // refused by the checks
+      case BoundaryType::reflection: break;  // no steady row: refused by the checks
     }
   }
   // A node that no vessel touches carries nothing: a unit shunt holds it at 0 Pa.

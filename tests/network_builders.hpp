@@ -58,7 +58,7 @@ inline Waveform tabulate(const std::function<double(double)>& f, double duration
 inline Outlet reflection_outlet(std::int32_t vessel, double coefficient) {
   Outlet o;
   o.vessel = vessel;
-  o.type = OutletType::reflection;
+  o.type = BoundaryType::reflection;
   o.reflection = coefficient;
   return o;
 }
@@ -66,7 +66,7 @@ inline Outlet reflection_outlet(std::int32_t vessel, double coefficient) {
 inline Outlet resistance_outlet(std::int32_t vessel, double r, double p_out) {
   Outlet o;
   o.vessel = vessel;
-  o.type = OutletType::resistance;
+  o.type = BoundaryType::resistance;
   o.r = r;
   o.p_out = p_out;
   return o;
@@ -75,7 +75,7 @@ inline Outlet resistance_outlet(std::int32_t vessel, double r, double p_out) {
 inline Outlet rcr_outlet(std::int32_t vessel, double r1, double c, double r2, double p_out) {
   Outlet o;
   o.vessel = vessel;
-  o.type = OutletType::rcr;
+  o.type = BoundaryType::rcr;
   o.r1 = r1;
   o.c = c;
   o.r2 = r2;
@@ -105,8 +105,7 @@ inline NodeBoundary pressure_boundary(std::int32_t node, double p) {
 inline NodeBoundary outlet_boundary(std::int32_t node, const Outlet& o) {
   NodeBoundary b;
   b.node = node;
-  b.type = o.type == OutletType::rcr ? BoundaryType::rcr
-           : o.type == OutletType::resistance ? BoundaryType::resistance : BoundaryType::reflection;
+  b.type = o.type;
   b.outlet = o;
   return b;
 }

@@ -171,7 +171,7 @@ TEST_F(OpenbfTest, ReadsEveryKeyOfAHandWrittenModel) {
   ASSERT_EQ(net.outlets.size(), 2u);
   const Outlet& wk3 = net.outlets[0];
   EXPECT_EQ(wk3.vessel, 1);
-  EXPECT_EQ(wk3.type, OutletType::rcr);
+  EXPECT_EQ(wk3.type, BoundaryType::rcr);
   EXPECT_DOUBLE_EQ(wk3.r1, 1e8);
   EXPECT_DOUBLE_EQ(wk3.r2, 1e9);
   EXPECT_DOUBLE_EQ(wk3.c, 2e-10);
@@ -187,7 +187,7 @@ TEST_F(OpenbfTest, ReadsEveryKeyOfAHandWrittenModel) {
   const double z = 1060 * c0 / (std::numbers::pi * r * r);
   EXPECT_NEAR(z, 3.66e8, 0.01e8);
   EXPECT_EQ(wk2.vessel, 2);
-  EXPECT_EQ(wk2.type, OutletType::rcr);
+  EXPECT_EQ(wk2.type, BoundaryType::rcr);
   EXPECT_NEAR(wk2.r1, z, 1e-9 * z);
   EXPECT_NEAR(wk2.r1 + wk2.r2, 2e9, 1e-6);
   EXPECT_DOUBLE_EQ(wk2.c, 1e-10);
@@ -528,7 +528,7 @@ TEST_F(OpenbfTest, RefusesToWriteWhatOpenbfCannotExpress) {
   EXPECT_EQ(message(with_pressure), "node 2: a pressure boundary: openBF prescribes only the inflow at its inlet node");
 
   Network resistance = net;
-  resistance.outlets[0].type = OutletType::resistance;
+  resistance.outlets[0].type = BoundaryType::resistance;
   resistance.outlets[0].r = 1e9;
   EXPECT_EQ(message(resistance), "vessel 2: a resistance (R) outlet; openBF has Windkessels and reflection only");
 
@@ -601,7 +601,7 @@ TEST_F(OpenbfTest, ReadsAndRoundTripsTheShippedModels) {
     EXPECT_EQ(tapered, reading == OpenbfReading::code ? 0u : s.tapered);
     EXPECT_EQ(net.outlets.size(), s.outlets);
     for (const Outlet& o : net.outlets) {
-      EXPECT_EQ(o.type, OutletType::rcr);
+      EXPECT_EQ(o.type, BoundaryType::rcr);
       EXPECT_GT(o.r1, 0);
       EXPECT_GT(o.r2, 0);
     }

@@ -348,7 +348,7 @@ TEST(ExportSecomb, Refusals) {
   };
   Network rcr = base;
   rcr.boundaries[1].type = BoundaryType::rcr;
-  rcr.boundaries[1].outlet.type = OutletType::rcr;
+  rcr.boundaries[1].outlet.type = BoundaryType::rcr;
   EXPECT_EQ(refusal(rcr), "node 4: an outlet model (RCR) cannot be written to network.dat, which holds pressures and flows only");
   Network pulsing = base;
   pulsing.boundaries[0].waveform.shape = Waveform::Shape::half_sine;

@@ -78,7 +78,7 @@ TEST(OutletCalibration, OutletTypesFollowTheDiameterAndRcrMatchesTheImpedance) {
   for (const Outlet& o : pruned.outlets) {
     const double d = pruned.diameter[o.vessel];
     EXPECT_DOUBLE_EQ(o.p_out, p.venous_pressure);
-    if (o.type == OutletType::rcr) {
+    if (o.type == BoundaryType::rcr) {
       ++rcr;
       EXPECT_GE(d, 100e-6);
       TubeLaw law = tube_law({d, pruned.wall_thickness[o.vessel], pruned.youngs_modulus[o.vessel]},
@@ -89,7 +89,7 @@ TEST(OutletCalibration, OutletTypesFollowTheDiameterAndRcrMatchesTheImpedance) {
       EXPECT_GT(o.r2, 0);
       EXPECT_GT(o.c, 0);
     } else {
-      EXPECT_EQ(o.type, OutletType::resistance);
+      EXPECT_EQ(o.type, BoundaryType::resistance);
     }
   }
   EXPECT_GT(rcr, 0u);

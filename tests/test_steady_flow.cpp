@@ -117,7 +117,7 @@ TEST(SteadyFlow, RefusesNetworksItCannotSolve) {
   net.outlets.pop_back();
   Outlet reflecting;
   reflecting.vessel = 2;
-  reflecting.type = OutletType::reflection;
+  reflecting.type = BoundaryType::reflection;
   net.outlets.push_back(reflecting);
   EXPECT_THROW(solve_steady_flow(net, r, 1e-6), InputError);
   EXPECT_THROW(solve_steady_flow(bifurcation(1e-3, 8e-4, 6e-4)), InputError);  // no inlet
