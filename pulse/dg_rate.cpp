@@ -111,7 +111,7 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
   friction_rate_.segment(first, count).noalias() = source_q.lazyProduct(basis.rule.weights) / 2;
   source_q.array() *= -flow_q.array();
   // Tapered elements: the part of the pressure force that the flux does not hold,
-  // A (g1 sqrt(A) + g0) (vessel_equations.hpp, docs/solver.md §1a).
+  // A (g1 sqrt(A) + g0) (physics/vessel_taper.hpp, docs/solver.md §1a).
   for (auto it = tapered_begin; it != tapered_end; ++it) {
     const Eigen::Index el = *it - first, row = it - tapered_elements_.begin();
     for (Eigen::Index q = 0; q < points; ++q) {

@@ -332,7 +332,7 @@ void LumpedVessels::start_at_rest(std::span<const TubeLaw> laws) {
   for (std::size_t e = 0; e < vessels_.size(); ++e)
     for (const std::int32_t k : {a_[e], b_[e]}) {
       const TubeLaw& law = laws[static_cast<std::size_t>(vessels_[e])];
-      // A tapered vessel rests at its measured lumen (vessel_equations.hpp), at that pressure.
+      // A tapered vessel rests at its measured lumen (physics/vessel_taper.hpp), at that pressure.
       sum[static_cast<std::size_t>(k)] += tapered(e) ? law.pressure(tapered_[static_cast<std::size_t>(taper_edge_[e])].taper.rest_area(0))
                                                      : law.reference_pressure;
       count[static_cast<std::size_t>(k)] += 1;

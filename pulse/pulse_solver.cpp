@@ -84,7 +84,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
       law.reference_pressure = t.reference_pressure;
     }
     if (net.is_tapered(v)) {
-      // The law along the vessel (vessel_equations.hpp): the wall's h and E, or the given
+      // The law along the vessel (physics/vessel_taper.hpp): the wall's h and E, or the given
       // beta at the proximal diameter, with the proximal diameter's wall model.
       VesselTaper taper;
       taper.d0 = net.diameter[v];
@@ -359,7 +359,7 @@ void PulseSolver::start_at_rest() {
   for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
     if (is_tapered(v) && !zero_d_[v]) {
       // A tapered vessel rests at its measured lumen pi D(x)^2 / 4, where the pressure is the
-      // same all along (vessel_equations.hpp): quadratic in x, projected exactly at degree 2.
+      // same all along (physics/vessel_taper.hpp): quadratic in x, projected exactly at degree 2.
       const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
       project_along(v, [&](double x) { return taper.rest_area(x); }, state_.area);
       continue;
