@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <initializer_list>
+#include <string>
+#include <utility>
 
 #include "core/units.hpp"
 #include "core/errors.hpp"
@@ -31,26 +34,6 @@ void check_range(double value, const Interval& range, const std::string& setting
 
 }  // namespace
 
-const char* to_string(RedCells cells) { return cells == RedCells::transport ? "transport" : "fixed"; }
-
-const char* to_string(ModelChoice model) {
-  switch (model) {
-    case ModelChoice::automatic: return "auto";
-    case ModelChoice::one_d: return "1d";
-    case ModelChoice::zero_d: return "0d";
-  }
-  return "auto";
-}
-
-const char* to_string(TimeScheme scheme) {
-  switch (scheme) {
-    case TimeScheme::exponential_ab2: return "etd2";
-    case TimeScheme::adams_bashforth2: return "ab2";
-    case TimeScheme::runge_kutta4: return "rk4";
-  }
-  return "etd2";
-}
-
 namespace {
 // A caller's text as a message shows it: as written, unless it holds a control character
 // (which a one-line message, and a placeholder's marks, must not carry).
@@ -64,32 +47,50 @@ std::string shown(const std::string& text) {
 [[noreturn]] void refuse_choice(const char* setting, const char* choices, const std::string& name) {
   throw SettingError(setting, placeholder(setting) + " must be " + choices + " (got '" + shown(name) + "')");
 }
+
+// Each choice's words, once: to_string and the *_named parsers below read the same table.
+template <class Choice>
+using ChoiceNames = std::initializer_list<std::pair<Choice, const char*>>;
+constexpr ChoiceNames<TimeScheme> scheme_names = {
+    {TimeScheme::exponential_ab2, "etd2"}, {TimeScheme::adams_bashforth2, "ab2"}, {TimeScheme::runge_kutta4, "rk4"}};
+constexpr ChoiceNames<ModelChoice> model_names = {
+    {ModelChoice::automatic, "auto"}, {ModelChoice::one_d, "1d"}, {ModelChoice::zero_d, "0d"}};
+constexpr ChoiceNames<RedCells> red_cell_names = {{RedCells::fixed, "fixed"}, {RedCells::transport, "transport"}};
+constexpr ChoiceNames<Rheology> rheology_names = {{Rheology::pries, "pries"}, {Rheology::newtonian, "newtonian"}};
+
+template <class Choice>
+const char* name_of(Choice choice, ChoiceNames<Choice> names) {
+  for (const auto& [c, name] : names)
+    if (c == choice) return name;
+  return names.begin()->second;
+}
+
+// The choice a text names; SettingError listing the choices ("etd2, ab2 or rk4") otherwise.
+template <class Choice>
+Choice named(const std::string& text, ChoiceNames<Choice> names, const char* setting) {
+  for (const auto& [choice, name] : names)
+    if (text == name) return choice;
+  std::string choices;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    choices += std::string(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names.begin()[i].second;
+  refuse_choice(setting, choices.c_str(), text);
+}
 }  // namespace
 
-TimeScheme time_scheme_named(const std::string& name) {
-  if (name == "rk4") return TimeScheme::runge_kutta4;
-  if (name == "ab2") return TimeScheme::adams_bashforth2;
-  if (name == "etd2") return TimeScheme::exponential_ab2;
-  refuse_choice("scheme", "etd2, ab2 or rk4", name);
-}
+const char* to_string(RedCells cells) { return name_of(cells, red_cell_names); }
+const char* to_string(ModelChoice model) { return name_of(model, model_names); }
+const char* to_string(TimeScheme scheme) { return name_of(scheme, scheme_names); }
 
-ModelChoice model_named(const std::string& name) {
-  if (name == "auto") return ModelChoice::automatic;
-  if (name == "1d") return ModelChoice::one_d;
-  if (name == "0d") return ModelChoice::zero_d;
-  refuse_choice("model", "auto, 1d or 0d", name);
-}
+TimeScheme time_scheme_named(const std::string& name) { return named(name, scheme_names, "scheme"); }
+
+ModelChoice model_named(const std::string& name) { return named(name, model_names, "model"); }
 
 bool steady_start_named(const std::string& name) {
   if (name != "steady" && name != "rest") refuse_choice("start", "steady or rest", name);
   return name == "steady";
 }
 
-Rheology rheology_named(const std::string& name) {
-  if (name == "pries") return Rheology::pries;
-  if (name == "newtonian") return Rheology::newtonian;
-  refuse_choice("rheology", "pries or newtonian", name);
-}
+Rheology rheology_named(const std::string& name) { return named(name, rheology_names, "rheology"); }
 
 int degree_named(const std::string& name) {
   if (name == "auto") return SolverOptions::automatic;
@@ -105,11 +106,7 @@ int degree_named(const std::string& name) {
   return degree;
 }
 
-RedCells red_cells_named(const std::string& name) {
-  if (name == "transport") return RedCells::transport;
-  if (name != "fixed") refuse_choice("red_cells", "fixed or transport", name);
-  return RedCells::fixed;
-}
+RedCells red_cells_named(const std::string& name) { return named(name, red_cell_names, "red_cells"); }
 
 // In the order hemosolve has always checked them, so that its first complaint is the same.
 void check_configuration(const RunConfiguration& c) {
