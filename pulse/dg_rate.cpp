@@ -16,7 +16,7 @@
 //   lift_to_rate           the surface term, 1/J and the source's projection
 //
 // Every step acts on all elements at once through flat arrays (rows of elements; one trace and
-// one end flux per element and side); U* at a vessel end is the node's (pulse/riemann.hpp).
+// one end flux per element and side); U* at a vessel end is the node's (physics/riemann.hpp).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -27,13 +27,13 @@
 
 #include "core/parallel_errors.hpp"
 #include "pulse/pulse_solver.hpp"
-#include "pulse/boundaries/coupled_node.hpp"
-#include "pulse/boundaries/flow_inlet.hpp"
-#include "pulse/boundaries/pressure_end.hpp"
-#include "pulse/boundaries/rcr_outlet.hpp"
-#include "pulse/boundaries/reflection_outlet.hpp"
-#include "pulse/boundaries/resistance_outlet.hpp"
-#include "pulse/riemann.hpp"
+#include "boundaries/coupled_node.hpp"
+#include "boundaries/flow_inlet.hpp"
+#include "boundaries/pressure_end.hpp"
+#include "boundaries/rcr_outlet.hpp"
+#include "boundaries/reflection_outlet.hpp"
+#include "boundaries/resistance_outlet.hpp"
+#include "physics/riemann.hpp"
 #include "pulse/solution_breakdown.hpp"
 
 namespace hemotree {
@@ -192,7 +192,7 @@ void PulseSolver::trace(const VesselEnd& end, double& a, double& q) const {
 }
 
 void PulseSolver::prescribed_end_fluxes(double t) {
-  // Prescribed flows into the network (pulse/boundaries/flow_inlet.hpp).
+  // Prescribed flows into the network (boundaries/flow_inlet.hpp).
   for (const auto& f : boundaries_.flows) {
     double a, q;
     trace(f.end, a, q);
@@ -200,7 +200,7 @@ void PulseSolver::prescribed_end_fluxes(double t) {
     const TubeLaw& law = end_law(static_cast<std::size_t>(f.end.vessel), f.end.distal);
     set_end_flux(f.end, FlowInlet{q_in}.end_state(law, a, q, f.end.distal));
   }
-  // Prescribed pressures (pulse/boundaries/pressure_end.hpp).
+  // Prescribed pressures (boundaries/pressure_end.hpp).
   for (const auto& g : boundaries_.pressures) {
     double a, q;
     trace(g.end, a, q);
@@ -212,7 +212,7 @@ void PulseSolver::prescribed_end_fluxes(double t) {
 
 void PulseSolver::coupled_end_fluxes(double t, PulseState& rate) {
   // Ends at nodes of 0D vessels: the node's pressure, moving through the 0D step
-  // (pulse/boundaries/coupled_node.hpp).
+  // (boundaries/coupled_node.hpp).
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
     const auto& c = boundaries_.coupled[k];
     double a, q;
@@ -241,7 +241,7 @@ void PulseSolver::outlet_end_fluxes(const PulseState& s, PulseState& rate) {
     const double sign = o.end.distal ? 1.0 : -1.0;
     q *= sign;
     EndState u;
-    // The outlet models (pulse/boundaries/*_outlet.hpp).
+    // The outlet models (boundaries/*_outlet.hpp).
     switch (o.outlet.type) {
       case BoundaryType::resistance:
         u = ResistanceOutlet{o.outlet.r, o.outlet.p_out}.end_state(law, a, q);

@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "boundaries/rcr_outlet.hpp"
+#include "boundaries/resistance_outlet.hpp"
+#include "boundaries/system_rows.hpp"
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
-#include "pulse/boundaries/lumped_rows.hpp"
-#include "pulse/boundaries/rcr_outlet.hpp"
-#include "pulse/boundaries/resistance_outlet.hpp"
 #include "pulse/lumped_vessels.hpp"
 #include "pulse/network_boundaries.hpp"
 
@@ -65,7 +65,7 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
       throw SettingError("model", "vessel " + std::to_string(net.id[v]) + ": a reflection outlet needs a 1D vessel (" +
                                       placeholder("model") + " 1d, or auto, keeps it 1D)");
     outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(at), -1});
-    // The outlet's rows (pulse/boundaries/resistance_outlet.hpp, rcr_outlet.hpp).
+    // The outlet's rows (boundaries/resistance_outlet.hpp, rcr_outlet.hpp).
     const RcrOutlet rcr{o.r1, o.c, o.r2, o.p_out};
     if (o.type == BoundaryType::rcr && o.c > 0) {
       const LumpedCapacitor rows = rcr.lumped_capacitor();

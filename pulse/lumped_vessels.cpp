@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "boundaries/pressure_end.hpp"
+#include "boundaries/system_rows.hpp"
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
 #include "core/parallel_errors.hpp"
@@ -421,14 +423,15 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
     throw std::invalid_argument("LumpedVessels::predict: one value per boundary flow and pressure");
   dt_ = dt;
   inflow_.assign(inflow.begin(), inflow.end());
-  // A held node's shunt in the solve: 1e10 times what else reaches it (its vessel's
-  // conductance at rest and its compliance's C / dt), so that the pressure its neighbour sees
-  // departs from the held one by 1e-10 of its vessel's drop. complete() then puts the node
-  // at the held pressure exactly.
+  // A held node's shunt in the solve (boundaries/pressure_end.hpp), sized by what else
+  // reaches it: its vessel's conductance at rest and its compliance's C / dt. complete() then
+  // puts the node at the held pressure exactly.
   for (std::size_t j = 0; j < held_node_.size(); ++j) {
     const auto k = static_cast<std::size_t>(held_node_[j]);
-    shunt_[k] = 1e10 * (held_reference_conductance_[j] + 1.5 * node_compliance(k, pressure_[k]) / dt);
-    shunt_pressure_[k] = held_pressure[j];
+    const LumpedShunt held = PressureEnd{held_pressure[j]}.held_shunt(
+        held_reference_conductance_[j] + 1.5 * node_compliance(k, pressure_[k]) / dt);
+    shunt_[k] = held.conductance;
+    shunt_pressure_[k] = held.pressure;
     shunt_current_[k] = shunt_[k] * held_pressure[j];
   }
   for (int pass = 0; pass < passes_; ++pass) {

@@ -5,7 +5,7 @@
 //
 // Boundary conditions sit at nodes where exactly one vessel ends, at either of its ends: the
 // 1D equations are symmetric under x -> -x, Q -> -Q, so a condition written for one end
-// (pulse/riemann.hpp) acts at the other on the mirrored trace (A, -Q), its flow negated.
+// (physics/riemann.hpp) acts at the other on the mirrored trace (A, -Q), its flow negated.
 #pragma once
 
 #include <cstdint>
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "formats/network.hpp"
-#include "pulse/riemann.hpp"
+#include "physics/riemann.hpp"
 
 namespace hemotree {
 

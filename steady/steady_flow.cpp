@@ -9,6 +9,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "boundaries/flow_inlet.hpp"
+#include "boundaries/pressure_end.hpp"
+#include "boundaries/rcr_outlet.hpp"
+#include "boundaries/resistance_outlet.hpp"
+#include "boundaries/system_rows.hpp"
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
 #include "formats/connected_parts.hpp"
@@ -16,11 +21,6 @@
 #include "network_flow/flow_network.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/rheology.hpp"
-#include "steady/boundaries/flow_inlet.hpp"
-#include "steady/boundaries/nodal_rows.hpp"
-#include "steady/boundaries/pressure_end.hpp"
-#include "steady/boundaries/rcr_outlet.hpp"
-#include "steady/boundaries/resistance_outlet.hpp"
 
 namespace hemotree {
 
@@ -175,23 +175,23 @@ SteadySystem::SteadySystem(const Network& net) : net_(net) {
     check_node_form(boundaries);
   }
   if (net.inlet) inlet_node_ = net.from[static_cast<std::size_t>(net.index_of(net.inlet->vessel))];
-  // Each condition's row (steady/boundaries/).
-  steady::NodalRows rows{shunt_, inflow_, pressure_, prescribed_};
+  // Each condition's row (boundaries/).
+  NodalRows rows{shunt_, inflow_, pressure_, prescribed_};
   for (const NodeBoundary& b : boundaries) {
     const auto i = static_cast<std::size_t>(b.node);
     switch (b.type) {
       case BoundaryType::flow:
-        if (static_cast<std::int64_t>(i) != inlet_node_) steady::FlowInlet{b.waveform.mean_value()}.add_row(rows, i);
+        if (static_cast<std::int64_t>(i) != inlet_node_) FlowInlet{b.waveform.mean_value()}.add_steady_row(rows, i);
         break;
       case BoundaryType::pressure:
-        steady::PressureEnd{b.waveform.mean_value()}.add_row(rows, i);
+        PressureEnd{b.waveform.mean_value()}.add_steady_row(rows, i);
         break;
       case BoundaryType::rcr:
       case BoundaryType::resistance:  // the outlet's parameters are of its own type
         if (b.outlet.type == BoundaryType::rcr)
-          steady::RcrOutlet{b.outlet.r1, b.outlet.r2, b.outlet.p_out}.add_row(rows, i);
+          RcrOutlet{b.outlet.r1, b.outlet.c, b.outlet.r2, b.outlet.p_out}.add_steady_row(rows, i);
         else
-          steady::ResistanceOutlet{b.outlet.r, b.outlet.p_out}.add_row(rows, i);
+          ResistanceOutlet{b.outlet.r, b.outlet.p_out}.add_steady_row(rows, i);
         break;
       case BoundaryType::reflection: break;  // no steady row: refused by the checks
     }

@@ -1,26 +1,21 @@
-// Each boundary condition's 1D end state (pulse/boundaries/) against the equation its header
+// Each boundary condition (boundaries/): its 1D end state against the equation its header
 // claims it imposes, at both ends where it may sit, with the characteristic leaving the
-// vessel kept: Q* - Q = lambda_in (A* - A) (pulse/riemann.hpp); and its steady row
-// (steady/boundaries/) in the nodal system.
+// vessel kept: Q* - Q = lambda_in (A* - A) (physics/riemann.hpp); its 0D rows; and its
+// steady row in the nodal system.
 #include <cmath>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "boundaries/coupled_node.hpp"
+#include "boundaries/flow_inlet.hpp"
+#include "boundaries/pressure_end.hpp"
+#include "boundaries/rcr_outlet.hpp"
+#include "boundaries/reflection_outlet.hpp"
+#include "boundaries/resistance_outlet.hpp"
+#include "boundaries/system_rows.hpp"
+#include "physics/riemann.hpp"
 #include "physics/tube_law.hpp"
-#include "pulse/boundaries/coupled_node.hpp"
-#include "pulse/boundaries/flow_inlet.hpp"
-#include "pulse/boundaries/lumped_rows.hpp"
-#include "pulse/boundaries/pressure_end.hpp"
-#include "pulse/boundaries/rcr_outlet.hpp"
-#include "pulse/boundaries/reflection_outlet.hpp"
-#include "pulse/boundaries/resistance_outlet.hpp"
-#include "pulse/riemann.hpp"
-#include "steady/boundaries/flow_inlet.hpp"
-#include "steady/boundaries/nodal_rows.hpp"
-#include "steady/boundaries/pressure_end.hpp"
-#include "steady/boundaries/rcr_outlet.hpp"
-#include "steady/boundaries/resistance_outlet.hpp"
 
 using namespace hemotree;
 
@@ -134,18 +129,28 @@ TEST(CoupledNode, TheEndsTotalPressureIsTheNodesPlusItsResponse) {
   }
 }
 
+TEST(PressureEnd, ItsZeroDShuntHoldsTheNodeTo1e10OfTheVesselsDrop) {
+  // A node joined by one vessel of conductance g to a neighbour at p_n, held to p by the
+  // shunt: its pressure (g p_n + G p_s) / (g + G) departs from p by g / (g + G) of the drop.
+  const double g = 3e-12, p = 1.1e4, p_n = 1.4e4;
+  const LumpedShunt held = PressureEnd{p}.held_shunt(g);
+  EXPECT_EQ(held.pressure, p);
+  const double node = (g * p_n + held.conductance * held.pressure) / (g + held.conductance);
+  EXPECT_NEAR((node - p) / (p_n - p), 1e-10, 1e-15);
+}
+
 // Three nodes' rows, empty.
 struct Rows {
   std::vector<double> shunt = std::vector<double>(3, 0.0), inflow = std::vector<double>(3, 0.0),
                       pressure = std::vector<double>(3, 0.0);
   std::vector<unsigned char> prescribed = std::vector<unsigned char>(3, 0);
-  steady::NodalRows rows{shunt, inflow, pressure, prescribed};
+  NodalRows rows{shunt, inflow, pressure, prescribed};
 };
 
 TEST(SteadyRows, AFlowIsACurrentIntoItsNode) {
   Rows r;
-  steady::FlowInlet{2e-6}.add_row(r.rows, 1);
-  steady::FlowInlet{-5e-7}.add_row(r.rows, 1);
+  FlowInlet{2e-6}.add_steady_row(r.rows, 1);
+  FlowInlet{-5e-7}.add_steady_row(r.rows, 1);
   EXPECT_DOUBLE_EQ(r.inflow[1], 2e-6 - 5e-7);
   EXPECT_EQ(r.shunt, std::vector<double>(3, 0.0));
   EXPECT_EQ(r.prescribed, std::vector<unsigned char>(3, 0));
@@ -153,7 +158,7 @@ TEST(SteadyRows, AFlowIsACurrentIntoItsNode) {
 
 TEST(SteadyRows, APressureIsPrescribed) {
   Rows r;
-  steady::PressureEnd{1.2e4}.add_row(r.rows, 2);
+  PressureEnd{1.2e4}.add_steady_row(r.rows, 2);
   EXPECT_EQ(r.prescribed, (std::vector<unsigned char>{0, 0, 1}));
   EXPECT_EQ(r.pressure[2], 1.2e4);
   EXPECT_EQ(r.inflow, std::vector<double>(3, 0.0));
@@ -162,12 +167,12 @@ TEST(SteadyRows, APressureIsPrescribed) {
 TEST(SteadyRows, AnOutletIsAShuntToItsOutflowPressure) {
   // Q = (p_i - p_out) / R: G_i = 1/R, b_i = p_out / R.
   Rows r;
-  steady::ResistanceOutlet{4e8, 1.5e3}.add_row(r.rows, 0);
+  ResistanceOutlet{4e8, 1.5e3}.add_steady_row(r.rows, 0);
   EXPECT_EQ(r.shunt[0], 1 / 4e8);
   EXPECT_EQ(r.inflow[0], 1.5e3 / 4e8);
   // An RCR's capacitor carries no steady flow: R1 + R2 in series.
   Rows rcr;
-  steady::RcrOutlet{1e8, 3e8, 1.5e3}.add_row(rcr.rows, 0);
+  RcrOutlet{1e8, 2e-9, 3e8, 1.5e3}.add_steady_row(rcr.rows, 0);
   EXPECT_EQ(rcr.shunt, r.shunt);
   EXPECT_EQ(rcr.inflow, r.inflow);
 }

@@ -1,4 +1,4 @@
-// The Riemann problems of the 1D model (pulse/riemann.hpp) on their own: the upwind flux
+// The Riemann problems of the 1D model (physics/riemann.hpp) on their own: the upwind flux
 // between elements, the prescribed inflow, the resistance and reflection outlets and the
 // junctions, each against the equations it claims to solve, on many random states.
 #include <array>
@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pulse/riemann.hpp"
+#include "physics/riemann.hpp"
 #include "physics/tube_law.hpp"
 
 using namespace hemotree;

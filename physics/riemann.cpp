@@ -1,4 +1,4 @@
-#include "pulse/riemann.hpp"
+#include "physics/riemann.hpp"
 
 #include <array>
 #include <cmath>

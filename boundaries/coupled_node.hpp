@@ -5,12 +5,12 @@
 //            with p(t) the node's pressure at this point of the 0D step, p_dyn the kinetic
 //            energy of its 0D vessels, r = 3/2 Z its response to the flow Q_in from the end
 //            into it and Q_held that flow held over the step (docs/solver.md §10); the
-//            characteristic leaving the vessel is kept (pulse/riemann.hpp's pressure_state).
+//            characteristic leaving the vessel is kept (physics/riemann.hpp's pressure_state).
 //   0D rows: Q_in, a current into the node (PulseState's coupled part).
 #pragma once
 
 #include "physics/tube_law.hpp"
-#include "pulse/riemann.hpp"
+#include "physics/riemann.hpp"
 
 namespace hemotree {
 

@@ -2,18 +2,21 @@
 //
 //   1D end:  Q* = Q_in at a proximal end (Q* = -Q_in at a distal one: the flow along the
 //            vessel), with the characteristic leaving the vessel kept,
-//            Q* - Q = lambda_in (A* - A) (pulse/riemann.hpp).
-//   0D rows: a current Q_in into its node (pulse/lumped_boundary_rows.cpp).
-//   steady:  Q_in's period mean injected at its node (steady/steady_flow.cpp).
+//            Q* - Q = lambda_in (A* - A) (physics/riemann.hpp).
+//   0D rows: a current Q_in into its node (pulse/lumped_boundary_rows.cpp keeps its node).
+//   steady:  Q_in's period mean injected at its node, b_i += Q_in.
 #pragma once
 
+#include <cstddef>
+
+#include "boundaries/system_rows.hpp"
+#include "physics/riemann.hpp"
 #include "physics/tube_law.hpp"
-#include "pulse/riemann.hpp"
 
 namespace hemotree {
 
 struct FlowInlet {
-  double inflow = 0;  // Q_in(t) [m^3/s], into the network
+  double inflow = 0;  // Q_in(t) [m^3/s], into the network (its mean in a steady row)
 
   // The end state from the trace (a, q) of the vessel's end; a distal end takes the
   // condition on the mirrored trace (a, -q), its flow negated back (x -> -x symmetry).
@@ -23,6 +26,7 @@ struct FlowInlet {
     u.flow = -u.flow;
     return u;
   }
+  void add_steady_row(NodalRows& rows, std::size_t node) const { rows.inflow[node] += inflow; }
 };
 
 }  // namespace hemotree

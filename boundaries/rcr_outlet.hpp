@@ -2,19 +2,21 @@
 // p_c, and R2 from there to the outflow pressure p_out.
 //
 //   1D end:     p(A*) - p_c = R1 Q*, with the characteristic leaving the vessel kept,
-//               Q* - Q = lambda_in (A* - A) (pulse/riemann.hpp's resistance_state);
+//               Q* - Q = lambda_in (A* - A) (physics/riemann.hpp's resistance_state);
 //   capacitor:  C dp_c/dt = Q* - (p_c - p_out) / R2.
 //   Without compliance (C = 0) R1 and R2 are in series: p(A*) - p_out = (R1 + R2) Q*.
-//   0D rows: R1 an edge to a capacitor node with C and a shunt 1/R2 to p_out
-//            (pulse/lumped_boundary_rows.cpp).
-//   steady:  a shunt 1/(R1 + R2) to p_out (steady/steady_flow.cpp).
+//   0D rows: R1 an edge to a capacitor node with C and a shunt 1/R2 to p_out.
+//   steady:  the capacitor carries nothing, so R1 and R2 are in series, a shunt
+//            1/(R1 + R2) to p_out.
 // Written for a distal end, Q* along the vessel (out of the network).
 #pragma once
 
+#include <cstddef>
+
+#include "boundaries/resistance_outlet.hpp"
+#include "boundaries/system_rows.hpp"
+#include "physics/riemann.hpp"
 #include "physics/tube_law.hpp"
-#include "pulse/boundaries/lumped_rows.hpp"
-#include "pulse/boundaries/resistance_outlet.hpp"
-#include "pulse/riemann.hpp"
 
 namespace hemotree {
 
@@ -29,13 +31,15 @@ struct RcrOutlet {
   // dp_c/dt from the end's flow Q* and the capacitor's pressure p_c.
   double capacitor_rate(double q_star, double p_c) const { return (q_star - (p_c - p_out) / r2) / c; }
   // With no compliance: R1 + R2 in series to p_out.
-  EndState series_end_state(const TubeLaw& law, double a, double q) const {
-    return resistance_state(law, a, q, r1 + r2, p_out);
-  }
+  EndState series_end_state(const TubeLaw& law, double a, double q) const { return in_series().end_state(law, a, q); }
   // Its 0D rows: R1 to a capacitor node of its own, or, with no compliance, a shunt
   // 1/(R1 + R2) to p_out.
   LumpedCapacitor lumped_capacitor() const { return {r1, {1 / r2, p_out}, c}; }
-  LumpedShunt series_lumped_shunt() const { return ResistanceOutlet{r1 + r2, p_out}.lumped_shunt(); }
+  LumpedShunt series_lumped_shunt() const { return in_series().lumped_shunt(); }
+  void add_steady_row(NodalRows& rows, std::size_t node) const { in_series().add_steady_row(rows, node); }
+
+ private:
+  ResistanceOutlet in_series() const { return {r1 + r2, p_out}; }
 };
 
 }  // namespace hemotree
