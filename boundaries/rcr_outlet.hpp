@@ -8,9 +8,11 @@
 //   0D rows: R1 an edge to a capacitor node with C and a shunt 1/R2 to p_out.
 //   steady:  the capacitor carries nothing, so R1 and R2 are in series, a shunt
 //            1/(R1 + R2) to p_out.
+//   harmonic: its impedance Z(w) = R1 + R2 / (1 + i w R2 C) (harmonic/linear_periodic.cpp).
 // Written for a distal end, Q* along the vessel (out of the network).
 #pragma once
 
+#include <complex>
 #include <cstddef>
 
 #include "boundaries/resistance_outlet.hpp"
@@ -37,6 +39,7 @@ struct RcrOutlet {
   LumpedCapacitor lumped_capacitor() const { return {r1, {1 / r2, p_out}, c}; }
   LumpedShunt series_lumped_shunt() const { return in_series().lumped_shunt(); }
   void add_steady_row(NodalRows& rows, std::size_t node) const { in_series().add_steady_row(rows, node); }
+  std::complex<double> impedance(double omega) const { return r1 + r2 / std::complex<double>(1.0, omega * r2 * c); }
 
  private:
   ResistanceOutlet in_series() const { return {r1 + r2, p_out}; }

@@ -1,0 +1,140 @@
+#include "harmonic/linear_periodic.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include "boundaries/rcr_outlet.hpp"
+#include "boundaries/resistance_outlet.hpp"
+#include "core/errors.hpp"
+#include "network_flow/harmonic_system.hpp"
+#include "physics/poiseuille.hpp"
+#include "steady/steady_flow.hpp"
+
+namespace hemotree {
+
+namespace {
+
+// The network's oscillation at one angular frequency w: every node's pressure amplitude.
+std::vector<Complex> solve_harmonic(const Network& net, const std::vector<NodeBoundary>& boundaries,
+                                    const std::vector<FourierSeries>& series, const std::vector<VesselLine>& lines,
+                                    int k, double w) {
+  const std::size_t nodes = net.node_count(), n = net.vessel_count();
+  std::vector<Complex> shunt(nodes, 0.0), current(nodes, 0.0), held_value(nodes, 0.0);
+  std::vector<unsigned char> held(nodes, 0);
+  for (std::size_t i = 0; i < boundaries.size(); ++i) {
+    const NodeBoundary& b = boundaries[i];
+    const auto node = static_cast<std::size_t>(b.node);
+    const Complex amplitude = series[i].amplitude[static_cast<std::size_t>(k)];
+    switch (b.type) {
+      case BoundaryType::flow: current[node] += amplitude; break;
+      case BoundaryType::pressure:
+        held[node] = 1;
+        held_value[node] = amplitude;
+        break;
+      case BoundaryType::resistance: shunt[node] += 1.0 / ResistanceOutlet{b.outlet.r, b.outlet.p_out}.impedance(w); break;
+      case BoundaryType::rcr:
+        shunt[node] += 1.0 / RcrOutlet{b.outlet.r1, b.outlet.c, b.outlet.r2, b.outlet.p_out}.impedance(w);
+        break;
+      case BoundaryType::reflection:
+        throw InputError("node " + std::to_string(net.node_id[node]) +
+                         ": a reflection outlet has no steady state to linearise about");
+    }
+  }
+  // Each vessel's pi circuit; a vessel ending at a held node becomes, at its other node, a
+  // shunt and the current the held pressure drives through it.
+  std::vector<std::int32_t> a, b;
+  std::vector<Complex> admittance;
+  for (std::size_t v = 0; v < n; ++v) {
+    const VesselLine::PiCircuit pi = lines[v].pi_circuit(w);
+    const auto i = static_cast<std::size_t>(net.from[v]), j = static_cast<std::size_t>(net.to[v]);
+    if (!held[i]) shunt[i] += pi.shunt;
+    if (!held[j]) shunt[j] += pi.shunt;
+    if (held[i] && held[j]) continue;
+    if (held[i] || held[j]) {
+      const std::size_t free = held[i] ? j : i, fixed = held[i] ? i : j;
+      shunt[free] += pi.series;
+      current[free] += pi.series * held_value[fixed];
+      continue;
+    }
+    a.push_back(net.from[v]);
+    b.push_back(net.to[v]);
+    admittance.push_back(pi.series);
+  }
+  std::vector<unsigned char> touched(nodes, 0);  // a node no vessel reaches stays at 0
+  for (std::size_t v = 0; v < n; ++v) touched[static_cast<std::size_t>(net.from[v])] = touched[static_cast<std::size_t>(net.to[v])] = 1;
+  for (std::size_t node = 0; node < nodes; ++node) {
+    if (held[node]) {
+      shunt[node] = 1.0;
+      current[node] = held_value[node];
+    } else if (!touched[node]) {
+      shunt[node] = 1.0;
+    }
+  }
+  try {
+    return solve_harmonic_system(nodes, a, b, admittance, shunt, current);
+  } catch (const std::invalid_argument&) {
+    throw InputError("the linear periodic solution: a part of the network has no path to an outlet or a pressure");
+  }
+}
+
+}  // namespace
+
+LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                     const ViscosityTable& viscosity, int harmonics) {
+  if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
+  const std::size_t n = net.vessel_count();
+  LinearPeriodic out;
+  out.net_ = &net;
+  out.period_ = driving_waveform(net).period;
+  const SteadyFlow steady =
+      solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
+  out.mean_node_pressure_ = steady.node_pressure;
+  out.mean_flow_ = steady.flow;
+
+  const double k_friction = friction_coefficient(blood.alpha);
+  out.line_.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const TubeLaw& law = laws[v];
+    const double p = 0.5 * (steady.node_pressure[static_cast<std::size_t>(net.from[v])] +
+                            steady.node_pressure[static_cast<std::size_t>(net.to[v])]);
+    const double area = law.area(p);
+    out.line_[v] = {k_friction * viscosity(area) / (area * area), blood.density / area, law.compliance_per_length(area),
+                    net.length[v]};
+  }
+
+  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
+  std::vector<FourierSeries> series;
+  for (const NodeBoundary& b : boundaries) series.push_back(fourier_series(b.waveform, harmonics));
+  for (int k = 1; k <= harmonics; ++k)
+    out.node_pressure_.push_back(solve_harmonic(net, boundaries, series, out.line_, k, out.omega(k)));
+  return out;
+}
+
+LinearPeriodic::Complex LinearPeriodic::pressure(int k, std::size_t vessel, double s) const {
+  const auto& p = node_pressure_[static_cast<std::size_t>(k - 1)];
+  const VesselLine& line = line_[vessel];
+  return line.pressure(omega(k), p[static_cast<std::size_t>(net_->from[vessel])], p[static_cast<std::size_t>(net_->to[vessel])],
+                       s * line.length);
+}
+
+LinearPeriodic::Complex LinearPeriodic::flow(int k, std::size_t vessel, double s) const {
+  const auto& p = node_pressure_[static_cast<std::size_t>(k - 1)];
+  const VesselLine& line = line_[vessel];
+  return line.flow(omega(k), p[static_cast<std::size_t>(net_->from[vessel])], p[static_cast<std::size_t>(net_->to[vessel])],
+                   s * line.length);
+}
+
+double LinearPeriodic::pressure_at(std::size_t vessel, double s, double t) const {
+  double p = (1 - s) * mean_node_pressure_[static_cast<std::size_t>(net_->from[vessel])] +
+             s * mean_node_pressure_[static_cast<std::size_t>(net_->to[vessel])];
+  for (int k = 1; k <= harmonics(); ++k) p += (pressure(k, vessel, s) * std::polar(1.0, omega(k) * t)).real();
+  return p;
+}
+
+double LinearPeriodic::flow_at(std::size_t vessel, double s, double t) const {
+  double q = mean_flow_[vessel];
+  for (int k = 1; k <= harmonics(); ++k) q += (flow(k, vessel, s) * std::polar(1.0, omega(k) * t)).real();
+  return q;
+}
+
+}  // namespace hemotree

@@ -1,0 +1,73 @@
+// The periodic state of a network linearised about its loaded steady state, harmonic by
+// harmonic: the mean is the steady flow of the pulse solver's own equations (every vessel at
+// the lumen of its mean pressure), and each harmonic k of the inflow (w_k = 2 pi k / T)
+// drives the network's small oscillations about it:
+//   - each vessel a uniform transmission line about its loaded lumen (harmonic/vessel_line.hpp;
+//     where the pulse crosses it in phase, the 0D vessel's R, L and C),
+//   - each outlet its impedance Z(w) to an outflow pressure that does not oscillate
+//     (boundaries/: R; RCR: R1 + R2 / (1 + i w R2 C)),
+//   - a prescribed flow a current of its waveform's k-th harmonic into its node, a prescribed
+//     pressure its node held at its waveform's k-th harmonic,
+// in one complex nodal system per harmonic (network_flow/harmonic_system.hpp): on a tree, the
+// elimination from the leaves, O(vessels) per harmonic.
+//
+// It leaves out what is nonlinear in the 1D model: the convective term, the tube law's
+// curvature over the pulse (the lumen's swing is a few per cent in arteries), and the
+// friction's dependence on the lumen; their effect on the time-stepped periodic state is of
+// the order of the square of the pulse's relative amplitude (tests/test_linear_periodic.cpp).
+#pragma once
+
+#include <complex>
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "harmonic/fourier_series.hpp"
+#include "harmonic/vessel_line.hpp"
+#include "formats/network.hpp"
+#include "physics/blood.hpp"
+#include "physics/tube_law.hpp"
+#include "physics/viscosity_table.hpp"
+
+namespace hemotree {
+
+class LinearPeriodic {
+ public:
+  using Complex = std::complex<double>;
+
+  double period() const { return period_; }
+  int harmonics() const { return static_cast<int>(node_pressure_.size()); }
+  double omega(int k) const { return 2 * 3.14159265358979323846 * k / period_; }
+  const VesselLine& line(std::size_t vessel) const { return line_[vessel]; }
+  // The loaded (mean) state: per node [Pa], per vessel [m^3/s, from -> to].
+  const std::vector<double>& mean_node_pressure() const { return mean_node_pressure_; }
+  const std::vector<double>& mean_flow() const { return mean_flow_; }
+  // Harmonic k >= 1 at a node, and in a vessel at a fraction s of its length from `from`.
+  Complex node_pressure(int k, std::size_t node) const { return node_pressure_[static_cast<std::size_t>(k - 1)][node]; }
+  Complex pressure(int k, std::size_t vessel, double s) const;
+  Complex flow(int k, std::size_t vessel, double s) const;
+  // The periodic state at time t: the mean plus every harmonic. The mean pressure along a
+  // vessel is taken linear between its nodes.
+  double pressure_at(std::size_t vessel, double s, double t) const;
+  double flow_at(std::size_t vessel, double s, double t) const;
+
+  friend LinearPeriodic solve_linear_periodic(const Network&, const Blood&, std::span<const TubeLaw>,
+                                              const ViscosityTable&, int);
+
+ private:
+  const Network* net_ = nullptr;
+  double period_ = 1.0;
+  std::vector<double> mean_node_pressure_, mean_flow_;
+  std::vector<VesselLine> line_;
+  std::vector<std::vector<Complex>> node_pressure_;  // [k - 1][node]
+};
+
+// The linear periodic state with the first `harmonics` harmonics of the network's boundary
+// waveforms (their common period: driving_waveform). laws: per vessel (a tapered vessel's at
+// its proximal end); viscosity: mu(A) of the run's blood. Throws InputError where the steady
+// state does (a reflection outlet has no steady state), or where a part of the network has
+// no path to ground.
+LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                     const ViscosityTable& viscosity, int harmonics);
+
+}  // namespace hemotree

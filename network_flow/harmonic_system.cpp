@@ -1,0 +1,133 @@
+#include "network_flow/harmonic_system.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseLU>
+
+namespace hemotree {
+
+namespace {
+
+[[noreturn]] void singular_at(std::size_t node) {
+  throw std::invalid_argument("harmonic system: node " + std::to_string(node) +
+                              " lies in a part with no admittance to ground");
+}
+
+// The forest's elimination order by peeling leaves; false if the graph has a cycle.
+bool peel_leaves(std::size_t nodes, std::span<const std::int32_t> a, std::span<const std::int32_t> b,
+                 std::vector<std::int32_t>& order, std::vector<std::int32_t>& parent_edge,
+                 std::vector<std::int64_t>& offset, std::vector<std::int32_t>& incident) {
+  const std::size_t edges = a.size();
+  offset.assign(nodes + 1, 0);
+  for (std::size_t e = 0; e < edges; ++e) {
+    ++offset[static_cast<std::size_t>(a[e]) + 1];
+    ++offset[static_cast<std::size_t>(b[e]) + 1];
+  }
+  for (std::size_t i = 0; i < nodes; ++i) offset[i + 1] += offset[i];
+  incident.assign(2 * edges, 0);
+  std::vector<std::int64_t> fill(offset.begin(), offset.end() - 1);
+  for (std::size_t e = 0; e < edges; ++e) {
+    incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(a[e])]++)] = static_cast<std::int32_t>(e);
+    incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(b[e])]++)] = static_cast<std::int32_t>(e);
+  }
+  std::vector<std::int64_t> degree(nodes);
+  for (std::size_t i = 0; i < nodes; ++i) degree[i] = offset[i + 1] - offset[i];
+  std::vector<unsigned char> edge_used(edges, 0), done(nodes, 0);
+  order.clear();
+  order.reserve(nodes);
+  parent_edge.assign(nodes, -1);
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (degree[i] <= 1) order.push_back(static_cast<std::int32_t>(i));
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const auto i = static_cast<std::size_t>(order[k]);
+    done[i] = 1;
+    for (std::int64_t s = offset[i]; s < offset[i + 1]; ++s) {
+      const auto e = static_cast<std::size_t>(incident[static_cast<std::size_t>(s)]);
+      if (edge_used[e]) continue;
+      edge_used[e] = 1;
+      parent_edge[i] = static_cast<std::int32_t>(e);
+      const auto p = static_cast<std::size_t>(a[e] == static_cast<std::int32_t>(i) ? b[e] : a[e]);
+      if (--degree[p] == 1 && !done[p]) order.push_back(static_cast<std::int32_t>(p));
+    }
+  }
+  return order.size() == nodes;
+}
+
+}  // namespace
+
+std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const std::int32_t> a,
+                                           std::span<const std::int32_t> b, std::span<const Complex> admittance,
+                                           std::span<const Complex> shunt, std::span<const Complex> current) {
+  const std::size_t edges = a.size();
+  if (b.size() != edges || admittance.size() != edges || shunt.size() != nodes || current.size() != nodes)
+    throw std::invalid_argument("harmonic system: one admittance per edge, one shunt and current per node");
+  for (std::size_t e = 0; e < edges; ++e)
+    if (a[e] < 0 || b[e] < 0 || static_cast<std::size_t>(a[e]) >= nodes || static_cast<std::size_t>(b[e]) >= nodes ||
+        a[e] == b[e])
+      throw std::invalid_argument("harmonic system: edge " + std::to_string(e) + " joins no two distinct nodes");
+
+  std::vector<Complex> pivot(shunt.begin(), shunt.end()), x(current.begin(), current.end());
+  for (std::size_t e = 0; e < edges; ++e) {
+    pivot[static_cast<std::size_t>(a[e])] += admittance[e];
+    pivot[static_cast<std::size_t>(b[e])] += admittance[e];
+  }
+  std::vector<std::int32_t> order, parent_edge, incident;
+  std::vector<std::int64_t> offset;
+  if (peel_leaves(nodes, a, b, order, parent_edge, offset, incident)) {
+    // Leaves up: node i, its pivot final, hands y^2 / d_i and y B_i / d_i to its parent
+    // (the off-diagonal entry is -y).
+    for (const std::int32_t node : order) {
+      const auto i = static_cast<std::size_t>(node);
+      if (pivot[i] == Complex(0)) singular_at(i);
+      const std::int32_t e = parent_edge[i];
+      if (e < 0) continue;
+      const auto p = static_cast<std::size_t>(a[static_cast<std::size_t>(e)] == node ? b[static_cast<std::size_t>(e)]
+                                                                                      : a[static_cast<std::size_t>(e)]);
+      const Complex y = admittance[static_cast<std::size_t>(e)];
+      pivot[p] -= y * y / pivot[i];
+      x[p] += y * x[i] / pivot[i];
+    }
+    // Roots down: X_i = (B_i + y X_parent) / d_i.
+    for (auto k = order.size(); k-- > 0;) {
+      const auto i = static_cast<std::size_t>(order[k]);
+      const std::int32_t e = parent_edge[i];
+      if (e < 0) {
+        x[i] /= pivot[i];
+        continue;
+      }
+      const auto p = static_cast<std::size_t>(a[static_cast<std::size_t>(e)] == order[k] ? b[static_cast<std::size_t>(e)]
+                                                                                          : a[static_cast<std::size_t>(e)]);
+      x[i] = (x[i] + admittance[static_cast<std::size_t>(e)] * x[p]) / pivot[i];
+    }
+    return x;
+  }
+
+  // Loops: the assembled matrix and a sparse LU.
+  std::vector<Eigen::Triplet<Complex>> entries;
+  entries.reserve(nodes + 2 * edges);
+  for (std::size_t i = 0; i < nodes; ++i)
+    entries.emplace_back(static_cast<int>(i), static_cast<int>(i), shunt[i]);
+  for (std::size_t e = 0; e < edges; ++e) {
+    const int i = a[e], j = b[e];
+    entries.emplace_back(i, i, admittance[e]);
+    entries.emplace_back(j, j, admittance[e]);
+    entries.emplace_back(i, j, -admittance[e]);
+    entries.emplace_back(j, i, -admittance[e]);
+  }
+  Eigen::SparseMatrix<Complex> m(static_cast<Eigen::Index>(nodes), static_cast<Eigen::Index>(nodes));
+  m.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<Complex>, Eigen::COLAMDOrdering<int>> lu;
+  lu.compute(m);
+  if (lu.info() != Eigen::Success)
+    throw std::invalid_argument("harmonic system: singular (a part with no admittance to ground): " + lu.lastErrorMessage());
+  const Eigen::Map<const Eigen::VectorXcd> rhs(current.data(), static_cast<Eigen::Index>(nodes));
+  const Eigen::VectorXcd solution = lu.solve(rhs);
+  for (Eigen::Index i = 0; i < solution.size(); ++i)
+    if (!std::isfinite(solution(i).real()) || !std::isfinite(solution(i).imag())) singular_at(static_cast<std::size_t>(i));
+  return std::vector<Complex>(solution.data(), solution.data() + solution.size());
+}
+
+}  // namespace hemotree
