@@ -51,7 +51,7 @@ Network vessel(double length, double diameter, double wave_speed, const Blood& b
 std::vector<std::array<double, 2>> second_cycle(const Network& net, ModelChoice model, double& dt) {
   SolverOptions options;
   options.model = model;
-  options.steady_start = true;
+  options.start = StartChoice::steady;
   PulseSolver solver(net, options);
   const auto steps = static_cast<std::size_t>(std::ceil(1.0 / solver.dt() - 1e-9));
   solver.set_time_step(1.0 / static_cast<double>(steps));

@@ -8,7 +8,6 @@
 #include "core/errors.hpp"
 #include "network_flow/harmonic_system.hpp"
 #include "physics/poiseuille.hpp"
-#include "steady/steady_flow.hpp"
 
 namespace hemotree {
 
@@ -40,25 +39,25 @@ std::vector<Complex> solve_harmonic(const Network& net, const std::vector<NodeBo
                          ": a reflection outlet has no steady state to linearise about");
     }
   }
-  // Each vessel's pi circuit; a vessel ending at a held node becomes, at its other node, a
+  // Each vessel's two-port; a vessel ending at a held node becomes, at its other node, a
   // shunt and the current the held pressure drives through it.
   std::vector<std::int32_t> a, b;
-  std::vector<Complex> admittance;
+  std::vector<TwoPort> edge;
   for (std::size_t v = 0; v < n; ++v) {
-    const VesselLine::PiCircuit pi = lines[v].pi_circuit(w);
+    const TwoPort y = lines[v].two_port(w);
     const auto i = static_cast<std::size_t>(net.from[v]), j = static_cast<std::size_t>(net.to[v]);
-    if (!held[i]) shunt[i] += pi.shunt;
-    if (!held[j]) shunt[j] += pi.shunt;
     if (held[i] && held[j]) continue;
-    if (held[i] || held[j]) {
-      const std::size_t free = held[i] ? j : i, fixed = held[i] ? i : j;
-      shunt[free] += pi.series;
-      current[free] += pi.series * held_value[fixed];
-      continue;
+    if (held[i]) {
+      shunt[j] += y.bb;
+      current[j] -= y.ba * held_value[i];
+    } else if (held[j]) {
+      shunt[i] += y.aa;
+      current[i] -= y.ab * held_value[j];
+    } else {
+      a.push_back(net.from[v]);
+      b.push_back(net.to[v]);
+      edge.push_back(y);
     }
-    a.push_back(net.from[v]);
-    b.push_back(net.to[v]);
-    admittance.push_back(pi.series);
   }
   std::vector<unsigned char> touched(nodes, 0);  // a node no vessel reaches stays at 0
   for (std::size_t v = 0; v < n; ++v) touched[static_cast<std::size_t>(net.from[v])] = touched[static_cast<std::size_t>(net.to[v])] = 1;
@@ -71,7 +70,7 @@ std::vector<Complex> solve_harmonic(const Network& net, const std::vector<NodeBo
     }
   }
   try {
-    return solve_harmonic_system(nodes, a, b, admittance, shunt, current);
+    return solve_harmonic_system(nodes, a, b, edge, shunt, current);
   } catch (const std::invalid_argument&) {
     throw InputError("the linear periodic solution: a part of the network has no path to an outlet or a pressure");
   }
@@ -81,13 +80,18 @@ std::vector<Complex> solve_harmonic(const Network& net, const std::vector<NodeBo
 
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, int harmonics) {
+  const SteadyFlow steady =
+      solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
+  return solve_linear_periodic(net, blood, laws, viscosity, steady, harmonics);
+}
+
+LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int harmonics) {
   if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
   const std::size_t n = net.vessel_count();
   LinearPeriodic out;
   out.net_ = &net;
   out.period_ = driving_waveform(net).period;
-  const SteadyFlow steady =
-      solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
   out.mean_node_pressure_ = steady.node_pressure;
   out.mean_flow_ = steady.flow;
 
@@ -99,7 +103,7 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
                             steady.node_pressure[static_cast<std::size_t>(net.to[v])]);
     const double area = law.area(p);
     out.line_[v] = {k_friction * viscosity(area) / (area * area), blood.density / area, law.compliance_per_length(area),
-                    net.length[v]};
+                    net.length[v], steady.flow[v] / area, law.alpha};
   }
 
   const std::vector<NodeBoundary> boundaries = run_boundaries(net);
@@ -128,6 +132,12 @@ double LinearPeriodic::pressure_at(std::size_t vessel, double s, double t) const
   double p = (1 - s) * mean_node_pressure_[static_cast<std::size_t>(net_->from[vessel])] +
              s * mean_node_pressure_[static_cast<std::size_t>(net_->to[vessel])];
   for (int k = 1; k <= harmonics(); ++k) p += (pressure(k, vessel, s) * std::polar(1.0, omega(k) * t)).real();
+  return p;
+}
+
+double LinearPeriodic::node_pressure_at(std::size_t node, double t) const {
+  double p = mean_node_pressure_[node];
+  for (int k = 1; k <= harmonics(); ++k) p += (node_pressure(k, node) * std::polar(1.0, omega(k) * t)).real();
   return p;
 }
 

@@ -28,6 +28,7 @@
 #include "physics/blood.hpp"
 #include "physics/tube_law.hpp"
 #include "physics/viscosity_table.hpp"
+#include "steady/steady_flow.hpp"
 
 namespace hemotree {
 
@@ -49,10 +50,11 @@ class LinearPeriodic {
   // The periodic state at time t: the mean plus every harmonic. The mean pressure along a
   // vessel is taken linear between its nodes.
   double pressure_at(std::size_t vessel, double s, double t) const;
+  double node_pressure_at(std::size_t node, double t) const;
   double flow_at(std::size_t vessel, double s, double t) const;
 
   friend LinearPeriodic solve_linear_periodic(const Network&, const Blood&, std::span<const TubeLaw>,
-                                              const ViscosityTable&, int);
+                                              const ViscosityTable&, const SteadyFlow&, int);
 
  private:
   const Network* net_ = nullptr;
@@ -69,5 +71,9 @@ class LinearPeriodic {
 // no path to ground.
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, int harmonics);
+// The same about a steady state already solved (solve_distended_steady_flow with the same
+// blood, laws and viscosity).
+LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int harmonics);
 
 }  // namespace hemotree

@@ -59,10 +59,10 @@ bool peel_leaves(std::size_t nodes, std::span<const std::int32_t> a, std::span<c
 }  // namespace
 
 std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const std::int32_t> a,
-                                           std::span<const std::int32_t> b, std::span<const Complex> admittance,
+                                           std::span<const std::int32_t> b, std::span<const TwoPort> edge,
                                            std::span<const Complex> shunt, std::span<const Complex> current) {
   const std::size_t edges = a.size();
-  if (b.size() != edges || admittance.size() != edges || shunt.size() != nodes || current.size() != nodes)
+  if (b.size() != edges || edge.size() != edges || shunt.size() != nodes || current.size() != nodes)
     throw std::invalid_argument("harmonic system: one admittance per edge, one shunt and current per node");
   for (std::size_t e = 0; e < edges; ++e)
     if (a[e] < 0 || b[e] < 0 || static_cast<std::size_t>(a[e]) >= nodes || static_cast<std::size_t>(b[e]) >= nodes ||
@@ -71,26 +71,33 @@ std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const st
 
   std::vector<Complex> pivot(shunt.begin(), shunt.end()), x(current.begin(), current.end());
   for (std::size_t e = 0; e < edges; ++e) {
-    pivot[static_cast<std::size_t>(a[e])] += admittance[e];
-    pivot[static_cast<std::size_t>(b[e])] += admittance[e];
+    pivot[static_cast<std::size_t>(a[e])] += edge[e].aa;
+    pivot[static_cast<std::size_t>(b[e])] += edge[e].bb;
   }
   std::vector<std::int32_t> order, parent_edge, incident;
   std::vector<std::int64_t> offset;
   if (peel_leaves(nodes, a, b, order, parent_edge, offset, incident)) {
-    // Leaves up: node i, its pivot final, hands y^2 / d_i and y B_i / d_i to its parent
-    // (the off-diagonal entry is -y).
+    // Leaves up: node i, its pivot final, hands its parent p m_pi m_ip / d_i of the pivot and
+    // m_pi B_i / d_i of the current (m_pi: the entry in p's row and i's column).
+    auto couplings = [&](std::size_t i, std::int32_t e, std::size_t& p, Complex& m_ip, Complex& m_pi) {
+      const TwoPort& y = edge[static_cast<std::size_t>(e)];
+      const bool i_is_a = a[static_cast<std::size_t>(e)] == static_cast<std::int32_t>(i);
+      p = static_cast<std::size_t>(i_is_a ? b[static_cast<std::size_t>(e)] : a[static_cast<std::size_t>(e)]);
+      m_ip = i_is_a ? y.ab : y.ba;
+      m_pi = i_is_a ? y.ba : y.ab;
+    };
     for (const std::int32_t node : order) {
       const auto i = static_cast<std::size_t>(node);
       if (pivot[i] == Complex(0)) singular_at(i);
       const std::int32_t e = parent_edge[i];
       if (e < 0) continue;
-      const auto p = static_cast<std::size_t>(a[static_cast<std::size_t>(e)] == node ? b[static_cast<std::size_t>(e)]
-                                                                                      : a[static_cast<std::size_t>(e)]);
-      const Complex y = admittance[static_cast<std::size_t>(e)];
-      pivot[p] -= y * y / pivot[i];
-      x[p] += y * x[i] / pivot[i];
+      std::size_t p;
+      Complex m_ip, m_pi;
+      couplings(i, e, p, m_ip, m_pi);
+      pivot[p] -= m_pi * m_ip / pivot[i];
+      x[p] -= m_pi * x[i] / pivot[i];
     }
-    // Roots down: X_i = (B_i + y X_parent) / d_i.
+    // Roots down: X_i = (B_i - m_ip X_p) / d_i.
     for (auto k = order.size(); k-- > 0;) {
       const auto i = static_cast<std::size_t>(order[k]);
       const std::int32_t e = parent_edge[i];
@@ -98,9 +105,10 @@ std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const st
         x[i] /= pivot[i];
         continue;
       }
-      const auto p = static_cast<std::size_t>(a[static_cast<std::size_t>(e)] == order[k] ? b[static_cast<std::size_t>(e)]
-                                                                                          : a[static_cast<std::size_t>(e)]);
-      x[i] = (x[i] + admittance[static_cast<std::size_t>(e)] * x[p]) / pivot[i];
+      std::size_t p;
+      Complex m_ip, m_pi;
+      couplings(i, e, p, m_ip, m_pi);
+      x[i] = (x[i] - m_ip * x[p]) / pivot[i];
     }
     return x;
   }
@@ -112,10 +120,10 @@ std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const st
     entries.emplace_back(static_cast<int>(i), static_cast<int>(i), shunt[i]);
   for (std::size_t e = 0; e < edges; ++e) {
     const int i = a[e], j = b[e];
-    entries.emplace_back(i, i, admittance[e]);
-    entries.emplace_back(j, j, admittance[e]);
-    entries.emplace_back(i, j, -admittance[e]);
-    entries.emplace_back(j, i, -admittance[e]);
+    entries.emplace_back(i, i, edge[e].aa);
+    entries.emplace_back(j, j, edge[e].bb);
+    entries.emplace_back(i, j, edge[e].ab);
+    entries.emplace_back(j, i, edge[e].ba);
   }
   Eigen::SparseMatrix<Complex> m(static_cast<Eigen::Index>(nodes), static_cast<Eigen::Index>(nodes));
   m.setFromTriplets(entries.begin(), entries.end());

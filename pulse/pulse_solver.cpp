@@ -128,9 +128,17 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   allocate_state();
 
   compute_rest_correction();
-  started_from_steady_ = options.steady_start && steady;
-  if (started_from_steady_) start_from_steady_flow(*steady);
-  else start_at_rest();
+  started_from_steady_ = options.start != StartChoice::rest && steady;
+  if (started_from_steady_) {
+    start_from_steady_flow(*steady);
+    started_from_ = StartChoice::steady;
+    if (options.start == StartChoice::periodic) {
+      start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.start_harmonics));
+      started_from_ = StartChoice::periodic;
+    }
+  } else {
+    start_at_rest();
+  }
   choose_time_step(options);
   // The coupled ends' first linearisation needs their end states.
   if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);
@@ -470,6 +478,35 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) = p - o.outlet.r1 * q;
     o.rest_area = end_law(v, o.end.distal).area(p);
     o.rest_flow = s.flow[v];
+  }
+}
+
+void PulseSolver::start_from_periodic(const LinearPeriodic& periodic) {
+  // The steady start has set what else a start needs (the reflection outlets' rest states);
+  // this replaces the state with the periodic one at t = 0.
+  const Network& net = net_;
+  const std::size_t n = net.vessel_count();
+  std::vector<double> node_pressure(net.node_count()), flow(n);
+  for (std::size_t i = 0; i < node_pressure.size(); ++i) node_pressure[i] = periodic.node_pressure_at(i, time_);
+  for (std::size_t v = 0; v < n; ++v) flow[v] = periodic.flow_at(v, 0.5, time_);
+  lumped_.start(node_pressure, flow);
+  for (std::size_t v = 0; v < n; ++v) {
+    if (zero_d_[v]) continue;
+    auto pressure = [&](double x) { return periodic.pressure_at(v, x, time_); };
+    if (is_tapered(v)) {
+      const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
+      project_along(v, [&](double x) { return taper.at(x).area(pressure(x)); }, state_.area);
+    } else {
+      project_along(v, [&](double x) { return laws_[v].area(pressure(x)); }, state_.area);
+    }
+    project_along(v, [&](double x) { return periodic.flow_at(v, x, time_); }, state_.flow);
+  }
+  for (const auto& o : boundaries_.outlets) {
+    if (o.capacitor < 0) continue;
+    const auto v = static_cast<std::size_t>(o.end.vessel);
+    const double s = o.end.distal ? 1.0 : 0.0;
+    const double q = (o.end.distal ? 1.0 : -1.0) * periodic.flow_at(v, s, time_);
+    state_.capacitor(o.capacitor) = periodic.pressure_at(v, s, time_) - o.outlet.r1 * q;
   }
 }
 

@@ -17,6 +17,7 @@
 #include <Eigen/Dense>
 
 #include "formats/network.hpp"
+#include "harmonic/linear_periodic.hpp"
 #include "physics/viscosity_table.hpp"
 #include "pulse/degree_choice.hpp"
 #include "pulse/legendre_basis.hpp"
@@ -31,6 +32,11 @@ namespace hemotree {
 
 // Which vessels are 1D (DG) and which 0D (lumped): all of one kind, or chosen per vessel.
 enum class ModelChoice { automatic, one_d, zero_d };
+
+// The state a run starts from: the reference pressures at rest; the steady solution of the
+// mean inflow; or the linear periodic state about it (harmonic/linear_periodic.hpp) at t = 0.
+// The last two fall back to rest where the network has no steady state (reflection outlets).
+enum class StartChoice { rest, steady, periodic };
 
 struct SolverOptions {
   static constexpr int automatic = -1;
@@ -52,7 +58,8 @@ struct SolverOptions {
   double friction_safety = 0.5;  // safety on the friction-stiffness limit
   double external_pressure = 10 * 133.322;  // p_ext for the wall laws [Pa]
   double thick_wall_ratio = 0.1;
-  bool steady_start = true; // start from the steady Poiseuille solution when it exists
+  StartChoice start = StartChoice::steady;
+  int start_harmonics = 10;  // periodic start: the inflow's harmonics it takes
   int rheology_override = -1;  // -1: the file's; else static_cast<int>(Rheology)
   // Threads over elements. One by default: a step has several parallel sections, and a
   // thread that the system deschedules stalls every barrier (measured on the shared 2-core
@@ -171,7 +178,10 @@ class PulseSolver {
 
   // Whether the run started from the steady solution; if it was asked to and could not,
   // why (the steady solver's message).
+  // Whether the run started from the steady solution (alone, or with the periodic state
+  // about it), and which start it took.
   bool started_from_steady() const { return started_from_steady_; }
+  StartChoice started_from() const { return started_from_; }
   const std::string& steady_refusal() const { return steady_refusal_; }
   // Lowest and highest steady node pressure [Pa] (NaN without a steady solution), and the
   // index of the vessel entering the node of the highest.
@@ -229,6 +239,8 @@ class PulseSolver {
   void allocate_state();      // the state's and the point values' storage
   void choose_models(const SolverOptions& options);
   void start_from_steady_flow(const SteadyFlow& steady);
+  // Then the linear periodic state about it at t = 0: pressures and flows along every vessel.
+  void start_from_periodic(const LinearPeriodic& periodic);
   std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
   void start_at_rest();
   // steady: the network's steady flow, or null where it has none.
@@ -315,6 +327,7 @@ class PulseSolver {
   std::string stable_dt_reason_;
   std::size_t steps_ = 0;
   bool started_from_steady_ = false;
+  StartChoice started_from_ = StartChoice::rest;
   std::string steady_refusal_;
   double steady_pressure_min_ = std::numeric_limits<double>::quiet_NaN();
   double steady_pressure_max_ = std::numeric_limits<double>::quiet_NaN();

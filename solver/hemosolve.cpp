@@ -183,7 +183,7 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
       ->capture_default_str();
   app.add_option("--scheme", scheme, "time scheme: etd2 (Adams-Bashforth 2 with exact friction), ab2 (the paper's) or rk4")->capture_default_str();
   app.add_option("--rheology", rheology, "pries or newtonian (default: the network's blood)");
-  app.add_option("--start", start, "initial state: steady (Poiseuille solution) or rest")->capture_default_str();
+  app.add_option("--start", start, "initial state: steady (the steady solution), periodic (the linear periodic state about it, at t = 0) or rest")->capture_default_str();
   app.add_option("--external-pressure", external_text, "interstitial pressure for the wall laws, in [-100, 100] mmHg")
       ->capture_default_str();
   app.add_option("--thick-wall-ratio", options.thick_wall_ratio, "h/D above which a wall is thick, in (0, 10]")
@@ -254,7 +254,7 @@ int run_command_line(CommandLine& line, int cores) {
   check_configuration(config);
   options.scheme = time_scheme_named(line.scheme);
   options.model = model_named(line.model);
-  options.steady_start = steady_start_named(line.start);
+  options.start = start_named(line.start);
   if (!line.rheology.empty()) options.rheology_override = static_cast<int>(rheology_named(line.rheology));
   options.degree = degree_named(line.degree_text);
   if (!line.dt_text.empty()) options.dt = parse_quantity(line.dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");

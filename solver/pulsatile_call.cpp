@@ -187,8 +187,8 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
                          {"rheology", to_string(run.blood().rheology)},
                          {"red_cells", to_string(config.red_cells)},
                          {"mean_cell_volume", run.blood().mean_cell_volume},
-                         {"start", steady_start ? "steady" : "rest"},
-                         {"start_requested", options.steady_start ? "steady" : "rest"},
+                         {"start", to_string(run.started_from())},
+                         {"start_requested", to_string(options.start)},
                          {"balance_compliances", config.balance_compliances && steady_start},
                          {"period", driving.period},
                          {"pulse_frequency", pulse_frequency(driving)},
@@ -200,7 +200,7 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
                          {"steps", static_cast<std::uint64_t>(pulsatile.cycles_done()) * steps_per_cycle},
                          {"compliance_balances", pulsatile.compliance_balances()},
                          {"wall_time", wall}};
-  if (!steady_start && options.steady_start) info["steady_refusal"] = run.steady_refusal();
+  if (!steady_start && options.start != StartChoice::rest) info["steady_refusal"] = run.steady_refusal();
   for (const auto& [p, count] : d.degrees) info["elements_of_degree"][std::to_string(p)] = count;
   if (pulsatile.has_change()) {
     info["periodic_change"] = pulsatile.change().change;
@@ -290,7 +290,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   const double dt = d.step.cycle.dt;
 
   // ---- what the run starts from, said as it is --------------------------------------------
-  if (config.solver.steady_start && !run.started_from_steady())
+  if (config.solver.start != StartChoice::rest && !run.started_from_steady())
     observer.warn("no steady solution to start from (" + run.steady_refusal() + "): starting from rest" +
                   (config.balance_compliances ? std::string(", without the compliance balance (it needs the steady network)")
                                               : std::string()));

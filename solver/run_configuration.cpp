@@ -56,6 +56,8 @@ constexpr ChoiceNames<TimeScheme> scheme_names = {
 constexpr ChoiceNames<ModelChoice> model_names = {
     {ModelChoice::automatic, "auto"}, {ModelChoice::one_d, "1d"}, {ModelChoice::zero_d, "0d"}};
 constexpr ChoiceNames<RedCells> red_cell_names = {{RedCells::fixed, "fixed"}, {RedCells::transport, "transport"}};
+constexpr ChoiceNames<StartChoice> start_names = {
+    {StartChoice::steady, "steady"}, {StartChoice::rest, "rest"}, {StartChoice::periodic, "periodic"}};
 constexpr ChoiceNames<Rheology> rheology_names = {{Rheology::pries, "pries"}, {Rheology::newtonian, "newtonian"}};
 
 template <class Choice>
@@ -80,15 +82,13 @@ Choice named(const std::string& text, ChoiceNames<Choice> names, const char* set
 const char* to_string(RedCells cells) { return name_of(cells, red_cell_names); }
 const char* to_string(ModelChoice model) { return name_of(model, model_names); }
 const char* to_string(TimeScheme scheme) { return name_of(scheme, scheme_names); }
+const char* to_string(StartChoice start) { return name_of(start, start_names); }
 
 TimeScheme time_scheme_named(const std::string& name) { return named(name, scheme_names, "scheme"); }
 
 ModelChoice model_named(const std::string& name) { return named(name, model_names, "model"); }
 
-bool steady_start_named(const std::string& name) {
-  if (name != "steady" && name != "rest") refuse_choice("start", "steady or rest", name);
-  return name == "steady";
-}
+StartChoice start_named(const std::string& name) { return named(name, start_names, "start"); }
 
 Rheology rheology_named(const std::string& name) { return named(name, rheology_names, "rheology"); }
 

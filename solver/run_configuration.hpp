@@ -21,13 +21,14 @@ enum class RedCells { fixed, transport };
 const char* to_string(RedCells cells);          // "fixed", "transport"
 const char* to_string(ModelChoice model);       // "auto", "1d", "0d"
 const char* to_string(TimeScheme scheme);       // "etd2", "ab2", "rk4"
+const char* to_string(StartChoice start);       // "steady", "rest", "periodic"
 
 // The choices from their names, as a caller writes them (a command line, a script): a
 // SettingError naming the setting (scheme, model, start, rheology, degree, red_cells) for any
 // other text.
 TimeScheme time_scheme_named(const std::string& name);
 ModelChoice model_named(const std::string& name);
-bool steady_start_named(const std::string& name);  // "steady" (true) or "rest"
+StartChoice start_named(const std::string& name);
 Rheology rheology_named(const std::string& name);  // "pries" or "newtonian"
 int degree_named(const std::string& name);         // "auto" (SolverOptions::automatic) or 0 to 30
 RedCells red_cells_named(const std::string& name);

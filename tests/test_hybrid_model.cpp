@@ -83,7 +83,7 @@ TEST(HybridModel, AShortHalfMade0dFollowsTheAll1dSolution) {
   Network net = network({{0, 1, 0.12}, {1, 2, 0.02}}, 3, 5e-3, 5.0);
   net.inlet = Inlet{0, gaussian_pulse(5e-6, 0.5, 0.1, 1.0)};
   SolverOptions one_d;
-  one_d.steady_start = false;
+  one_d.start = StartChoice::rest;
   SolverOptions hybrid = one_d;
   hybrid.model = ModelChoice::automatic;
   hybrid.lumped_transit = 0.01;  // transits 0.024 s and 0.004 s

@@ -111,7 +111,7 @@ TEST(NetworkGraphsPulsatile, ConstantBoundariesSettleOnTheSteadySolution) {
       sort_boundaries(net);
       const SteadyFlow steady = solve_steady_flow(net, vessel_resistances(net, *net.blood), 0.0);
       SolverOptions options = options_for(model);
-      options.steady_start = false;
+      options.start = StartChoice::rest;
       PulseSolver solver(net, options);
       if (model == ModelChoice::automatic) {
         EXPECT_FALSE(solver.is_lumped(1));  // a hybrid: the long vessels 1D, the others 0D

@@ -212,7 +212,7 @@ SteadyRun run_to_steady_state(Network& net, double q, double duration, const Sol
   w.value = {0.0, q, q};
   net.inlet = Inlet{0, w};
   SolverOptions o = options;
-  o.steady_start = false;
+  o.start = StartChoice::rest;
   PulseSolver s(net, o);
   const auto steps = static_cast<std::size_t>(std::ceil(duration / s.dt()));
   double before = 0;
@@ -580,7 +580,7 @@ struct TimeOrderCase {
     SolverOptions o;
     o.degree = 4;
     o.elements = 2;
-    o.steady_start = false;
+    o.start = StartChoice::rest;
     o.scheme = scheme;
     return o;
   }

@@ -108,7 +108,8 @@ TEST(RunIdentity, EveryOptionThatShapesTheStateIsInIt) {
       {"friction safety", [](RunConfiguration& c) { nudge(c.solver.friction_safety); }},
       {"external pressure", [](RunConfiguration& c) { nudge(c.solver.external_pressure); }},
       {"thick wall ratio", [](RunConfiguration& c) { nudge(c.solver.thick_wall_ratio); }},
-      {"start", [](RunConfiguration& c) { c.solver.steady_start = false; }},
+      {"start", [](RunConfiguration& c) { c.solver.start = StartChoice::rest; }},
+      {"periodic start", [](RunConfiguration& c) { c.solver.start = StartChoice::periodic; }},
       {"balance", [](RunConfiguration& c) { c.balance_compliances = false; }},
       {"sample interval", [](RunConfiguration& c) { nudge(c.sample_interval); }},
       {"probe position", [](RunConfiguration& c) { nudge(c.probes[0].x); }},
@@ -132,6 +133,14 @@ TEST(RunIdentity, EveryOptionThatShapesTheStateIsInIt) {
     change(changed);
     EXPECT_NE(state_shaping(changed, net, dt, Rheology::newtonian), shaping) << option;
   }
+  // A periodic start is shaped by the harmonics it takes; another start is not.
+  RunConfiguration periodic = base, more_harmonics = base;
+  periodic.solver.start = more_harmonics.solver.start = StartChoice::periodic;
+  more_harmonics.solver.start_harmonics = 12;
+  EXPECT_NE(state_shaping(more_harmonics, net, dt, Rheology::newtonian), state_shaping(periodic, net, dt, Rheology::newtonian));
+  RunConfiguration steady_more = base;
+  steady_more.solver.start_harmonics = 12;
+  EXPECT_EQ(state_shaping(steady_more, net, dt, Rheology::newtonian), shaping);
   // The step and the rheology the run takes.
   double later = dt;
   nudge(later);

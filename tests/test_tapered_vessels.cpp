@@ -102,7 +102,7 @@ TEST(TaperedVessels, RestStateStaysAtRestWithAGivenBeta) {
       SolverOptions o;
       o.degree = degree;
       o.elements = elements;
-      o.steady_start = false;
+      o.start = StartChoice::rest;
       PulseSolver s(net, o);
       for (int k = 0; k < 2000; ++k) s.step();
       const RestDeparture d = rest_departure(s, net);
@@ -133,7 +133,7 @@ TEST(TaperedVessels, RestStateStaysAtRestThroughAJunctionWithWallLaws) {
     SolverOptions o;
     o.degree = 1;
     o.elements = 2;
-    o.steady_start = false;
+    o.start = StartChoice::rest;
     PulseSolver s(net, o);
     EXPECT_EQ(s.degree(0), 2);
     EXPECT_EQ(s.degree(1), 2);
@@ -228,7 +228,7 @@ TEST(TaperedVessels, SteadyFlowMatchesTheSteadyModel) {
   net.inlet = Inlet{0, constant_flow(q)};
   SolverOptions o;
   o.degree = 9;
-  o.steady_start = false;
+  o.start = StartChoice::rest;
   PulseSolver s(net, o);
   const SteadyState run = run_to_steady(s, 2.0);
   const std::vector<double> at = {0.0, 0.25, 0.5, 0.75, 1.0};
@@ -263,7 +263,7 @@ TEST(TaperedVessels, StiffTaperGivesTheClosedFormResistance) {
   net.inlet = Inlet{0, constant_flow(q)};
   SolverOptions o;
   o.degree = 3;
-  o.steady_start = false;
+  o.start = StartChoice::rest;
   PulseSolver s(net, o);
   const SteadyState run = run_to_steady(s, 0.12);
   const double convective = alpha * rho * q * q * (1 / (a1 * a1) - 1 / (a0 * a0)) / 2;
@@ -315,7 +315,7 @@ Peaks pulse_through(double d0, double d1, double taper_length, int taper_pieces)
   net.outlets.push_back(reflection_outlet(static_cast<std::int32_t>(net.vessel_count() - 1), 0.0));
   SolverOptions o;
   o.degree = 7;
-  o.steady_start = false;
+  o.start = StartChoice::rest;
   PulseSolver s(net, o);
   Peaks peaks;
   const std::size_t probe_in = 10, probe_out = net.vessel_count() - 20;  // 1 m before and after the taper
@@ -442,7 +442,7 @@ TEST(TaperedVessels, UniformPiecesConvergeToTheTaper) {
     net.inlet = Inlet{0, constant_flow(q)};
     SolverOptions o;
     o.degree = degree;
-    o.steady_start = false;
+    o.start = StartChoice::rest;
     PulseSolver s(net, o);
     return run_to_steady(s, 1.5).inlet_pressure;
   };
@@ -474,7 +474,7 @@ TEST(TaperedVessels, LumpedStiffTaperGivesTheClosedFormResistance) {
   net.inlet = Inlet{0, constant_flow(q)};
   SolverOptions o;
   o.model = ModelChoice::zero_d;
-  o.steady_start = false;
+  o.start = StartChoice::rest;
   PulseSolver s(net, o);
   ASSERT_TRUE(s.is_lumped(0));
   for (int k = 0; k < 40; ++k) s.step();  // 0D steps of 1 s: the 10 ms ramp, then steady
