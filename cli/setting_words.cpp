@@ -23,6 +23,7 @@ const SettingWords& hemosolve_words() {
       {"mean_flow", "--mean-flow"},  // vprune's
       {"model", "--model"},
       {"out", "--out"},
+      {"periodic_harmonics", "--harmonics"},
       {"periodic_tolerance", "--until-periodic"},
       {"pressure_at", "--pressure-at"},
       {"probe", "--probe"},

@@ -38,8 +38,10 @@ inline FourierSeries fourier_series(const Waveform& wave, int harmonics, int sam
   }
   for (int m = 0; m < samples; ++m) {
     const double t = s.period * m / samples, f = wave(t);
-    for (int k = 0; k <= harmonics; ++k)
-      s.amplitude[static_cast<std::size_t>(k)] += f * std::polar(1.0, -2 * std::numbers::pi * k * m / samples);
+    // e^{-2 pi i k m / M} by powers of its k = 1 value: K products, rounding K times 1e-16.
+    const std::complex<double> step = std::polar(1.0, -2 * std::numbers::pi * m / samples);
+    std::complex<double> e = 1.0;
+    for (int k = 0; k <= harmonics; ++k, e *= step) s.amplitude[static_cast<std::size_t>(k)] += f * e;
   }
   for (int k = 0; k <= harmonics; ++k) s.amplitude[static_cast<std::size_t>(k)] *= (k == 0 ? 1.0 : 2.0) / samples;
   return s;

@@ -23,7 +23,7 @@ std::vector<Complex> solve_harmonic(const Network& net, const std::vector<NodeBo
   for (std::size_t i = 0; i < boundaries.size(); ++i) {
     const NodeBoundary& b = boundaries[i];
     const auto node = static_cast<std::size_t>(b.node);
-    const Complex amplitude = series[i].amplitude[static_cast<std::size_t>(k)];
+    const Complex amplitude = b.is_outlet() ? Complex(0.0) : series[i].amplitude[static_cast<std::size_t>(k)];
     switch (b.type) {
       case BoundaryType::flow: current[node] += amplitude; break;
       case BoundaryType::pressure:
@@ -108,7 +108,8 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
 
   const std::vector<NodeBoundary> boundaries = run_boundaries(net);
   std::vector<FourierSeries> series;
-  for (const NodeBoundary& b : boundaries) series.push_back(fourier_series(b.waveform, harmonics));
+  for (const NodeBoundary& b : boundaries)  // an outlet's pressure beyond does not oscillate
+    series.push_back(b.is_outlet() ? FourierSeries{} : fourier_series(b.waveform, harmonics));
   for (int k = 1; k <= harmonics; ++k)
     out.node_pressure_.push_back(solve_harmonic(net, boundaries, series, out.line_, k, out.omega(k)));
   return out;

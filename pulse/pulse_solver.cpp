@@ -21,6 +21,7 @@
 #include "physics/poiseuille.hpp"
 #include "physics/wall_law.hpp"
 #include "steady/steady_flow.hpp"
+#include "steady/vessel_laws.hpp"
 
 namespace hemotree {
 
@@ -63,26 +64,10 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   friction_k_ = friction_coefficient(blood_.alpha);
   const std::size_t n = net.vessel_count();
 
-  // Each vessel's tube law: given directly, or from its wall by the thin/thick model.
-  laws_.resize(n);
+  // Each vessel's tube law (steady/vessel_laws.hpp); a tapered vessel's along it.
+  laws_ = vessel_laws(net, blood_, options.external_pressure, options.thick_wall_ratio);
   for (std::size_t v = 0; v < n; ++v) {
-    const std::string name = "vessel " + std::to_string(net.id[v]);
     TubeLaw& law = laws_[v];
-    law.density = blood_.density;
-    law.alpha = blood_.momentum_alpha();
-    if (!net.beta.empty() && !std::isnan(net.beta[v])) {
-      law.beta = net.beta[v];
-      law.reference_area = std::numbers::pi / 4 * net.diameter[v] * net.diameter[v];
-      law.reference_pressure = net.reference_pressure[v];
-    } else {
-      if (std::isnan(net.wall_thickness[v]) || std::isnan(net.youngs_modulus[v]))
-        throw InputError(name + ": needs wall_thickness and youngs_modulus (or beta and reference_pressure)");
-      const TubeLaw t = tube_law({net.diameter[v], net.wall_thickness[v], net.youngs_modulus[v]},
-                                 options.external_pressure, options.thick_wall_ratio);
-      law.beta = t.beta;
-      law.reference_area = t.reference_area;
-      law.reference_pressure = t.reference_pressure;
-    }
     if (net.is_tapered(v)) {
       // The law along the vessel (physics/vessel_taper.hpp): the wall's h and E, or the given
       // beta at the proximal diameter, with the proximal diameter's wall model.
@@ -133,7 +118,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     start_from_steady_flow(*steady);
     started_from_ = StartChoice::steady;
     if (options.start == StartChoice::periodic) {
-      start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.start_harmonics));
+      start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.periodic_harmonics));
       started_from_ = StartChoice::periodic;
     }
   } else {

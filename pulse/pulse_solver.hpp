@@ -59,7 +59,7 @@ struct SolverOptions {
   double external_pressure = 10 * 133.322;  // p_ext for the wall laws [Pa]
   double thick_wall_ratio = 0.1;
   StartChoice start = StartChoice::steady;
-  int start_harmonics = 10;  // periodic start: the inflow's harmonics it takes
+  int periodic_harmonics = 10;  // the inflow's harmonics the linear periodic state takes (start and --linear)
   int rheology_override = -1;  // -1: the file's; else static_cast<int>(Rheology)
   // Threads over elements. One by default: a step has several parallel sections, and a
   // thread that the system deschedules stalls every barrier (measured on the shared 2-core

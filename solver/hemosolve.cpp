@@ -19,6 +19,7 @@
 #include "core/errors.hpp"
 #include "formats/network_io.hpp"
 #include "formats/pressure_reference.hpp"
+#include "solver/linear_run.hpp"
 #include "solver/outcome_lines.hpp"
 #include "solver/pulsatile_call.hpp"
 #include "solver/run_configuration.hpp"
@@ -100,7 +101,7 @@ struct CommandLine {
   std::string out_dir, resume_dir, rheology, scheme = "etd2", start = "steady", dt_text, sample_text = "1ms",
       external_text = "10mmHg", degree_text = "auto", model = "auto", vtk_min_text, red_cells = "fixed";
   std::vector<std::string> probe_texts, tracer_texts, pressure_at_texts;
-  bool quiet = false, steady = false;
+  bool quiet = false, steady = false, linear = false;
   CLI::Option* until_periodic = nullptr;
 };
 
@@ -117,7 +118,7 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
   std::vector<std::string> &probe_texts = line.probe_texts, &tracer_texts = line.tracer_texts,
                            &pressure_at_texts = line.pressure_at_texts;
   bool &vtk = config.vtk, &balance = config.balance_compliances, &force = config.force, &quiet = line.quiet,
-       &steady = line.steady;
+       &steady = line.steady, &linear = line.linear;
   app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
   app.add_option("--out", out_dir,
                                     "folder for summary.json, probes.csv, results.vtp and frames/; written as "
@@ -209,6 +210,14 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
       "--steady", steady,
       "the steady state alone, vessels at their file diameters (what NetFlow computes): flows, pressures and wall "
       "shear stress in the same files as a run; any connected network with boundaries at nodes");
+  auto* linear_flag = app.add_flag(
+      "--linear", linear,
+      "the linear periodic state about the steady one as the result, harmonic by harmonic (every vessel a "
+      "transmission line, every outlet its impedance): the same files as a run, in seconds on a full tree, for "
+      "screening (docs/solver.md §6a gives its error against a run)");
+  app.add_option("--harmonics", options.periodic_harmonics,
+                 "the inflow's harmonics the linear periodic state takes (--linear, --start periodic), in [1, 1000]")
+      ->capture_default_str();
   app.add_option("--red-cells", red_cells,
                  "fixed (the blood's hematocrit in every vessel) or transport: red cells split by the "
                  "Pries-Secomb law at diverging bifurcations and mixed where blood meets; with --steady each "
@@ -233,6 +242,10 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
   for (const char* pulsatile_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
                                      "--probe", "--frames", "--dt", "--start", "--transport-step", "--tracer"})
     steady_flag->excludes(app.get_option(pulsatile_only));
+  for (const char* time_stepped_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
+                                        "--frames", "--dt", "--start", "--transport-step", "--tracer", "--steady",
+                                        "--red-cells"})
+    linear_flag->excludes(app.get_option(time_stepped_only));
 }
 
 // Every option checked before any work, the network read, the run called.
@@ -285,6 +298,10 @@ int run_command_line(CommandLine& line, int cores) {
   }
   check_pulsatile(net, config);
   for (const auto& t : line.probe_texts) config.probes.push_back(parse_probe(t, net));
+  if (line.linear) {
+    run_linear(net, config, observer);
+    return 0;
+  }
   return finish(run_pulsatile(net, config, observer), config);
 }
 

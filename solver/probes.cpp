@@ -37,12 +37,18 @@ std::string number(double v) {
 }  // namespace
 
 void ProbeRecorder::sample(const PulseSolver& solver) {
-  rows_ << number(solver.time());
-  for (const Probe& p : probes_) {
-    const double a = solver.area_at(p.vessel, p.x), q = solver.flow_at(p.vessel, p.x);
+  add_row(solver.time(), [&](const Probe& p) {
+    const double a = solver.area_at(p.vessel, p.x);
     // The law where the probe is: a tapered vessel's reference lumen changes along it.
-    rows_ << ',' << number(solver.law_at(p.vessel, p.x).pressure(a)) << ',' << number(q) << ',' << number(a) << ','
-          << number(q / a);
+    return Values{solver.law_at(p.vessel, p.x).pressure(a), solver.flow_at(p.vessel, p.x), a};
+  });
+}
+
+void ProbeRecorder::add_row(double t, const std::function<Values(const Probe&)>& at) {
+  rows_ << number(t);
+  for (const Probe& p : probes_) {
+    const Values v = at(p);
+    rows_ << ',' << number(v.pressure) << ',' << number(v.flow) << ',' << number(v.area) << ',' << number(v.flow / v.area);
     for (std::size_t j = 0; j < headers_.size(); ++j) rows_ << ',' << number(column_(j, p));
   }
   rows_ << '\n';

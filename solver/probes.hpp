@@ -27,6 +27,11 @@ class ProbeRecorder {
  public:
   explicit ProbeRecorder(std::vector<Probe> probes) : probes_(std::move(probes)) {}
   void sample(const PulseSolver& solver);  // one row at the solver's time
+  // One row at time t of values given per probe (a run without a solver: hemosolve --linear).
+  struct Values {
+    double pressure, flow, area;
+  };
+  void add_row(double t, const std::function<Values(const Probe&)>& at);
   // Further columns at every probe (the transported red cells and tracers): their headers'
   // names and units, and the value of column j at a probe now.
   void add_columns(std::vector<std::string> headers, std::function<double(std::size_t, const Probe&)> value) {

@@ -114,6 +114,7 @@ void check_configuration(const RunConfiguration& c) {
   check_count(c.max_cycles, 1, 100000, "max_cycles");
   check_count(c.checkpoint_every, 0, 100000, "checkpoint_every");
   check_count(c.frames, 0, 10000, "frames");
+  check_count(c.solver.periodic_harmonics, 1, 1000, "periodic_harmonics");
   if (c.until_periodic) check_range(c.periodic_tolerance, {0, 1, true, true}, "periodic_tolerance");
   const SolverOptions& s = c.solver;
   check_range(s.lumped_transit, {0, 1}, "lumped_transit");

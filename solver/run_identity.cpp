@@ -79,7 +79,7 @@ std::string state_shaping(const RunConfiguration& config, const Network& net, do
       (void)max_cycles, (void)checkpoint_every, (void)resume, (void)frames, (void)vtk, (void)vtk_keep, (void)force, (void)words;
   const auto& [model, lumped_transit, lumped_rc, lumped_step, lumped_passes, degree, degree_rule, elements,
                quadrature_points, scheme, asked_dt, cfl, friction_safety, external_pressure, thick_wall_ratio,
-               start, start_harmonics, rheology_override, threads] = solver;
+               start, periodic_harmonics, rheology_override, threads] = solver;
   // The step taken is dt (asked_dt only proposes it); the rheology taken is `rheology`
   // (the override only chooses it); threads change the sums' order, which the solver keeps
   // within round-off (docs/solver.md), and a resume may use the idle cores.
@@ -95,7 +95,7 @@ std::string state_shaping(const RunConfiguration& config, const Network& net, do
     << harmonics << "), elements " << elements << ", quadrature " << quadrature_points << ", time step " << dt
     << " (cfl " << cfl << ", friction safety " << friction_safety << "), rheology " << to_string(rheology)
     << ", start " << to_string(start)
-    << (start == StartChoice::periodic ? " of " + std::to_string(start_harmonics) + " harmonics" : std::string()) << ", external pressure " << external_pressure
+    << (start == StartChoice::periodic ? " of " + std::to_string(periodic_harmonics) + " harmonics" : std::string()) << ", external pressure " << external_pressure
     << " Pa, thick wall ratio " << thick_wall_ratio << ", balance " << (balance_compliances ? "on" : "off")
     << ", sample interval " << sample_interval << " s, probes";
   for (const Probe& p : probes) {

@@ -136,10 +136,10 @@ TEST(RunIdentity, EveryOptionThatShapesTheStateIsInIt) {
   // A periodic start is shaped by the harmonics it takes; another start is not.
   RunConfiguration periodic = base, more_harmonics = base;
   periodic.solver.start = more_harmonics.solver.start = StartChoice::periodic;
-  more_harmonics.solver.start_harmonics = 12;
+  more_harmonics.solver.periodic_harmonics = 12;
   EXPECT_NE(state_shaping(more_harmonics, net, dt, Rheology::newtonian), state_shaping(periodic, net, dt, Rheology::newtonian));
   RunConfiguration steady_more = base;
-  steady_more.solver.start_harmonics = 12;
+  steady_more.solver.periodic_harmonics = 12;
   EXPECT_EQ(state_shaping(steady_more, net, dt, Rheology::newtonian), shaping);
   // The step and the rheology the run takes.
   double later = dt;

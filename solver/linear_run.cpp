@@ -1,0 +1,169 @@
+#include "solver/linear_run.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "core/units.hpp"
+#include "harmonic/linear_periodic.hpp"
+#include "physics/womersley.hpp"
+#include "solver/cycle_statistics.hpp"
+#include "solver/output_folder.hpp"
+#include "solver/probes.hpp"
+#include "solver/run_report.hpp"
+#include "solver/steady_run.hpp"
+#include "steady/vessel_laws.hpp"
+
+namespace hemotree {
+
+namespace {
+
+// Points per period at which the extremes are taken: the peak of the tenth harmonic is then
+// missed by at most 1 - cos(pi 10 / 256) = 0.8 % of that harmonic's amplitude.
+constexpr int samples_per_period = 256;
+
+struct LinearCycle {
+  CycleSummary cycle;
+  std::vector<std::uint8_t> wave_travels;
+  std::vector<double> womersley, pwv_elastic, pwv_theory;
+};
+
+LinearCycle linear_cycle(const Network& net, const Blood& blood, const ViscosityTable& viscosity,
+                         const LinearPeriodic& periodic, const SolverOptions& options, double analysis) {
+  const std::size_t n = net.vessel_count();
+  LinearCycle out;
+  out.cycle = steady_cycle(net, blood, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}, nullptr);
+  out.wave_travels.assign(n, 0);
+  out.womersley.assign(n, 0.0);
+  out.pwv_elastic.assign(n, 0.0);
+  out.pwv_theory.assign(n, 0.0);
+  const int harmonics = periodic.harmonics();
+  const double period = periodic.period(), omega = 2 * std::numbers::pi / period;
+  const int analysed = static_cast<int>(std::lround(analysis * period));
+  // e^{i w_k t_m}, one row per sample.
+  std::vector<std::complex<double>> phase(static_cast<std::size_t>(samples_per_period * harmonics));
+  for (int m = 0; m < samples_per_period; ++m)
+    for (int k = 1; k <= harmonics; ++k)
+      phase[static_cast<std::size_t>(m * harmonics + k - 1)] =
+          std::polar(1.0, 2 * std::numbers::pi * k * m / samples_per_period);
+  const auto vessels = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(dynamic, 1024) num_threads(options.threads) if (options.threads > 1)
+  for (std::int64_t i = 0; i < vessels; ++i) {
+    const auto v = static_cast<std::size_t>(i);
+    const VesselLine& line = periodic.line(v);
+    VesselCycle& c = out.cycle.vessels[v];
+    const double area = blood.density / line.inertance, radius = std::sqrt(area / std::numbers::pi);
+    const double mu = viscosity(area);
+    std::vector<std::complex<double>> p(static_cast<std::size_t>(harmonics)), q(p.size());
+    for (int k = 1; k <= harmonics; ++k) {
+      p[static_cast<std::size_t>(k - 1)] = periodic.pressure(k, v, 0.5);
+      q[static_cast<std::size_t>(k - 1)] = periodic.flow(k, v, 0.5);
+    }
+    double p_max = -std::numeric_limits<double>::infinity(), p_min = -p_max, q_max = p_max, q_min = p_min;
+    for (int m = 0; m < samples_per_period; ++m) {
+      double dp = 0, dq = 0;
+      for (std::size_t k = 0; k < p.size(); ++k) {
+        const std::complex<double> e = phase[static_cast<std::size_t>(m * harmonics) + k];
+        dp += (p[k] * e).real();
+        dq += (q[k] * e).real();
+      }
+      p_max = std::max(p_max, dp), p_min = std::min(p_min, dp), q_max = std::max(q_max, dq), q_min = std::min(q_min, dq);
+    }
+    c.mean_flow = periodic.mean_flow()[v];
+    c.systolic_pressure = c.mean_pressure + p_max;
+    c.diastolic_pressure = c.mean_pressure + p_min;
+    c.peak_flow = c.mean_flow + q_max;
+    c.least_flow = c.mean_flow + q_min;
+    const double u = c.mean_flow / area;
+    c.mean_wss = wall_shear_stress(mu, u, radius, blood.alpha);  // linear in u: its cycle mean
+    c.reynolds = blood.density * u * 2 * radius / mu;
+    // A wave travels where the run's --model auto would keep the vessel 1D.
+    const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
+    const double rc = line.resistance * line.length * line.compliance * line.length;
+    out.wave_travels[v] =
+        !(line.length / c0 < options.lumped_transit * period && omega * rc < options.lumped_rc);
+    c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();
+    if (analysed >= 1 && analysed <= harmonics) {
+      const double w = periodic.omega(analysed);
+      c.pwv_pressure = phase_velocity(periodic.pressure(analysed, v, 0.0), periodic.pressure(analysed, v, 1.0), w, line.length);
+      c.pwv_velocity = phase_velocity(periodic.flow(analysed, v, 0.0), periodic.flow(analysed, v, 1.0), w, line.length);
+    }
+    const double w = 2 * std::numbers::pi * analysis;
+    out.pwv_elastic[v] = c0;
+    out.womersley[v] = womersley_number(2 * radius, blood.density, mu, w);
+    out.pwv_theory[v] = womersley_wave(c0, out.womersley[v], w).phase_velocity;
+  }
+  return out;
+}
+
+void write_probes(const std::filesystem::path& file, const Network& net, const std::vector<TubeLaw>& laws,
+                  const LinearPeriodic& periodic, const std::vector<Probe>& probes) {
+  ProbeRecorder recorder(probes);
+  for (int m = 0; m <= samples_per_period; ++m) {
+    const double t = periodic.period() * m / samples_per_period;
+    recorder.add_row(t, [&](const Probe& probe) {
+      const double p = periodic.pressure_at(probe.vessel, probe.x, t), q = periodic.flow_at(probe.vessel, probe.x, t);
+      const double a = laws[probe.vessel].area(p);
+      return ProbeRecorder::Values{p, q, a};
+    });
+  }
+  recorder.write(file);
+  (void)net;
+}
+
+}  // namespace
+
+void run_linear(const Network& net, const RunConfiguration& config, RunObserver& observer) {
+  const SolverOptions& options = config.solver;
+  Blood blood = net.blood.value_or(Blood{});
+  if (options.rheology_override >= 0) blood.rheology = static_cast<Rheology>(options.rheology_override);
+  OutputFolder folder(config.out_dir);
+  const auto started = std::chrono::steady_clock::now();
+  const ViscosityTable viscosity(blood);
+  const std::vector<TubeLaw> laws = vessel_laws(net, blood, options.external_pressure, options.thick_wall_ratio);
+  const LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics);
+  const Waveform driving = driving_waveform(net);
+  const double analysis = analysis_frequency(driving);
+  const LinearCycle linear = linear_cycle(net, blood, viscosity, periodic, options, analysis);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+  const std::size_t n = net.vessel_count();
+  VesselTable results = cycle_table(net, linear.cycle, std::vector<std::uint8_t>(n, 0), {"linear"},
+                                    std::vector<std::int64_t>(n, VesselTable::null_integer), linear.wave_travels);
+  results.add_number("womersley", linear.womersley);
+  results.add_number("pwv_elastic", linear.pwv_elastic);
+  results.add_number("pwv_theory", linear.pwv_theory);
+  nlohmann::json run_info = {{"tool", "hemosolve"},
+                             {"version", HEMOTREE_VERSION},
+                             {"network", config.network_name},
+                             {"mode", "linear"},
+                             {"model", "linear"},
+                             {"harmonics", periodic.harmonics()},
+                             {"vessels_1d", 0},
+                             {"vessels_0d", 0},
+                             {"rheology", to_string(blood.rheology)},
+                             {"red_cells", "fixed"},
+                             {"period", driving.period},
+                             {"pulse_frequency", pulse_frequency(driving)},
+                             {"analysis_frequency", analysis},
+                             {"status", "complete"},
+                             {"cycles", 0},
+                             {"wall_time", wall}};
+  run_info["boundaries"] = boundary_results(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0});
+  run_info["statistics"] = group_statistics(net, results);
+  folder.open();
+  const std::filesystem::path dir = folder.staging();
+  write_summary(dir / "summary.json", run_info, results, linear.cycle);
+  write_vessel_table(dir / "vessels.csv", results);
+  if (!config.probes.empty()) write_probes(dir / "probes.csv", net, laws, periodic, config.probes);
+  if (config.vtk) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
+  folder.publish();
+  observer.note("linear periodic state of " + std::to_string(n) + " vessels (" + std::to_string(periodic.harmonics()) +
+                " harmonics) in " + format_quantity(wall, "s") + "; results in " + config.out_dir);
+}
+
+}  // namespace hemotree
