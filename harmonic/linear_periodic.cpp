@@ -129,6 +129,12 @@ LinearPeriodic::Complex LinearPeriodic::flow(int k, std::size_t vessel, double s
                    s * line.length);
 }
 
+std::array<VesselLine::Point, 3> LinearPeriodic::ends_and_middle(int k, std::size_t vessel) const {
+  const auto& p = node_pressure_[static_cast<std::size_t>(k - 1)];
+  return line_[vessel].ends_and_middle(omega(k), p[static_cast<std::size_t>(net_->from[vessel])],
+                                       p[static_cast<std::size_t>(net_->to[vessel])]);
+}
+
 double LinearPeriodic::pressure_at(std::size_t vessel, double s, double t) const {
   double p = (1 - s) * mean_node_pressure_[static_cast<std::size_t>(net_->from[vessel])] +
              s * mean_node_pressure_[static_cast<std::size_t>(net_->to[vessel])];

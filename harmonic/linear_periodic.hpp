@@ -47,6 +47,8 @@ class LinearPeriodic {
   Complex node_pressure(int k, std::size_t node) const { return node_pressure_[static_cast<std::size_t>(k - 1)][node]; }
   Complex pressure(int k, std::size_t vessel, double s) const;
   Complex flow(int k, std::size_t vessel, double s) const;
+  // Harmonic k >= 1 at the vessel's start, middle and end.
+  std::array<VesselLine::Point, 3> ends_and_middle(int k, std::size_t vessel) const;
   // The periodic state at time t: the mean plus every harmonic. The mean pressure along a
   // vessel is taken linear between its nodes.
   double pressure_at(std::size_t vessel, double s, double t) const;

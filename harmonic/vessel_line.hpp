@@ -29,6 +29,7 @@
 // with i w C / 2 at each end, the 0D vessel's own pi circuit.
 #pragma once
 
+#include <array>
 #include <complex>
 
 #include "network_flow/harmonic_system.hpp"
@@ -80,25 +81,36 @@ struct VesselLine {
   // Pressure and flow (from -> to) at x along the vessel, given its end pressures; carried
   // from the nearer end, so that a long lossy line's growing and decaying waves stay within
   // half the line's attenuation of each other.
-  Complex pressure(double w, Complex p0, Complex p1, double x) const { return at(w, p0, p1, x).pressure; }
-  Complex flow(double w, Complex p0, Complex p1, double x) const { return at(w, p0, p1, x).flow; }
+  Complex pressure(double w, Complex p0, Complex p1, double x) const { return at(w, p0, p1, {x})[0].pressure; }
+  Complex flow(double w, Complex p0, Complex p1, double x) const { return at(w, p0, p1, {x})[0].flow; }
 
- private:
   struct Point {
     Complex pressure, flow;
   };
-  Point at(double w, Complex p0, Complex p1, double x) const {
+  // At its start, middle and end at once (one evaluation of the line's coefficients).
+  std::array<Point, 3> ends_and_middle(double w, Complex p0, Complex p1) const {
+    const auto points = at(w, p0, p1, {0.0, 0.5 * length, length});
+    return {points[0], points[1], points[2]};
+  }
+
+ private:
+  template <std::size_t N>
+  std::array<Point, N> at(double w, Complex p0, Complex p1, const double (&xs)[N]) const {
     const Matrix m = matrix(w);
     const TwoPort y = two_port(w);
-    // From x0 = 0 with (P0, Q(0)), or from x0 = l with (P1, Q(l)).
-    const bool from_start = x <= 0.5 * length;
-    const double dx = from_start ? x : x - length;
-    const Complex p = from_start ? p0 : p1;
-    const Complex q = from_start ? y.aa * p0 + y.ab * p1 : -(y.ba * p0 + y.bb * p1);
-    const Complex sx = m.s * dx, e = std::exp(0.5 * m.tau * dx);
-    const Complex ch = std::cosh(sx), sh_over_s = std::abs(sx) < 1e-8 ? Complex(dx) : std::sinh(sx) / m.s;
-    return {e * (ch * p + sh_over_s * (0.5 * m.tau * p + m.m12 * q)),
-            e * (ch * q + sh_over_s * (m.m21 * p - 0.5 * m.tau * q))};
+    const Complex q0 = y.aa * p0 + y.ab * p1, q1 = -(y.ba * p0 + y.bb * p1);
+    std::array<Point, N> out;
+    for (std::size_t i = 0; i < N; ++i) {
+      // From x0 = 0 with (P0, Q(0)), or from x0 = l with (P1, Q(l)).
+      const bool from_start = xs[i] <= 0.5 * length;
+      const double dx = from_start ? xs[i] : xs[i] - length;
+      const Complex p = from_start ? p0 : p1, q = from_start ? q0 : q1;
+      const Complex sx = m.s * dx, e = std::exp(0.5 * m.tau * dx);
+      const Complex ch = std::cosh(sx), sh_over_s = std::abs(sx) < 1e-8 ? Complex(dx) : std::sinh(sx) / m.s;
+      out[i] = {e * (ch * p + sh_over_s * (0.5 * m.tau * p + m.m12 * q)),
+                e * (ch * q + sh_over_s * (m.m21 * p - 0.5 * m.tau * q))};
+    }
+    return out;
   }
 };
 

@@ -1,5 +1,6 @@
 #include "solver/linear_run.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -59,9 +60,12 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
     const double area = blood.density / line.inertance, radius = std::sqrt(area / std::numbers::pi);
     const double mu = viscosity(area);
     std::vector<std::complex<double>> p(static_cast<std::size_t>(harmonics)), q(p.size());
+    std::array<VesselLine::Point, 3> analysed_points{};
     for (int k = 1; k <= harmonics; ++k) {
-      p[static_cast<std::size_t>(k - 1)] = periodic.pressure(k, v, 0.5);
-      q[static_cast<std::size_t>(k - 1)] = periodic.flow(k, v, 0.5);
+      const auto points = periodic.ends_and_middle(k, v);
+      p[static_cast<std::size_t>(k - 1)] = points[1].pressure;
+      q[static_cast<std::size_t>(k - 1)] = points[1].flow;
+      if (k == analysed) analysed_points = points;
     }
     double p_max = -std::numeric_limits<double>::infinity(), p_min = -p_max, q_max = p_max, q_min = p_min;
     for (int m = 0; m < samples_per_period; ++m) {
@@ -89,8 +93,8 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
     c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();
     if (analysed >= 1 && analysed <= harmonics) {
       const double w = periodic.omega(analysed);
-      c.pwv_pressure = phase_velocity(periodic.pressure(analysed, v, 0.0), periodic.pressure(analysed, v, 1.0), w, line.length);
-      c.pwv_velocity = phase_velocity(periodic.flow(analysed, v, 0.0), periodic.flow(analysed, v, 1.0), w, line.length);
+      c.pwv_pressure = phase_velocity(analysed_points[0].pressure, analysed_points[2].pressure, w, line.length);
+      c.pwv_velocity = phase_velocity(analysed_points[0].flow, analysed_points[2].flow, w, line.length);
     }
     const double w = 2 * std::numbers::pi * analysis;
     out.pwv_elastic[v] = c0;
