@@ -19,6 +19,7 @@
 
 #include <complex>
 #include <cstddef>
+#include <numbers>
 #include <span>
 #include <vector>
 
@@ -38,7 +39,7 @@ class LinearPeriodic {
 
   double period() const { return period_; }
   int harmonics() const { return static_cast<int>(node_pressure_.size()); }
-  double omega(int k) const { return 2 * 3.14159265358979323846 * k / period_; }
+  double omega(int k) const { return 2 * std::numbers::pi * k / period_; }
   const VesselLine& line(std::size_t vessel) const { return line_[vessel]; }
   // The loaded (mean) state: per node [Pa], per vessel [m^3/s, from -> to].
   const std::vector<double>& mean_node_pressure() const { return mean_node_pressure_; }

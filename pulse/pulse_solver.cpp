@@ -237,8 +237,7 @@ void PulseSolver::choose_models(const SolverOptions& options) {
       resistance = tapered_poiseuille_resistance(
           [&](double d) { return viscosity_(std::numbers::pi / 4 * d * d); }, length, taper.d0, taper.d1, blood_.alpha);
     }
-    zero_d_[v] = !reflecting[v] && transit < options.lumped_transit * period &&
-                 omega * resistance * compliance < options.lumped_rc;
+    zero_d_[v] = !reflecting[v] && options.moves_in_phase(transit, omega * resistance * compliance, period);
   }
 }
 

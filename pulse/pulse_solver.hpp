@@ -65,6 +65,12 @@ struct SolverOptions {
   // thread that the system deschedules stalls every barrier (measured on the shared 2-core
   // machine: 1001 vessels ran 35x slower with 2 threads while another job ran).
   int threads = 1;
+
+  // --model automatic's rule: a vessel the pulse crosses in phase, its wave transit L / c0
+  // and its w R C (at the fundamental) below their bounds, is 0D.
+  bool moves_in_phase(double transit, double omega_rc, double period) const {
+    return transit < lumped_transit * period && omega_rc < lumped_rc;
+  }
 };
 
 // The discrete state: modal coefficients of A and Q per element, the pressures of the RCR

@@ -88,8 +88,7 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
     // A wave travels where the run's --model auto would keep the vessel 1D.
     const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
     const double rc = line.resistance * line.length * line.compliance * line.length;
-    out.wave_travels[v] =
-        !(line.length / c0 < options.lumped_transit * period && omega * rc < options.lumped_rc);
+    out.wave_travels[v] = !options.moves_in_phase(line.length / c0, omega * rc, period);
     c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();
     if (analysed >= 1 && analysed <= harmonics) {
       const double w = periodic.omega(analysed);
@@ -104,7 +103,7 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
   return out;
 }
 
-void write_probes(const std::filesystem::path& file, const Network& net, const std::vector<TubeLaw>& laws,
+void write_probes(const std::filesystem::path& file, const std::vector<TubeLaw>& laws,
                   const LinearPeriodic& periodic, const std::vector<Probe>& probes) {
   ProbeRecorder recorder(probes);
   for (int m = 0; m <= samples_per_period; ++m) {
@@ -116,7 +115,6 @@ void write_probes(const std::filesystem::path& file, const Network& net, const s
     });
   }
   recorder.write(file);
-  (void)net;
 }
 
 }  // namespace
@@ -163,7 +161,7 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   const std::filesystem::path dir = folder.staging();
   write_summary(dir / "summary.json", run_info, results, linear.cycle);
   write_vessel_table(dir / "vessels.csv", results);
-  if (!config.probes.empty()) write_probes(dir / "probes.csv", net, laws, periodic, config.probes);
+  if (!config.probes.empty()) write_probes(dir / "probes.csv", laws, periodic, config.probes);
   if (config.vtk) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
   folder.publish();
   observer.note("linear periodic state of " + std::to_string(n) + " vessels (" + std::to_string(periodic.harmonics()) +
