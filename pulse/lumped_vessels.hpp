@@ -129,29 +129,20 @@ class LumpedVessels {
   // Every 0D vessel's lumen area, flow and (unless empty) pressure at fraction x along it,
   // into the network's per-vessel arrays (the cycle statistics' samples).
   void sample(double x, std::span<double> area, std::span<double> flow, std::span<double> pressure, int threads) const;
-  // Each 0D vessel's state at its two ends and its centre, as sample() gives them, passed to
-  // f(network vessel index, sample) in parallel over the vessels (f must touch only that
-  // vessel's data): all three points in one pass over the state, nothing written between.
+  // Each 0D vessel's flow, and pressure and lumen area at its centre, as sample() gives them,
+  // passed to f(network vessel index, sample) in parallel over the vessels (f must touch only
+  // that vessel's data): what the cycle statistics take of a 0D vessel, in one pass.
   struct Sample {
-    double flow, pressure_in, area_in, pressure_centre, area_centre, pressure_out, area_out;
+    double flow, pressure, area;
   };
   template <class F>
-  void for_each_sample(F&& f, int threads) const {
+  void for_each_centre_sample(F&& f, int threads) const {
     const auto vessels = static_cast<std::int64_t>(vessels_.size());
     parallel_blocks(vessels, threads, [&](std::int64_t first, std::int64_t last) {  // f may throw (the caller's)
       for (std::int64_t i = first; i < last; ++i) {
         const auto e = static_cast<std::size_t>(i);
-        Sample s;
-        s.flow = flow_[e];
-        s.pressure_in = pressure_at(static_cast<std::int32_t>(i), 0.0);
-        s.pressure_centre = pressure_at(static_cast<std::int32_t>(i), 0.5);
-        s.pressure_out = pressure_at(static_cast<std::int32_t>(i), 1.0);
-        const double root_in = lumen_root(e, s.pressure_in, 0.0), root_centre = lumen_root(e, s.pressure_centre, 0.5),
-                     root_out = lumen_root(e, s.pressure_out, 1.0);
-        s.area_in = root_in * root_in;
-        s.area_centre = root_centre * root_centre;
-        s.area_out = root_out * root_out;
-        f(static_cast<std::size_t>(vessels_[e]), s);
+        const double p = pressure_at(static_cast<std::int32_t>(i), 0.5), root = lumen_root(e, p, 0.5);
+        f(static_cast<std::size_t>(vessels_[e]), Sample{flow_[e], p, root * root});
       }
     });
   }

@@ -53,35 +53,50 @@ double PulseSolver::viscosity_at(std::size_t vessel, double x) const {
 }
 
 void PulseSolver::sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
-                             std::vector<double>* pressure, bool zero_d) const {
+                             std::vector<double>* pressure) const {
   const std::size_t n = net_.vessel_count();
   area.resize(n);
   flow.resize(n);
   if (pressure) pressure->resize(n);
   if (n == 0) return;
-  // The same element k and point xi in every vessel (locate's arithmetic).
+  // The 0D vessels from their own state, then the 1D ones.
+  lumped_.sample(std::clamp(x, 0.0, 1.0), area, flow, pressure ? std::span<double>(*pressure) : std::span<double>(), threads_);
+  for_each_one_d_sample(x, pressure != nullptr, [&](std::size_t, std::size_t v, double a, double q, double p) {
+    area[v] = a;
+    flow[v] = q;
+    if (pressure) (*pressure)[v] = p;
+  });
+}
+
+void PulseSolver::sample_one_d(double x, std::span<double> area, std::span<double> flow, std::span<double> pressure) const {
+  for_each_one_d_sample(x, !pressure.empty(), [&](std::size_t j, std::size_t, double a, double q, double p) {
+    area[j] = a;
+    flow[j] = q;
+    if (!pressure.empty()) pressure[j] = p;
+  });
+}
+
+template <class F>
+void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) const {
+  // The same element k and point xi in every vessel (locate's arithmetic); the first of each
+  // vessel's elements names it.
   const double s = std::clamp(x, 0.0, 1.0) * elements_per_vessel_;
   const auto k = std::min(static_cast<std::int32_t>(s), elements_per_vessel_ - 1);
   const double xi = 2 * (s - k) - 1;
   std::array<double, 32> phi;  // degrees are at most 30
   for (std::size_t j = 0; j <= static_cast<std::size_t>(max_degree()); ++j) phi[j] = legendre(static_cast<int>(j), xi);
-  // The 0D vessels from their own state, then the 1D ones (the first of each one's elements
-  // names it).
-  if (zero_d)
-    lumped_.sample(std::clamp(x, 0.0, 1.0), area, flow, pressure ? std::span<double>(*pressure) : std::span<double>(), threads_);
   const auto one_d = static_cast<std::int64_t>(one_d_vessels_.size());
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t j = 0; j < one_d; ++j) {
     const auto v = static_cast<std::size_t>(one_d_vessels_[static_cast<std::size_t>(j)]);
     const Eigen::Index el = first_element_[v] + k;
     double a = 0, q = 0;
-    for (int j = 0; j <= vessel_degree_[v]; ++j) {
-      a += state_.area(el, j) * phi[static_cast<std::size_t>(j)];
-      q += state_.flow(el, j) * phi[static_cast<std::size_t>(j)];
+    for (int m = 0; m <= vessel_degree_[v]; ++m) {
+      a += state_.area(el, m) * phi[static_cast<std::size_t>(m)];
+      q += state_.flow(el, m) * phi[static_cast<std::size_t>(m)];
     }
-    area[v] = a;
-    flow[v] = q;
-    if (pressure) (*pressure)[v] = is_tapered(v) ? law_at(v, x).pressure(a) : laws_[v].pressure(a);
+    const double p = with_pressure ? (is_tapered(v) ? law_at(v, x).pressure(a) : laws_[v].pressure(a)) : 0.0;
+    f(static_cast<std::size_t>(j), v, a, q, p);
   }
 }
 

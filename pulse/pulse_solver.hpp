@@ -136,12 +136,13 @@ class PulseSolver {
   // The same for one vessel (the rest keep theirs): O(1), as a transport updates them.
   void set_viscosity_factor(std::size_t vessel, double factor);
   const std::vector<double>& viscosity_factors() const { return viscosity_factor_; }
-  // Area, flow and pressure of every vessel at the same fraction x along each, in one pass
-  // (the cycle statistics sample all vessels every few steps); pressure may be null.
-  // With zero_d false the 0D vessels' entries are left as they are: their state is read
-  // whole from lumped() (the statistics take all three points of a 0D vessel in one pass).
+  // Area, flow and pressure of every vessel at the same fraction x along each, in one pass;
+  // pressure may be null.
   void sample_all(double x, std::vector<double>& area, std::vector<double>& flow,
-                  std::vector<double>* pressure = nullptr, bool zero_d = true) const;
+                  std::vector<double>* pressure = nullptr) const;
+  // The same for the 1D vessels alone, in one_d_vessels()' order (spans of that size;
+  // pressure may be empty): the cycle statistics read the 0D vessels whole from lumped().
+  void sample_one_d(double x, std::span<double> area, std::span<double> flow, std::span<double> pressure = {}) const;
   const LumpedVessels& lumped() const { return lumped_; }
   // The run's boundary conditions (pulse/network_boundaries.hpp: run_boundaries), and per
   // boundary whether its flow counts as "in"; the period of its waveforms.
@@ -257,6 +258,10 @@ class PulseSolver {
   std::vector<double> capacitor_pressures() const;  // per run outlet (NaN: none)
   // A point of a 1D vessel: its element and xi in [-1, 1] there, and the modes' value (pulse_sampling.cpp).
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;
+  // f(j, vessel, area, flow, pressure) for the j-th 1D vessel at fraction x, in parallel
+  // (pressure 0 unless with_pressure).
+  template <class F>
+  void for_each_one_d_sample(double x, bool with_pressure, F&& f) const;
   double evaluate_modes(const Eigen::MatrixXd& coefficients, std::size_t element, double xi) const;
 
   const Network& net_;

@@ -31,11 +31,21 @@ CycleStatistics::CycleStatistics(const Network& net, double analysis_frequency)
       p_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()),
       q_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
       q_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()), wss_(net.vessel_count(), 0.0),
-      reynolds_(net.vessel_count(), 0.0), p_in_(net.vessel_count()), p_out_(net.vessel_count()),
-      u_in_(net.vessel_count()), u_out_(net.vessel_count()), first_(4 * net.vessel_count()),
-      last_(4 * net.vessel_count()) {}
+      reynolds_(net.vessel_count(), 0.0) {}
+
+void CycleStatistics::fit(const PulseSolver& solver) {
+  if (one_d_ == solver.one_d_vessels()) return;
+  one_d_ = solver.one_d_vessels();
+  const std::size_t n = one_d_.size();
+  for (auto* sums : {&p_in_, &p_out_, &u_in_, &u_out_}) sums->assign(n, 0.0);
+  first_.assign(4 * n, 0.0);
+  last_.assign(4 * n, 0.0);
+  for (auto* scratch : {&area_, &q_, &p_, &area_end_, &q_end_, &p_end_, &area_out_, &q_out_, &p_out_end_})
+    scratch->assign(n, 0.0);
+}
 
 void CycleStatistics::begin(const PulseSolver& solver) {
+  fit(solver);
   exchanged_start_ = solver.state().exchanged;
   boundary_start_ = solver.state().boundary;
   volume_start_ = solver.network_volume();
@@ -46,6 +56,7 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
   const double rho = solver.blood().density, alpha = solver.blood().alpha;
   const int threads = solver.threads();
   const std::complex<double> phase = weight * std::polar(1.0, -omega_ * t);
+  fit(solver);
   if (duration_ == 0) {
     first_time_ = t;
     record_ends(solver, first_);
@@ -66,45 +77,37 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     wss_[v] += weight * wall_shear_stress(mu, u, radius, alpha);
     reynolds_[v] += weight * rho * u * 2 * radius / mu;
   };
-  // At the ends: the Fourier sums of pressure and velocity.
-  auto ends = [&](std::size_t v, double p_in, double u_in, double p_out, double u_out) {
-    p_in_[v] += phase * p_in;
-    u_in_[v] += phase * u_in;
-    p_out_[v] += phase * p_out;
-    u_out_[v] += phase * u_out;
-  };
-  // The 1D vessels through the solver's arrays, three points each.
-  const std::vector<std::int32_t>& one_d = solver.one_d_vessels();
-  if (!one_d.empty()) {
-    solver.sample_all(0.5, area_, q_, &p_, false);
-    solver.sample_all(0.0, area_end_, q_end_, &p_end_, false);
-    solver.sample_all(1.0, area_out_, q_out_, &p_out_end_, false);
-    parallel_blocks(static_cast<std::int64_t>(one_d.size()), threads, [&](std::int64_t first, std::int64_t last) {
+  // The 1D vessels through the solver's arrays, three points each; at the ends the Fourier
+  // sums of pressure and velocity.
+  if (!one_d_.empty()) {
+    solver.sample_one_d(0.5, area_, q_, p_);
+    solver.sample_one_d(0.0, area_end_, q_end_, p_end_);
+    solver.sample_one_d(1.0, area_out_, q_out_, p_out_end_);
+    parallel_blocks(static_cast<std::int64_t>(one_d_.size()), threads, [&](std::int64_t first, std::int64_t last) {
       for (auto j = static_cast<std::size_t>(first); j < static_cast<std::size_t>(last); ++j) {
-        const auto v = static_cast<std::size_t>(one_d[j]);
-        centre(v, area_[v], q_[v], p_[v], solver.mean_flow(v));
-        ends(v, p_end_[v], q_end_[v] / area_end_[v], p_out_end_[v], q_out_[v] / area_out_[v]);
+        const auto v = static_cast<std::size_t>(one_d_[j]);
+        centre(v, area_[j], q_[j], p_[j], solver.mean_flow(v));
+        p_in_[j] += phase * p_end_[j];
+        u_in_[j] += phase * (q_end_[j] / area_end_[j]);
+        p_out_[j] += phase * p_out_end_[j];
+        u_out_[j] += phase * (q_out_[j] / area_out_[j]);
       }
     });
   }
-  // The 0D vessels straight from their state, all three points in one pass (their flow is
-  // one along the vessel: its mean).
-  solver.lumped().for_each_sample(
-      [&](std::size_t v, const LumpedVessels::Sample& s) {
-        centre(v, s.area_centre, s.flow, s.pressure_centre, s.flow);
-        ends(v, s.pressure_in, s.flow / s.area_in, s.pressure_out, s.flow / s.area_out);
-      },
-      threads);
+  // The 0D vessels straight from their state, in one pass (their flow is one along the
+  // vessel: its mean).
+  solver.lumped().for_each_centre_sample(
+      [&](std::size_t v, const LumpedVessels::Sample& s) { centre(v, s.area, s.flow, s.pressure, s.flow); }, threads);
 }
 
 void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>& values) {
   // Kept apart from sample(): the first and last samples alone (the drift between them),
   // rather than four more values written per vessel at every sample.
   for (const int end : {0, 1}) {
-    solver.sample_all(end, area_end_, q_end_, &p_end_);
-    for (std::size_t v = 0; v < flow_.size(); ++v) {
-      values[4 * v + static_cast<std::size_t>(end)] = p_end_[v];
-      values[4 * v + 2 + static_cast<std::size_t>(end)] = q_end_[v] / area_end_[v];
+    solver.sample_one_d(end, area_end_, q_end_, p_end_);
+    for (std::size_t j = 0; j < one_d_.size(); ++j) {
+      values[4 * j + static_cast<std::size_t>(end)] = p_end_[j];
+      values[4 * j + 2 + static_cast<std::size_t>(end)] = q_end_[j] / area_end_[j];
     }
   }
 }
@@ -119,6 +122,7 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   summary.volume_change = solver.network_volume() - volume_start_;
   summary.conservation_error =
       (exchanged(0) - exchanged(1) - summary.volume_change) / exchange_scale(exchanged(0), exchanged(1), volume_start_);
+  fit(solver);
   if (duration_ > 0) record_ends(solver, last_);  // the state of the cycle's last sample
   begin(solver);  // the next cycle starts here unless begin() is called again
   std::vector<VesselCycle>& out = summary.vessels;
@@ -138,14 +142,19 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
     c.least_flow = q_min_[v];
     c.mean_wss = wss_[v] / duration_;
     c.reynolds = reynolds_[v] / duration_;
-    c.pwv_pressure = phase_velocity(detrended(p_in_[v], 4 * v), detrended(p_out_[v], 4 * v + 1), omega_, net_.length[v]);
-    c.pwv_velocity = phase_velocity(detrended(u_in_[v], 4 * v + 2), detrended(u_out_[v], 4 * v + 3), omega_, net_.length[v]);
+    c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();  // 0D: no wave (below: 1D)
     flow_[v] = pressure_[v] = wss_[v] = reynolds_[v] = 0;
-    p_in_[v] = p_out_[v] = u_in_[v] = u_out_[v] = 0;
     p_min_[v] = std::numeric_limits<double>::infinity();
     p_max_[v] = -std::numeric_limits<double>::infinity();
     q_min_[v] = std::numeric_limits<double>::infinity();
     q_max_[v] = -std::numeric_limits<double>::infinity();
+  }
+  for (std::size_t j = 0; j < one_d_.size(); ++j) {
+    VesselCycle& c = out[static_cast<std::size_t>(one_d_[j])];
+    const double length = net_.length[static_cast<std::size_t>(one_d_[j])];
+    c.pwv_pressure = phase_velocity(detrended(p_in_[j], 4 * j), detrended(p_out_[j], 4 * j + 1), omega_, length);
+    c.pwv_velocity = phase_velocity(detrended(u_in_[j], 4 * j + 2), detrended(u_out_[j], 4 * j + 3), omega_, length);
+    p_in_[j] = p_out_[j] = u_in_[j] = u_out_[j] = 0;
   }
   duration_ = 0;
   return summary;

@@ -2,8 +2,9 @@
 // - at each vessel's centre: mean, systolic and diastolic pressure, pulsatility index, mean
 //   wall shear stress (the paper's eq. WSS) and Reynolds number;
 // - over the vessel: mean flow (its mode-0 coefficients);
-// - at both ends: one Fourier coefficient of pressure and velocity, whose phase lag along
-//   the vessel gives the measured pulse wave speeds;
+// - at both ends of a 1D vessel: one Fourier coefficient of pressure and velocity, whose
+//   phase lag along the vessel gives the measured pulse wave speeds (NaN in 0D vessels,
+//   where no wave travels);
 // and the cycle-to-cycle change that decides when the solution is periodic.
 #pragma once
 
@@ -77,14 +78,18 @@ class CycleStatistics {
   Eigen::Vector2d exchanged_start_ = Eigen::Vector2d::Zero();  // at begin()
   Eigen::VectorXd boundary_start_;                               // at begin()
   double volume_start_ = 0;
-  std::vector<double> flow_, pressure_, p_min_, p_max_, q_min_, q_max_, wss_, reynolds_;
-  // Fourier sums at the ends, and each signal's first and last sample of the cycle: a
-  // cycle that is not yet periodic drifts, and the drift's own Fourier component is removed.
+  std::vector<double> flow_, pressure_, p_min_, p_max_, q_min_, q_max_, wss_, reynolds_;  // per vessel
+  // Per 1D vessel (one_d_, the solver's one_d_vessels(); a wave speed is measured only where a
+  // wave travels, run_report.hpp): the Fourier sums at the ends, and each signal's first and
+  // last sample of the cycle (a cycle that is not yet periodic drifts, and the drift's own
+  // Fourier component is removed).
+  std::vector<std::int32_t> one_d_;
   std::vector<std::complex<double>> p_in_, p_out_, u_in_, u_out_;
-  std::vector<double> first_, last_;  // per vessel: p_in, p_out, u_in, u_out
+  std::vector<double> first_, last_;  // per 1D vessel: p_in, p_out, u_in, u_out
   double first_time_ = 0, last_time_ = 0;
-  // Scratch: the 1D vessels' samples at the centre and the two ends (of every vessel's size).
+  // Scratch: the 1D vessels' samples at the centre and the two ends.
   std::vector<double> area_, q_, p_, area_end_, q_end_, p_end_, area_out_, q_out_, p_out_end_;
+  void fit(const PulseSolver& solver);  // the per-1D-vessel arrays to the solver's 1D vessels
   void record_ends(const PulseSolver& solver, std::vector<double>& values);  // p_in, p_out, u_in, u_out
   double duration_ = 0;
 };
