@@ -20,7 +20,8 @@ constexpr std::string_view magic = "hemotree checkpoint\n";
 // 5: sections framed by their length and checksummed, and the file checksummed.
 // 6: the transport's last face volumes; 7: the run's identity in a section of its own (a hash of the
 // whole network and the options that shape the state), so that no field is left out of it.
-constexpr std::uint64_t format_version = 7;
+// 8: the last two cycles' results in sections of their own (a writer holds one section at a time).
+constexpr std::uint64_t format_version = 8;
 constexpr std::size_t word = sizeof(std::uint64_t);
 constexpr std::size_t header = magic.size() + word;  // the magic line and the format
 
@@ -45,11 +46,67 @@ std::string describe_section(const std::string& name, std::size_t index) {
                         std::all_of(name.begin(), name.end(), [](char c) { return c >= ' ' && c <= '~'; });
   return readable ? "section \"" + name + "\"" : "section " + std::to_string(index + 1);
 }
+
+
+// All of it to fd, IoError naming the file where it cannot.
+void write_all(int fd, const char* data, std::size_t size, const std::filesystem::path& file) {
+  std::size_t written = 0;
+  while (written < size) {
+    const ssize_t n = ::write(fd, data + written, size - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw IoError("cannot write " + file.string() + ": " + std::strerror(errno));
+    written += static_cast<std::size_t>(n);
+  }
+}
 }  // namespace
 
 CheckpointWriter::CheckpointWriter() {
   bytes_.append(magic);
   append_word(bytes_, format_version);
+}
+
+CheckpointWriter::CheckpointWriter(const std::filesystem::path& file) : CheckpointWriter() {
+  file_ = file;
+  fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw IoError("cannot write " + file.string() + ": " + std::strerror(errno));
+  written_hash_ = Fingerprint().value();
+}
+
+CheckpointWriter::~CheckpointWriter() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void CheckpointWriter::flush() {
+  write_all(fd_, bytes_.data(), bytes_.size(), file_);
+  // FNV-1a goes byte by byte: carried on from the bytes before, it is the whole file's.
+  Fingerprint f(written_hash_);
+  f.add(bytes_.data(), bytes_.size());
+  written_hash_ = f.value();
+  bytes_.clear();
+}
+
+void CheckpointWriter::finish() {
+  if (fd_ < 0) throw std::logic_error("checkpoint: finish() of a writer in memory");
+  if (vector_left_ != 0) throw std::logic_error("checkpoint: a vector given in parts is short");
+  if (section_start_ != std::string::npos) close_section(bytes_, section_start_);
+  flush();
+  append_word(bytes_, written_hash_);
+  write_all(fd_, bytes_.data(), bytes_.size(), file_);
+  bytes_.clear();
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) throw IoError("cannot write " + file_.string() + ": " + std::strerror(errno));
+}
+
+void CheckpointWriter::begin_vector(std::uint64_t count) {
+  put(count);
+  vector_left_ = count;
+}
+
+void CheckpointWriter::put_part(std::span<const double> values) {
+  if (values.size() > vector_left_) throw std::logic_error("checkpoint: a vector given in parts is too long");
+  vector_left_ -= values.size();
+  raw(values.data(), values.size() * sizeof(double));
 }
 
 void CheckpointWriter::raw(const void* data, std::size_t size) {
@@ -67,7 +124,9 @@ void CheckpointWriter::close_section(std::string& bytes, std::size_t start) {
 }
 
 void CheckpointWriter::section(std::string_view name) {
+  if (vector_left_ != 0) throw std::logic_error("checkpoint: a vector given in parts is short");
   if (section_start_ != std::string::npos) close_section(bytes_, section_start_);
+  if (fd_ >= 0) flush();
   section_start_ = bytes_.size();
   append_word(bytes_, name.size());
   bytes_.append(name);
@@ -75,6 +134,7 @@ void CheckpointWriter::section(std::string_view name) {
 }
 
 std::string CheckpointWriter::bytes() const {
+  if (fd_ >= 0 || !file_.empty()) throw std::logic_error("checkpoint: bytes() of a writer to a file");
   std::string file = bytes_;
   if (section_start_ != std::string::npos) close_section(file, section_start_);
   append_word(file, checksum(file, 0, file.size()));
@@ -269,6 +329,20 @@ void write_checkpoint_file(const std::filesystem::path& file, const std::string&
     ::unlink(temp.c_str());
     throw IoError("cannot write " + file.string() + ": " + std::strerror(error));
   }
+}
+
+void promote_checkpoint_file(const std::filesystem::path& from, const std::filesystem::path& to) {
+  const int fd = ::open(from.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError("cannot read " + from.string() + ": " + std::strerror(errno));
+  // On disk before the rename: after a crash the name holds a whole checkpoint or the old one.
+  if (::fsync(fd) != 0) {
+    const int error = errno;
+    ::close(fd);
+    throw IoError("cannot write " + from.string() + ": " + std::strerror(error));
+  }
+  ::close(fd);
+  if (std::rename(from.c_str(), to.c_str()) != 0)
+    throw IoError("cannot write " + to.string() + ": " + std::strerror(errno));
 }
 
 std::string read_checkpoint_file(const std::filesystem::path& file) {

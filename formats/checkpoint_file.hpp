@@ -7,7 +7,7 @@
 // reading it as garbage, and checksums a file changed after it was written: a flipped bit
 // in a stored state would otherwise resume as a plausible run with wrong numbers.
 //
-// The file (format 7):
+// The file (format 8):
 //   "hemotree checkpoint\n", u64 format
 //   each section: u64 name length, name, u64 payload length, payload,
 //                 u64 checksum of the section (its name, length and payload)
@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -28,7 +29,15 @@ namespace hemotree {
 
 class CheckpointWriter {
  public:
-  CheckpointWriter();  // starts with the file's magic line and format version
+  CheckpointWriter();  // in memory (bytes()); starts with the file's magic line and format version
+  // Straight to `file` (created or truncated), IoError naming it where it cannot be written:
+  // each section goes out whole as the next one opens, so the writer holds one section at a
+  // time, not the file (a full tree's checkpoint is a gigabyte). finish() ends the file; it
+  // is not synced to disk (promote_checkpoint_file does that).
+  explicit CheckpointWriter(const std::filesystem::path& file);
+  ~CheckpointWriter();
+  CheckpointWriter(const CheckpointWriter&) = delete;
+  CheckpointWriter& operator=(const CheckpointWriter&) = delete;
   // Closes the section before (its length and checksum) and opens one; every value is in one.
   void section(std::string_view name);
   void put(double x);
@@ -38,14 +47,26 @@ class CheckpointWriter {
   void put(const std::vector<double>& values);
   void put(const Eigen::MatrixXd& m);
   void put(const Eigen::VectorXd& v);
-  // The whole file: the open section closed and the file's checksum appended.
+  // A vector of `count` doubles given in parts (put_part, in order, `count` in all), so that
+  // one assembled from per-vessel records need not be held whole: get_vector() reads it.
+  void begin_vector(std::uint64_t count);
+  void put_part(std::span<const double> values);
+  // In memory: the whole file, the open section closed and the file's checksum appended.
   std::string bytes() const;
+  // To a file: the open section and the file's checksum written, the file closed.
+  void finish();
 
  private:
   void raw(const void* data, std::size_t size);
   static void close_section(std::string& bytes, std::size_t start);
+  void flush();  // to the file: bytes_ out, the file's checksum carried on
   std::string bytes_;
   std::size_t section_start_ = std::string::npos;  // of the open section
+  std::uint64_t vector_left_ = 0;                   // of a vector being given in parts
+  // The file mode: its descriptor (-1: in memory), name, and the checksum of what went out.
+  int fd_ = -1;
+  std::filesystem::path file_;
+  std::uint64_t written_hash_ = 0;
 };
 
 // Reads what a CheckpointWriter wrote, in the same order; InputError naming the file at the
@@ -87,6 +108,9 @@ class CheckpointReader {
 
 // bytes: a CheckpointWriter's bytes().
 void write_checkpoint_file(const std::filesystem::path& file, const std::string& bytes);
+// A finished file of a CheckpointWriter(file) made the checkpoint `to`: synced to disk, then
+// renamed over it, so that `to` holds the old checkpoint or the new one whatever happens.
+void promote_checkpoint_file(const std::filesystem::path& from, const std::filesystem::path& to);
 // An empty file is refused here (InputError): it holds no run, and resuming nothing would
 // silently start again from the first cycle.
 std::string read_checkpoint_file(const std::filesystem::path& file);
@@ -94,6 +118,9 @@ std::string read_checkpoint_file(const std::filesystem::path& file);
 // FNV-1a over bytes: a fingerprint of what a checkpoint belongs to (the network's arrays).
 class Fingerprint {
  public:
+  Fingerprint() = default;
+  // Carried on from a value(): FNV-1a goes byte by byte, so the bytes in parts hash as a whole.
+  explicit Fingerprint(std::uint64_t carried) : hash_(carried) {}
   void add(const void* data, std::size_t size);
   template <class T>
   void add(const std::vector<T>& values) {

@@ -371,6 +371,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   }
   const std::filesystem::path dir = folder.staging();
   if (status == RunStatus::interrupted || config.checkpoint_every > 0) pulsatile.write_checkpoint();
+  pulsatile.discard_snapshot();
   pulsatile.probes().write(dir / "probes.csv");
   VesselTable results = last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(driving));
   if (transport && !last.vessels.empty())

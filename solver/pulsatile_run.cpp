@@ -21,14 +21,16 @@ double seconds_since_epoch_start() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// A cycle's summary as numbers, for the checkpoint.
+// A cycle's summary as numbers, for the checkpoint: given vessel by vessel, not assembled.
 constexpr std::size_t vessel_fields = 10;
 void put_summary(CheckpointWriter& out, const CycleSummary& c) {
-  std::vector<double> values{c.inlet_mean_flow, c.outlets_mean_flow, c.volume_change, c.conservation_error};
-  for (const VesselCycle& v : c.vessels)
-    values.insert(values.end(), {v.mean_flow, v.mean_pressure, v.systolic_pressure, v.diastolic_pressure,
-                                 v.peak_flow, v.least_flow, v.mean_wss, v.reynolds, v.pwv_pressure, v.pwv_velocity});
-  out.put(values);
+  out.begin_vector(4 + vessel_fields * c.vessels.size());
+  out.put_part(std::vector<double>{c.inlet_mean_flow, c.outlets_mean_flow, c.volume_change, c.conservation_error});
+  for (const VesselCycle& v : c.vessels) {
+    const double fields[vessel_fields] = {v.mean_flow, v.mean_pressure, v.systolic_pressure, v.diastolic_pressure,
+                                          v.peak_flow, v.least_flow, v.mean_wss, v.reynolds, v.pwv_pressure, v.pwv_velocity};
+    out.put_part(fields);
+  }
   out.put(c.boundary_mean_flow);
 }
 
@@ -69,15 +71,18 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
 }
 
 void PulsatileRun::snapshot() {
-  CheckpointWriter out;
+  snapshot_pending_ = false;
+  CheckpointWriter out(pending());
   out.section("identity");
   out.put(plan_.network_identity);
   out.put(plan_.state_shaping);
+  out.section("last cycle");
+  put_summary(out, last_);
+  out.section("previous cycle");
+  put_summary(out, previous_);
   out.section("run");
   out.put(static_cast<std::uint64_t>(done_));
   out.put(static_cast<std::uint64_t>(balances_));
-  put_summary(out, last_);
-  put_summary(out, previous_);
   out.put(change_.change);
   out.put(static_cast<std::uint64_t>(change_.vessel));
   out.put(probes_.rows());
@@ -92,7 +97,8 @@ void PulsatileRun::snapshot() {
                                 red_cell_change_});
   }
   out.section("end");
-  snapshot_ = out.bytes();
+  out.finish();
+  snapshot_pending_ = true;
 }
 
 void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
@@ -102,11 +108,13 @@ void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
   const std::string options = in.get_string();
   if (options != plan_.state_shaping)
     in.fail("written by a run with other options (there: " + options + "; here: " + plan_.state_shaping + ")");
+  in.section("last cycle");
+  last_ = get_summary(in, net_.vessel_count());
+  in.section("previous cycle");
+  previous_ = get_summary(in, net_.vessel_count());
   in.section("run");
   done_ = static_cast<int>(in.get_u64());
   balances_ = static_cast<int>(in.get_u64());
-  last_ = get_summary(in, net_.vessel_count());
-  previous_ = get_summary(in, net_.vessel_count());
   change_.change = in.get_double();
   change_.vessel = static_cast<std::size_t>(in.get_u64());
   probes_.restore_rows(in.get_string());
@@ -128,7 +136,7 @@ void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
   in.section("end");
   if (!in.at_end()) in.fail("unexpected bytes after the checkpoint");
   resumed_ = true;
-  snapshot_ = bytes;  // written again as it is if no cycle follows
+  resumed_bytes_ = bytes;  // the snapshot as it is until a cycle ends (written once the folder is open)
   if (!cycles_left()) check_run_end(source);
 }
 
@@ -193,7 +201,17 @@ bool PulsatileRun::has_last_cycle_frames() const {
          std::abs(times.back() - end) <= 1e-6 * period + 1e-8 * std::abs(end) && times.front() > end - period;
 }
 
-void PulsatileRun::write_checkpoint() const { write_checkpoint_file(folder_ / "checkpoint.bin", snapshot_); }
+void PulsatileRun::write_checkpoint() {
+  if (!snapshot_pending_) return;  // checkpoint.bin is the last cycle end's already
+  promote_checkpoint_file(pending(), folder_ / "checkpoint.bin");
+  snapshot_pending_ = false;
+}
+
+void PulsatileRun::discard_snapshot() {
+  std::error_code ec;
+  std::filesystem::remove(pending(), ec);
+  snapshot_pending_ = false;
+}
 
 void PulsatileRun::progress(RunObserver& observer, std::size_t k, double started) {
   const double elapsed = seconds_since_epoch_start() - started;
@@ -219,6 +237,10 @@ RunStatus PulsatileRun::run(RunObserver& observer) {
     if (plan_.balance_compliances) solver_.balance_compliances(period);
     if (transport_) transport_->take_volumes();
     snapshot();
+  } else if (!resumed_bytes_.empty()) {
+    write_checkpoint_file(pending(), resumed_bytes_);
+    snapshot_pending_ = true;
+    std::string().swap(resumed_bytes_);
   }
   try {
     while (cycles_left()) {

@@ -1,8 +1,9 @@
 // The time loop of a pulsatile run: cardiac cycles of the solver, their statistics, probes,
 // frames and compliance balances, until the planned cycles are done, the solution is
-// periodic, it breaks down or the user interrupts it. At every cycle end the loop keeps a
-// checkpoint of itself (solver and progress) in memory and, every --checkpoint-every
-// cycles, on disk: a run resumed from it continues bit for bit as if never stopped.
+// periodic, it breaks down or the user interrupts it. At every cycle end the loop writes a
+// checkpoint of itself (solver and progress) beside the results, made the folder's
+// checkpoint.bin every --checkpoint-every cycles or on an interrupt: a run resumed from it
+// continues bit for bit as if never stopped.
 #pragma once
 
 #include <cstdint>
@@ -31,7 +32,7 @@ struct RunPlan {
   std::vector<std::uint8_t> vtk_keep;  // the vessels the frames show (empty: all)
   std::size_t steps_per_cycle = 1;
   std::size_t sample_every = 1;  // steps between probe samples
-  int checkpoint_every = 0;     // cycles; 0: only in memory (written on an interrupt)
+  int checkpoint_every = 0;     // cycles; 0: only on an interrupt
   // The run's identity (solver/run_identity.hpp): a checkpoint of another is refused.
   std::uint64_t network_identity = 0;
   std::string state_shaping;    // readable, for a clear refusal of another run's checkpoint
@@ -80,11 +81,19 @@ class PulsatileRun {
   // Wall time per step measured over the first steps this process ran [s]; 0 before.
   double measured_step() const { return measured_step_; }
   const ProbeRecorder& probes() const { return probes_; }
-  // Writes the checkpoint of the last cycle end to folder/checkpoint.bin.
-  void write_checkpoint() const;
+  // Makes the checkpoint of the last cycle end folder/checkpoint.bin (where it is not already).
+  void write_checkpoint();
+  // Removes the last cycle end's snapshot where it was not made the checkpoint: before the
+  // folder is published.
+  void discard_snapshot();
 
  private:
-  void snapshot();  // the checkpoint of this cycle end, in memory
+  // The checkpoint of this cycle end, written to folder/snapshot.pending: an interrupt or
+  // --checkpoint-every makes it checkpoint.bin by a rename. On disk, not in memory: it is a
+  // gigabyte on a full tree, which the run would otherwise hold throughout (and three times
+  // over while building the next).
+  void snapshot();
+  std::filesystem::path pending() const { return folder_ / "snapshot.pending"; }
   int planned() const { return plan_.until_periodic ? plan_.max_cycles : plan_.cycles; }
   bool periodic() const;
   void check_run_end(const std::filesystem::path& source) const;
@@ -103,7 +112,8 @@ class PulsatileRun {
   bool resumed_ = false;
   double measured_step_ = 0;
   std::string breakdown_;
-  std::string snapshot_;  // a checkpoint file's bytes
+  bool snapshot_pending_ = false;  // pending() holds the last cycle end's checkpoint
+  std::string resumed_bytes_;      // the checkpoint resumed from, until the folder is open (run())
   FlowTransport* transport_ = nullptr;
   RedCellCycle red_cells_last_;
   double red_cell_change_ = std::numeric_limits<double>::quiet_NaN();

@@ -81,6 +81,63 @@ TEST(Checkpoint, FileIsReplacedWhole) {
   std::filesystem::remove(file);
 }
 
+// Written straight to a file, section by section, a checkpoint has the bytes the writer in
+// memory gives (the file's checksum carried across the sections), and a vector given in parts
+// reads back as one; promoted, it replaces the checkpoint whole.
+TEST(Checkpoint, AFileWrittenBySectionsIsTheSameBytes) {
+  const auto dir = std::filesystem::temp_directory_path() / ("checkpoint-sections-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto fill = [](CheckpointWriter& out) {
+    out.section("first");
+    out.put(0.25);
+    out.put(std::string("name"));
+    out.section("parts");
+    out.begin_vector(5);
+    out.put_part(std::vector<double>{1, 2});
+    out.put_part(std::vector<double>{});
+    out.put_part(std::vector<double>{3, 4, 5});
+    out.put(std::uint64_t{7});
+    out.section("end");
+  };
+  CheckpointWriter memory;
+  fill(memory);
+  {
+    CheckpointWriter file(dir / "snapshot");
+    fill(file);
+    file.finish();
+  }
+  EXPECT_EQ(read_checkpoint_file(dir / "snapshot"), memory.bytes());
+  CheckpointReader in(read_checkpoint_file(dir / "snapshot"), "snapshot");
+  in.section("first");
+  EXPECT_EQ(in.get_double(), 0.25);
+  EXPECT_EQ(in.get_string(), "name");
+  in.section("parts");
+  EXPECT_EQ(in.get_vector(), (std::vector<double>{1, 2, 3, 4, 5}));
+  EXPECT_EQ(in.get_u64(), 7u);
+  write_checkpoint_file(dir / "checkpoint.bin", "old");
+  promote_checkpoint_file(dir / "snapshot", dir / "checkpoint.bin");
+  EXPECT_EQ(read_checkpoint_file(dir / "checkpoint.bin"), memory.bytes());
+  EXPECT_FALSE(std::filesystem::exists(dir / "snapshot"));
+  // A vector given short or long is the writer's caller's error, caught before a file is written.
+  CheckpointWriter shortened;
+  shortened.section("a");
+  shortened.begin_vector(2);
+  shortened.put_part(std::vector<double>{1});
+  EXPECT_THROW(shortened.section("b"), std::logic_error);
+  CheckpointWriter lengthened;
+  lengthened.section("a");
+  lengthened.begin_vector(1);
+  EXPECT_THROW(lengthened.put_part(std::vector<double>{1, 2}), std::logic_error);
+  // Where the file cannot be written, the error names it.
+  try {
+    CheckpointWriter nowhere(dir / "no such folder" / "snapshot");
+    FAIL() << "opened a file in a missing folder";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("no such folder/snapshot"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Checkpoint, RefusesAnEmptyFileAndAnEarlierFormat) {
   const auto file = std::filesystem::temp_directory_path() / ("checkpoint-empty-" + std::to_string(::getpid()));
   { std::ofstream touch(file); }
