@@ -14,7 +14,7 @@
 namespace hemotree {
 
 std::vector<double> PulseSolver::capacitor_pressures() const {
-  std::vector<double> p(run_outlets_.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> p(outlet_capacitance_.size(), std::numeric_limits<double>::quiet_NaN());
   for (const auto& o : boundaries_.outlets)
     if (o.capacitor >= 0) p[static_cast<std::size_t>(o.index)] = state_.capacitor(o.capacitor);
   for (std::size_t k = 0; k < p.size(); ++k)
@@ -95,9 +95,9 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   TreeLoads loads;
   loads.node_shunt.assign(net_.node_count(), 0.0);
   loads.node_current.assign(net_.node_count(), 0.0);
-  loads.capacitor_shunt.assign(run_outlets_.size(), 0.0);
-  loads.capacitor_current.assign(run_outlets_.size(), 0.0);
-  std::vector<double> node_compliance(net_.node_count(), 0.0), capacitor_compliance(run_outlets_.size(), 0.0);
+  loads.capacitor_shunt.assign(outlet_capacitance_.size(), 0.0);
+  loads.capacitor_current.assign(outlet_capacitance_.size(), 0.0);
+  std::vector<double> node_compliance(net_.node_count(), 0.0), capacitor_compliance(outlet_capacitance_.size(), 0.0);
   for (std::size_t v = 0; v < n; ++v) {
     const double rate = (volume[v] - cycle_volume_[v]) / period, compliance = area_per_pressure[v] * net_.length[v];
     for (const auto node : {net_.from[v], net_.to[v]}) {
@@ -105,10 +105,10 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       node_compliance[static_cast<std::size_t>(node)] += compliance / 2;
     }
   }
-  for (std::size_t k = 0; k < run_outlets_.size(); ++k) {
+  for (std::size_t k = 0; k < outlet_capacitance_.size(); ++k) {
     if (std::isnan(capacitor_now[k])) continue;
-    capacitor_compliance[k] = run_outlets_[k].c;
-    loads.capacitor_current[k] = run_outlets_[k].c * (capacitor_now[k] - cycle_capacitor_[k]) / period;
+    capacitor_compliance[k] = outlet_capacitance_[k];
+    loads.capacitor_current[k] = outlet_capacitance_[k] * (capacitor_now[k] - cycle_capacitor_[k]) / period;
   }
   // delta = K^-1 I: the shifts that cancel the rates in the linear network (K its conductance).
   const TreePotentials delta = solve_loaded_tree(net_, resistance, loads);

@@ -36,7 +36,6 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
     if (!zero_d[v]) continue;
     index_of_vessel_[v] = static_cast<std::int32_t>(vessels_.size());
     vessels_.push_back(static_cast<std::int32_t>(v));
-    vessel_ids_.push_back(net.id[v]);
     a_.push_back(node(net.from[v]));
     b_.push_back(node(net.to[v]));
     const TubeLaw& law = laws[v];
@@ -87,9 +86,9 @@ void LumpedVessels::allocate_system() {
   system_ = NodalSystem(nodes_, a_, b_);
   const std::size_t edges = a_.size();
   volume_.assign(nodes_, 0.0);
-  previous_volume_ = pressure_ = previous_pressure_ = predicted_ = system_shunt_ = rhs_ = impedance_ = dynamic_ = volume_;
+  previous_volume_ = pressure_ = previous_pressure_ = predicted_ = system_shunt_ = rhs_ = volume_;
   flow_.assign(edges, 0.0);
-  previous_flow_ = conductance_ = history_ = next_flow_ = flow_;
+  previous_flow_ = conductance_ = history_ = flow_;
   capacity_a_.assign(vessels_.size(), 0.0);
   capacity_b_ = resistance_ = previous_resistance_ = capacity_a_;
   // The R1 edges of RCR outlets keep their conductance, and have no inertance.
@@ -198,6 +197,8 @@ double LumpedVessels::resistance_fraction(std::size_t e, double x) const {
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
   coupling_nodes_ = std::move(nodes);
   held_inflow_.assign(coupling_nodes_.size(), 0.0);
+  impedance_.assign(coupling_nodes_.size(), 0.0);
+  dynamic_.assign(coupling_nodes_.size(), 0.0);
   coupling_scratch_.assign(coupling_nodes_.size(), 0.0);
   std::vector<std::int32_t> slot(nodes_, -1);
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) slot[static_cast<std::size_t>(coupling_nodes_[j])] = static_cast<std::int32_t>(j);
@@ -286,7 +287,7 @@ void LumpedVessels::update_dynamic_pressures() {
       weight += q;
     }
     const double u = weight > 0 ? weighted / weight : 0.0;
-    dynamic_[k] = 0.5 * density_ * u * u;
+    dynamic_[j] = 0.5 * density_ * u * u;
   }
 }
 
@@ -450,9 +451,7 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
   system_.backward_at(coupling_nodes_, rhs_, coupling_scratch_);
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j)
     predicted_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_scratch_[j];
-  system_.inverse_diagonal(coupling_nodes_, coupling_scratch_);
-  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j)
-    impedance_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_scratch_[j];
+  system_.inverse_diagonal(coupling_nodes_, impedance_);
 }
 
 void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
@@ -472,7 +471,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < edges; ++i) {
       const auto e = static_cast<std::size_t>(i);
-      next_flow_[e] = conductance_[e] * (predicted_[static_cast<std::size_t>(a_[e])] - predicted_[static_cast<std::size_t>(b_[e])]) +
+      previous_flow_[e] = conductance_[e] * (predicted_[static_cast<std::size_t>(a_[e])] - predicted_[static_cast<std::size_t>(b_[e])]) +
                       history_[e];
     }
     // Each node's net inflow at t1 (BDF2 takes the right-hand side there), as the solve had
@@ -492,7 +491,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
         double inflow = -shunted;
         for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
           const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
-          inflow += e >= 0 ? -next_flow_[static_cast<std::size_t>(e)] : next_flow_[static_cast<std::size_t>(~e)];
+          inflow += e >= 0 ? -previous_flow_[static_cast<std::size_t>(e)] : previous_flow_[static_cast<std::size_t>(~e)];
         }
         if (!held_.empty() && held_[k]) {
           // Dirichlet: the node sits at the held pressure, and the boundary lets in what its
@@ -518,8 +517,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     volume_[k] += 2 * volume / 3;
     pressure_[k] = pressure_from_excess(k, volume_[k]);
   });
-  previous_flow_.swap(flow_);
-  flow_.swap(next_flow_);
+  previous_flow_.swap(flow_);  // the new flows went where the oldest were
   for (std::size_t e = 0; e < passed_.size(); ++e) passed_[e] += dt * flow_[e];
   previous_resistance_.swap(resistance_);
   update_resistances();
@@ -608,12 +606,12 @@ void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std
   update_dynamic_pressures();
 }
 
-void LumpedVessels::check(double time) const {
+void LumpedVessels::check(double time, std::span<const std::int64_t> vessel_id) const {
   for (std::size_t e = 0; e < vessels_.size(); ++e) {
     const double s_a = lumen_root(e, pressure_[static_cast<std::size_t>(a_[e])], 0.0);
     const double s_b = lumen_root(e, pressure_[static_cast<std::size_t>(b_[e])], 1.0);
     if (!(s_a > 0) || !(s_b > 0) || !std::isfinite(flow_[e]) || !std::isfinite(s_a * s_b))
-      throw SolutionBreakdown(vessel_ids_[e], time);
+      throw SolutionBreakdown(vessel_id[static_cast<std::size_t>(vessels_[e])], time);
   }
 }
 

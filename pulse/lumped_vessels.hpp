@@ -86,9 +86,10 @@ class LumpedVessels {
 
   // The nodes where 1D vessel ends meet 0D vessels (each once).
   void set_coupling_nodes(std::vector<std::int32_t> nodes);
-  // rho u^2 / 2 of the 0D vessels at a coupling node (u their flow-weighted mean velocity
-  // there, now): what a 1D end's total pressure adds to the node's (static) pressure.
-  double dynamic_pressure(std::int32_t node) const { return dynamic_[static_cast<std::size_t>(node)]; }
+  // rho u^2 / 2 of the 0D vessels at coupling node j (set_coupling_nodes' order; u their
+  // flow-weighted mean velocity there, now): what a 1D end's total pressure adds to the
+  // node's (static) pressure.
+  double dynamic_pressure(std::size_t j) const { return dynamic_[j]; }
 
   // One step of length dt to t1, in two halves around the 1D vessels' substeps.
   // predict: the pressures at t1 at the coupling nodes with the coupled 1D ends' inflows held
@@ -108,7 +109,7 @@ class LumpedVessels {
     const auto i = static_cast<std::size_t>(node);
     return pressure_[i] + s * (predicted_[i] - pressure_[i]);
   }
-  double impedance(std::int32_t node) const { return impedance_[static_cast<std::size_t>(node)]; }
+  double impedance(std::size_t j) const { return impedance_[j]; }  // at coupling node j
   // Completes the step with the volumes the 1D ends actually let into each coupling node
   // (coupled_volume, in set_coupling_nodes' order): the pressures at t1 with the departure
   // from the predicted inflows (the same factorisation: its forward half along the coupling
@@ -185,9 +186,9 @@ class LumpedVessels {
   // Shifts every node's pressure by dp of its network node (network_node_dp) or of its
   // outlet (outlet_dp, capacitors), and its volume with it; the multistep history restarts.
   void shift_pressures(std::span<const double> network_node_dp, std::span<const double> outlet_dp);
-  // Throws SolutionBreakdown (naming a vessel) where a volume is not finite or a lumen
-  // not positive.
-  void check(double time) const;
+  // Throws SolutionBreakdown (naming the vessel by its id in vessel_id, per network vessel)
+  // where a volume is not finite or a lumen not positive.
+  void check(double time, std::span<const std::int64_t> vessel_id) const;
 
   void save(CheckpointWriter& out) const;
   void restore(CheckpointReader& in);
@@ -256,7 +257,6 @@ class LumpedVessels {
   std::vector<std::int64_t> network_node_;     // per node below network_nodes_
   std::vector<std::int32_t> index_of_vessel_;  // per network vessel
   std::vector<std::int32_t> vessels_;          // per 0D vessel: its network index
-  std::vector<std::int64_t> vessel_ids_;       // and its id, for messages
   // Boundary flows (currents into their nodes) and held pressures: node, place in
   // run_boundaries, whether "in"; a held node's conductance scale (its vessel's at rest).
   std::vector<std::int32_t> inflow_node_, inflow_boundary_, held_node_, held_boundary_;
@@ -290,19 +290,19 @@ class LumpedVessels {
   std::vector<double> volume_, previous_volume_, pressure_, previous_pressure_, flow_, previous_flow_;
   // The step being taken: predicted pressures, and the edges' conductances and history
   // terms of the last linearisation (Q = g (p_a - p_b) + f), the inflows and prediction.
-  std::vector<double> predicted_, conductance_, history_, system_shunt_, rhs_, next_flow_;
+  std::vector<double> predicted_, conductance_, history_, system_shunt_, rhs_;
   std::vector<double> passed_;  // per 0D vessel, where tracked (track_passed_volumes)
   std::vector<double> viscosity_factor_;  // per 0D vessel (empty: 1)
   void refresh_resistance(std::size_t e);  // after its factor changed: what restore() computes
   std::vector<std::int32_t> coupling_nodes_;
   std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
   std::vector<std::int32_t> coupling_edge_;
-  std::vector<double> dynamic_;  // per node (coupling nodes only)
+  std::vector<double> dynamic_;  // per coupling node
   // The flow capacity G at each 0D vessel's two ends at the pressures now (the interior profile
   // reads them), and its resistance now and a step before (the next step's extrapolation):
   // the viscosity is most of the cost, three evaluations a vessel and step.
   std::vector<double> capacity_a_, capacity_b_, resistance_, previous_resistance_;
-  std::vector<double> impedance_;     // per node (coupling nodes only): Z
+  std::vector<double> impedance_;     // per coupling node: Z
   std::vector<double> held_inflow_;   // per coupling node: the inflows predicted with
   std::vector<double> coupling_scratch_;  // per coupling node
   // Each node's edges, in increasing order (e where the edge leaves it, ~e where it enters):

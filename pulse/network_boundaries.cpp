@@ -75,15 +75,18 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
       }
       if (lumped) continue;  // the 0D vessel's boundary: pulse/lumped_vessels
       const NodeBoundary& c = b.list[static_cast<std::size_t>(bi)];
+      const auto slot = static_cast<std::int32_t>(b.one_d_boundary.size());
+      b.one_d_boundary.push_back(bi);
       if (c.type == BoundaryType::flow) {
-        b.flows.push_back({e, bi});
+        b.flows.push_back({e, bi, slot});
       } else if (c.type == BoundaryType::pressure) {
-        b.pressures.push_back({e, bi});
+        b.pressures.push_back({e, bi, slot});
       } else {
         NetworkBoundaries::OutletEnd o;
         o.end = e;
         o.index = outlet_index[static_cast<std::size_t>(bi)];
         o.boundary = bi;
+        o.slot = slot;
         o.outlet = c.outlet;
         o.outlet.vessel = static_cast<std::int32_t>(v);
         if (o.outlet.type == BoundaryType::rcr && o.outlet.c > 0)

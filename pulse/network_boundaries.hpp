@@ -37,10 +37,12 @@ struct NetworkBoundaries {
   std::vector<NodeBoundary> list;
   std::vector<unsigned char> entering;
 
-  // Prescribed flows and pressures at 1D ends (index: the boundary's place in list).
+  // Prescribed flows and pressures at 1D ends (index: the boundary's place in list; slot: its
+  // place in one_d_boundary).
   struct GivenEnd {
     VesselEnd end;
     std::int32_t index = -1;
+    std::int32_t slot = -1;
   };
   std::vector<GivenEnd> flows, pressures;
 
@@ -56,12 +58,17 @@ struct NetworkBoundaries {
     Outlet outlet;
     std::int32_t index = -1;      // its place among the run's outlets (run_outlets)
     std::int32_t boundary = -1;   // its place in list
+    std::int32_t slot = -1;       // its place in one_d_boundary
     std::int32_t capacitor = -1;  // index of its RCR state, or -1
     // For the reflection coefficient: the rest area and the flow along the vessel there.
     double rest_area = 0, rest_flow = 0;
   };
   std::vector<OutletEnd> outlets;
   std::size_t capacitors = 0;
+  // The boundaries at 1D ends (flows, pressures, outlets), by their places in list: the 1D
+  // scheme integrates the volume through these alone (a full tree has two million boundaries,
+  // nearly all at 0D vessels, whose volumes pulse/lumped_vessels sums once a step).
+  std::vector<std::int32_t> one_d_boundary;
 
   // The end states of the last solve, per vessel end: [2 v] proximal, [2 v + 1] distal.
   std::vector<EndState> end_state;

@@ -107,6 +107,12 @@ double PulseSolver::mean_flow(std::size_t vessel) const {
   return sum / elements_per_vessel_;
 }
 
+Eigen::VectorXd PulseSolver::boundary_volumes() const {
+  Eigen::VectorXd volumes(static_cast<Eigen::Index>(lumped_boundary_volume_.size()));
+  for (std::size_t b = 0; b < lumped_boundary_volume_.size(); ++b) volumes(static_cast<Eigen::Index>(b)) = boundary_volume(b);
+  return volumes;
+}
+
 double PulseSolver::network_volume() const {
   // The 1D vessels' volumes and what the 0D scheme conserves (lumped_vessels.hpp).
   double volume = lumped_.stored_volume();
@@ -116,7 +122,7 @@ double PulseSolver::network_volume() const {
 }
 
 void PulseSolver::check_solution() const {
-  lumped_.check(time_);
+  lumped_.check(time_, net_.id);
   for (Eigen::Index el = 0; el < state_.area.rows(); ++el)
     if (!(state_.area(el, 0) > 0) || !state_.area.row(el).allFinite() || !state_.flow.row(el).allFinite())
       throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], time_);

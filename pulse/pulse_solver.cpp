@@ -94,7 +94,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   }
 
   period_ = driving_waveform(net).period;
-  run_outlets_ = run_outlets(run_boundaries(net));
+  for (const Outlet& o : run_outlets(run_boundaries(net))) outlet_capacitance_.push_back(o.type == BoundaryType::rcr ? o.c : 0.0);
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_);
   lumped_.set_passes(options.lumped_passes);
@@ -194,7 +194,11 @@ void PulseSolver::allocate_state() {
   state_.flow.setZero(rows, modes);
   state_.capacitor.setZero(static_cast<Eigen::Index>(boundaries_.capacitors));
   state_.coupled.setZero(static_cast<Eigen::Index>(boundaries_.coupled.size()));
-  state_.boundary.setZero(static_cast<Eigen::Index>(boundaries_.list.size()));
+  state_.boundary.setZero(static_cast<Eigen::Index>(boundaries_.one_d_boundary.size()));
+  boundary_slot_.assign(boundaries_.list.size(), -1);
+  for (std::size_t j = 0; j < boundaries_.one_d_boundary.size(); ++j)
+    boundary_slot_[static_cast<std::size_t>(boundaries_.one_d_boundary[j])] = static_cast<std::int32_t>(j);
+  lumped_boundary_volume_.assign(boundaries_.list.size(), 0.0);
   area_q_.resize(rows, points);
   flow_q_.resize(rows, points);
   flux_q_.resize(rows, points);

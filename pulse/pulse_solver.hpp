@@ -84,7 +84,9 @@ struct PulseState {
   // entering), out through the others and the outlets [m^3].
   Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();
   Eigen::VectorXd coupled;     // per 1D end at a 0D node: the volume it let into the node [m^3]
-  Eigen::VectorXd boundary;    // per boundary (run_boundaries' order): the volume in through it [m^3]
+  // Per boundary at a 1D end (NetworkBoundaries::one_d_boundary): the volume in through it
+  // [m^3]; PulseSolver::boundary_volume gives every boundary's.
+  Eigen::VectorXd boundary;
   // Per element, where tracked (track_face_volumes; else empty): the volume through its left
   // face along the vessel [m^3]. Its area's mode 0 changes by exactly the difference of two
   // of these, which is what a transport scheme's cells need (transport/).
@@ -180,6 +182,13 @@ class PulseSolver {
   int max_degree() const { return static_cast<int>(bases_.size()) - 1; }
   std::size_t element_count() const { return static_cast<std::size_t>(state_.area.rows()); }
   const PulseState& state() const { return state_; }
+  // The volume in through boundary b (run_boundaries' order: boundary_list()) since the start
+  // [m^3], and every boundary's.
+  double boundary_volume(std::size_t b) const {
+    const std::int32_t slot = boundary_slot_[b];
+    return slot >= 0 ? state_.boundary(slot) : lumped_boundary_volume_[b];
+  }
+  Eigen::VectorXd boundary_volumes() const;
   // Throws SolutionBreakdown when A <= 0 or a value is not finite.
   void check_solution() const;
 
@@ -266,7 +275,9 @@ class PulseSolver {
 
   const Network& net_;
   double period_ = 1;                      // driving_waveform(net)'s
-  std::vector<Outlet> run_outlets_;        // run_outlets(run_boundaries(net))
+  // Per run outlet (run_outlets(run_boundaries(net))): its capacitance (an RCR's C, else 0)
+  // [m^3/Pa]; the outlets themselves are in boundaries_.list.
+  std::vector<double> outlet_capacitance_;
   std::vector<double> lumped_inflow_, lumped_held_;  // the 0D nodes' boundary values at a step's end
   Blood blood_;
   ViscosityTable viscosity_;
@@ -316,6 +327,10 @@ class PulseSolver {
   Eigen::VectorXd element_beta_;           // per element
   double friction_k_ = 0;                  // 2 pi alpha / (alpha - 1)
   NetworkBoundaries boundaries_;
+  // Per boundary: its place in state_.boundary (a 1D end's) or -1; and the volumes in through
+  // the others, at 0D nodes (LumpedVessels::complete sums them; the 1D entries stay 0).
+  std::vector<std::int32_t> boundary_slot_;
+  std::vector<double> lumped_boundary_volume_;
 
   PulseState state_, rate_, previous_rate_, stage_[4];
   // Per element: the friction rate r = k mu(A_mean) / (rho A_mean) the last evaluate() used;

@@ -26,6 +26,7 @@ void PulseSolver::save(CheckpointWriter& out) const {
     out.put(s->faces);
   }
   out.put(previous_flow_);
+  out.put(lumped_boundary_volume_);
   out.put(cycle_volume_);
   out.put(cycle_capacitor_);
   // The junctions' Newton iterations start from the last end states.
@@ -82,6 +83,9 @@ void PulseSolver::restore(CheckpointReader& in) {
        previous_rate_.flow.rows() != state_.flow.rows() || previous_rate_.capacitor.size() != state_.capacitor.size()))
     in.fail("multistep history of another discretisation");
   previous_flow_ = in.get_matrix();
+  std::vector<double> lumped_boundary_volume = in.get_vector();
+  if (lumped_boundary_volume.size() != lumped_boundary_volume_.size()) in.fail("boundaries of another network");
+  lumped_boundary_volume_ = std::move(lumped_boundary_volume);
   cycle_volume_ = in.get_vector();
   cycle_capacitor_ = in.get_vector();
   const std::vector<double> ends = in.get_vector();

@@ -230,7 +230,7 @@ void PulseSolver::step_coupled() {
   }
   // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
   lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1),
-                   std::span<double>(state_.boundary.data(), static_cast<std::size_t>(state_.boundary.size())));
+                   lumped_boundary_volume_);
   time_ = t1;
 }
 

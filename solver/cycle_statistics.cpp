@@ -47,7 +47,7 @@ void CycleStatistics::fit(const PulseSolver& solver) {
 void CycleStatistics::begin(const PulseSolver& solver) {
   fit(solver);
   exchanged_start_ = solver.state().exchanged;
-  boundary_start_ = solver.state().boundary;
+  boundary_start_ = solver.boundary_volumes();
   volume_start_ = solver.network_volume();
 }
 
@@ -117,7 +117,7 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   const Eigen::Vector2d exchanged = solver.state().exchanged - exchanged_start_;
   summary.inlet_mean_flow = exchanged(0) / duration_;
   summary.outlets_mean_flow = exchanged(1) / duration_;
-  const Eigen::VectorXd through = solver.state().boundary - boundary_start_;
+  const Eigen::VectorXd through = solver.boundary_volumes() - boundary_start_;
   for (Eigen::Index i = 0; i < through.size(); ++i) summary.boundary_mean_flow.push_back(through(i) / duration_);
   summary.volume_change = solver.network_volume() - volume_start_;
   summary.conservation_error =

@@ -270,7 +270,7 @@ void FlowTransport::solver_volumes(std::vector<double>& volume) const {
 
 void FlowTransport::mark() {
   solver_.clear_face_volumes();
-  boundary_mark_ = solver_.state().boundary;
+  boundary_mark_ = solver_.boundary_volumes();
 }
 
 void FlowTransport::take_volumes() {
@@ -287,7 +287,8 @@ void FlowTransport::advance() {
         lumped.passed_volume(static_cast<std::int32_t>(i));
   for (std::size_t j = 0; j < node_boundary_face_.size(); ++j) {
     const auto b = static_cast<Eigen::Index>(node_boundary_[j]);
-    face_volume_[static_cast<std::size_t>(node_boundary_face_[j])] = -(s.boundary(b) - boundary_mark_(b));
+    face_volume_[static_cast<std::size_t>(node_boundary_face_[j])] =
+        -(solver_.boundary_volume(static_cast<std::size_t>(b)) - boundary_mark_(b));
   }
   // 1D vessels: the proximal face's volume, then each slice's change passed on.
   now_.resize(cell_count());  // only its 0D nodes and slices are read below

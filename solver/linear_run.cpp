@@ -155,11 +155,11 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
                              {"status", "complete"},
                              {"cycles", 0},
                              {"wall_time", wall}};
-  run_info["boundaries"] = boundary_results(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0});
   run_info["statistics"] = group_statistics(net, results);
   folder.open();
   const std::filesystem::path dir = folder.staging();
-  write_summary(dir / "summary.json", run_info, results, linear.cycle);
+  write_summary(dir / "summary.json", run_info, results, linear.cycle,
+                boundary_results(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}));
   write_vessel_table(dir / "vessels.csv", results);
   if (!config.probes.empty()) write_probes(dir / "probes.csv", laws, periodic, config.probes);
   if (config.vtk) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);

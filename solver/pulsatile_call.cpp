@@ -206,19 +206,20 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
     info["periodic_change"] = pulsatile.change().change;
     info["slowest_vessel"] = net.id[pulsatile.change().vessel];
   }
-  const CycleSummary& last = pulsatile.last_cycle();
-  if (!last.boundary_mean_flow.empty()) {
-    // Each boundary's mean flow into the network over the last cycle (as the steady run reports).
-    info["boundaries"] = nlohmann::json::array();
-    for (std::size_t i = 0; i < run.boundary_list().size(); ++i) {
-      const NodeBoundary& b = run.boundary_list()[i];
-      info["boundaries"].push_back({{"node", net.node_id[static_cast<std::size_t>(b.node)]},
-                                    {"type", to_string(b.type)},
-                                    {"flow", last.boundary_mean_flow[i]}});
-      if (!b.is_outlet()) info["boundaries"].back()["hematocrit"] = b.entering_hematocrit(run.blood());
-    }
-  }
   return info;
+}
+
+// Each boundary's mean flow into the network over the last cycle (as the steady run reports).
+SummaryArray boundary_flows(const Network& net, const PulseSolver& run, const CycleSummary& last) {
+  if (last.boundary_mean_flow.empty()) return {};
+  return {"boundaries", run.boundary_list().size(), [&net, &run, &last](std::size_t i) {
+            const NodeBoundary& b = run.boundary_list()[i];
+            nlohmann::json entry = {{"node", net.node_id[static_cast<std::size_t>(b.node)]},
+                                    {"type", to_string(b.type)},
+                                    {"flow", last.boundary_mean_flow[i]}};
+            if (!b.is_outlet()) entry["hematocrit"] = b.entering_hematocrit(run.blood());
+            return entry;
+          }};
 }
 
 // The notes and warnings of a run that ended with its numbers: its length, the red cells'
@@ -378,7 +379,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
     report_transport(net, *transport, pulsatile.last_red_cells(), pulsatile.red_cell_change(),
                      static_cast<double>(plan.transport_every) * dt, results, info);
   if (!last.vessels.empty()) info["statistics"] = group_statistics(net, results);
-  write_summary(dir / "summary.json", info, results, last);
+  write_summary(dir / "summary.json", info, results, last, boundary_flows(net, run, last));
   write_vessel_table(dir / "vessels.csv", results);
   if (config.vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
   folder.publish();

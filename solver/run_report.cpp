@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 
 #include "formats/output_stream.hpp"
@@ -97,8 +98,34 @@ VesselTable vessel_results(const Network& net, const PulseSolver& solver, const 
   return table;
 }
 
+namespace {
+// Where a top-level member `name` goes among the members of `head` (an object dumped with an
+// indent of one, its closing brace cut off): before the first whose name sorts after it, as
+// nlohmann::json's std::map orders them; npos: after the last. A member starts with a newline,
+// one space and its quoted name (deeper members are indented further; strings escape newlines).
+std::size_t member_place(const std::string& head, const std::string& name) {
+  for (std::size_t at = head.find("\n \""); at != std::string::npos; at = head.find("\n \"", at + 1)) {
+    const std::size_t begin = at + 3, end = head.find('"', begin);
+    if (head.compare(begin, end - begin, name) > 0) return at;
+  }
+  return std::string::npos;
+}
+
+// The member as nlohmann::json dumps it with an indent of one at depth one.
+void write_array(OutputStream& out, const SummaryArray& array) {
+  constexpr auto replace = nlohmann::json::error_handler_t::replace;
+  out << "\n \"" << array.name << "\": [";
+  for (std::size_t i = 0; i < array.size; ++i) {
+    std::string entry = array.entry(i).dump(1, ' ', false, replace);
+    for (std::size_t at = entry.find('\n'); at != std::string::npos; at = entry.find('\n', at + 3)) entry.insert(at + 1, "  ");
+    out << (i ? ",\n  " : "\n  ") << entry;
+  }
+  out << (array.size == 0 ? "]" : "\n ]");
+}
+}  // namespace
+
 void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const VesselTable& vessels,
-                   const CycleSummary& cycle) {
+                   const CycleSummary& cycle, const SummaryArray& array) {
   nlohmann::json summary = run;
   summary["inlet_mean_flow"] = cycle.inlet_mean_flow;
   summary["outlets_mean_flow"] = cycle.outlets_mean_flow;
@@ -118,7 +145,21 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
   head.resize(head.rfind('}'));  // the run's facts, open for the vessels
   while (!head.empty() && (head.back() == '\n' || head.back() == ' ')) head.pop_back();
   OutputStream out(file.string());
-  out << head << ",\n \"vessels\": [";
+  if (array.name.empty()) {
+    out << head;
+  } else {
+    if (summary.contains(array.name)) throw std::logic_error("summary.json: " + array.name + " given twice");
+    const std::size_t place = member_place(head, array.name);
+    if (place == std::string::npos) {
+      out << head << ",";
+      write_array(out, array);
+    } else {
+      out << std::string_view(head).substr(0, place);
+      write_array(out, array);
+      out << "," << std::string_view(head).substr(place);
+    }
+  }
+  out << ",\n \"vessels\": [";
   for (std::size_t v = 0; v < vessels.rows(); ++v) {
     out << (v ? ",\n  " : "\n  ");
     vessels.write_json_row(out, v);

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -53,10 +54,19 @@ VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vect
 VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
                            double analysis_frequency);
 
-// summary.json: the run's facts (`run`), the mass balance and the vessels' results, one
-// vessel a line.
+// A member of summary.json with an entry per boundary: two million on a full tree, too many
+// to hold as a JSON tree (a few hundred bytes each), so written entry by entry, in the place
+// and the bytes nlohmann::json gives the member among the run's facts. entry(i) is the i-th.
+struct SummaryArray {
+  std::string name;  // empty: none
+  std::size_t size = 0;
+  std::function<nlohmann::json(std::size_t)> entry;
+};
+
+// summary.json: the run's facts (`run`, and `array` among them), the mass balance and the
+// vessels' results, one vessel a line.
 void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const VesselTable& vessels,
-                   const CycleSummary& cycle);
+                   const CycleSummary& cycle, const SummaryArray& array = {});
 
 // The results summarised per class, model, generation and diameter bin (a factor sqrt(2)
 // wide): each group's vessel count and the median, 5th and 95th percentile of its mean

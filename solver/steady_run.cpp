@@ -1,6 +1,7 @@
 #include "solver/steady_run.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -67,19 +68,22 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
   return cycle;
 }
 
-nlohmann::json boundary_results(const Network& net, const SteadyFlow& steady) {
-  const std::vector<double> inflow = boundary_inflow(net, steady);
+SummaryArray boundary_results(const Network& net, const SteadyFlow& steady) {
+  // Shared by the entries (the function outlives this call: write_summary calls it).
+  auto boundaries = std::make_shared<const std::vector<NodeBoundary>>(node_boundaries(net));
+  auto inflow = std::make_shared<const std::vector<double>>(boundary_inflow(net, steady));
+  auto pressure = std::make_shared<const std::vector<double>>(steady.node_pressure);
   const Blood blood = net.blood.value_or(Blood{});
-  nlohmann::json list = nlohmann::json::array();
-  for (const NodeBoundary& b : node_boundaries(net)) {
-    const auto i = static_cast<std::size_t>(b.node);
-    list.push_back({{"node", net.node_id[i]},
-                    {"type", to_string(b.type)},
-                    {"flow", inflow[i]},
-                    {"pressure", steady.node_pressure[i]}});
-    if (!b.is_outlet()) list.back()["hematocrit"] = b.entering_hematocrit(blood);
-  }
-  return list;
+  return {"boundaries", boundaries->size(), [&net, boundaries, inflow, pressure, blood](std::size_t k) {
+            const NodeBoundary& b = (*boundaries)[k];
+            const auto i = static_cast<std::size_t>(b.node);
+            nlohmann::json entry = {{"node", net.node_id[i]},
+                                    {"type", to_string(b.type)},
+                                    {"flow", (*inflow)[i]},
+                                    {"pressure", (*pressure)[i]}};
+            if (!b.is_outlet()) entry["hematocrit"] = b.entering_hematocrit(blood);
+            return entry;
+          }};
 }
 
 VesselTable steady_results(const Network& net, const CycleSummary& cycle) {
@@ -129,7 +133,6 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
                              {"status", !request.phase_separation || separated.converged ? "complete" : "not converged"},
                              {"cycles", 0},
                              {"wall_time", wall}};
-  run_info["boundaries"] = boundary_results(net, steady);
   if (request.phase_separation)
     run_info["red_cell_iterations"] = {{"passes", separated.iterations},
                                        {"change", separated.change},
@@ -138,7 +141,7 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
   run_info["statistics"] = group_statistics(net, results);
   folder.open();
   const std::filesystem::path dir = folder.staging();
-  write_summary(dir / "summary.json", run_info, results, cycle);
+  write_summary(dir / "summary.json", run_info, results, cycle, boundary_results(net, steady));
   write_vessel_table(dir / "vessels.csv", results);
   if (request.vtk) write_results_vtk(dir / "results.vtp", net, results, request.vtk_keep);
   folder.publish();

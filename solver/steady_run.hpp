@@ -14,6 +14,7 @@
 #include "formats/network.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/run_observer.hpp"
+#include "solver/run_report.hpp"
 #include "steady/steady_flow.hpp"
 #include "solver/vessel_table.hpp"
 
@@ -29,7 +30,7 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
 
 // Every boundary node's condition and what the solve gives there: {"node", "type", "flow"
 // (into the network, m^3/s), "pressure" (Pa)}, by node.
-nlohmann::json boundary_results(const Network& net, const SteadyFlow& steady);
+SummaryArray boundary_results(const Network& net, const SteadyFlow& steady);
 
 // cycle_table's columns with the model "steady" and no degree, and null wave columns.
 VesselTable steady_results(const Network& net, const CycleSummary& cycle);
