@@ -217,11 +217,42 @@ void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
 }
 
 void LumpedVessels::update_resistances() {
+  linearised_dt_ = 0;
   parallel_blocks(static_cast<std::int64_t>(vessels_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
     for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e)
       resistance_[e] = resistance(e, pressure_[static_cast<std::size_t>(a_[e])],
                                   pressure_[static_cast<std::size_t>(b_[e])], capacity_a_[e], capacity_b_[e]);
   });
+}
+
+void LumpedVessels::update_resistances_and_linearise(double dt) {
+  // One pass where two read each vessel's ends and law: the resistances at the new pressures,
+  // then the next step's edges at the state extrapolated from them (linearise's first pass,
+  // the same arithmetic), should that step be as long as this one.
+  parallel_blocks(static_cast<std::int64_t>(vessels_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
+    for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
+      const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
+      resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
+      linearise_edge(e, 2 * pressure_[a] - previous_pressure_[a], 2 * pressure_[b] - previous_pressure_[b], true, dt);
+    }
+  });
+  linearised_dt_ = dt;
+}
+
+void LumpedVessels::linearise_edge(std::size_t e, double pa, double pb, bool extrapolated, double dt) {
+  // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
+  // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
+  double r;
+  if (extrapolated) {
+    r = std::clamp(2 * resistance_[e] - previous_resistance_[e], 0.5 * resistance_[e], 2 * resistance_[e]);
+  } else {
+    double capacity_a, capacity_b;
+    r = resistance(e, pa, pb, capacity_a, capacity_b);
+  }
+  const double s = edge_root_intercept_[e] + edge_root_slope_[e] * 0.5 * (pa + pb);
+  const double inertance = tapered(e) ? tapered_inertance(static_cast<std::int32_t>(e), pa, pb) : density_ * edge_length_[e] / (s * s);
+  conductance_[e] = 1 / (r + 1.5 * inertance / dt);
+  history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
 }
 
 double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const {
@@ -267,6 +298,7 @@ void LumpedVessels::set_viscosity_factor(std::int32_t index, double factor) {
 }
 
 void LumpedVessels::refresh_resistance(std::size_t e) {
+  linearised_dt_ = 0;
   // What restore() computes from the pressures: a run resumed from a checkpoint has the same
   // resistances, whenever the factors changed.
   double capacity_a, capacity_b;
@@ -368,30 +400,18 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
   // error of O(dt^2) in the coefficients keeps BDF2 second order with one solve; the
   // resistance is extrapolated itself, no viscosity to evaluate, within a factor of two of
   // today's), or a Picard pass's last solution.
-  const bool has_tapers = !tapered_.empty();
   auto at = [&](std::int32_t k) {
     const auto i = static_cast<std::size_t>(k);
     return extrapolated ? 2 * pressure_[i] - previous_pressure_[i] : predicted_[i];
   };
-  // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
-  // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
-  parallel_blocks(vessels_i, threads_, [&](std::int64_t first, std::int64_t last) {
-    for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
-      const double pa = at(a_[e]), pb = at(b_[e]);
-      double r;
-      if (extrapolated) {
-        r = std::clamp(2 * resistance_[e] - previous_resistance_[e], 0.5 * resistance_[e], 2 * resistance_[e]);
-      } else {
-        double capacity_a, capacity_b;
-        r = resistance(e, pa, pb, capacity_a, capacity_b);
-      }
-      const double s = edge_root_intercept_[e] + edge_root_slope_[e] * 0.5 * (pa + pb);
-      const double inertance = has_tapers && tapered(e) ? tapered_inertance(static_cast<std::int32_t>(e), pa, pb)
-                                                        : density_ * edge_length_[e] / (s * s);
-      conductance_[e] = 1 / (r + 1.5 * inertance / dt);
-      history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
-    }
-  });
+  // The edges of the extrapolated pass were linearised with the last step's completion
+  // (complete(): update_resistances_and_linearise).
+  if (!(extrapolated && linearised_dt_ == dt))
+    parallel_blocks(vessels_i, threads_, [&](std::int64_t first, std::int64_t last) {
+      for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e)
+        linearise_edge(e, at(a_[e]), at(b_[e]), extrapolated, dt);
+    });
+  linearised_dt_ = 0;
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
   {
     // BDF2 for a node's volume, V(p) linearised at p*:
@@ -520,7 +540,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   previous_flow_.swap(flow_);  // the new flows went where the oldest were
   for (std::size_t e = 0; e < passed_.size(); ++e) passed_[e] += dt * flow_[e];
   previous_resistance_.swap(resistance_);
-  update_resistances();
+  update_resistances_and_linearise(dt);
   update_dynamic_pressures();
   // Across the network's boundary: flows, outlet shunts and the R1 of RCR outlets, held
   // pressures' shunts; each to "in" or "out" as its boundary counts (set_entering).

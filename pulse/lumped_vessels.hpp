@@ -251,6 +251,11 @@ class LumpedVessels {
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R
+  // The same after a step, and the next step's edges (linearise's extrapolated pass) for a
+  // step of dt in the same pass; linearised_dt_ = dt says they are (0: not).
+  void update_resistances_and_linearise(double dt);
+  void linearise_edge(std::size_t e, double pa, double pb, bool extrapolated, double dt);
+  double linearised_dt_ = 0;
 
   std::size_t nodes_ = 0, network_nodes_ = 0;  // network nodes first, then capacitor nodes
   std::vector<std::int32_t> node_of_;          // per network node
