@@ -12,9 +12,14 @@
 namespace hemotree {
 
 TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& resistance, const TreeLoads& loads) {
+  if (net.vessel_count() == 0) throw InputError("the network has no vessels");
+  return solve_loaded_tree(net, run_boundaries(net), resistance, loads);
+}
+
+TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBoundary>& boundaries,
+                                 const std::vector<double>& resistance, const TreeLoads& loads) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   if (n == 0) throw InputError("the network has no vessels");
-  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
   const std::vector<Outlet> outlets = run_outlets(boundaries);
   if (resistance.size() != n || loads.node_shunt.size() != nodes || loads.node_current.size() != nodes ||
       loads.capacitor_shunt.size() != outlets.size() || loads.capacitor_current.size() != outlets.size())

@@ -32,5 +32,9 @@ struct TreePotentials {
 // without an outlet, an outlet on a vessel that is not terminal), for a reflection outlet,
 // and where a part of the network has no path to ground.
 TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& resistance, const TreeLoads& loads);
+// The same with the network's run_boundaries(net) given (a run holds them: on a full tree two
+// million entries, not to be built again at every cycle end).
+TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBoundary>& boundaries,
+                                 const std::vector<double>& resistance, const TreeLoads& loads);
 
 }  // namespace hemotree
