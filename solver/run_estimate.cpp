@@ -15,10 +15,10 @@ constexpr double step_cost = 10e-6;    // [s per step]
 constexpr double fixed_cost = 300e-9;  // [s per element and step]
 constexpr double modal_cost = 18e-9;   // [s per element, step and (p + 1)^2]
 // 0D vessels: one linearisation, factorisation and two solves of the nodal system per step,
-// and the cycle statistics' samples. Measured on one thread 0.19 us a vessel and step on the
-// 100001-vessel network, and with two 0.10-0.11 us on 1 M and 3.8 M vessels (bench/README.md,
-// "The hybrid model"): the one-thread figure, so that the estimate errs long.
-constexpr double lumped_cost = 200e-9;  // [s per 0D vessel and step]
+// and the cycle statistics' samples. Measured with two threads 42 ns a vessel and step on
+// 1 M and 3.8 M vessels (bench/README.md, "The lean engine"), about 76 ns on one at two
+// threads' 1.8-fold speed-up: 100 ns, so that the estimate errs long.
+constexpr double lumped_cost = 100e-9;  // [s per 0D vessel and step]
 }  // namespace
 
 double element_step_seconds(int degree) {
