@@ -272,7 +272,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   const Waveform driving = driving_waveform(net);
   const double period = driving.period;
   OutputFolder folder(config.out_dir);
-  const Checkpoint checkpoint = checkpoint_to_resume(folder, config);
+  Checkpoint checkpoint = checkpoint_to_resume(folder, config);
   RunResult result;
   auto interrupted_before_start = [&] {  // before the time loop nothing is written: just stop
     if ((result.signal = observer.poll_interrupt()) == 0) return false;
@@ -330,7 +330,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   }
   PulsatileRun pulsatile(net, run, config.probes, plan, folder.staging(), transport ? &*transport : nullptr);
   if (!checkpoint.bytes.empty()) {
-    pulsatile.resume(checkpoint.bytes, checkpoint.source);
+    pulsatile.resume(std::move(checkpoint.bytes), checkpoint.source);  // not held through the run
     observer.note("resuming from " + checkpoint.source + " after " + std::to_string(pulsatile.cycles_done()) +
                   " cycles (t = " + format_quantity(run.time(), "s") + ")");
   }

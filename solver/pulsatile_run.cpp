@@ -101,7 +101,7 @@ void PulsatileRun::snapshot() {
   snapshot_pending_ = true;
 }
 
-void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
+void PulsatileRun::resume(std::string bytes, const std::string& source) {
   CheckpointReader in(bytes, source);
   in.section("identity");
   if (in.get_u64() != plan_.network_identity) in.fail("written for another network (its fingerprint differs)");
@@ -136,7 +136,7 @@ void PulsatileRun::resume(const std::string& bytes, const std::string& source) {
   in.section("end");
   if (!in.at_end()) in.fail("unexpected bytes after the checkpoint");
   resumed_ = true;
-  resumed_bytes_ = bytes;  // the snapshot as it is until a cycle ends (written once the folder is open)
+  resumed_bytes_ = std::move(bytes);  // the snapshot as it is until a cycle ends (written once the folder is open)
   if (!cycles_left()) check_run_end(source);
 }
 

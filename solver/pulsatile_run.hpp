@@ -57,7 +57,7 @@ class PulsatileRun {
   // source: the checkpoint file. One at the run's end (no cycle left to run) is taken only
   // from a killed run's staging folder (the run's folder), whose frames of that last cycle
   // are then this run's; a published run that already has its cycles is refused as it is.
-  void resume(const std::string& checkpoint_bytes, const std::string& source);
+  void resume(std::string checkpoint_bytes, const std::string& source);
   // Progress goes to the observer, as its progress_style() asks; its interrupt requests are
   // polled every 256 steps and answered at the last cycle end.
   RunStatus run(RunObserver& observer);
