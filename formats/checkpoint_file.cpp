@@ -47,7 +47,6 @@ std::string describe_section(const std::string& name, std::size_t index) {
   return readable ? "section \"" + name + "\"" : "section " + std::to_string(index + 1);
 }
 
-
 // All of it to fd, IoError naming the file where it cannot.
 void write_all(int fd, const char* data, std::size_t size, const std::filesystem::path& file) {
   std::size_t written = 0;
@@ -134,7 +133,7 @@ void CheckpointWriter::section(std::string_view name) {
 }
 
 std::string CheckpointWriter::bytes() const {
-  if (fd_ >= 0 || !file_.empty()) throw std::logic_error("checkpoint: bytes() of a writer to a file");
+  if (!file_.empty()) throw std::logic_error("checkpoint: bytes() of a writer to a file");
   std::string file = bytes_;
   if (section_start_ != std::string::npos) close_section(file, section_start_);
   append_word(file, checksum(file, 0, file.size()));
@@ -307,27 +306,19 @@ void write_checkpoint_file(const std::filesystem::path& file, const std::string&
   const std::filesystem::path temp = file.string() + ".tmp";
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw IoError("cannot write " + temp.string() + ": " + std::strerror(errno));
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int error = errno;
-      ::close(fd);
-      ::unlink(temp.c_str());
-      throw IoError("cannot write " + temp.string() + ": " + std::strerror(error));
-    }
-    written += static_cast<std::size_t>(n);
-  }
-  // On disk before the rename: after a crash the name holds a whole checkpoint or the old one.
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+  try {
+    write_all(fd, bytes.data(), bytes.size(), temp);
+  } catch (...) {
+    ::close(fd);
     ::unlink(temp.c_str());
-    throw IoError("cannot write " + temp.string() + ": " + std::strerror(errno));
+    throw;
   }
-  if (std::rename(temp.c_str(), file.c_str()) != 0) {
-    const int error = errno;
+  try {
+    if (::close(fd) != 0) throw IoError("cannot write " + temp.string() + ": " + std::strerror(errno));
+    promote_checkpoint_file(temp, file);  // synced, then renamed over `file`
+  } catch (...) {
     ::unlink(temp.c_str());
-    throw IoError("cannot write " + file.string() + ": " + std::strerror(error));
+    throw;
   }
 }
 

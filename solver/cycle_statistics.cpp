@@ -24,18 +24,14 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
   return omega * dx / lag;
 }
 
-CycleStatistics::CycleStatistics(const Network& net, double analysis_frequency)
+CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, double analysis_frequency)
     : net_(net), omega_(2 * std::numbers::pi * analysis_frequency),
       flow_(net.vessel_count(), 0.0), pressure_(net.vessel_count(), 0.0),
       p_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
       p_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()),
       q_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
       q_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()), wss_(net.vessel_count(), 0.0),
-      reynolds_(net.vessel_count(), 0.0) {}
-
-void CycleStatistics::fit(const PulseSolver& solver) {
-  if (one_d_ == solver.one_d_vessels()) return;
-  one_d_ = solver.one_d_vessels();
+      reynolds_(net.vessel_count(), 0.0), one_d_(solver.one_d_vessels()) {
   const std::size_t n = one_d_.size();
   for (auto* sums : {&p_in_, &p_out_, &u_in_, &u_out_}) sums->assign(n, 0.0);
   first_.assign(4 * n, 0.0);
@@ -45,7 +41,6 @@ void CycleStatistics::fit(const PulseSolver& solver) {
 }
 
 void CycleStatistics::begin(const PulseSolver& solver) {
-  fit(solver);
   exchanged_start_ = solver.state().exchanged;
   boundary_start_ = solver.boundary_volumes();
   volume_start_ = solver.network_volume();
@@ -56,7 +51,6 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
   const double rho = solver.blood().density, alpha = solver.blood().alpha;
   const int threads = solver.threads();
   const std::complex<double> phase = weight * std::polar(1.0, -omega_ * t);
-  fit(solver);
   if (duration_ == 0) {
     first_time_ = t;
     record_ends(solver, first_);
@@ -122,7 +116,6 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   summary.volume_change = solver.network_volume() - volume_start_;
   summary.conservation_error =
       (exchanged(0) - exchanged(1) - summary.volume_change) / exchange_scale(exchanged(0), exchanged(1), volume_start_);
-  fit(solver);
   if (duration_ > 0) record_ends(solver, last_);  // the state of the cycle's last sample
   begin(solver);  // the next cycle starts here unless begin() is called again
   std::vector<VesselCycle>& out = summary.vessels;

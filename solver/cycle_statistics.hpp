@@ -62,8 +62,9 @@ double exchange_scale(double in, double out, double network_volume);
 
 class CycleStatistics {
  public:
-  // analysis_frequency: the harmonic [Hz] at which the pulse wave speeds are measured.
-  CycleStatistics(const Network& net, double analysis_frequency);
+  // analysis_frequency: the harmonic [Hz] at which the pulse wave speeds are measured, in
+  // the solver's 1D vessels.
+  CycleStatistics(const Network& net, const PulseSolver& solver, double analysis_frequency);
   // Marks the start of a cycle (after any compliance balance, which moves volume).
   void begin(const PulseSolver& solver);
   // Samples the solver's state at time t, standing for the `weight` seconds before it. The
@@ -89,7 +90,6 @@ class CycleStatistics {
   double first_time_ = 0, last_time_ = 0;
   // Scratch: the 1D vessels' samples at the centre and the two ends.
   std::vector<double> area_, q_, p_, area_end_, q_end_, p_end_, area_out_, q_out_, p_out_end_;
-  void fit(const PulseSolver& solver);  // the per-1D-vessel arrays to the solver's 1D vessels
   void record_ends(const PulseSolver& solver, std::vector<double>& values);  // p_in, p_out, u_in, u_out
   double duration_ = 0;
 };

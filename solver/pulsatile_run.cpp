@@ -54,7 +54,7 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
 PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<Probe> probes, RunPlan plan,
                            std::filesystem::path folder, FlowTransport* transport)
     : net_(net), solver_(solver), plan_(std::move(plan)), folder_(std::move(folder)),
-      stats_(net, analysis_frequency(driving_waveform(net))), probes_(std::move(probes)), transport_(transport) {
+      stats_(net, solver, analysis_frequency(driving_waveform(net))), probes_(std::move(probes)), transport_(transport) {
   plan_.transport_every = std::max<std::size_t>(plan_.transport_every, 1);
   if (!transport_) return;
   // probes.csv: the discharge hematocrit and each tracer's concentration at every probe.

@@ -224,7 +224,7 @@ TEST(NetworkGraphsPulsatile, SeveralPulsatileInflowsBalanceOverAPeriodicCycle) {
     EXPECT_DOUBLE_EQ(solver.period(), period);
     const auto steps = static_cast<std::size_t>(std::ceil(period / solver.dt() - 1e-9));
     solver.set_time_step(period / static_cast<double>(steps));
-    CycleStatistics stats(net, 1 / period);
+    CycleStatistics stats(net, solver, 1 / period);
     solver.balance_compliances(period);
     CycleSummary last;
     for (int cycle = 0; cycle < 6; ++cycle) {
@@ -331,7 +331,7 @@ TEST(NetworkGraphsPulsatile, RatMesenteryRunsAndMatchesItsSteadyState) {
   EXPECT_EQ(period, 1.0);  // constant boundaries
   const auto steps = static_cast<std::size_t>(std::ceil(period / solver.dt() - 1e-9));
   solver.set_time_step(period / static_cast<double>(steps));
-  CycleStatistics stats(net, 1.0);
+  CycleStatistics stats(net, solver, 1.0);
   stats.begin(solver);
   const auto started = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < steps; ++k) {

@@ -26,7 +26,7 @@ CycleSummary run_cycles(const Network& net, const SolverOptions& options, int cy
   const double period = net.inlet->waveform.period;
   const auto steps = static_cast<std::size_t>(std::ceil(period / solver.dt()));
   solver.set_time_step(period / static_cast<double>(steps));
-  CycleStatistics stats(net, frequency);
+  CycleStatistics stats(net, solver, frequency);
   CycleSummary last;
   for (int c = 0; c < cycles; ++c) {
     for (std::size_t k = 0; k < steps; ++k) {
