@@ -1,7 +1,10 @@
 #include "harmonic/linear_periodic.hpp"
 
+#include <cstdint>
+#include <exception>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "boundaries/rcr_outlet.hpp"
 #include "boundaries/resistance_outlet.hpp"
@@ -13,23 +16,57 @@ namespace hemotree {
 
 namespace {
 
-// The network's oscillation at one angular frequency w: every node's pressure amplitude.
-std::vector<Complex> solve_harmonic(const Network& net, const std::vector<NodeBoundary>& boundaries,
-                                    const std::vector<FourierSeries>& series, const std::vector<VesselLine>& lines,
-                                    int k, double w) {
+// What every harmonic shares: the held nodes, the vessels between free nodes (the system's
+// edges) and those with one end held, and the system's structure.
+struct HarmonicNetwork {
+  std::vector<unsigned char> held, touched;
+  std::vector<std::int32_t> edge_vessel, held_end_vessel;
+  HarmonicSystem system;
+};
+
+HarmonicNetwork harmonic_network(const Network& net, const std::vector<NodeBoundary>& boundaries) {
   const std::size_t nodes = net.node_count(), n = net.vessel_count();
-  std::vector<Complex> shunt(nodes, 0.0), current(nodes, 0.0), held_value(nodes, 0.0);
-  std::vector<unsigned char> held(nodes, 0);
+  std::vector<unsigned char> held(nodes, 0), touched(nodes, 0);  // a node no vessel reaches stays at 0
+  for (const NodeBoundary& b : boundaries)
+    if (b.type == BoundaryType::pressure) held[static_cast<std::size_t>(b.node)] = 1;
+  std::vector<std::int32_t> a, b, edge_vessel, held_end_vessel;
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto i = static_cast<std::size_t>(net.from[v]), j = static_cast<std::size_t>(net.to[v]);
+    touched[i] = touched[j] = 1;
+    if (held[i] && held[j]) continue;
+    if (held[i] || held[j]) {
+      held_end_vessel.push_back(static_cast<std::int32_t>(v));
+    } else {
+      a.push_back(net.from[v]);
+      b.push_back(net.to[v]);
+      edge_vessel.push_back(static_cast<std::int32_t>(v));
+    }
+  }
+  return {std::move(held), std::move(touched), std::move(edge_vessel), std::move(held_end_vessel),
+          HarmonicSystem(nodes, std::move(a), std::move(b))};
+}
+
+// One harmonic's system, kept from one harmonic to the next: fresh pages of this size cost
+// more than the solve.
+struct HarmonicWorkspace {
+  std::vector<Complex> shunt, current, held_value;
+  std::vector<TwoPort> edge;
+};
+
+// The network's oscillation at one angular frequency w: every node's pressure amplitude.
+std::vector<Complex> solve_harmonic(const Network& net, const HarmonicNetwork& h, const std::vector<NodeBoundary>& boundaries,
+                                    const std::vector<FourierSeries>& series, const std::vector<VesselLine>& lines,
+                                    int k, double w, HarmonicWorkspace& work) {
+  const std::size_t nodes = net.node_count();
+  std::vector<Complex>&shunt = work.shunt, &current = work.current, &held_value = work.held_value;
+  shunt.assign(nodes, 0.0), current.assign(nodes, 0.0), held_value.assign(nodes, 0.0);
   for (std::size_t i = 0; i < boundaries.size(); ++i) {
     const NodeBoundary& b = boundaries[i];
     const auto node = static_cast<std::size_t>(b.node);
     const Complex amplitude = b.is_outlet() ? Complex(0.0) : series[i].amplitude[static_cast<std::size_t>(k)];
     switch (b.type) {
       case BoundaryType::flow: current[node] += amplitude; break;
-      case BoundaryType::pressure:
-        held[node] = 1;
-        held_value[node] = amplitude;
-        break;
+      case BoundaryType::pressure: held_value[node] = amplitude; break;
       case BoundaryType::resistance: shunt[node] += 1.0 / ResistanceOutlet{b.outlet.r, b.outlet.p_out}.impedance(w); break;
       case BoundaryType::rcr:
         shunt[node] += 1.0 / RcrOutlet{b.outlet.r1, b.outlet.c, b.outlet.r2, b.outlet.p_out}.impedance(w);
@@ -41,36 +78,32 @@ std::vector<Complex> solve_harmonic(const Network& net, const std::vector<NodeBo
   }
   // Each vessel's two-port; a vessel ending at a held node becomes, at its other node, a
   // shunt and the current the held pressure drives through it.
-  std::vector<std::int32_t> a, b;
-  std::vector<TwoPort> edge;
-  for (std::size_t v = 0; v < n; ++v) {
+  for (const std::int32_t vessel : h.held_end_vessel) {
+    const auto v = static_cast<std::size_t>(vessel);
     const TwoPort y = lines[v].two_port(w);
     const auto i = static_cast<std::size_t>(net.from[v]), j = static_cast<std::size_t>(net.to[v]);
-    if (held[i] && held[j]) continue;
-    if (held[i]) {
+    if (h.held[i]) {
       shunt[j] += y.bb;
       current[j] -= y.ba * held_value[i];
-    } else if (held[j]) {
+    } else {
       shunt[i] += y.aa;
       current[i] -= y.ab * held_value[j];
-    } else {
-      a.push_back(net.from[v]);
-      b.push_back(net.to[v]);
-      edge.push_back(y);
     }
   }
-  std::vector<unsigned char> touched(nodes, 0);  // a node no vessel reaches stays at 0
-  for (std::size_t v = 0; v < n; ++v) touched[static_cast<std::size_t>(net.from[v])] = touched[static_cast<std::size_t>(net.to[v])] = 1;
+  std::vector<TwoPort>& edge = work.edge;
+  edge.resize(h.edge_vessel.size());
+  for (std::size_t e = 0; e < edge.size(); ++e) edge[e] = lines[static_cast<std::size_t>(h.edge_vessel[e])].two_port(w);
   for (std::size_t node = 0; node < nodes; ++node) {
-    if (held[node]) {
+    if (h.held[node]) {
       shunt[node] = 1.0;
       current[node] = held_value[node];
-    } else if (!touched[node]) {
+    } else if (!h.touched[node]) {
       shunt[node] = 1.0;
     }
   }
   try {
-    return solve_harmonic_system(nodes, a, b, edge, shunt, current);
+    h.system.solve_in_place(edge, shunt, current);
+    return current;
   } catch (const std::invalid_argument&) {
     throw InputError("the linear periodic solution: a part of the network has no path to an outlet or a pressure");
   }
@@ -79,14 +112,14 @@ std::vector<Complex> solve_harmonic(const Network& net, const std::vector<NodeBo
 }  // namespace
 
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
-                                     const ViscosityTable& viscosity, int harmonics) {
+                                     const ViscosityTable& viscosity, int harmonics, int threads) {
   const SteadyFlow steady =
       solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
-  return solve_linear_periodic(net, blood, laws, viscosity, steady, harmonics);
+  return solve_linear_periodic(net, blood, laws, viscosity, steady, harmonics, threads);
 }
 
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
-                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int harmonics) {
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int harmonics, int threads) {
   if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
   const std::size_t n = net.vessel_count();
   LinearPeriodic out;
@@ -97,7 +130,10 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
 
   const double k_friction = friction_coefficient(blood.alpha);
   out.line_.resize(n);
-  for (std::size_t v = 0; v < n; ++v) {
+  const auto vessels = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t i = 0; i < vessels; ++i) {
+    const auto v = static_cast<std::size_t>(i);
     const TubeLaw& law = laws[v];
     const double p = 0.5 * (steady.node_pressure[static_cast<std::size_t>(net.from[v])] +
                             steady.node_pressure[static_cast<std::size_t>(net.to[v])]);
@@ -110,8 +146,25 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
   std::vector<FourierSeries> series;
   for (const NodeBoundary& b : boundaries)  // an outlet's pressure beyond does not oscillate
     series.push_back(b.is_outlet() ? FourierSeries{} : fourier_series(b.waveform, harmonics));
-  for (int k = 1; k <= harmonics; ++k)
-    out.node_pressure_.push_back(solve_harmonic(net, boundaries, series, out.line_, k, out.omega(k)));
+  const HarmonicNetwork network = harmonic_network(net, boundaries);
+  // The harmonics are independent: one to a thread (each solve the same arithmetic).
+  out.node_pressure_.resize(static_cast<std::size_t>(harmonics));
+  std::vector<std::exception_ptr> failure(static_cast<std::size_t>(harmonics));
+#pragma omp parallel num_threads(threads) if (threads > 1)
+  {
+    HarmonicWorkspace work;
+#pragma omp for schedule(dynamic, 1)
+    for (int k = 1; k <= harmonics; ++k) {
+      try {
+        out.node_pressure_[static_cast<std::size_t>(k - 1)] =
+            solve_harmonic(net, network, boundaries, series, out.line_, k, out.omega(k), work);
+      } catch (...) {
+        failure[static_cast<std::size_t>(k - 1)] = std::current_exception();
+      }
+    }
+  }
+  for (const std::exception_ptr& f : failure)
+    if (f) std::rethrow_exception(f);
   return out;
 }
 

@@ -57,7 +57,7 @@ class LinearPeriodic {
   double flow_at(std::size_t vessel, double s, double t) const;
 
   friend LinearPeriodic solve_linear_periodic(const Network&, const Blood&, std::span<const TubeLaw>,
-                                              const ViscosityTable&, const SteadyFlow&, int);
+                                              const ViscosityTable&, const SteadyFlow&, int, int);
 
  private:
   const Network* net_ = nullptr;
@@ -71,12 +71,14 @@ class LinearPeriodic {
 // waveforms (their common period: driving_waveform). laws: per vessel (a tapered vessel's at
 // its proximal end); viscosity: mu(A) of the run's blood. Throws InputError where the steady
 // state does (a reflection outlet has no steady state), or where a part of the network has
-// no path to ground.
+// no path to ground. threads: for the vessels' lines and two-ports (the same numbers for any
+// count).
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
-                                     const ViscosityTable& viscosity, int harmonics);
+                                     const ViscosityTable& viscosity, int harmonics, int threads = 1);
 // The same about a steady state already solved (solve_distended_steady_flow with the same
 // blood, laws and viscosity).
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
-                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int harmonics);
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int harmonics,
+                                     int threads = 1);
 
 }  // namespace hemotree

@@ -30,6 +30,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <complex>
 
 #include "network_flow/harmonic_system.hpp"
@@ -46,37 +47,24 @@ struct VesselLine {
   double alpha = 4.0 / 3.0;  // momentum-flux factor
 
   struct Matrix {
-    Complex tau, m12, m21, s;  // M's entries (M_11 = tau, M_22 = 0) and s
+    Complex tau, m12, m21, s2;  // M's entries (M_11 = tau, M_22 = 0) and s^2
+    Complex s() const {
+      const Complex s = std::sqrt(s2);
+      return s.real() < 0 ? -s : s;
+    }
   };
   Matrix matrix(double w) const {
     const double uc2 = mean_velocity * mean_velocity * inertance * compliance;  // U^2 / c^2
     const double d = 1 - alpha * uc2;
     const Complex tau(0, 2 * alpha * w * mean_velocity * inertance * compliance / d);
     const Complex m12 = -Complex(resistance, w * inertance) / d, m21(0, -w * compliance);
-    Complex s = std::sqrt(0.25 * tau * tau + m12 * m21);
-    if (s.real() < 0) s = -s;
-    return {tau, m12, m21, s};
+    return {tau, m12, m21, 0.25 * tau * tau + m12 * m21};
   }
   // At rest (U = 0): the propagation constant gamma and the characteristic impedance.
-  Complex propagation(double w) const { return matrix(w).s; }
+  Complex propagation(double w) const { return matrix(w).s(); }
   Complex characteristic_impedance(double w) const { return Complex(resistance, w * inertance) / propagation(w); }
 
-  TwoPort two_port(double w) const {
-    const Matrix m = matrix(w);
-    const Complex sl = m.s * length, e = std::exp(0.5 * m.tau * length);
-    Complex coth, csch;
-    if (sl.real() < 20) {
-      const Complex sinh = std::sinh(sl);
-      coth = std::cosh(sl) / sinh;
-      csch = 1.0 / sinh;
-    } else {
-      const Complex q = std::exp(-2.0 * sl);
-      coth = (1.0 + q) / (1.0 - q);
-      csch = 2.0 * std::exp(-sl) / (1.0 - q);
-    }
-    return {-(m.s * coth + 0.5 * m.tau) / m.m12, m.s * csch / (e * m.m12), e * m.s * csch / m.m12,
-            -(m.s * coth - 0.5 * m.tau) / m.m12};
-  }
+  TwoPort two_port(double w) const { return two_port(matrix(w)); }
 
   // Pressure and flow (from -> to) at x along the vessel, given its end pressures; carried
   // from the nearer end, so that a long lossy line's growing and decaying waves stay within
@@ -87,17 +75,80 @@ struct VesselLine {
   struct Point {
     Complex pressure, flow;
   };
-  // At its start, middle and end at once (one evaluation of the line's coefficients).
+  // At its start, middle and end at once. Where the series serve (|s l| <= 2), the whole
+  // line's functions are the half line's doubled: cosh 2x = 2 cosh^2 x - 1,
+  // sinh(2x) / 2x = sinhc(x) cosh x, e^{2a} = (e^a)^2.
   std::array<Point, 3> ends_and_middle(double w, Complex p0, Complex p1) const {
-    const auto points = at(w, p0, p1, {0.0, 0.5 * length, length});
-    return {points[0], points[1], points[2]};
+    const Matrix m = matrix(w);
+    if (std::norm(m.s2 * (length * length)) > 16) {
+      const auto points = at(w, p0, p1, {0.0, 0.5 * length, length});
+      return {points[0], points[1], points[2]};
+    }
+    const double dx = 0.5 * length;
+    const Hyperbolic half = hyperbolic(m, dx);
+    const Complex e_half = std::polar(1.0, 0.5 * m.tau.imag() * dx);
+    const TwoPort y = two_port(m, {2.0 * half.cosh * half.cosh - 1.0, half.sinhc * half.cosh}, e_half * e_half);
+    const Complex q0 = y.aa * p0 + y.ab * p1, q1 = -(y.ba * p0 + y.bb * p1);
+    return {Point{p0, q0}, along(m, half, e_half, dx, p0, q0), Point{p1, q1}};
   }
 
  private:
+  // cosh(s x) and sinh(s x) / (s x), both even in s x, from s^2: by their Taylor series
+  // through (s x)^18 where |s x| <= 1 (the first term left out, (s x)^20 / 20!, is below
+  // 1e-18, and no term exceeds cosh 1 = 1.54 for a sum of at least cos 1 = 0.54: rounding
+  // stays within a few 1e-16), so that a vessel the pulse crosses nearly in phase (almost
+  // every vessel of a tree at every harmonic) needs no square root and no transcendental
+  // function; else from one real exponential and one sincos.
+  struct Hyperbolic {
+    Complex cosh, sinhc;
+  };
+  static Hyperbolic hyperbolic(const Matrix& m, double x) {
+    const Complex x2 = m.s2 * (x * x);
+    if (std::norm(x2) <= 1) {
+      // Horner from the highest term: 1/(2n)! and 1/(2n+1)! as ratios of their neighbours.
+      Complex ch = 1.0, shc = 1.0;
+      for (int n = 9; n >= 1; --n) {
+        ch = 1.0 + x2 * ch * (1.0 / ((2 * n - 1) * (2 * n)));
+        shc = 1.0 + x2 * shc * (1.0 / ((2 * n) * (2 * n + 1)));
+      }
+      return {ch, shc};
+    }
+    const Complex z = m.s() * std::abs(x);
+    const double grow = std::exp(z.real()), ch = 0.5 * (grow + 1 / grow), sh = 0.5 * (grow - 1 / grow);
+    const double c = std::cos(z.imag()), s = std::sin(z.imag());
+    return {Complex(ch * c, sh * s), Complex(sh * c, ch * s) / z};
+  }
+
+  TwoPort two_port(const Matrix& m) const {
+    const Complex e = std::polar(1.0, 0.5 * m.tau.imag() * length);  // tau is imaginary
+    const Complex s2l2 = m.s2 * (length * length);
+    if (std::norm(s2l2) <= 400 || m.s().real() * length < 20) return two_port(m, hyperbolic(m, length), e);
+    // sinh would overflow: in e^{-2 s l}, which underflows harmlessly
+    const Complex s = m.s(), sl = s * length, q = std::exp(-2.0 * sl);
+    return two_port(m, s * (1.0 + q) / (1.0 - q), s * 2.0 * std::exp(-sl) / (1.0 - q), e);
+  }
+  // With S = sinh(s l) / (s l) and C = cosh(s l): s coth(s l) = C / (l S), s csch(s l) = 1 / (l S).
+  TwoPort two_port(const Matrix& m, const Hyperbolic& whole, Complex e) const {
+    const Complex s_csch = 1.0 / (length * whole.sinhc);  // the only division a short vessel needs
+    return two_port(m, whole.cosh * s_csch, s_csch, e);
+  }
+  TwoPort two_port(const Matrix& m, Complex s_coth, Complex s_csch, Complex e) const {
+    const Complex over_m12 = 1.0 / m.m12;
+    return {-(s_coth + 0.5 * m.tau) * over_m12, s_csch * std::conj(e) * over_m12, e * s_csch * over_m12,
+            -(s_coth - 0.5 * m.tau) * over_m12};
+  }
+
+  // exp(M dx) (P, Q): h the hyperbolic functions and e = e^{tau dx / 2} at dx.
+  static Point along(const Matrix& m, const Hyperbolic& h, Complex e, double dx, Complex p, Complex q) {
+    const Complex sh_over_s = dx * h.sinhc;
+    return {e * (h.cosh * p + sh_over_s * (0.5 * m.tau * p + m.m12 * q)),
+            e * (h.cosh * q + sh_over_s * (m.m21 * p - 0.5 * m.tau * q))};
+  }
+
   template <std::size_t N>
   std::array<Point, N> at(double w, Complex p0, Complex p1, const double (&xs)[N]) const {
     const Matrix m = matrix(w);
-    const TwoPort y = two_port(w);
+    const TwoPort y = two_port(m);
     const Complex q0 = y.aa * p0 + y.ab * p1, q1 = -(y.ba * p0 + y.bb * p1);
     std::array<Point, N> out;
     for (std::size_t i = 0; i < N; ++i) {
@@ -105,10 +156,11 @@ struct VesselLine {
       const bool from_start = xs[i] <= 0.5 * length;
       const double dx = from_start ? xs[i] : xs[i] - length;
       const Complex p = from_start ? p0 : p1, q = from_start ? q0 : q1;
-      const Complex sx = m.s * dx, e = std::exp(0.5 * m.tau * dx);
-      const Complex ch = std::cosh(sx), sh_over_s = std::abs(sx) < 1e-8 ? Complex(dx) : std::sinh(sx) / m.s;
-      out[i] = {e * (ch * p + sh_over_s * (0.5 * m.tau * p + m.m12 * q)),
-                e * (ch * q + sh_over_s * (m.m21 * p - 0.5 * m.tau * q))};
+      if (dx == 0) {
+        out[i] = {p, q};
+        continue;
+      }
+      out[i] = along(m, hyperbolic(m, dx), std::polar(1.0, 0.5 * m.tau.imag() * dx), dx, p, q);
     }
     return out;
   }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseLU>
@@ -58,68 +59,89 @@ bool peel_leaves(std::size_t nodes, std::span<const std::int32_t> a, std::span<c
 
 }  // namespace
 
-std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const std::int32_t> a,
-                                           std::span<const std::int32_t> b, std::span<const TwoPort> edge,
-                                           std::span<const Complex> shunt, std::span<const Complex> current) {
-  const std::size_t edges = a.size();
-  if (b.size() != edges || edge.size() != edges || shunt.size() != nodes || current.size() != nodes)
-    throw std::invalid_argument("harmonic system: one admittance per edge, one shunt and current per node");
-  for (std::size_t e = 0; e < edges; ++e)
-    if (a[e] < 0 || b[e] < 0 || static_cast<std::size_t>(a[e]) >= nodes || static_cast<std::size_t>(b[e]) >= nodes ||
-        a[e] == b[e])
+HarmonicSystem::HarmonicSystem(std::size_t nodes, std::vector<std::int32_t> a, std::vector<std::int32_t> b)
+    : nodes_(nodes), a_(std::move(a)), b_(std::move(b)) {
+  if (b_.size() != a_.size()) throw std::invalid_argument("harmonic system: two nodes per edge");
+  for (std::size_t e = 0; e < a_.size(); ++e)
+    if (a_[e] < 0 || b_[e] < 0 || static_cast<std::size_t>(a_[e]) >= nodes || static_cast<std::size_t>(b_[e]) >= nodes ||
+        a_[e] == b_[e])
       throw std::invalid_argument("harmonic system: edge " + std::to_string(e) + " joins no two distinct nodes");
+  std::vector<std::int64_t> offset;
+  std::vector<std::int32_t> incident;
+  forest_ = peel_leaves(nodes, a_, b_, order_, parent_edge_, offset, incident);
+  if (!forest_) order_ = {}, parent_edge_ = {};
+}
 
+std::vector<Complex> HarmonicSystem::solve(std::span<const TwoPort> edge, std::span<const Complex> shunt,
+                                           std::span<const Complex> current) const {
   std::vector<Complex> pivot(shunt.begin(), shunt.end()), x(current.begin(), current.end());
-  for (std::size_t e = 0; e < edges; ++e) {
+  solve_in_place(edge, pivot, x);
+  return x;
+}
+
+void HarmonicSystem::solve_in_place(std::span<const TwoPort> edge, std::span<Complex> shunt,
+                                    std::span<Complex> current) const {
+  if (edge.size() != a_.size() || shunt.size() != nodes_ || current.size() != nodes_)
+    throw std::invalid_argument("harmonic system: one admittance per edge, one shunt and current per node");
+  if (forest_) {
+    solve_forest(edge, shunt, current);
+  } else {
+    solve_sparse(edge, shunt, current);
+  }
+}
+
+void HarmonicSystem::solve_forest(std::span<const TwoPort> edge, std::span<Complex> pivot, std::span<Complex> x) const {
+  const std::span<const std::int32_t> a = a_, b = b_;
+  for (std::size_t e = 0; e < a.size(); ++e) {
     pivot[static_cast<std::size_t>(a[e])] += edge[e].aa;
     pivot[static_cast<std::size_t>(b[e])] += edge[e].bb;
   }
-  std::vector<std::int32_t> order, parent_edge, incident;
-  std::vector<std::int64_t> offset;
-  if (peel_leaves(nodes, a, b, order, parent_edge, offset, incident)) {
-    // Leaves up: node i, its pivot final, hands its parent p m_pi m_ip / d_i of the pivot and
-    // m_pi B_i / d_i of the current (m_pi: the entry in p's row and i's column).
-    auto couplings = [&](std::size_t i, std::int32_t e, std::size_t& p, Complex& m_ip, Complex& m_pi) {
-      const TwoPort& y = edge[static_cast<std::size_t>(e)];
-      const bool i_is_a = a[static_cast<std::size_t>(e)] == static_cast<std::int32_t>(i);
-      p = static_cast<std::size_t>(i_is_a ? b[static_cast<std::size_t>(e)] : a[static_cast<std::size_t>(e)]);
-      m_ip = i_is_a ? y.ab : y.ba;
-      m_pi = i_is_a ? y.ba : y.ab;
-    };
-    for (const std::int32_t node : order) {
-      const auto i = static_cast<std::size_t>(node);
-      if (pivot[i] == Complex(0)) singular_at(i);
-      const std::int32_t e = parent_edge[i];
-      if (e < 0) continue;
-      std::size_t p;
-      Complex m_ip, m_pi;
-      couplings(i, e, p, m_ip, m_pi);
-      pivot[p] -= m_pi * m_ip / pivot[i];
-      x[p] -= m_pi * x[i] / pivot[i];
-    }
-    // Roots down: X_i = (B_i - m_ip X_p) / d_i.
-    for (auto k = order.size(); k-- > 0;) {
-      const auto i = static_cast<std::size_t>(order[k]);
-      const std::int32_t e = parent_edge[i];
-      if (e < 0) {
-        x[i] /= pivot[i];
-        continue;
-      }
-      std::size_t p;
-      Complex m_ip, m_pi;
-      couplings(i, e, p, m_ip, m_pi);
-      x[i] = (x[i] - m_ip * x[p]) / pivot[i];
-    }
-    return x;
+  // Leaves up: node i, its pivot final, hands its parent p m_pi m_ip / d_i of the pivot and
+  // m_pi B_i / d_i of the current (m_pi: the entry in p's row and i's column).
+  auto couplings = [&](std::size_t i, std::int32_t e, std::size_t& p, Complex& m_ip, Complex& m_pi) {
+    const TwoPort& y = edge[static_cast<std::size_t>(e)];
+    const bool i_is_a = a[static_cast<std::size_t>(e)] == static_cast<std::int32_t>(i);
+    p = static_cast<std::size_t>(i_is_a ? b[static_cast<std::size_t>(e)] : a[static_cast<std::size_t>(e)]);
+    m_ip = i_is_a ? y.ab : y.ba;
+    m_pi = i_is_a ? y.ba : y.ab;
+  };
+  for (const std::int32_t node : order_) {
+    const auto i = static_cast<std::size_t>(node);
+    if (pivot[i] == Complex(0)) singular_at(i);
+    const std::int32_t e = parent_edge_[i];
+    if (e < 0) continue;
+    std::size_t p;
+    Complex m_ip, m_pi;
+    couplings(i, e, p, m_ip, m_pi);
+    const Complex m_pi_over_d = m_pi / pivot[i];
+    pivot[p] -= m_pi_over_d * m_ip;
+    x[p] -= m_pi_over_d * x[i];
   }
+  // Roots down: X_i = (B_i - m_ip X_p) / d_i.
+  for (auto k = order_.size(); k-- > 0;) {
+    const auto i = static_cast<std::size_t>(order_[k]);
+    const std::int32_t e = parent_edge_[i];
+    if (e < 0) {
+      x[i] /= pivot[i];
+      continue;
+    }
+    std::size_t p;
+    Complex m_ip, m_pi;
+    couplings(i, e, p, m_ip, m_pi);
+    x[i] = (x[i] - m_ip * x[p]) / pivot[i];
+  }
+}
 
-  // Loops: the assembled matrix and a sparse LU.
+// Loops: the assembled matrix and a sparse LU.
+void HarmonicSystem::solve_sparse(std::span<const TwoPort> edge, std::span<const Complex> shunt,
+                                  std::span<Complex> x) const {
+  const std::size_t nodes = nodes_, edges = a_.size();
   std::vector<Eigen::Triplet<Complex>> entries;
   entries.reserve(nodes + 2 * edges);
   for (std::size_t i = 0; i < nodes; ++i)
     entries.emplace_back(static_cast<int>(i), static_cast<int>(i), shunt[i]);
   for (std::size_t e = 0; e < edges; ++e) {
-    const int i = a[e], j = b[e];
+    const int i = a_[e], j = b_[e];
     entries.emplace_back(i, i, edge[e].aa);
     entries.emplace_back(j, j, edge[e].bb);
     entries.emplace_back(i, j, edge[e].ab);
@@ -131,11 +153,19 @@ std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const st
   lu.compute(m);
   if (lu.info() != Eigen::Success)
     throw std::invalid_argument("harmonic system: singular (a part with no admittance to ground): " + lu.lastErrorMessage());
-  const Eigen::Map<const Eigen::VectorXcd> rhs(current.data(), static_cast<Eigen::Index>(nodes));
+  const Eigen::Map<const Eigen::VectorXcd> rhs(x.data(), static_cast<Eigen::Index>(nodes));
   const Eigen::VectorXcd solution = lu.solve(rhs);
-  for (Eigen::Index i = 0; i < solution.size(); ++i)
+  for (Eigen::Index i = 0; i < solution.size(); ++i) {
     if (!std::isfinite(solution(i).real()) || !std::isfinite(solution(i).imag())) singular_at(static_cast<std::size_t>(i));
-  return std::vector<Complex>(solution.data(), solution.data() + solution.size());
+    x[static_cast<std::size_t>(i)] = solution(i);
+  }
+}
+
+std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const std::int32_t> a,
+                                           std::span<const std::int32_t> b, std::span<const TwoPort> edge,
+                                           std::span<const Complex> shunt, std::span<const Complex> current) {
+  if (b.size() != a.size()) throw std::invalid_argument("harmonic system: two nodes per edge");
+  return HarmonicSystem(nodes, {a.begin(), a.end()}, {b.begin(), b.end()}).solve(edge, shunt, current);
 }
 
 }  // namespace hemotree

@@ -10,8 +10,9 @@
 // line with a mean flow through it is not reciprocal (y_ab != y_ba), so the matrix is
 // neither Hermitian nor symmetric. On a forest the elimination from the leaves up makes no
 // fill, as for the real system (nodal_system.hpp): O(nodes), a child i handing its parent p
-// y_pi y_ip / d_i of its pivot. On any other graph, Eigen's SparseLU (COLAMD ordering). Each
-// solve factorises afresh: every harmonic has its own admittances.
+// y_pi y_ip / d_i of its pivot. On any other graph, Eigen's SparseLU (COLAMD ordering). The
+// graph's structure (checked, and a forest's elimination order) is set once for every
+// frequency; each solve factorises afresh: every harmonic has its own admittances.
 #pragma once
 
 #include <complex>
@@ -29,10 +30,34 @@ struct TwoPort {
   static TwoPort series(Complex y) { return {y, -y, -y, y}; }
 };
 
-// Edges join nodes a[e] and b[e] (a[e] != b[e], below nodes); one two-port per edge, a shunt
-// and a current per node. Returns the node potentials. std::invalid_argument for sizes that
-// do not match, an edge out of range, or a singular system (a zero pivot: a part of the
-// network with no admittance to ground), naming the node.
+// Edges join nodes a[e] and b[e] (a[e] != b[e], below nodes). std::invalid_argument for an
+// edge out of range.
+class HarmonicSystem {
+ public:
+  HarmonicSystem(std::size_t nodes, std::vector<std::int32_t> a, std::vector<std::int32_t> b);
+  std::size_t nodes() const { return nodes_; }
+  std::size_t edges() const { return a_.size(); }
+  // One two-port per edge, a shunt and a current per node: the node potentials.
+  // std::invalid_argument for sizes that do not match, or a singular system (a zero pivot: a
+  // part of the network with no admittance to ground), naming the node.
+  std::vector<Complex> solve(std::span<const TwoPort> edge, std::span<const Complex> shunt,
+                             std::span<const Complex> current) const;
+  // The same in the caller's storage: shunt is overwritten (with the pivots), current with
+  // the potentials.
+  void solve_in_place(std::span<const TwoPort> edge, std::span<Complex> shunt, std::span<Complex> current) const;
+
+ private:
+  void solve_forest(std::span<const TwoPort> edge, std::span<Complex> pivot, std::span<Complex> x) const;
+  void solve_sparse(std::span<const TwoPort> edge, std::span<const Complex> shunt, std::span<Complex> x) const;
+
+  std::size_t nodes_;
+  std::vector<std::int32_t> a_, b_;
+  bool forest_ = false;
+  // A forest's elimination order (leaves first) and each node's edge to its parent (-1 at a root).
+  std::vector<std::int32_t> order_, parent_edge_;
+};
+
+// One solve: HarmonicSystem(nodes, a, b).solve(edge, shunt, current).
 std::vector<Complex> solve_harmonic_system(std::size_t nodes, std::span<const std::int32_t> a,
                                            std::span<const std::int32_t> b, std::span<const TwoPort> edge,
                                            std::span<const Complex> shunt, std::span<const Complex> current);

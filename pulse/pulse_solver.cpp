@@ -118,7 +118,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     start_from_steady_flow(*steady);
     started_from_ = StartChoice::steady;
     if (options.start == StartChoice::periodic) {
-      start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.periodic_harmonics));
+      start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.periodic_harmonics, threads_));
       started_from_ = StartChoice::periodic;
     }
   } else {

@@ -324,5 +324,53 @@ TEST(LinearPeriodic, TheSteppedPeriodicStateDepartsFromItByThePulsesSquare) {
   EXPECT_LT(d1.oscillation, 0.01 * d1.swing);
 }
 
+// The two-port from its series (|s l| <= 1) and from one exponential and one sincos (beyond),
+// against the textbook formula with the library's complex cosh and sinh, on both sides of
+// the switch and far beyond it, at rest and with a mean flow.
+TEST(VesselLine, TheTwoPortIsTheTextbookOneOnBothSidesOfTheSeries) {
+  const double w = 2 * std::numbers::pi * 10;
+  for (const double velocity : {0.0, 0.6}) {
+    VesselLine line{2.2e8, 8.3e7, 3.3e-10, 1.0, velocity, 4.0 / 3.0};
+    const VesselLine::Matrix m = line.matrix(w);
+    const C s = m.s();
+    for (const double sl : {0.01, 0.5, 0.99, 1.01, 1.9, 2.1, 5.0, 30.0}) {
+      line.length = sl / std::abs(s);
+      const C x = s * line.length, e = std::exp(0.5 * m.tau * line.length);
+      const C coth = std::cosh(x) / std::sinh(x), csch = 1.0 / std::sinh(x);
+      const TwoPort expected{-(s * coth + 0.5 * m.tau) / m.m12, s * csch / (e * m.m12), e * s * csch / m.m12,
+                             -(s * coth - 0.5 * m.tau) / m.m12};
+      const TwoPort y = line.two_port(w);
+      const double scale = std::abs(expected.aa);
+      EXPECT_LT(std::abs(y.aa - expected.aa), 1e-13 * scale) << "|s l| " << sl << ", U " << velocity;
+      EXPECT_LT(std::abs(y.ab - expected.ab), 1e-13 * scale) << "|s l| " << sl << ", U " << velocity;
+      EXPECT_LT(std::abs(y.ba - expected.ba), 1e-13 * scale) << "|s l| " << sl << ", U " << velocity;
+      EXPECT_LT(std::abs(y.bb - expected.bb), 1e-13 * scale) << "|s l| " << sl << ", U " << velocity;
+    }
+  }
+}
+
+// ends_and_middle takes the whole line's functions as the half line's doubled where the series
+// serve: it gives what the line's own point evaluations give.
+TEST(VesselLine, TheMiddleByDoublingIsTheLinesOwnPoint) {
+  const double w = 2 * std::numbers::pi * 7;
+  VesselLine line{2.2e8, 8.3e7, 3.3e-10, 1.0, 0.6, 4.0 / 3.0};
+  const double modulus = std::abs(line.matrix(w).s());
+  const C p0(1000, 200), p1(-300, 650);
+  for (const double sl : {0.05, 0.9, 1.5, 1.99, 3.0}) {
+    line.length = sl / modulus;
+    const auto points = line.ends_and_middle(w, p0, p1);
+    const TwoPort y = line.two_port(w);
+    const C q0 = y.aa * p0 + y.ab * p1, q1 = -(y.ba * p0 + y.bb * p1);
+    const double mid = 0.5 * line.length;
+    const double p_scale = std::abs(p0), q_scale = std::abs(q0) + std::abs(q1);
+    EXPECT_EQ(points[0].pressure, p0);
+    EXPECT_EQ(points[2].pressure, p1);
+    EXPECT_LT(std::abs(points[0].flow - q0), 1e-13 * q_scale) << "|s l| " << sl;
+    EXPECT_LT(std::abs(points[2].flow - q1), 1e-13 * q_scale) << "|s l| " << sl;
+    EXPECT_LT(std::abs(points[1].pressure - line.pressure(w, p0, p1, mid)), 1e-13 * p_scale) << "|s l| " << sl;
+    EXPECT_LT(std::abs(points[1].flow - line.flow(w, p0, p1, mid)), 1e-13 * q_scale) << "|s l| " << sl;
+  }
+}
+
 }  // namespace
 }  // namespace hemotree
