@@ -1,5 +1,6 @@
 #include "solver/linear_run.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -11,6 +12,7 @@
 
 #include "core/units.hpp"
 #include "harmonic/linear_periodic.hpp"
+#include "harmonic/trigonometric_extremes.hpp"
 #include "physics/womersley.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/output_folder.hpp"
@@ -23,8 +25,8 @@ namespace hemotree {
 
 namespace {
 
-// Points per period at which the extremes are taken: the peak of the tenth harmonic is then
-// missed by at most 1 - cos(pi 10 / 256) = 0.8 % of that harmonic's amplitude.
+// Rows of probes.csv over one period (the extremes are the series' own:
+// harmonic/trigonometric_extremes.hpp).
 constexpr int samples_per_period = 256;
 
 struct LinearCycle {
@@ -45,60 +47,50 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
   const int harmonics = periodic.harmonics();
   const double period = periodic.period(), omega = 2 * std::numbers::pi / period;
   const int analysed = static_cast<int>(std::lround(analysis * period));
-  // e^{i w_k t_m}, one row per sample.
-  std::vector<std::complex<double>> phase(static_cast<std::size_t>(samples_per_period * harmonics));
-  for (int m = 0; m < samples_per_period; ++m)
-    for (int k = 1; k <= harmonics; ++k)
-      phase[static_cast<std::size_t>(m * harmonics + k - 1)] =
-          std::polar(1.0, 2 * std::numbers::pi * k * m / samples_per_period);
+  const TrigonometricExtremes extremes(harmonics);
   const auto vessels = static_cast<std::int64_t>(n);
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(options.threads) if (options.threads > 1)
-  for (std::int64_t i = 0; i < vessels; ++i) {
-    const auto v = static_cast<std::size_t>(i);
-    const VesselLine& line = periodic.line(v);
-    VesselCycle& c = out.cycle.vessels[v];
-    const double area = blood.density / line.inertance, radius = std::sqrt(area / std::numbers::pi);
-    const double mu = viscosity(area);
+#pragma omp parallel num_threads(options.threads) if (options.threads > 1)
+  {
     std::vector<std::complex<double>> p(static_cast<std::size_t>(harmonics)), q(p.size());
-    std::array<VesselLine::Point, 3> analysed_points{};
-    for (int k = 1; k <= harmonics; ++k) {
-      const auto points = periodic.ends_and_middle(k, v);
-      p[static_cast<std::size_t>(k - 1)] = points[1].pressure;
-      q[static_cast<std::size_t>(k - 1)] = points[1].flow;
-      if (k == analysed) analysed_points = points;
-    }
-    double p_max = -std::numeric_limits<double>::infinity(), p_min = -p_max, q_max = p_max, q_min = p_min;
-    for (int m = 0; m < samples_per_period; ++m) {
-      double dp = 0, dq = 0;
-      for (std::size_t k = 0; k < p.size(); ++k) {
-        const std::complex<double> e = phase[static_cast<std::size_t>(m * harmonics) + k];
-        dp += (p[k] * e).real();
-        dq += (q[k] * e).real();
+    std::vector<double> scratch;
+#pragma omp for schedule(dynamic, 1024)
+    for (std::int64_t i = 0; i < vessels; ++i) {
+      const auto v = static_cast<std::size_t>(i);
+      const VesselLine& line = periodic.line(v);
+      VesselCycle& c = out.cycle.vessels[v];
+      const double area = blood.density / line.inertance, radius = std::sqrt(area / std::numbers::pi);
+      const double mu = viscosity(area);
+      std::array<VesselLine::Point, 3> analysed_points{};
+      for (int k = 1; k <= harmonics; ++k) {
+        const auto points = periodic.ends_and_middle(k, v);
+        if (k == analysed) analysed_points = points;
+        p[static_cast<std::size_t>(k - 1)] = points[1].pressure;
+        q[static_cast<std::size_t>(k - 1)] = points[1].flow;
       }
-      p_max = std::max(p_max, dp), p_min = std::min(p_min, dp), q_max = std::max(q_max, dq), q_min = std::min(q_min, dq);
+      const Extremes dp = extremes(p, scratch), dq = extremes(q, scratch);
+      c.mean_flow = periodic.mean_flow()[v];
+      c.systolic_pressure = c.mean_pressure + dp.greatest;
+      c.diastolic_pressure = c.mean_pressure + dp.least;
+      c.peak_flow = c.mean_flow + dq.greatest;
+      c.least_flow = c.mean_flow + dq.least;
+      const double u = c.mean_flow / area;
+      c.mean_wss = wall_shear_stress(mu, u, radius, blood.alpha);  // linear in u: its cycle mean
+      c.reynolds = blood.density * u * 2 * radius / mu;
+      // A wave travels where the run's --model auto would keep the vessel 1D.
+      const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
+      const double rc = line.resistance * line.length * line.compliance * line.length;
+      out.wave_travels[v] = !options.moves_in_phase(line.length / c0, omega * rc, period);
+      c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();
+      if (analysed >= 1 && analysed <= harmonics) {
+        const double w = periodic.omega(analysed);
+        c.pwv_pressure = phase_velocity(analysed_points[0].pressure, analysed_points[2].pressure, w, line.length);
+        c.pwv_velocity = phase_velocity(analysed_points[0].flow, analysed_points[2].flow, w, line.length);
+      }
+      const double w = 2 * std::numbers::pi * analysis;
+      out.pwv_elastic[v] = c0;
+      out.womersley[v] = womersley_number(2 * radius, blood.density, mu, w);
+      out.pwv_theory[v] = womersley_wave(c0, out.womersley[v], w).phase_velocity;
     }
-    c.mean_flow = periodic.mean_flow()[v];
-    c.systolic_pressure = c.mean_pressure + p_max;
-    c.diastolic_pressure = c.mean_pressure + p_min;
-    c.peak_flow = c.mean_flow + q_max;
-    c.least_flow = c.mean_flow + q_min;
-    const double u = c.mean_flow / area;
-    c.mean_wss = wall_shear_stress(mu, u, radius, blood.alpha);  // linear in u: its cycle mean
-    c.reynolds = blood.density * u * 2 * radius / mu;
-    // A wave travels where the run's --model auto would keep the vessel 1D.
-    const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
-    const double rc = line.resistance * line.length * line.compliance * line.length;
-    out.wave_travels[v] = !options.moves_in_phase(line.length / c0, omega * rc, period);
-    c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();
-    if (analysed >= 1 && analysed <= harmonics) {
-      const double w = periodic.omega(analysed);
-      c.pwv_pressure = phase_velocity(analysed_points[0].pressure, analysed_points[2].pressure, w, line.length);
-      c.pwv_velocity = phase_velocity(analysed_points[0].flow, analysed_points[2].flow, w, line.length);
-    }
-    const double w = 2 * std::numbers::pi * analysis;
-    out.pwv_elastic[v] = c0;
-    out.womersley[v] = womersley_number(2 * radius, blood.density, mu, w);
-    out.pwv_theory[v] = womersley_wave(c0, out.womersley[v], w).phase_velocity;
   }
   return out;
 }
@@ -127,7 +119,7 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   const auto started = std::chrono::steady_clock::now();
   const ViscosityTable viscosity(blood);
   const std::vector<TubeLaw> laws = vessel_laws(net, blood, options.external_pressure, options.thick_wall_ratio);
-  const LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics);
+  const LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics, options.threads);
   const Waveform driving = driving_waveform(net);
   const double analysis = analysis_frequency(driving);
   const LinearCycle linear = linear_cycle(net, blood, viscosity, periodic, options, analysis);
