@@ -118,8 +118,14 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     start_from_steady_flow(*steady);
     started_from_ = StartChoice::steady;
     if (options.start == StartChoice::periodic) {
-      start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.periodic_harmonics, threads_));
-      started_from_ = StartChoice::periodic;
+      // Where the linear periodic state cannot be formed (a harmonic's system singular where
+      // the steady one is not), the run keeps the steady start and says why.
+      try {
+        start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.periodic_harmonics, threads_));
+        started_from_ = StartChoice::periodic;
+      } catch (const InputError& e) {
+        periodic_refusal_ = e.what();
+      }
     }
   } else {
     start_at_rest();

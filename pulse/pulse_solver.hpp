@@ -58,7 +58,7 @@ struct SolverOptions {
   double friction_safety = 0.5;  // safety on the friction-stiffness limit
   double external_pressure = 10 * 133.322;  // p_ext for the wall laws [Pa]
   double thick_wall_ratio = 0.1;
-  StartChoice start = StartChoice::steady;
+  StartChoice start = StartChoice::periodic;
   int periodic_harmonics = 10;  // the inflow's harmonics the linear periodic state takes (start and --linear)
   int rheology_override = -1;  // -1: the file's; else static_cast<int>(Rheology)
   // Threads over elements. One by default: a step has several parallel sections, and a
@@ -199,6 +199,8 @@ class PulseSolver {
   bool started_from_steady() const { return started_from_steady_; }
   StartChoice started_from() const { return started_from_; }
   const std::string& steady_refusal() const { return steady_refusal_; }
+  // Why a periodic start fell back to the steady one ("" where it did not).
+  const std::string& periodic_refusal() const { return periodic_refusal_; }
   // Lowest and highest steady node pressure [Pa] (NaN without a steady solution), and the
   // index of the vessel entering the node of the highest.
   double steady_pressure_min() const { return steady_pressure_min_; }
@@ -354,7 +356,7 @@ class PulseSolver {
   std::size_t steps_ = 0;
   bool started_from_steady_ = false;
   StartChoice started_from_ = StartChoice::rest;
-  std::string steady_refusal_;
+  std::string steady_refusal_, periodic_refusal_;
   double steady_pressure_min_ = std::numeric_limits<double>::quiet_NaN();
   double steady_pressure_max_ = std::numeric_limits<double>::quiet_NaN();
   std::size_t steady_pressure_max_vessel_ = 0;

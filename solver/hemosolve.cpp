@@ -98,7 +98,7 @@ int finish(const RunResult& result, const RunConfiguration& config) {
 // kept for translation once the network is read.
 struct CommandLine {
   RunConfiguration config;
-  std::string out_dir, resume_dir, rheology, scheme = "etd2", start = "steady", dt_text, sample_text = "1ms",
+  std::string out_dir, resume_dir, rheology, scheme = "etd2", start = "periodic", dt_text, sample_text = "1ms",
       external_text = "10mmHg", degree_text = "auto", model = "auto", vtk_min_text, red_cells = "fixed";
   std::vector<std::string> probe_texts, tracer_texts, pressure_at_texts;
   bool quiet = false, steady = false, linear = false;
@@ -184,7 +184,7 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
       ->capture_default_str();
   app.add_option("--scheme", scheme, "time scheme: etd2 (Adams-Bashforth 2 with exact friction), ab2 (the paper's) or rk4")->capture_default_str();
   app.add_option("--rheology", rheology, "pries or newtonian (default: the network's blood)");
-  app.add_option("--start", start, "initial state: steady (the steady solution), periodic (the linear periodic state about it, at t = 0) or rest")->capture_default_str();
+  app.add_option("--start", start, "initial state: periodic (the linear periodic state about the steady solution, at t = 0), steady (the steady solution) or rest")->capture_default_str();
   app.add_option("--external-pressure", external_text, "interstitial pressure for the wall laws, in [-100, 100] mmHg")
       ->capture_default_str();
   app.add_option("--thick-wall-ratio", options.thick_wall_ratio, "h/D above which a wall is thick, in (0, 10]")

@@ -1,6 +1,5 @@
 #include "solver/linear_run.hpp"
 
-#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>

@@ -201,6 +201,7 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
                          {"compliance_balances", pulsatile.compliance_balances()},
                          {"wall_time", wall}};
   if (!steady_start && options.start != StartChoice::rest) info["steady_refusal"] = run.steady_refusal();
+  if (!run.periodic_refusal().empty()) info["periodic_refusal"] = run.periodic_refusal();
   for (const auto& [p, count] : d.degrees) info["elements_of_degree"][std::to_string(p)] = count;
   if (pulsatile.has_change()) {
     info["periodic_change"] = pulsatile.change().change;
@@ -295,6 +296,8 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
     observer.warn("no steady solution to start from (" + run.steady_refusal() + "): starting from rest" +
                   (config.balance_compliances ? std::string(", without the compliance balance (it needs the steady network)")
                                               : std::string()));
+  if (!run.periodic_refusal().empty())
+    observer.warn("no linear periodic state to start from (" + run.periodic_refusal() + "): starting from the steady state");
   warn_unphysiological(run.steady_pressure_min(), run.steady_pressure_max(), net.id[run.steady_pressure_max_vessel()],
                        net, "steady pressures", config.words, observer);
 

@@ -109,7 +109,7 @@ TEST(RunIdentity, EveryOptionThatShapesTheStateIsInIt) {
       {"external pressure", [](RunConfiguration& c) { nudge(c.solver.external_pressure); }},
       {"thick wall ratio", [](RunConfiguration& c) { nudge(c.solver.thick_wall_ratio); }},
       {"start", [](RunConfiguration& c) { c.solver.start = StartChoice::rest; }},
-      {"periodic start", [](RunConfiguration& c) { c.solver.start = StartChoice::periodic; }},
+      {"steady start", [](RunConfiguration& c) { c.solver.start = StartChoice::steady; }},
       {"balance", [](RunConfiguration& c) { c.balance_compliances = false; }},
       {"sample interval", [](RunConfiguration& c) { nudge(c.sample_interval); }},
       {"probe position", [](RunConfiguration& c) { nudge(c.probes[0].x); }},
@@ -138,9 +138,10 @@ TEST(RunIdentity, EveryOptionThatShapesTheStateIsInIt) {
   periodic.solver.start = more_harmonics.solver.start = StartChoice::periodic;
   more_harmonics.solver.periodic_harmonics = 12;
   EXPECT_NE(state_shaping(more_harmonics, net, dt, Rheology::newtonian), state_shaping(periodic, net, dt, Rheology::newtonian));
-  RunConfiguration steady_more = base;
+  RunConfiguration steady = base, steady_more = base;
+  steady.solver.start = steady_more.solver.start = StartChoice::steady;
   steady_more.solver.periodic_harmonics = 12;
-  EXPECT_EQ(state_shaping(steady_more, net, dt, Rheology::newtonian), shaping);
+  EXPECT_EQ(state_shaping(steady_more, net, dt, Rheology::newtonian), state_shaping(steady, net, dt, Rheology::newtonian));
   // The step and the rheology the run takes.
   double later = dt;
   nudge(later);
