@@ -71,8 +71,8 @@ class LinearPeriodic {
 // waveforms (their common period: driving_waveform). laws: per vessel (a tapered vessel's at
 // its proximal end); viscosity: mu(A) of the run's blood. Throws InputError where the steady
 // state does (a reflection outlet has no steady state), or where a part of the network has
-// no path to ground. threads: for the vessels' lines and two-ports (the same numbers for any
-// count).
+// no path to ground. threads: the harmonics one to a thread, and the vessels' lines (the
+// same numbers for any count).
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, int harmonics, int threads = 1);
 // The same about a steady state already solved (solve_distended_steady_flow with the same

@@ -194,6 +194,20 @@ TEST(LinearPeriodic, ATubeCutInSegmentsIsTheSameLine) {
   }
 }
 
+// The harmonics one to a thread, the lines in parallel: the same bits for any thread count.
+TEST(LinearPeriodic, AnyThreadCountGivesTheSameBits) {
+  const TubeIntoWindkessel cut(5, 0.15, 4e-3, 6.0);
+  const Blood blood = newtonian(TubeIntoWindkessel::mu);
+  const ViscosityTable viscosity(blood);
+  const LinearPeriodic one = solve_linear_periodic(cut.net, blood, cut.laws, viscosity, 7, 1);
+  const LinearPeriodic three = solve_linear_periodic(cut.net, blood, cut.laws, viscosity, 7, 3);
+  for (int k = 1; k <= 7; ++k)
+    for (std::size_t node = 0; node < cut.net.node_count(); ++node) {
+      EXPECT_EQ(one.node_pressure(k, node).real(), three.node_pressure(k, node).real()) << k << ", " << node;
+      EXPECT_EQ(one.node_pressure(k, node).imag(), three.node_pressure(k, node).imag()) << k << ", " << node;
+    }
+}
+
 TEST(LinearPeriodic, AShortVesselIntoAWindkesselIsTheRcAndRlcCircuit) {
   // 5 mm of a stiff 1 mm vessel: |gamma l| ~ 1e-2, so the line is its R and L in series
   // with the outlet (C l / 2 at its ends, beside the Windkessel's C, is 4e-5 of it).
