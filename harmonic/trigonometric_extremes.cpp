@@ -47,7 +47,7 @@ double refine(std::span<const std::complex<double>> c, double theta0, double the
 }  // namespace
 
 TrigonometricExtremes::TrigonometricExtremes(int harmonics)
-    : harmonics_(harmonics), samples_(std::max(16, 8 * harmonics)) {
+    : harmonics_(harmonics), samples_(harmonics <= 64 ? std::max(16, 8 * harmonics) : 4 * harmonics) {
   if (harmonics < 1) throw std::invalid_argument("trigonometric extremes: at least one harmonic");
   const auto m_count = static_cast<std::size_t>(samples_);
   cosine_.resize(m_count * static_cast<std::size_t>(harmonics));

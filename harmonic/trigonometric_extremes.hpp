@@ -3,7 +3,8 @@
 //   f(theta) = Re sum_{k=1}^{K} c_k e^{i k theta},   theta in [0, 2 pi),
 //
 // (a Fourier series without its mean: the systolic and diastolic excursions of a pressure,
-// the peak and least of a flow). f is sampled at M = 8 K points (at least 16), h = 2 pi / M
+// the peak and least of a flow). f is sampled at M = 8 K points (at least 16; 4 K beyond 64
+// harmonics, where the table of M K cosines and sines grows large), h = 2 pi / M
 // apart; each sample that is a local extreme of the samples and within S h^2 / 8 of the
 // extreme sample (S = sum k^2 |c_k| bounds |f''|, so the sample nearest the true extreme is
 // among them) is refined by Newton's method on f' = 0, from the vertex of the parabola
