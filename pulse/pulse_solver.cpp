@@ -119,7 +119,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     started_from_ = StartChoice::steady;
     if (options.start == StartChoice::periodic) {
       // Where the linear periodic state cannot be formed (a harmonic's system singular where
-      // the steady one is not), the run keeps the steady start and says why.
+      // the steady one is not: no input is known to reach this, and the default start should
+      // not be what fails a run), the run keeps the steady start and says why.
       try {
         start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.periodic_harmonics, threads_));
         started_from_ = StartChoice::periodic;
