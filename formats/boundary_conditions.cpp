@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include "core/errors.hpp"
@@ -170,9 +171,9 @@ Blood blood_from_json(const nlohmann::json& j) {
                                             b.momentum_flux_coefficient, where);
   const std::string rheology =
       text(j, "rheology", "pries", where, "\"pries\" or \"newtonian\"");
-  if (rheology == "pries") b.rheology = Rheology::pries;
-  else if (rheology == "newtonian") b.rheology = Rheology::newtonian;
-  else throw InputError("blood: \"rheology\" must be \"pries\" or \"newtonian\"");
+  const std::optional<Rheology> law = rheology_of(rheology);
+  if (!law) throw InputError("blood: \"rheology\" must be \"pries\" or \"newtonian\"");
+  b.rheology = *law;
   b.newtonian_viscosity =
       in_range_or(j, "newtonian_viscosity", ranges::viscosity, b.newtonian_viscosity, where);
   b.pries_max_diameter = in_range_or(j, "pries_max_diameter", ranges::pries_max_diameter,

@@ -13,4 +13,10 @@ std::string_view to_string(Rheology rheology) {
   return rheology == Rheology::pries ? "pries" : "newtonian";
 }
 
+std::optional<Rheology> rheology_of(std::string_view name) {
+  for (const Rheology r : {Rheology::pries, Rheology::newtonian})
+    if (name == to_string(r)) return r;
+  return std::nullopt;
+}
+
 }  // namespace hemotree

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <string_view>
 
 namespace hemotree {
@@ -40,7 +41,9 @@ struct Blood {
   static constexpr double phase_separation_mean_cell_volume = 55e-18;
 };
 
-// The law's name: "pries" or "newtonian" (the network format's and the reports' word).
+// The law's name: "pries" or "newtonian" (the network format's and the reports' word), and
+// the law of a name (none for any other word).
 std::string_view to_string(Rheology rheology);
+std::optional<Rheology> rheology_of(std::string_view name);
 
 }  // namespace hemotree

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -247,8 +248,9 @@ int main(int argc, char** argv) {
     blood.pries_max_diameter =
         parse_quantity(pries_max_text, Dimension::length, "--pries-max-diameter",
                        accepted(ranges::pries_max_diameter), "um");
-    if (rheology == "newtonian") blood.rheology = Rheology::newtonian;
-    else if (rheology != "pries") throw InputError("--rheology must be pries or newtonian");
+    const std::optional<Rheology> law = rheology_of(rheology);
+    if (!law) throw InputError("--rheology must be pries or newtonian");
+    blood.rheology = *law;
     blood = blood_from_json(to_json(blood));  // the same checks as a file's "blood"
 
     const double period = parse_quantity(period_text, Dimension::time, "--period",
