@@ -1,10 +1,13 @@
 #include "harmonic/linear_periodic.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <exception>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include <omp.h>
 
 #include "boundaries/rcr_outlet.hpp"
 #include "boundaries/resistance_outlet.hpp"
@@ -115,12 +118,11 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
                                      const ViscosityTable& viscosity, int harmonics, int threads) {
   const SteadyFlow steady =
       solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
-  return solve_linear_periodic(net, blood, laws, viscosity, steady, harmonics, threads);
+  return solve_linear_periodic(net, blood, laws, viscosity, steady, run_boundaries(net), harmonics, threads);
 }
 
-LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
-                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int harmonics, int threads) {
-  if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
+LinearPeriodic LinearPeriodic::about(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int threads) {
   const std::size_t n = net.vessel_count();
   LinearPeriodic out;
   out.net_ = &net;
@@ -141,51 +143,119 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
     out.line_[v] = {k_friction * viscosity(area) / (area * area), blood.density / area, law.compliance_per_length(area),
                     net.length[v], steady.flow[v] / area, law.alpha};
   }
+  return out;
+}
 
-  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
+namespace {
+
+// Solves harmonics 1 .. K of the network about `lines`, `batch` at a time (one to a thread),
+// and hands each one's node amplitudes to consume(k, amplitudes) in the order of k, so that
+// what the caller sums over the harmonics is summed in one order whatever the threads. The
+// lowest harmonic that fails is the one thrown.
+template <class Consume>
+void solve_harmonics(const Network& net, const LinearPeriodic& lines, const std::vector<NodeBoundary>& boundaries,
+                     int harmonics, int batch, int threads, Consume&& consume) {
   std::vector<FourierSeries> series;
   for (const NodeBoundary& b : boundaries)  // an outlet's pressure beyond does not oscillate
     series.push_back(b.is_outlet() ? FourierSeries{} : fourier_series(b.waveform, harmonics));
   const HarmonicNetwork network = harmonic_network(net, boundaries);
-  // The harmonics are independent: one to a thread (each solve the same arithmetic).
-  out.node_pressure_.resize(static_cast<std::size_t>(harmonics));
-  std::vector<std::exception_ptr> failure(static_cast<std::size_t>(harmonics));
+  std::vector<HarmonicWorkspace> work(static_cast<std::size_t>(std::max(threads, 1)));
+  for (int first = 1; first <= harmonics; first += batch) {
+    const int last = std::min(harmonics, first + batch - 1);
+    std::vector<std::vector<Complex>> solved(static_cast<std::size_t>(last - first + 1));
+    std::vector<std::exception_ptr> failure(solved.size());
 #pragma omp parallel num_threads(threads) if (threads > 1)
-  {
-    HarmonicWorkspace work;
+    {
+      HarmonicWorkspace& mine = work[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(dynamic, 1)
-    for (int k = 1; k <= harmonics; ++k) {
-      try {
-        out.node_pressure_[static_cast<std::size_t>(k - 1)] =
-            solve_harmonic(net, network, boundaries, series, out.line_, k, out.omega(k), work);
-      } catch (...) {
-        failure[static_cast<std::size_t>(k - 1)] = std::current_exception();
+      for (int k = first; k <= last; ++k) {
+        try {
+          solved[static_cast<std::size_t>(k - first)] =
+              solve_harmonic(net, network, boundaries, series, lines.lines(), k, lines.omega(k), mine);
+        } catch (...) {
+          failure[static_cast<std::size_t>(k - first)] = std::current_exception();
+        }
       }
     }
+    for (const std::exception_ptr& f : failure)
+      if (f) std::rethrow_exception(f);
+    for (int k = first; k <= last; ++k) consume(k, std::move(solved[static_cast<std::size_t>(k - first)]));
   }
-  for (const std::exception_ptr& f : failure)
-    if (f) std::rethrow_exception(f);
+}
+
+}  // namespace
+
+LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady,
+                                     const std::vector<NodeBoundary>& boundaries, int harmonics, int threads) {
+  if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
+  LinearPeriodic out = LinearPeriodic::about(net, blood, laws, viscosity, steady, threads);
+  // Every harmonic kept: all of them at once, one to a thread.
+  solve_harmonics(net, out, boundaries, harmonics, harmonics, threads,
+                  [&](int, std::vector<Complex>&& p) { out.node_pressure_.push_back(std::move(p)); });
+  return out;
+}
+
+PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                       const ViscosityTable& viscosity, const SteadyFlow& steady,
+                                       const std::vector<NodeBoundary>& boundaries, int harmonics, double time,
+                                       const std::vector<bool>& keep, int threads) {
+  if (harmonics < 1) throw std::invalid_argument("solve_periodic_instant: at least one harmonic");
+  PeriodicInstant out{steady.node_pressure, steady.flow,
+                      LinearPeriodic::about(net, blood, laws, viscosity, steady, threads)};
+  LinearPeriodic& along = out.along;
+  along.kept_.assign(net.node_count(), -1);
+  std::vector<std::size_t> kept_node;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    if (!keep[v]) continue;
+    for (const std::int64_t node : {net.from[v], net.to[v]}) {
+      auto& slot = along.kept_[static_cast<std::size_t>(node)];
+      if (slot >= 0) continue;
+      slot = static_cast<std::int32_t>(kept_node.size());
+      kept_node.push_back(static_cast<std::size_t>(node));
+    }
+  }
+  const auto nodes = static_cast<std::int64_t>(net.node_count()), vessels = static_cast<std::int64_t>(net.vessel_count());
+  // As many harmonics at once as threads; each added to every sum in the order of k, in the
+  // arithmetic of node_pressure_at and flow_at(v, 0.5, t).
+  solve_harmonics(net, along, boundaries, harmonics, std::max(threads, 1), threads, [&](int k, std::vector<Complex>&& p) {
+    const Complex turn = std::polar(1.0, along.omega(k) * time);
+#pragma omp parallel num_threads(threads) if (threads > 1)
+    {
+#pragma omp for schedule(static)
+      for (std::int64_t i = 0; i < nodes; ++i)
+        out.node_pressure[static_cast<std::size_t>(i)] += (p[static_cast<std::size_t>(i)] * turn).real();
+#pragma omp for schedule(static)
+      for (std::int64_t i = 0; i < vessels; ++i) {
+        const auto v = static_cast<std::size_t>(i);
+        const VesselLine& line = along.line(v);
+        const Complex q = line.flow(along.omega(k), p[static_cast<std::size_t>(net.from[v])],
+                                    p[static_cast<std::size_t>(net.to[v])], 0.5 * line.length);
+        out.middle_flow[v] += (q * turn).real();
+      }
+    }
+    std::vector<Complex> kept(kept_node.size());
+    for (std::size_t j = 0; j < kept_node.size(); ++j) kept[j] = p[kept_node[j]];
+    along.node_pressure_.push_back(std::move(kept));
+  });
   return out;
 }
 
 LinearPeriodic::Complex LinearPeriodic::pressure(int k, std::size_t vessel, double s) const {
-  const auto& p = node_pressure_[static_cast<std::size_t>(k - 1)];
   const VesselLine& line = line_[vessel];
-  return line.pressure(omega(k), p[static_cast<std::size_t>(net_->from[vessel])], p[static_cast<std::size_t>(net_->to[vessel])],
-                       s * line.length);
+  return line.pressure(omega(k), node_pressure(k, static_cast<std::size_t>(net_->from[vessel])),
+                       node_pressure(k, static_cast<std::size_t>(net_->to[vessel])), s * line.length);
 }
 
 LinearPeriodic::Complex LinearPeriodic::flow(int k, std::size_t vessel, double s) const {
-  const auto& p = node_pressure_[static_cast<std::size_t>(k - 1)];
   const VesselLine& line = line_[vessel];
-  return line.flow(omega(k), p[static_cast<std::size_t>(net_->from[vessel])], p[static_cast<std::size_t>(net_->to[vessel])],
-                   s * line.length);
+  return line.flow(omega(k), node_pressure(k, static_cast<std::size_t>(net_->from[vessel])),
+                   node_pressure(k, static_cast<std::size_t>(net_->to[vessel])), s * line.length);
 }
 
 std::array<VesselLine::Point, 3> LinearPeriodic::ends_and_middle(int k, std::size_t vessel) const {
-  const auto& p = node_pressure_[static_cast<std::size_t>(k - 1)];
-  return line_[vessel].ends_and_middle(omega(k), p[static_cast<std::size_t>(net_->from[vessel])],
-                                       p[static_cast<std::size_t>(net_->to[vessel])]);
+  return line_[vessel].ends_and_middle(omega(k), node_pressure(k, static_cast<std::size_t>(net_->from[vessel])),
+                                       node_pressure(k, static_cast<std::size_t>(net_->to[vessel])));
 }
 
 double LinearPeriodic::pressure_at(std::size_t vessel, double s, double t) const {

@@ -19,6 +19,7 @@
 
 #include <complex>
 #include <cstddef>
+#include <cstdint>
 #include <numbers>
 #include <span>
 #include <vector>
@@ -33,6 +34,8 @@
 
 namespace hemotree {
 
+struct PeriodicInstant;
+
 class LinearPeriodic {
  public:
   using Complex = std::complex<double>;
@@ -41,11 +44,15 @@ class LinearPeriodic {
   int harmonics() const { return static_cast<int>(node_pressure_.size()); }
   double omega(int k) const { return 2 * std::numbers::pi * k / period_; }
   const VesselLine& line(std::size_t vessel) const { return line_[vessel]; }
+  const std::vector<VesselLine>& lines() const { return line_; }  // per vessel
   // The loaded (mean) state: per node [Pa], per vessel [m^3/s, from -> to].
   const std::vector<double>& mean_node_pressure() const { return mean_node_pressure_; }
   const std::vector<double>& mean_flow() const { return mean_flow_; }
-  // Harmonic k >= 1 at a node, and in a vessel at a fraction s of its length from `from`.
-  Complex node_pressure(int k, std::size_t node) const { return node_pressure_[static_cast<std::size_t>(k - 1)][node]; }
+  // Harmonic k >= 1 at a node, and in a vessel at a fraction s of its length from `from`
+  // (one the solve kept: every one, or those of solve_periodic_instant's `keep`).
+  Complex node_pressure(int k, std::size_t node) const {
+    return node_pressure_[static_cast<std::size_t>(k - 1)][kept_.empty() ? node : static_cast<std::size_t>(kept_[node])];
+  }
   Complex pressure(int k, std::size_t vessel, double s) const;
   Complex flow(int k, std::size_t vessel, double s) const;
   // Harmonic k >= 1 at the vessel's start, middle and end.
@@ -57,14 +64,23 @@ class LinearPeriodic {
   double flow_at(std::size_t vessel, double s, double t) const;
 
   friend LinearPeriodic solve_linear_periodic(const Network&, const Blood&, std::span<const TubeLaw>,
-                                              const ViscosityTable&, const SteadyFlow&, int, int);
+                                              const ViscosityTable&, const SteadyFlow&,
+                                              const std::vector<NodeBoundary>&, int, int);
+  friend PeriodicInstant solve_periodic_instant(const Network&, const Blood&, std::span<const TubeLaw>,
+                                                const ViscosityTable&, const SteadyFlow&,
+                                                const std::vector<NodeBoundary>&, int, double,
+                                                const std::vector<bool>&, int);
 
  private:
+  // The mean state and every vessel's line about it; no harmonic yet.
+  static LinearPeriodic about(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                              const ViscosityTable& viscosity, const SteadyFlow& steady, int threads);
   const Network* net_ = nullptr;
   double period_ = 1.0;
   std::vector<double> mean_node_pressure_, mean_flow_;
   std::vector<VesselLine> line_;
-  std::vector<std::vector<Complex>> node_pressure_;  // [k - 1][node]
+  std::vector<std::vector<Complex>> node_pressure_;  // [k - 1][node, or its place in kept_]
+  std::vector<std::int32_t> kept_;                   // per node: its place, -1 (empty: every node's own)
 };
 
 // The linear periodic state with the first `harmonics` harmonics of the network's boundary
@@ -76,9 +92,25 @@ class LinearPeriodic {
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, int harmonics, int threads = 1);
 // The same about a steady state already solved (solve_distended_steady_flow with the same
-// blood, laws and viscosity).
+// blood, laws and viscosity), with the network's boundary list (run_boundaries(net)) where the
+// caller holds it: on the full tree a copy is two million entries, 0.3 GB.
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
-                                     const ViscosityTable& viscosity, const SteadyFlow& steady, int harmonics,
-                                     int threads = 1);
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady,
+                                     const std::vector<NodeBoundary>& boundaries, int harmonics, int threads = 1);
+
+// The linear periodic state at one instant t: every node's pressure and every vessel's flow
+// at its middle, summed harmonic by harmonic as each is solved, and the whole state (`along`)
+// for the vessels marked in `keep` only (the amplitudes at their nodes): what a time-stepped
+// run starts from (pulse/pulse_solver.cpp), without every node's K amplitudes at once (16 B a
+// node and harmonic: 0.6 GB for ten on the full tree). The same numbers, bit for bit, as
+// LinearPeriodic's node_pressure_at(i, t) and flow_at(v, 0.5, t).
+struct PeriodicInstant {
+  std::vector<double> node_pressure, middle_flow;  // per node [Pa], per vessel [m^3/s]
+  LinearPeriodic along;
+};
+PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                       const ViscosityTable& viscosity, const SteadyFlow& steady,
+                                       const std::vector<NodeBoundary>& boundaries, int harmonics, double time,
+                                       const std::vector<bool>& keep, int threads = 1);
 
 }  // namespace hemotree

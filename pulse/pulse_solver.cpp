@@ -122,7 +122,10 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
       // the steady one is not: no input is known to reach this, and the default start should
       // not be what fails a run), the run keeps the steady start and says why.
       try {
-        start_from_periodic(solve_linear_periodic(net, blood_, laws_, viscosity_, *steady, options.periodic_harmonics, threads_));
+        std::vector<bool> one_d = zero_d_;  // the vessels whose whole state it keeps
+        one_d.flip();
+        start_from_periodic(solve_periodic_instant(net, blood_, laws_, viscosity_, *steady, boundaries_.list,
+                                                   options.periodic_harmonics, time_, one_d, threads_));
         started_from_ = StartChoice::periodic;
       } catch (const InputError& e) {
         periodic_refusal_ = e.what();
@@ -476,23 +479,13 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
   }
 }
 
-void PulseSolver::start_from_periodic(const LinearPeriodic& periodic) {
+void PulseSolver::start_from_periodic(const PeriodicInstant& instant) {
   // The steady start has set what else a start needs (the reflection outlets' rest states);
-  // this replaces the state with the periodic one at t = 0.
+  // this replaces the state with the periodic one at t = time_ (the instant's).
   const Network& net = net_;
   const std::size_t n = net.vessel_count();
-  std::vector<double> node_pressure(net.node_count()), flow(n);
-  const auto nodes = static_cast<std::int64_t>(node_pressure.size()), vessels = static_cast<std::int64_t>(n);
-  // Every node and vessel on its own (on the full tree, 38 million line evaluations).
-#pragma omp parallel num_threads(threads_) if (threads_ > 1)
-  {
-#pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < nodes; ++i)
-      node_pressure[static_cast<std::size_t>(i)] = periodic.node_pressure_at(static_cast<std::size_t>(i), time_);
-#pragma omp for schedule(static)
-    for (std::int64_t v = 0; v < vessels; ++v) flow[static_cast<std::size_t>(v)] = periodic.flow_at(static_cast<std::size_t>(v), 0.5, time_);
-  }
-  lumped_.start(node_pressure, flow);
+  const LinearPeriodic& periodic = instant.along;  // the 1D vessels' whole state
+  lumped_.start(instant.node_pressure, instant.middle_flow);
   for (std::size_t v = 0; v < n; ++v) {
     if (zero_d_[v]) continue;
     auto pressure = [&](double x) { return periodic.pressure_at(v, x, time_); };

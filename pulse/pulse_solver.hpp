@@ -258,7 +258,7 @@ class PulseSolver {
   void choose_models(const SolverOptions& options);
   void start_from_steady_flow(const SteadyFlow& steady);
   // Then the linear periodic state about it at t = 0: pressures and flows along every vessel.
-  void start_from_periodic(const LinearPeriodic& periodic);
+  void start_from_periodic(const PeriodicInstant& instant);
   std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
   void start_at_rest();
   // steady: the network's steady flow, or null where it has none.

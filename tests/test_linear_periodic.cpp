@@ -208,6 +208,37 @@ TEST(LinearPeriodic, AnyThreadCountGivesTheSameBits) {
     }
 }
 
+// The periodic start's instant (harmonics summed as they are solved, the series kept along
+// some vessels only) is the whole solution's at that instant, bit for bit, for any threads.
+TEST(LinearPeriodic, TheInstantIsTheWholeSolutionsBitForBit) {
+  const TubeIntoWindkessel cut(5, 0.15, 4e-3, 6.0);
+  const Blood blood = newtonian(TubeIntoWindkessel::mu);
+  const ViscosityTable viscosity(blood);
+  const SteadyFlow steady = solve_distended_steady_flow(cut.net, blood, cut.laws, viscosity,
+                                                        cut.net.inlet->waveform.mean_value());
+  const std::vector<NodeBoundary> boundaries = run_boundaries(cut.net);
+  const LinearPeriodic whole = solve_linear_periodic(cut.net, blood, cut.laws, viscosity, steady, boundaries, 7, 1);
+  std::vector<bool> keep(cut.net.vessel_count(), false);
+  keep[1] = keep[3] = true;
+  const double t = 0.37 * whole.period();
+  for (const int threads : {1, 2, 3}) {
+    const PeriodicInstant instant =
+        solve_periodic_instant(cut.net, blood, cut.laws, viscosity, steady, boundaries, 7, t, keep, threads);
+    for (std::size_t node = 0; node < cut.net.node_count(); ++node)
+      EXPECT_EQ(instant.node_pressure[node], whole.node_pressure_at(node, t)) << threads << " threads, node " << node;
+    for (std::size_t v = 0; v < cut.net.vessel_count(); ++v)
+      EXPECT_EQ(instant.middle_flow[v], whole.flow_at(v, 0.5, t)) << threads << " threads, vessel " << v;
+    ASSERT_EQ(instant.along.harmonics(), 7);
+    for (const std::size_t v : {1u, 3u})
+      for (const double s : {0.0, 0.3, 1.0}) {
+        EXPECT_EQ(instant.along.pressure_at(v, s, t), whole.pressure_at(v, s, t)) << "vessel " << v << " at " << s;
+        EXPECT_EQ(instant.along.flow_at(v, s, t), whole.flow_at(v, s, t)) << "vessel " << v << " at " << s;
+      }
+  }
+  // The mean alone and a harmonic that moves it: the instant is not the mean.
+  EXPECT_NE(whole.node_pressure_at(0, t), whole.mean_node_pressure()[0]);
+}
+
 TEST(LinearPeriodic, AShortVesselIntoAWindkesselIsTheRcAndRlcCircuit) {
   // 5 mm of a stiff 1 mm vessel: |gamma l| ~ 1e-2, so the line is its R and L in series
   // with the outlet (C l / 2 at its ends, beside the Windkessel's C, is 4e-5 of it).
