@@ -21,7 +21,8 @@ constexpr std::string_view magic = "hemotree checkpoint\n";
 // 6: the transport's last face volumes; 7: the run's identity in a section of its own (a hash of the
 // whole network and the options that shape the state), so that no field is left out of it.
 // 8: the last two cycles' results in sections of their own (a writer holds one section at a time).
-constexpr std::uint64_t format_version = 8;
+// 9: of the cycle before the last, its mean pressures alone (what the periodicity test reads).
+constexpr std::uint64_t format_version = 9;
 constexpr std::size_t word = sizeof(std::uint64_t);
 constexpr std::size_t header = magic.size() + word;  // the magic line and the format
 

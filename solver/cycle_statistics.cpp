@@ -153,11 +153,11 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   return summary;
 }
 
-PeriodicityChange cycle_change(const std::vector<VesselCycle>& previous,
+PeriodicityChange cycle_change(std::span<const double> previous_mean_pressure,
                                const std::vector<VesselCycle>& current) {
   PeriodicityChange worst;
   for (std::size_t v = 0; v < current.size(); ++v) {
-    const double change = std::abs(current[v].mean_pressure - previous[v].mean_pressure) /
+    const double change = std::abs(current[v].mean_pressure - previous_mean_pressure[v]) /
                           std::abs(current[v].mean_pressure);
     if (change > worst.change) worst = {change, v};
   }

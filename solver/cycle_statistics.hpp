@@ -10,6 +10,7 @@
 
 #include <complex>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "pulse/pulse_solver.hpp"
@@ -99,7 +100,7 @@ struct PeriodicityChange {
   double change = 0;
   std::size_t vessel = 0;
 };
-PeriodicityChange cycle_change(const std::vector<VesselCycle>& previous,
+PeriodicityChange cycle_change(std::span<const double> previous_mean_pressure,
                                const std::vector<VesselCycle>& current);
 
 }  // namespace hemotree

@@ -79,7 +79,7 @@ void PulsatileRun::snapshot() {
   out.section("last cycle");
   put_summary(out, last_);
   out.section("previous cycle");
-  put_summary(out, previous_);
+  out.put(previous_mean_pressure_);
   out.section("run");
   out.put(static_cast<std::uint64_t>(done_));
   out.put(static_cast<std::uint64_t>(balances_));
@@ -111,7 +111,9 @@ void PulsatileRun::resume(std::string bytes, const std::string& source) {
   in.section("last cycle");
   last_ = get_summary(in, net_.vessel_count());
   in.section("previous cycle");
-  previous_ = get_summary(in, net_.vessel_count());
+  previous_mean_pressure_ = in.get_vector();
+  if (!previous_mean_pressure_.empty() && previous_mean_pressure_.size() != net_.vessel_count())
+    in.fail("cycle results of another network");
   in.section("run");
   done_ = static_cast<int>(in.get_u64());
   balances_ = static_cast<int>(in.get_u64());
@@ -285,7 +287,9 @@ RunStatus PulsatileRun::run(RunObserver& observer) {
         }
       }
       solver_.check_solution();
-      previous_ = std::move(last_);
+      previous_mean_pressure_.resize(last_.vessels.size());
+      for (std::size_t v = 0; v < last_.vessels.size(); ++v) previous_mean_pressure_[v] = last_.vessels[v].mean_pressure;
+      last_ = CycleSummary{};  // freed before the next is built
       last_ = stats_.close(solver_);
       if (series) series->finish();
       std::vector<double> mean_pressure(last_.vessels.size());
@@ -301,7 +305,7 @@ RunStatus PulsatileRun::run(RunObserver& observer) {
         red_cells_last_ = std::move(cycle);
         transport_->take_volumes();  // the balance's shifts, and the 0D nodes' round-off
       }
-      if (has_change()) change_ = cycle_change(previous_.vessels, last_.vessels);
+      if (has_change()) change_ = cycle_change(previous_mean_pressure_, last_.vessels);
       ++done_;
       snapshot();
       if (plan_.checkpoint_every > 0 && done_ % plan_.checkpoint_every == 0) write_checkpoint();
