@@ -110,8 +110,8 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
     capacitor_compliance[k] = outlet_capacitance_[k];
     loads.capacitor_current[k] = outlet_capacitance_[k] * (capacitor_now[k] - cycle_capacitor_[k]) / period;
   }
-  // delta = K^-1 I: the shifts that cancel the rates in the linear network (K its conductance).
-  const TreePotentials delta = solve_loaded_tree(net_, boundaries_.list, resistance, loads);
+  // move = delta = K^-1 I: the shifts that cancel the rates in the linear network (K its conductance).
+  TreePotentials move = solve_loaded_tree(net_, boundaries_.list, resistance, loads);
   // The distance still to go after a cycle that moved by the drift dP is f(Z) dP with
   // f(z) = e^(-z) / (1 - e^(-z)) = g(z) / z, g(z) = z / (e^z - 1), Z = C^-1 K T, and
   // Z^-1 dP = delta. g is taken as 1 / ((1 + a z)(1 + b z)), two solves of (C + a K T) y =
@@ -119,7 +119,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   // mode of Z contracts per cycle by e^(-z) |1 - g_a(z) / g(z)|, whose largest over all z is
   // 2.9 % with a = 0.315, b = 0.354 (fitted to equal ripple at z = 0.44 and 3), where the
   // earlier 1 / (1 + z/2) left 8.2 % (at z = 2: the modes that decay in about a cycle).
-  TreePotentials move = delta;
+  // (move starts as delta, and each solve replaces it.)
   for (const double a : {0.315, 0.354}) {
     for (std::size_t node = 0; node < node_compliance.size(); ++node) {
       loads.node_shunt[node] = node_compliance[node] / (a * period);

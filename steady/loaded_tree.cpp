@@ -20,28 +20,30 @@ TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBound
                                  const std::vector<double>& resistance, const TreeLoads& loads) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   if (n == 0) throw InputError("the network has no vessels");
-  const std::vector<Outlet> outlets = run_outlets(boundaries);
+  // The outlets in run_outlets' order, by their places in the list (not copied: a full tree
+  // has two million).
+  std::vector<std::int32_t> outlet_boundary;
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    if (boundaries[i].is_outlet()) outlet_boundary.push_back(static_cast<std::int32_t>(i));
+  const std::size_t outlets = outlet_boundary.size();
+  auto outlet = [&](std::size_t k) -> const NodeBoundary& { return boundaries[static_cast<std::size_t>(outlet_boundary[k])]; };
   if (resistance.size() != n || loads.node_shunt.size() != nodes || loads.node_current.size() != nodes ||
-      loads.capacitor_shunt.size() != outlets.size() || loads.capacitor_current.size() != outlets.size())
+      loads.capacitor_shunt.size() != outlets || loads.capacitor_current.size() != outlets)
     throw std::invalid_argument("solve_loaded_tree: resistances or loads not sized to the network");
   if (net.boundaries.empty()) steady_outlets(net);  // the outlets sit on exactly the terminal vessels, none a reflection
   for (const NodeBoundary& bc : boundaries)
     if (bc.type == BoundaryType::reflection)
       throw InputError("node " + std::to_string(net.node_id[static_cast<std::size_t>(bc.node)]) +
                        ": a reflection outlet has no resistance for the network's response");
-  // Each outlet's node (the tree form's: its vessel's `to`), and the nodes a prescribed
-  // pressure holds: their disturbance is 0.
-  std::vector<std::int32_t> outlet_node;
+  // The nodes a prescribed pressure holds: their disturbance is 0.
   std::vector<unsigned char> held(nodes, 0);
-  for (const NodeBoundary& bc : boundaries) {
-    if (bc.is_outlet()) outlet_node.push_back(bc.node);
+  for (const NodeBoundary& bc : boundaries)
     if (bc.type == BoundaryType::pressure) held[static_cast<std::size_t>(bc.node)] = 1;
-  }
 
   // The system's nodes: the network's, then a capacitor node per RCR outlet that has one
   // apart from both ends (R1 and R2 both positive). With R1 = 0 the capacitor sits on the
   // vessel's distal node; with R2 = 0 it is grounded (its potential 0, its loads shorted).
-  std::vector<std::int32_t> capacitor_node(outlets.size(), -1);
+  std::vector<std::int32_t> capacitor_node(outlets, -1);
   std::vector<std::int32_t> a(net.from), b(net.to);
   std::vector<double> conductance(n), shunt(loads.node_shunt), current(loads.node_current);
   for (std::size_t v = 0; v < n; ++v) conductance[v] = 1 / resistance[v];
@@ -79,9 +81,9 @@ TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBound
       shunt[i] = 1;
       current[i] = 0;
     }
-  for (std::size_t k = 0; k < outlets.size(); ++k) {
-    const Outlet& o = outlets[k];
-    const std::int32_t distal = outlet_node[k];
+  for (std::size_t k = 0; k < outlets; ++k) {
+    const Outlet& o = outlet(k).outlet;
+    const std::int32_t distal = outlet(k).node;  // the tree form's: its vessel's `to`
     const auto d = static_cast<std::size_t>(distal);
     if (o.type != BoundaryType::rcr) {
       shunt[d] += 1 / o.r;
@@ -113,11 +115,11 @@ TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBound
 
   TreePotentials p;
   p.node.assign(current.begin(), current.begin() + static_cast<std::ptrdiff_t>(nodes));
-  p.capacitor.assign(outlets.size(), 0.0);
-  for (std::size_t k = 0; k < outlets.size(); ++k) {
-    const Outlet& o = outlets[k];
+  p.capacitor.assign(outlets, 0.0);
+  for (std::size_t k = 0; k < outlets; ++k) {
+    const Outlet& o = outlet(k).outlet;
     if (capacitor_node[k] >= 0) p.capacitor[k] = current[static_cast<std::size_t>(capacitor_node[k])];
-    else if (o.type == BoundaryType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(outlet_node[k])];
+    else if (o.type == BoundaryType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(outlet(k).node)];
   }
   return p;
 }
