@@ -67,7 +67,7 @@ CheckpointWriter::CheckpointWriter() {
 
 CheckpointWriter::CheckpointWriter(const std::filesystem::path& file) : CheckpointWriter() {
   file_ = file;
-  fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);  // read: the checksums
   if (fd_ < 0) throw IoError("cannot write " + file.string() + ": " + std::strerror(errno));
   written_hash_ = Fingerprint().value();
 }
@@ -76,23 +76,55 @@ CheckpointWriter::~CheckpointWriter() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-void CheckpointWriter::flush() {
+void CheckpointWriter::spill() {
   write_all(fd_, bytes_.data(), bytes_.size(), file_);
-  // FNV-1a goes byte by byte: carried on from the bytes before, it is the whole file's.
-  Fingerprint f(written_hash_);
-  f.add(bytes_.data(), bytes_.size());
-  written_hash_ = f.value();
+  written_ += bytes_.size();
   bytes_.clear();
+}
+
+void CheckpointWriter::close_file_section() {
+  spill();
+  const std::uint64_t start = section_start_, length_at = start + word + section_name_size_;
+  const std::uint64_t length = written_ - length_at - word;
+  if (::pwrite(fd_, &length, word, static_cast<off_t>(length_at)) != static_cast<ssize_t>(word))
+    throw IoError("cannot write " + file_.string() + ": " + std::strerror(errno));
+  // The section's checksum, and the file's carried on (FNV-1a goes byte by byte), over its
+  // bytes as they now stand in the file (the page cache's: a read at memory speed).
+  Fingerprint section, file(written_hash_);
+  std::vector<char> piece(std::size_t{1} << 20);
+  for (std::uint64_t at = hashed_; at < written_;) {
+    const auto want = static_cast<std::size_t>(std::min<std::uint64_t>(piece.size(), written_ - at));
+    const ssize_t n = ::pread(fd_, piece.data(), want, static_cast<off_t>(at));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw IoError("cannot read back " + file_.string() + ": " + std::strerror(n < 0 ? errno : EIO));
+    file.add(piece.data(), static_cast<std::size_t>(n));
+    const std::uint64_t from = std::max(at, start);  // the header before the first section: the file's alone
+    if (from < at + static_cast<std::uint64_t>(n))
+      section.add(piece.data() + (from - at), static_cast<std::size_t>(at + static_cast<std::uint64_t>(n) - from));
+    at += static_cast<std::uint64_t>(n);
+  }
+  const std::uint64_t sum = section.value();
+  file.add(&sum, word);
+  append_word(bytes_, sum);
+  spill();
+  written_hash_ = file.value();
+  hashed_ = written_;
+  section_start_ = std::string::npos;
 }
 
 void CheckpointWriter::finish() {
   if (fd_ < 0) throw std::logic_error("checkpoint: finish() of a writer in memory");
   if (vector_left_ != 0) throw std::logic_error("checkpoint: a vector given in parts is short");
-  if (section_start_ != std::string::npos) close_section(bytes_, section_start_);
-  flush();
+  if (section_start_ != std::string::npos) close_file_section();
+  if (hashed_ < written_ + bytes_.size()) {  // no section at all: the header alone
+    Fingerprint f(written_hash_);
+    f.add(bytes_.data(), bytes_.size());
+    written_hash_ = f.value();
+    spill();
+    hashed_ = written_;
+  }
   append_word(bytes_, written_hash_);
-  write_all(fd_, bytes_.data(), bytes_.size(), file_);
-  bytes_.clear();
+  spill();
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) throw IoError("cannot write " + file_.string() + ": " + std::strerror(errno));
@@ -113,6 +145,7 @@ void CheckpointWriter::raw(const void* data, std::size_t size) {
   if (section_start_ == std::string::npos) throw std::logic_error("checkpoint: a value written before any section");
   if (size == 0) return;  // an empty matrix's data() is null, which memcpy must not see
   bytes_.append(static_cast<const char*>(data), size);
+  if (fd_ >= 0 && bytes_.size() >= (std::size_t{4} << 20)) spill();
 }
 
 // The section from start: its payload's length in the word after its name, its checksum after it.
@@ -125,9 +158,12 @@ void CheckpointWriter::close_section(std::string& bytes, std::size_t start) {
 
 void CheckpointWriter::section(std::string_view name) {
   if (vector_left_ != 0) throw std::logic_error("checkpoint: a vector given in parts is short");
-  if (section_start_ != std::string::npos) close_section(bytes_, section_start_);
-  if (fd_ >= 0) flush();
-  section_start_ = bytes_.size();
+  if (section_start_ != std::string::npos) {
+    if (fd_ >= 0) close_file_section();
+    else close_section(bytes_, section_start_);
+  }
+  section_start_ = written_ + bytes_.size();  // in memory, written_ stays 0
+  section_name_size_ = name.size();
   append_word(bytes_, name.size());
   bytes_.append(name);
   append_word(bytes_, 0);  // the payload's length, known when the section closes

@@ -31,9 +31,11 @@ class CheckpointWriter {
  public:
   CheckpointWriter();  // in memory (bytes()); starts with the file's magic line and format version
   // Straight to `file` (created or truncated), IoError naming it where it cannot be written:
-  // each section goes out whole as the next one opens, so the writer holds one section at a
-  // time, not the file (a full tree's checkpoint is a gigabyte). finish() ends the file; it
-  // is not synced to disk (promote_checkpoint_file does that).
+  // the bytes go out in pieces of a few megabytes as they come, and a section's length and
+  // checksum are written when it closes (its length in place, its bytes read back for the
+  // checksum), so the writer holds neither the file nor a whole section (the 0D vessels' of
+  // a full tree are 0.9 GB). finish() ends the file; it is not synced to disk
+  // (promote_checkpoint_file does that).
   explicit CheckpointWriter(const std::filesystem::path& file);
   ~CheckpointWriter();
   CheckpointWriter(const CheckpointWriter&) = delete;
@@ -59,14 +61,17 @@ class CheckpointWriter {
  private:
   void raw(const void* data, std::size_t size);
   static void close_section(std::string& bytes, std::size_t start);
-  void flush();  // to the file: bytes_ out, the file's checksum carried on
+  void spill();               // to the file: bytes_ out as they are
+  void close_file_section();  // to the file: the open section's length and checksum
   std::string bytes_;
-  std::size_t section_start_ = std::string::npos;  // of the open section
-  std::uint64_t vector_left_ = 0;                   // of a vector being given in parts
-  // The file mode: its descriptor (-1: in memory), name, and the checksum of what went out.
+  // The open section's start (in the file mode, its offset in the file) and its name's size.
+  std::size_t section_start_ = std::string::npos, section_name_size_ = 0;
+  std::uint64_t vector_left_ = 0;  // of a vector being given in parts
+  // The file mode: its descriptor (-1: in memory), name, the bytes written, and the file's
+  // checksum of the bytes before hashed_ (every section closed).
   int fd_ = -1;
   std::filesystem::path file_;
-  std::uint64_t written_hash_ = 0;
+  std::uint64_t written_ = 0, hashed_ = 0, written_hash_ = 0;
 };
 
 // Reads what a CheckpointWriter wrote, in the same order; InputError naming the file at the

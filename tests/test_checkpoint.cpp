@@ -97,6 +97,16 @@ TEST(Checkpoint, AFileWrittenBySectionsIsTheSameBytes) {
     out.put_part(std::vector<double>{});
     out.put_part(std::vector<double>{3, 4, 5});
     out.put(std::uint64_t{7});
+    // A section larger than the writer's pieces (4 MB out, 1 MB read back for the checksum),
+    // given in parts that cross them: streamed, its length and checksum written after.
+    out.section("large");
+    out.begin_vector(1'300'001);
+    std::vector<double> part(100'000);
+    for (std::size_t k = 0; k < 13; ++k) {
+      for (std::size_t i = 0; i < part.size(); ++i) part[i] = static_cast<double>(k * part.size() + i) * 0.5;
+      out.put_part(part);
+    }
+    out.put_part(std::vector<double>{-1});
     out.section("end");
   };
   CheckpointWriter memory;
@@ -114,6 +124,11 @@ TEST(Checkpoint, AFileWrittenBySectionsIsTheSameBytes) {
   in.section("parts");
   EXPECT_EQ(in.get_vector(), (std::vector<double>{1, 2, 3, 4, 5}));
   EXPECT_EQ(in.get_u64(), 7u);
+  in.section("large");
+  const std::vector<double> large = in.get_vector();
+  ASSERT_EQ(large.size(), 1'300'001u);
+  EXPECT_EQ(large[1'234'567], 1'234'567 * 0.5);
+  EXPECT_EQ(large.back(), -1);
   write_checkpoint_file(dir / "checkpoint.bin", "old");
   promote_checkpoint_file(dir / "snapshot", dir / "checkpoint.bin");
   EXPECT_EQ(read_checkpoint_file(dir / "checkpoint.bin"), memory.bytes());
