@@ -52,7 +52,7 @@ HarmonicNetwork harmonic_network(const Network& net, const std::vector<NodeBound
 // One harmonic's system, kept from one harmonic to the next: fresh pages of this size cost
 // more than the solve.
 struct HarmonicWorkspace {
-  std::vector<Complex> shunt, current, held_value;
+  std::vector<Complex> shunt, current;
   std::vector<TwoPort> edge;
 };
 
@@ -61,15 +61,18 @@ std::vector<Complex> solve_harmonic(const Network& net, const HarmonicNetwork& h
                                     const std::vector<FourierSeries>& series, const std::vector<VesselLine>& lines,
                                     int k, double w, HarmonicWorkspace& work) {
   const std::size_t nodes = net.node_count();
-  std::vector<Complex>&shunt = work.shunt, &current = work.current, &held_value = work.held_value;
-  shunt.assign(nodes, 0.0), current.assign(nodes, 0.0), held_value.assign(nodes, 0.0);
+  // A held node's current is its held pressure: nothing else flows into it (one boundary a
+  // node; a vessel to it draws its current at its other node), and its row is x = current.
+  std::vector<Complex>&shunt = work.shunt, &current = work.current;
+  shunt.assign(nodes, 0.0), current.assign(nodes, 0.0);
+  std::size_t next = 0;  // series holds the boundaries' that are not outlets, in their order
   for (std::size_t i = 0; i < boundaries.size(); ++i) {
     const NodeBoundary& b = boundaries[i];
     const auto node = static_cast<std::size_t>(b.node);
-    const Complex amplitude = b.is_outlet() ? Complex(0.0) : series[i].amplitude[static_cast<std::size_t>(k)];
+    const Complex amplitude = b.is_outlet() ? Complex(0.0) : series[next++].amplitude[static_cast<std::size_t>(k)];
     switch (b.type) {
       case BoundaryType::flow: current[node] += amplitude; break;
-      case BoundaryType::pressure: held_value[node] = amplitude; break;
+      case BoundaryType::pressure: current[node] = amplitude; break;
       case BoundaryType::resistance: shunt[node] += 1.0 / ResistanceOutlet{b.outlet.r, b.outlet.p_out}.impedance(w); break;
       case BoundaryType::rcr:
         shunt[node] += 1.0 / RcrOutlet{b.outlet.r1, b.outlet.c, b.outlet.r2, b.outlet.p_out}.impedance(w);
@@ -87,22 +90,17 @@ std::vector<Complex> solve_harmonic(const Network& net, const HarmonicNetwork& h
     const auto i = static_cast<std::size_t>(net.from[v]), j = static_cast<std::size_t>(net.to[v]);
     if (h.held[i]) {
       shunt[j] += y.bb;
-      current[j] -= y.ba * held_value[i];
+      current[j] -= y.ba * current[i];
     } else {
       shunt[i] += y.aa;
-      current[i] -= y.ab * held_value[j];
+      current[i] -= y.ab * current[j];
     }
   }
   std::vector<TwoPort>& edge = work.edge;
   edge.resize(h.edge_vessel.size());
   for (std::size_t e = 0; e < edge.size(); ++e) edge[e] = lines[static_cast<std::size_t>(h.edge_vessel[e])].two_port(w);
   for (std::size_t node = 0; node < nodes; ++node) {
-    if (h.held[node]) {
-      shunt[node] = 1.0;
-      current[node] = held_value[node];
-    } else if (!h.touched[node]) {
-      shunt[node] = 1.0;
-    }
+    if (h.held[node] || !h.touched[node]) shunt[node] = 1.0;
   }
   try {
     h.system.solve_in_place(edge, shunt, current);
@@ -155,9 +153,9 @@ namespace {
 template <class Consume>
 void solve_harmonics(const Network& net, const LinearPeriodic& lines, const std::vector<NodeBoundary>& boundaries,
                      int harmonics, int batch, int threads, Consume&& consume) {
-  std::vector<FourierSeries> series;
-  for (const NodeBoundary& b : boundaries)  // an outlet's pressure beyond does not oscillate
-    series.push_back(b.is_outlet() ? FourierSeries{} : fourier_series(b.waveform, harmonics));
+  std::vector<FourierSeries> series;  // an outlet's pressure beyond does not oscillate: none
+  for (const NodeBoundary& b : boundaries)
+    if (!b.is_outlet()) series.push_back(fourier_series(b.waveform, harmonics));
   const HarmonicNetwork network = harmonic_network(net, boundaries);
   std::vector<HarmonicWorkspace> work(static_cast<std::size_t>(std::max(threads, 1)));
   for (int first = 1; first <= harmonics; first += batch) {
