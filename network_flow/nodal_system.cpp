@@ -418,17 +418,22 @@ void NodalSystem::check_solvable(std::size_t size, const char* what) const {
 
 // ---- the tree's sweeps --------------------------------------------------------------------
 
+std::size_t NodalSystem::task_size_limit(std::size_t nodes) {
+  // Below 2^16 nodes a sweep is a few hundred microseconds: threads would only wait. Above,
+  // subtrees of at most 1/256 of the nodes: enough tasks for dynamic scheduling to balance
+  // two or a few threads, few enough top nodes (those above them) for the serial part.
+  if (nodes < (std::size_t{1} << 16)) return 0;
+  return std::max<std::size_t>(4096, nodes / 256);
+}
+
 void NodalSystem::plan_subtrees() {
-  // Below this many nodes a sweep is a few hundred microseconds: threads would only wait.
-  if (nodes_ < (std::size_t{1} << 16)) return;
+  if (task_size_limit(nodes_) == 0) return;
   std::vector<std::int32_t> size(nodes_, 1);
   for (std::size_t k = nodes_; k-- > 0;) {
     const auto c = static_cast<std::size_t>(order_[k]);
     if (parent_[c] >= 0) size[static_cast<std::size_t>(parent_[c])] += size[c];
   }
-  // Subtrees of at most 1/256 of the nodes: enough tasks for dynamic scheduling to balance
-  // two or a few threads, few enough top nodes (those above them) for the serial part.
-  const auto limit = std::max<std::int32_t>(4096, static_cast<std::int32_t>(nodes_ / 256));
+  const auto limit = static_cast<std::int32_t>(task_size_limit(nodes_));
   std::vector<std::int32_t> task(nodes_, -1), count;
   for (const std::int32_t c : order_) {
     const std::int32_t p = parent_[static_cast<std::size_t>(c)];

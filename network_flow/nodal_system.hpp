@@ -72,6 +72,9 @@ class NodalSystem {
   // Threads for the tree elimination's sweeps: subtrees in parallel, the top of the tree and
   // each subtree's root serially in the one-thread order, so the bits do not depend on it.
   void set_threads(int threads) { threads_ = threads; }
+  // The largest subtree a sweep's task takes on a forest of `nodes` (0: no tasks, one thread
+  // sweeps): the subtrees of at most this many nodes whose parent roots a larger one.
+  static std::size_t task_size_limit(std::size_t nodes);
   // (system^-1)_ii for each node i of `nodes` (any order, repeats allowed), with the last
   // factorisation, into out (of nodes' size): each node's own response, the potential that a
   // unit current into it alone raises there (the impedance to ground seen from the node).

@@ -1,6 +1,7 @@
 // The boundary conditions at nodes of 0D vessels as rows of the 0D system, built once by the
 // constructor (the 1D ends take the same conditions in pulse/dg_rate.cpp), and which of them
 // count as entering the network.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -88,6 +89,9 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
       shunt_pressure_[at] = row.pressure;
     }
   }
+  // By node: complete() reads each outlet's node, in the arrays' order.
+  std::stable_sort(outlet_boundary_.begin(), outlet_boundary_.end(),
+                   [](const OutletNode& x, const OutletNode& y) { return x.node < y.node; });
   if (!held_node_.empty()) {
     held_.assign(nodes_, 0);
     for (std::size_t j = 0; j < held_node_.size(); ++j) held_[static_cast<std::size_t>(held_node_[j])] = static_cast<std::int32_t>(j + 1);

@@ -13,6 +13,7 @@
 #include "core/setting_error.hpp"
 #include "core/parallel_errors.hpp"
 #include "physics/poiseuille.hpp"
+#include "pulse/lumped_order.hpp"
 #include "pulse/solution_breakdown.hpp"
 
 namespace hemotree {
@@ -24,20 +25,17 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   const std::size_t n = net.vessel_count();
   node_of_.assign(net.node_count(), -1);
   index_of_vessel_.assign(n, -1);
-  auto node = [&](std::int64_t network_node) {
-    auto& k = node_of_[static_cast<std::size_t>(network_node)];
-    if (k < 0) {
-      k = static_cast<std::int32_t>(network_node_.size());
-      network_node_.push_back(network_node);
-    }
-    return k;
-  };
-  for (std::size_t v = 0; v < n; ++v) {
-    if (!zero_d[v]) continue;
+  // Every subtree contiguous (pulse/lumped_order.hpp): the elimination's tasks stream.
+  LumpedOrder order = subtree_lumped_order(net, zero_d);
+  network_node_ = std::move(order.nodes);
+  for (std::size_t k = 0; k < network_node_.size(); ++k)
+    node_of_[static_cast<std::size_t>(network_node_[k])] = static_cast<std::int32_t>(k);
+  for (const std::int32_t vessel : order.vessels) {
+    const auto v = static_cast<std::size_t>(vessel);
     index_of_vessel_[v] = static_cast<std::int32_t>(vessels_.size());
-    vessels_.push_back(static_cast<std::int32_t>(v));
-    a_.push_back(node(net.from[v]));
-    b_.push_back(node(net.to[v]));
+    vessels_.push_back(vessel);
+    a_.push_back(node_of_[static_cast<std::size_t>(net.from[v])]);
+    b_.push_back(node_of_[static_cast<std::size_t>(net.to[v])]);
     const TubeLaw& law = laws[v];
     edge_length_.push_back(net.length[v]);
     edge_root_slope_.push_back(law.lumen_root_slope());
@@ -602,8 +600,10 @@ void LumpedVessels::sample(double x, std::span<double> area, std::span<double> f
 }
 
 double LumpedVessels::stored_volume() const {
+  // Summed in the network's order: the same bits whatever the arrays' order.
   double v = 0;
-  for (std::size_t k = 0; k < network_nodes_; ++k) v += volume_c_[k] + 0.5 * (3 * volume_[k] - previous_volume_[k]);
+  for (const std::int32_t node : network_order_nodes())
+    if (const auto k = static_cast<std::size_t>(node); k < network_nodes_) v += volume_c_[k] + 0.5 * (3 * volume_[k] - previous_volume_[k]);
   return v;
 }
 
@@ -627,7 +627,9 @@ void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std
 }
 
 void LumpedVessels::check(double time, std::span<const std::int64_t> vessel_id) const {
-  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+  for (const std::int32_t index : index_of_vessel_) {  // the first in the network's order is named
+    if (index < 0) continue;
+    const auto e = static_cast<std::size_t>(index);
     const double s_a = lumen_root(e, pressure_[static_cast<std::size_t>(a_[e])], 0.0);
     const double s_b = lumen_root(e, pressure_[static_cast<std::size_t>(b_[e])], 1.0);
     if (!(s_a > 0) || !(s_b > 0) || !std::isfinite(flow_[e]) || !std::isfinite(s_a * s_b))
@@ -637,19 +639,59 @@ void LumpedVessels::check(double time, std::span<const std::int64_t> vessel_id) 
 
 // ---- checkpoint ---------------------------------------------------------------------------------
 
+std::vector<std::int32_t> LumpedVessels::network_order_edges() const {
+  std::vector<std::int32_t> place;
+  place.reserve(a_.size());
+  for (const std::int32_t e : index_of_vessel_)
+    if (e >= 0) place.push_back(e);
+  for (std::size_t e = vessels_.size(); e < a_.size(); ++e) place.push_back(static_cast<std::int32_t>(e));  // R1 edges
+  return place;
+}
+
+std::vector<std::int32_t> LumpedVessels::network_order_nodes() const {
+  std::vector<std::int32_t> place;
+  place.reserve(nodes_);
+  std::vector<unsigned char> seen(network_nodes_, 0);
+  for (const std::int32_t e : index_of_vessel_) {
+    if (e < 0) continue;
+    for (const std::int32_t k : {a_[static_cast<std::size_t>(e)], b_[static_cast<std::size_t>(e)]})
+      if (!seen[static_cast<std::size_t>(k)]) {
+        seen[static_cast<std::size_t>(k)] = 1;
+        place.push_back(k);
+      }
+  }
+  for (std::size_t k = network_nodes_; k < nodes_; ++k) place.push_back(static_cast<std::int32_t>(k));  // capacitors
+  return place;
+}
+
 void LumpedVessels::save(CheckpointWriter& out) const {
+  // In the network's order (network_order_nodes): the file does not depend on the arrays'.
   out.section("0D vessels");
-  for (const auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_, &flow_, &previous_flow_})
-    out.put(*v);
+  const std::vector<std::int32_t> nodes = network_order_nodes(), edges = network_order_edges();
+  auto put = [&](const std::vector<double>& values, const std::vector<std::int32_t>& place) {
+    out.begin_vector(values.size());
+    std::vector<double> part;
+    part.reserve(4096);
+    for (std::size_t i = 0; i < place.size(); i += part.capacity()) {
+      part.clear();
+      for (std::size_t j = i; j < std::min(place.size(), i + 4096); ++j) part.push_back(values[static_cast<std::size_t>(place[j])]);
+      out.put_part(part);
+    }
+  };
+  for (const auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) put(*v, nodes);
+  for (const auto* v : {&flow_, &previous_flow_}) put(*v, edges);
 }
 
 void LumpedVessels::restore(CheckpointReader& in) {
   in.section("0D vessels");
-  for (auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_, &flow_, &previous_flow_}) {
-    const std::size_t size = v->size();
-    *v = in.get_vector();
-    if (v->size() != size) in.fail("0D vessels of another network or model");
-  }
+  const std::vector<std::int32_t> nodes = network_order_nodes(), edges = network_order_edges();
+  auto get = [&](std::vector<double>& values, const std::vector<std::int32_t>& place) {
+    const std::vector<double> given = in.get_vector();
+    if (given.size() != values.size()) in.fail("0D vessels of another network or model");
+    for (std::size_t i = 0; i < place.size(); ++i) values[static_cast<std::size_t>(place[i])] = given[i];
+  };
+  for (auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) get(*v, nodes);
+  for (auto* v : {&flow_, &previous_flow_}) get(*v, edges);
   predicted_ = pressure_;
   // The resistances are functions of the pressures: the same bits as the run had.
   for (std::size_t e = 0; e < vessels_.size(); ++e) {

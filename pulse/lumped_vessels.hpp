@@ -194,6 +194,13 @@ class LumpedVessels {
   void restore(CheckpointReader& in);
 
  private:
+  // The arrays are in pulse/lumped_order's subtree order; a checkpoint and the sums over all
+  // nodes keep the network's: the node, or edge, at each place of network_lumped_order (then
+  // the capacitors, or the R1 edges). O(nodes), built when asked (at cycle ends).
+  std::vector<std::int32_t> network_order_nodes() const;
+  std::vector<std::int32_t> network_order_edges() const;
+
+ private:
   // A node's volume is a quadratic in its pressure (each vessel's L A(p) / 2 is, with the
   // tube law's A = (c + p / beta)^2, and a capacitor's C p is linear): V = a p^2 + b p + c.
   // The state is the excess W = V - c = a p^2 + b p: c drops out of every step (BDF2 is
