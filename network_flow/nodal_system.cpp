@@ -426,27 +426,42 @@ std::size_t NodalSystem::task_size_limit(std::size_t nodes) {
   return std::max<std::size_t>(4096, nodes / 256);
 }
 
+std::vector<std::int32_t> NodalSystem::subtree_tasks(std::span<const std::int32_t> parent,
+                                                    std::span<const std::int32_t> order) {
+  const std::size_t nodes = parent.size();
+  std::vector<std::int32_t> task(nodes, -1);
+  const std::size_t limit = task_size_limit(nodes);
+  if (limit == 0) return task;
+  std::vector<std::int32_t> size(nodes, 1);
+  for (std::size_t k = nodes; k-- > 0;) {
+    const auto c = static_cast<std::size_t>(order[k]);
+    if (parent[c] >= 0) size[static_cast<std::size_t>(parent[c])] += size[c];
+  }
+  std::int32_t tasks = 0;
+  for (const std::int32_t node : order) {
+    const auto c = static_cast<std::size_t>(node);
+    if (static_cast<std::size_t>(size[c]) > limit) continue;
+    const std::int32_t p = parent[c];
+    task[c] = p >= 0 && task[static_cast<std::size_t>(p)] >= 0 ? task[static_cast<std::size_t>(p)] : tasks++;
+  }
+  return task;
+}
+
 void NodalSystem::plan_subtrees() {
   if (task_size_limit(nodes_) == 0) return;
-  std::vector<std::int32_t> size(nodes_, 1);
-  for (std::size_t k = nodes_; k-- > 0;) {
-    const auto c = static_cast<std::size_t>(order_[k]);
-    if (parent_[c] >= 0) size[static_cast<std::size_t>(parent_[c])] += size[c];
-  }
-  const auto limit = static_cast<std::int32_t>(task_size_limit(nodes_));
-  std::vector<std::int32_t> task(nodes_, -1), count;
+  const std::vector<std::int32_t> task = subtree_tasks(parent_, order_);
+  std::vector<std::int32_t> count;
   for (const std::int32_t c : order_) {
-    const std::int32_t p = parent_[static_cast<std::size_t>(c)];
-    if (size[static_cast<std::size_t>(c)] > limit) {
+    const std::int32_t t = task[static_cast<std::size_t>(c)], p = parent_[static_cast<std::size_t>(c)];
+    if (t < 0) {
       top_.push_back(c);
-    } else if (p < 0 || task[static_cast<std::size_t>(p)] < 0) {
-      task[static_cast<std::size_t>(c)] = static_cast<std::int32_t>(count.size());
+      continue;
+    }
+    if (p < 0 || task[static_cast<std::size_t>(p)] != t) {  // the task's root: tasks come numbered so
       count.push_back(0);
       top_.push_back(~c);
-    } else {
-      task[static_cast<std::size_t>(c)] = task[static_cast<std::size_t>(p)];
     }
-    if (task[static_cast<std::size_t>(c)] >= 0) ++count[static_cast<std::size_t>(task[static_cast<std::size_t>(c)])];
+    ++count[static_cast<std::size_t>(t)];
   }
   task_offset_.assign(count.size() + 1, 0);
   for (std::size_t t = 0; t < count.size(); ++t) task_offset_[t + 1] = task_offset_[t] + count[t];

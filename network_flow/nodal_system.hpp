@@ -75,6 +75,13 @@ class NodalSystem {
   // The largest subtree a sweep's task takes on a forest of `nodes` (0: no tasks, one thread
   // sweeps): the subtrees of at most this many nodes whose parent roots a larger one.
   static std::size_t task_size_limit(std::size_t nodes);
+  // The tasks themselves, on a forest given by each node's parent (-1 at roots) and an order
+  // with every parent before its children: per node its task, the largest subtree within the
+  // limit that holds it (numbered as their roots come in `order`), or -1 above them (every
+  // node below the limit's threshold). The sweeps' plan, and what an owner numbers its nodes
+  // by to keep each task's together (pulse/lumped_order).
+  static std::vector<std::int32_t> subtree_tasks(std::span<const std::int32_t> parent,
+                                                 std::span<const std::int32_t> order);
   // (system^-1)_ii for each node i of `nodes` (any order, repeats allowed), with the last
   // factorisation, into out (of nodes' size): each node's own response, the potential that a
   // unit current into it alone raises there (the impedance to ground seen from the node).

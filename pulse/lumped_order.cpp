@@ -6,49 +6,42 @@
 
 namespace hemotree {
 
+std::vector<std::int32_t> nodes_by_first_appearance(std::span<const std::int32_t> vessels,
+                                                    std::span<const std::int32_t> from,
+                                                    std::span<const std::int32_t> to, std::size_t nodes) {
+  std::vector<std::int32_t> order;
+  std::vector<unsigned char> seen(nodes, 0);
+  for (const std::int32_t v : vessels)
+    for (const std::int32_t k : {from[static_cast<std::size_t>(v)], to[static_cast<std::size_t>(v)]})
+      if (!seen[static_cast<std::size_t>(k)]) {
+        seen[static_cast<std::size_t>(k)] = 1;
+        order.push_back(k);
+      }
+  return order;
+}
+
 LumpedOrder network_lumped_order(const Network& net, const std::vector<bool>& zero_d) {
   LumpedOrder order;
-  std::vector<unsigned char> seen(net.node_count(), 0);
-  auto visit = [&](std::int32_t node) {
-    if (seen[static_cast<std::size_t>(node)]) return;
-    seen[static_cast<std::size_t>(node)] = 1;
-    order.nodes.push_back(node);
-  };
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    if (!zero_d[v]) continue;
-    order.vessels.push_back(static_cast<std::int32_t>(v));
-    visit(net.from[v]);
-    visit(net.to[v]);
-  }
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (zero_d[v]) order.vessels.push_back(static_cast<std::int32_t>(v));
+  const std::vector<std::int32_t> nodes = nodes_by_first_appearance(order.vessels, net.from, net.to, net.node_count());
+  order.nodes.assign(nodes.begin(), nodes.end());
   return order;
 }
 
 LumpedOrder subtree_lumped_order(const Network& net, const std::vector<bool>& zero_d) {
   LumpedOrder given = network_lumped_order(net, zero_d);
   const std::size_t nodes = given.nodes.size(), edges = given.vessels.size();
-  // Each node's place in the given order, and its vessels by their places (increasing).
+  if (NodalSystem::task_size_limit(nodes) == 0) return given;
+  // The vessels' ends by the nodes' places in the given order, and each node's vessels by
+  // their places (increasing).
   std::vector<std::int32_t> place(net.node_count(), -1);
   for (std::size_t k = 0; k < nodes; ++k) place[static_cast<std::size_t>(given.nodes[k])] = static_cast<std::int32_t>(k);
-  std::vector<std::int32_t> a(edges), b(edges);
+  std::vector<std::int32_t> a(edges), b(edges), offset(nodes + 1, 0), incident(2 * edges);
   for (std::size_t e = 0; e < edges; ++e) {
     const auto v = static_cast<std::size_t>(given.vessels[e]);
     a[e] = place[static_cast<std::size_t>(net.from[v])];
     b[e] = place[static_cast<std::size_t>(net.to[v])];
-  }
-  // A forest? (union-find, roots kept lowest; a loop or a doubled vessel says no)
-  std::vector<std::int32_t> root(nodes);
-  std::iota(root.begin(), root.end(), 0);
-  auto find = [&](std::int32_t k) {
-    while (root[static_cast<std::size_t>(k)] != k) k = root[static_cast<std::size_t>(k)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(k)])];
-    return k;
-  };
-  for (std::size_t e = 0; e < edges; ++e) {
-    const std::int32_t ra = find(a[e]), rb = find(b[e]);
-    if (ra == rb) return given;
-    root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-  }
-  std::vector<std::int32_t> offset(nodes + 1, 0), incident(2 * edges);
-  for (std::size_t e = 0; e < edges; ++e) {
     ++offset[static_cast<std::size_t>(a[e]) + 1];
     ++offset[static_cast<std::size_t>(b[e]) + 1];
   }
@@ -58,55 +51,45 @@ LumpedOrder subtree_lumped_order(const Network& net, const std::vector<bool>& ze
     incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(a[e])]++)] = static_cast<std::int32_t>(e);
     incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(b[e])]++)] = static_cast<std::int32_t>(e);
   }
-  // Each tree rooted at its lowest node: preorder (parents first), each node's parent vessel.
-  std::vector<std::int32_t> preorder, via(nodes, -1), parent(nodes, -1);
-  preorder.reserve(nodes);
+  // Each tree rooted at its lowest node, searched from there (parents before children): each
+  // node's parent and the vessel from it. A node met again by another vessel closes a loop.
+  std::vector<std::int32_t> reached, via(nodes, -1), parent(nodes, -1);
+  reached.reserve(nodes);
   std::vector<unsigned char> seen(nodes, 0);
-  std::vector<std::int32_t> stack;
   for (std::size_t first = 0; first < nodes; ++first) {
     if (seen[first]) continue;
     seen[first] = 1;
-    stack.push_back(static_cast<std::int32_t>(first));
-    while (!stack.empty()) {
-      const auto k = static_cast<std::size_t>(stack.back());
-      stack.pop_back();
-      preorder.push_back(static_cast<std::int32_t>(k));
+    reached.push_back(static_cast<std::int32_t>(first));
+    for (std::size_t next = reached.size() - 1; next < reached.size(); ++next) {
+      const auto k = static_cast<std::size_t>(reached[next]);
       for (auto j = offset[k]; j < offset[k + 1]; ++j) {
-        const auto e = static_cast<std::size_t>(incident[static_cast<std::size_t>(j)]);
-        const auto child = static_cast<std::size_t>(a[e] == static_cast<std::int32_t>(k) ? b[e] : a[e]);
-        if (seen[child]) continue;
+        const std::int32_t e = incident[static_cast<std::size_t>(j)];
+        if (e == via[k]) continue;
+        const auto child = static_cast<std::size_t>(a[static_cast<std::size_t>(e)] == static_cast<std::int32_t>(k)
+                                                        ? b[static_cast<std::size_t>(e)]
+                                                        : a[static_cast<std::size_t>(e)]);
+        if (seen[child]) return given;
         seen[child] = 1;
         parent[child] = static_cast<std::int32_t>(k);
-        via[child] = static_cast<std::int32_t>(e);
-        stack.push_back(static_cast<std::int32_t>(child));
+        via[child] = e;
+        reached.push_back(static_cast<std::int32_t>(child));
       }
     }
   }
-  // The sweeps' tasks (network_flow/nodal_system: the largest subtrees within its limit) and
-  // the nodes above them.
-  const std::size_t limit = NodalSystem::task_size_limit(nodes);
-  if (limit == 0) return given;
-  std::vector<std::int32_t> size(nodes, 1), task(nodes, -1);
-  for (std::size_t i = nodes; i-- > 0;) {
-    const auto k = static_cast<std::size_t>(preorder[i]);
-    if (parent[k] >= 0) size[static_cast<std::size_t>(parent[k])] += size[k];
-  }
-  std::int32_t tasks = 0;
-  for (const std::int32_t node : preorder) {
-    const auto k = static_cast<std::size_t>(node);
-    if (static_cast<std::size_t>(size[k]) > limit) continue;
-    task[k] = parent[k] >= 0 && task[static_cast<std::size_t>(parent[k])] >= 0 ? task[static_cast<std::size_t>(parent[k])] : tasks++;
-  }
-  // Each task's nodes in the given order, the task where its root was: siblings, top nodes
-  // and every node's vessels keep their given order.
-  std::vector<std::int32_t> task_offset(static_cast<std::size_t>(tasks) + 1, 0), task_nodes;
-  for (std::size_t k = 0; k < nodes; ++k)
-    if (task[k] >= 0) ++task_offset[static_cast<std::size_t>(task[k]) + 1];
+  // The sweeps' tasks (network_flow/nodal_system), each one's nodes in the given order.
+  const std::vector<std::int32_t> task = NodalSystem::subtree_tasks(parent, reached);
+  std::vector<std::int32_t> task_offset(1, 0);
+  for (const std::int32_t t : task)
+    if (t >= 0) {
+      if (static_cast<std::size_t>(t) + 2 > task_offset.size()) task_offset.resize(static_cast<std::size_t>(t) + 2, 0);
+      ++task_offset[static_cast<std::size_t>(t) + 1];
+    }
   std::partial_sum(task_offset.begin(), task_offset.end(), task_offset.begin());
-  task_nodes.resize(static_cast<std::size_t>(task_offset.back()));
+  std::vector<std::int32_t> task_nodes(static_cast<std::size_t>(task_offset.back()));
   std::vector<std::int32_t> cursor(task_offset.begin(), task_offset.end() - 1);
   for (std::size_t k = 0; k < nodes; ++k)
     if (task[k] >= 0) task_nodes[static_cast<std::size_t>(cursor[static_cast<std::size_t>(task[k])]++)] = static_cast<std::int32_t>(k);
+  // The nodes above the tasks where they were, each task where its root was.
   LumpedOrder order;
   order.nodes.reserve(nodes);
   order.vessels.reserve(edges);

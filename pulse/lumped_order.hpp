@@ -1,17 +1,19 @@
-// The order the 0D vessels and their nodes are kept in (pulse/lumped_vessels): on a forest,
-// each tree's nodes in depth-first preorder from its lowest node and each vessel at its
-// lower-end node's place, so that every subtree occupies one contiguous range of the arrays.
-// The elimination's parallel sweeps (network_flow/nodal_system) take subtrees as tasks: in
-// the network's own order (vgen's is breadth first) a subtree's nodes lie scattered over
-// every level of the tree, and two threads swept slower than one (measured, 1M vessels).
+// The order the 0D vessels and their nodes are kept in (pulse/lumped_vessels). The
+// elimination's parallel sweeps (network_flow/nodal_system) take subtrees as tasks; in the
+// network's own order (vgen's is breadth first) a task's nodes lie in short runs on every
+// level of the tree, and two threads swept slower than one (measured, 1 M vessels). On a
+// forest the subtree order keeps each task's nodes together, in the network's order, at the
+// place of the task's root; the nodes above the tasks keep their places, and each vessel
+// goes with the node it leads to from its tree's root.
 //
-// The elimination is the same as in the network's order wherever that joins every node to
-// one lower node (a network numbered from its root): the same root, the same parent of every
-// node, siblings in the same order, every node's vessels in the same order; so the same
-// pivots and sums, bit for bit. A graph with a loop keeps the network's order.
+// Where the network's order joins every node to one lower node (a network numbered from its
+// root) the elimination is the same in both orders: the same root, the same parent of every
+// node, siblings and every node's vessels in the same order; so the same pivots and sums, bit
+// for bit (tests/test_lumped_order).
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "formats/network.hpp"
@@ -23,10 +25,17 @@ struct LumpedOrder {
   std::vector<std::int64_t> nodes;    // network node indices of their nodes, in order
 };
 
-// The network's order: the 0D vessels as it lists them, their nodes as they first appear
-// (each vessel's `from`, then its `to`).
+// The network's order of the nodes of the given vessels (their `from` and `to` nodes, in
+// from[v], to[v] order of each): each node at its first appearance. The one definition of the
+// network's order, for the network's arrays and for the 0D vessels' own (their checkpoint).
+std::vector<std::int32_t> nodes_by_first_appearance(std::span<const std::int32_t> vessels,
+                                                    std::span<const std::int32_t> from,
+                                                    std::span<const std::int32_t> to, std::size_t nodes);
+
+// The network's order: the 0D vessels as it lists them, their nodes by first appearance.
 LumpedOrder network_lumped_order(const Network& net, const std::vector<bool>& zero_d);
-// The order above, or the network's where the 0D vessels form a graph with a loop.
+// The subtree order above; the network's below NodalSystem's task threshold, or where the 0D
+// vessels form a graph with a loop.
 LumpedOrder subtree_lumped_order(const Network& net, const std::vector<bool>& zero_d);
 
 }  // namespace hemotree

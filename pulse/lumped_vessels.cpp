@@ -649,17 +649,9 @@ std::vector<std::int32_t> LumpedVessels::network_order_edges() const {
 }
 
 std::vector<std::int32_t> LumpedVessels::network_order_nodes() const {
-  std::vector<std::int32_t> place;
-  place.reserve(nodes_);
-  std::vector<unsigned char> seen(network_nodes_, 0);
-  for (const std::int32_t e : index_of_vessel_) {
-    if (e < 0) continue;
-    for (const std::int32_t k : {a_[static_cast<std::size_t>(e)], b_[static_cast<std::size_t>(e)]})
-      if (!seen[static_cast<std::size_t>(k)]) {
-        seen[static_cast<std::size_t>(k)] = 1;
-        place.push_back(k);
-      }
-  }
+  std::vector<std::int32_t> edges = network_order_edges();
+  edges.resize(vessels_.size());  // the vessels' ends, not the R1 edges'
+  std::vector<std::int32_t> place = nodes_by_first_appearance(edges, a_, b_, network_nodes_);
   for (std::size_t k = network_nodes_; k < nodes_; ++k) place.push_back(static_cast<std::int32_t>(k));  // capacitors
   return place;
 }
@@ -670,12 +662,11 @@ void LumpedVessels::save(CheckpointWriter& out) const {
   const std::vector<std::int32_t> nodes = network_order_nodes(), edges = network_order_edges();
   auto put = [&](const std::vector<double>& values, const std::vector<std::int32_t>& place) {
     out.begin_vector(values.size());
-    std::vector<double> part;
-    part.reserve(4096);
-    for (std::size_t i = 0; i < place.size(); i += part.capacity()) {
-      part.clear();
-      for (std::size_t j = i; j < std::min(place.size(), i + 4096); ++j) part.push_back(values[static_cast<std::size_t>(place[j])]);
-      out.put_part(part);
+    std::vector<double> part(block);
+    for (std::size_t i = 0; i < place.size(); i += block) {
+      const std::size_t n = std::min(block, place.size() - i);
+      for (std::size_t j = 0; j < n; ++j) part[j] = values[static_cast<std::size_t>(place[i + j])];
+      out.put_part(std::span<const double>(part).first(n));
     }
   };
   for (const auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) put(*v, nodes);
