@@ -183,7 +183,7 @@ void PulseSolver::set_end_flux(const VesselEnd& end, const EndState& u) {
     flux_a_left_(end.element) = fa;
     flux_q_left_(end.element) = fq;
   }
-  boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)] = u;
+  boundaries_.state_at(end) = u;
 }
 
 void PulseSolver::trace(const VesselEnd& end, double& a, double& q) const {
@@ -274,7 +274,7 @@ void PulseSolver::boundary_exchange(PulseState& rate) const {
   // The volume fluxes the boundaries exchange, summed in a fixed order (the same bits
   // whatever the threads); an end's flow is positive along the vessel.
   auto leaving = [&](const VesselEnd& end) {
-    const double q = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)].flow;
+    const double q = boundaries_.state_at(end).flow;
     return end.distal ? q : -q;
   };
   rate.exchanged.setZero();
@@ -333,7 +333,7 @@ void PulseSolver::junction_fluxes(double t) {
         laws[i] = &end_law(static_cast<std::size_t>(end.vessel), end.distal);
         trace(end, ja[i], jq[i]);
         sign[i] = end.distal ? 1 : -1;
-        out[i] = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
+        out[i] = boundaries_.state_at(end);
       }
       if (!junction_state({laws, count}, {ja, count}, {jq, count}, {sign, count}, {out, count})) {
 #pragma omp critical

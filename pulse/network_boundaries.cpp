@@ -19,7 +19,10 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
 
   NetworkBoundaries b;
   b.list = run_boundaries(net);
-  b.end_state.resize(2 * n);
+  std::int32_t elements = 0;
+  for (std::size_t v = 0; v < n; ++v)
+    if (!zero_d[v]) elements = std::max(elements, first_element[v] + elements_per_vessel);
+  b.end_state.resize(2 * static_cast<std::size_t>(elements));
   const bool tree_form = net.boundaries.empty();
   // Where each entry of the list came from: the tree's outlets, its inlet, or net.boundaries.
   const std::size_t tree_inlet = net.inlet ? net.outlets.size() : static_cast<std::size_t>(-1);

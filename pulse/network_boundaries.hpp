@@ -70,8 +70,14 @@ struct NetworkBoundaries {
   // nearly all at 0D vessels, whose volumes pulse/lumped_vessels sums once a step).
   std::vector<std::int32_t> one_d_boundary;
 
-  // The end states of the last solve, per vessel end: [2 v] proximal, [2 v + 1] distal.
+  // The end states of the last solve, per 1D element's end ([2 el] left, [2 el + 1] right;
+  // only a vessel's ends are set): a 0D vessel has no elements and keeps none (on a full
+  // tree, 32 B a vessel that were never written).
   std::vector<EndState> end_state;
+  EndState& state_at(const VesselEnd& end) { return end_state[2 * static_cast<std::size_t>(end.element) + (end.distal ? 1 : 0)]; }
+  const EndState& state_at(const VesselEnd& end) const {
+    return end_state[2 * static_cast<std::size_t>(end.element) + (end.distal ? 1 : 0)];
+  }
 };
 
 // Vessel v's elements are first_element[v] .. first_element[v] + elements_per_vessel - 1;

@@ -266,6 +266,9 @@ class PulseSolver {
   std::int32_t end_element(std::size_t vessel) const {
     return zero_d_[vessel] ? first_element_[vessel] : first_element_[vessel] + elements_per_vessel_;
   }
+  VesselEnd vessel_end(std::size_t vessel, bool distal) const {  // a 1D vessel's
+    return {static_cast<std::int32_t>(vessel), distal ? end_element(vessel) - 1 : first_element_[vessel], distal};
+  }
   std::vector<double> capacitor_pressures() const;  // per run outlet (NaN: none)
   // A point of a 1D vessel: its element and xi in [-1, 1] there, and the modes' value (pulse_sampling.cpp).
   void locate(std::size_t vessel, double x, std::size_t& element, double& xi) const;

@@ -29,14 +29,25 @@ void PulseSolver::save(CheckpointWriter& out) const {
   out.put(lumped_boundary_volume_);
   out.put(cycle_volume_);
   out.put(cycle_capacitor_);
-  // The junctions' Newton iterations start from the last end states.
+  // The junctions' Newton iterations start from the last end states: per vessel, proximal
+  // then distal (area, flow), a 0D vessel's as zeros (the format's layout, which held them),
+  // written in pieces of `block` vessels.
+  const std::size_t n = first_element_.size();
+  out.begin_vector(4 * static_cast<std::uint64_t>(n));
+  constexpr std::size_t block = 1 << 16;
   std::vector<double> ends;
-  ends.reserve(2 * boundaries_.end_state.size());
-  for (const EndState& e : boundaries_.end_state) {
-    ends.push_back(e.area);
-    ends.push_back(e.flow);
+  ends.reserve(4 * std::min(n, block));
+  for (std::size_t first = 0; first < n; first += block) {
+    ends.clear();
+    for (std::size_t v = first; v < std::min(n, first + block); ++v) {
+      for (const bool distal : {false, true}) {
+        const EndState e = zero_d_[v] ? EndState{} : boundaries_.state_at(vessel_end(v, distal));
+        ends.push_back(e.area);
+        ends.push_back(e.flow);
+      }
+    }
+    out.put_part(ends);
   }
-  out.put(ends);
   std::vector<double> rest;
   for (const auto& o : boundaries_.outlets) {
     rest.push_back(o.rest_area);
@@ -89,9 +100,13 @@ void PulseSolver::restore(CheckpointReader& in) {
   cycle_volume_ = in.get_vector();
   cycle_capacitor_ = in.get_vector();
   const std::vector<double> ends = in.get_vector();
-  if (ends.size() != 2 * boundaries_.end_state.size()) in.fail("vessel ends of another network");
-  for (std::size_t k = 0; k < boundaries_.end_state.size(); ++k)
-    boundaries_.end_state[k] = {ends[2 * k], ends[2 * k + 1]};
+  if (ends.size() != 4 * first_element_.size()) in.fail("vessel ends of another network");
+  for (std::size_t v = 0; v < first_element_.size(); ++v)
+    if (!zero_d_[v])
+      for (const bool distal : {false, true}) {
+        const std::size_t k = 2 * v + (distal ? 1 : 0);
+        boundaries_.state_at(vessel_end(v, distal)) = {ends[2 * k], ends[2 * k + 1]};
+      }
   const std::vector<double> rest = in.get_vector();
   if (rest.size() != 2 * boundaries_.outlets.size()) in.fail("outlets of another network");
   for (std::size_t k = 0; k < boundaries_.outlets.size(); ++k) {

@@ -203,7 +203,7 @@ void PulseSolver::step_coupled() {
   std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
     const VesselEnd& end = boundaries_.coupled[k].end;
-    const EndState& u = boundaries_.end_state[2 * static_cast<std::size_t>(end.vessel) + (end.distal ? 1 : 0)];
+    const EndState& u = boundaries_.state_at(end);
     held_end_flow_[k] = end.distal ? u.flow : -u.flow;
     coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
   }
