@@ -25,19 +25,24 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 }
 
 CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, double analysis_frequency)
-    : net_(net), omega_(2 * std::numbers::pi * analysis_frequency),
-      flow_(net.vessel_count(), 0.0), pressure_(net.vessel_count(), 0.0),
-      p_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
-      p_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()),
-      q_min_(net.vessel_count(), std::numeric_limits<double>::infinity()),
-      q_max_(net.vessel_count(), -std::numeric_limits<double>::infinity()), wss_(net.vessel_count(), 0.0),
-      reynolds_(net.vessel_count(), 0.0), one_d_(solver.one_d_vessels()) {
+    : net_(net), omega_(2 * std::numbers::pi * analysis_frequency), one_d_(solver.one_d_vessels()) {
+  start_sums();
   const std::size_t n = one_d_.size();
   for (auto* sums : {&p_in_, &p_out_, &u_in_, &u_out_}) sums->assign(n, 0.0);
   first_.assign(4 * n, 0.0);
   last_.assign(4 * n, 0.0);
   for (auto* scratch : {&area_, &q_, &p_, &area_end_, &q_end_, &p_end_, &area_out_, &q_out_, &p_out_end_})
     scratch->assign(n, 0.0);
+}
+
+void CycleStatistics::start_sums() {
+  const std::size_t n = net_.vessel_count();
+  constexpr double infinity = std::numeric_limits<double>::infinity();
+  for (auto* sum : {&flow_, &pressure_, &wss_, &reynolds_}) sum->assign(n, 0.0);
+  p_min_.assign(n, infinity);
+  q_min_.assign(n, infinity);
+  p_max_.assign(n, -infinity);
+  q_max_.assign(n, -infinity);
 }
 
 void CycleStatistics::begin(const PulseSolver& solver) {
@@ -52,6 +57,7 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
   const int threads = solver.threads();
   const std::complex<double> phase = weight * std::polar(1.0, -omega_ * t);
   if (duration_ == 0) {
+    if (flow_.empty()) start_sums();
     first_time_ = t;
     record_ends(solver, first_);
   }
@@ -108,6 +114,7 @@ void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>
 
 CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   CycleSummary summary;
+  if (flow_.empty()) start_sums();  // no sample since the last close
   const Eigen::Vector2d exchanged = solver.state().exchanged - exchanged_start_;
   summary.inlet_mean_flow = exchanged(0) / duration_;
   summary.outlets_mean_flow = exchanged(1) / duration_;
@@ -136,12 +143,11 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
     c.mean_wss = wss_[v] / duration_;
     c.reynolds = reynolds_[v] / duration_;
     c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();  // 0D: no wave (below: 1D)
-    flow_[v] = pressure_[v] = wss_[v] = reynolds_[v] = 0;
-    p_min_[v] = std::numeric_limits<double>::infinity();
-    p_max_[v] = -std::numeric_limits<double>::infinity();
-    q_min_[v] = std::numeric_limits<double>::infinity();
-    q_max_[v] = -std::numeric_limits<double>::infinity();
   }
+  // The sums are freed until the next cycle's first sample (start_sums): the cycle's end (the
+  // compliance balance, the checkpoint, the report) runs without them, 64 B a vessel.
+  for (auto* sum : {&flow_, &pressure_, &p_min_, &p_max_, &q_min_, &q_max_, &wss_, &reynolds_})
+    std::vector<double>().swap(*sum);
   for (std::size_t j = 0; j < one_d_.size(); ++j) {
     VesselCycle& c = out[static_cast<std::size_t>(one_d_[j])];
     const double length = net_.length[static_cast<std::size_t>(one_d_[j])];
