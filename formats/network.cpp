@@ -46,6 +46,23 @@ void Network::reserve(std::size_t vessels, std::size_t nodes) {
   vessel_class.reserve(vessels);
 }
 
+void Network::shrink_to_fit() {
+  // Every member by name, as network_identity: a member added to Network stops this from compiling.
+  auto& [node_id_, x_, y_, z_, id_, from_, to_, length_, diameter_, wall_thickness_, youngs_modulus_, generation_,
+         vessel_class_, beta_, reference_pressure_, distal_diameter_, blood_, inlet_, outlets_, boundaries_,
+         provenance_, extra_] = *this;
+  (void)blood_, (void)inlet_, (void)provenance_, (void)extra_;  // no arrays
+  node_id_.shrink_to_fit();
+  id_.shrink_to_fit();
+  for (auto* v : {&x_, &y_, &z_, &length_, &diameter_, &wall_thickness_, &youngs_modulus_, &beta_,
+                  &reference_pressure_, &distal_diameter_})
+    v->shrink_to_fit();
+  for (auto* v : {&from_, &to_, &generation_}) v->shrink_to_fit();
+  vessel_class_.shrink_to_fit();
+  outlets_.shrink_to_fit();
+  boundaries_.shrink_to_fit();
+}
+
 std::int32_t Network::add_node(std::int64_t node_id_value) {
   node_id.push_back(node_id_value);
   return static_cast<std::int32_t>(node_id.size() - 1);

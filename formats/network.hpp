@@ -71,6 +71,9 @@ struct Network {
   bool has_coordinates() const { return !x.empty(); }
 
   void reserve(std::size_t vessels, std::size_t nodes);
+  // Every array's capacity to its size: a reader that grew them by doubling holds up to twice
+  // what it read (a 10-million-vessel tree: 1.6 times) until then.
+  void shrink_to_fit();
   std::int32_t add_node(std::int64_t node_id_value);
   std::int32_t add_node(std::int64_t node_id_value, double px, double py, double pz);
   // Appends a vessel between node indices; the class follows from the diameter.

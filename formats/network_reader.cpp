@@ -152,6 +152,7 @@ class Reader {
     if (net_.inlet && net_.index_of(net_.inlet->vessel) < 0)
       throw InputError(source_ + ": inlet: unknown vessel " + std::to_string(net_.inlet->vessel));
     read_boundaries();
+    net_.shrink_to_fit();
     return std::move(net_);
   }
 
