@@ -56,10 +56,12 @@ struct HarmonicWorkspace {
   std::vector<TwoPort> edge;
 };
 
-// The network's oscillation at one angular frequency w: every node's pressure amplitude.
-std::vector<Complex> solve_harmonic(const Network& net, const HarmonicNetwork& h, const std::vector<NodeBoundary>& boundaries,
-                                    const std::vector<FourierSeries>& series, const std::vector<VesselLine>& lines,
-                                    int k, double w, HarmonicWorkspace& work) {
+// The network's oscillation at one angular frequency w: every node's pressure amplitude,
+// left in work.current. threads: the vessels' two-ports built in parallel (each its own:
+// the same numbers for any count).
+void solve_harmonic(const Network& net, const HarmonicNetwork& h, const std::vector<NodeBoundary>& boundaries,
+                    const std::vector<FourierSeries>& series, const std::vector<VesselLine>& lines, int k, double w,
+                    HarmonicWorkspace& work, int threads = 1) {
   const std::size_t nodes = net.node_count();
   // A held node's current is its held pressure: nothing else flows into it (one boundary a
   // node; a vessel to it draws its current at its other node), and its row is x = current.
@@ -98,13 +100,15 @@ std::vector<Complex> solve_harmonic(const Network& net, const HarmonicNetwork& h
   }
   std::vector<TwoPort>& edge = work.edge;
   edge.resize(h.edge_vessel.size());
-  for (std::size_t e = 0; e < edge.size(); ++e) edge[e] = lines[static_cast<std::size_t>(h.edge_vessel[e])].two_port(w);
+  const auto edges = static_cast<std::int64_t>(edge.size());
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t e = 0; e < edges; ++e)
+    edge[static_cast<std::size_t>(e)] = lines[static_cast<std::size_t>(h.edge_vessel[static_cast<std::size_t>(e)])].two_port(w);
   for (std::size_t node = 0; node < nodes; ++node) {
     if (h.held[node] || !h.touched[node]) shunt[node] = 1.0;
   }
   try {
     h.system.solve_in_place(edge, shunt, current);
-    return current;
   } catch (const std::invalid_argument&) {
     throw InputError("the linear periodic solution: a part of the network has no path to an outlet or a pressure");
   }
@@ -146,39 +150,42 @@ LinearPeriodic LinearPeriodic::about(const Network& net, const Blood& blood, std
 
 namespace {
 
-// Solves harmonics 1 .. K of the network about `lines`, `batch` at a time (one to a thread),
-// and hands each one's node amplitudes to consume(k, amplitudes) in the order of k, so that
-// what the caller sums over the harmonics is summed in one order whatever the threads. The
-// lowest harmonic that fails is the one thrown.
-template <class Consume>
-void solve_harmonics(const Network& net, const LinearPeriodic& lines, const std::vector<NodeBoundary>& boundaries,
-                     int harmonics, int batch, int threads, Consume&& consume) {
-  std::vector<FourierSeries> series;  // an outlet's pressure beyond does not oscillate: none
+// The boundaries' Fourier series (an outlet's pressure beyond does not oscillate: none).
+std::vector<FourierSeries> boundary_series(const std::vector<NodeBoundary>& boundaries, int harmonics) {
+  std::vector<FourierSeries> series;
   for (const NodeBoundary& b : boundaries)
     if (!b.is_outlet()) series.push_back(fourier_series(b.waveform, harmonics));
+  return series;
+}
+
+// Solves harmonics 1 .. K of the network about `lines`, all at once (one to a thread), and
+// hands each one's node amplitudes to consume(k, amplitudes) in the order of k, so that what
+// the caller keeps is in one order whatever the threads. The lowest harmonic that fails is
+// the one thrown.
+template <class Consume>
+void solve_harmonics(const Network& net, const LinearPeriodic& lines, const std::vector<NodeBoundary>& boundaries,
+                     int harmonics, int threads, Consume&& consume) {
+  const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
   const HarmonicNetwork network = harmonic_network(net, boundaries);
   std::vector<HarmonicWorkspace> work(static_cast<std::size_t>(std::max(threads, 1)));
-  for (int first = 1; first <= harmonics; first += batch) {
-    const int last = std::min(harmonics, first + batch - 1);
-    std::vector<std::vector<Complex>> solved(static_cast<std::size_t>(last - first + 1));
-    std::vector<std::exception_ptr> failure(solved.size());
+  std::vector<std::vector<Complex>> solved(static_cast<std::size_t>(harmonics));
+  std::vector<std::exception_ptr> failure(solved.size());
 #pragma omp parallel num_threads(threads) if (threads > 1)
-    {
-      HarmonicWorkspace& mine = work[static_cast<std::size_t>(omp_get_thread_num())];
+  {
+    HarmonicWorkspace& mine = work[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(dynamic, 1)
-      for (int k = first; k <= last; ++k) {
-        try {
-          solved[static_cast<std::size_t>(k - first)] =
-              solve_harmonic(net, network, boundaries, series, lines.lines(), k, lines.omega(k), mine);
-        } catch (...) {
-          failure[static_cast<std::size_t>(k - first)] = std::current_exception();
-        }
+    for (int k = 1; k <= harmonics; ++k) {
+      try {
+        solve_harmonic(net, network, boundaries, series, lines.lines(), k, lines.omega(k), mine);
+        solved[static_cast<std::size_t>(k - 1)] = mine.current;
+      } catch (...) {
+        failure[static_cast<std::size_t>(k - 1)] = std::current_exception();
       }
     }
-    for (const std::exception_ptr& f : failure)
-      if (f) std::rethrow_exception(f);
-    for (int k = first; k <= last; ++k) consume(k, std::move(solved[static_cast<std::size_t>(k - first)]));
   }
+  for (const std::exception_ptr& f : failure)
+    if (f) std::rethrow_exception(f);
+  for (int k = 1; k <= harmonics; ++k) consume(k, std::move(solved[static_cast<std::size_t>(k - 1)]));
 }
 
 }  // namespace
@@ -189,7 +196,7 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
   if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
   LinearPeriodic out = LinearPeriodic::about(net, blood, laws, viscosity, steady, threads);
   // Every harmonic kept: all of them at once, one to a thread.
-  solve_harmonics(net, out, boundaries, harmonics, harmonics, threads,
+  solve_harmonics(net, out, boundaries, harmonics, threads,
                   [&](int, std::vector<Complex>&& p) { out.node_pressure_.push_back(std::move(p)); });
   return out;
 }
@@ -214,9 +221,16 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
     }
   }
   const auto nodes = static_cast<std::int64_t>(net.node_count()), vessels = static_cast<std::int64_t>(net.vessel_count());
-  // As many harmonics at once as threads; each added to every sum in the order of k, in the
-  // arithmetic of node_pressure_at and flow_at(v, 0.5, t).
-  solve_harmonics(net, along, boundaries, harmonics, std::max(threads, 1), threads, [&](int k, std::vector<Complex>&& p) {
+  // One harmonic at a time, the threads within it, each added to every sum as it is solved,
+  // in the order of k and the arithmetic of node_pressure_at and flow_at(v, 0.5, t). One
+  // harmonic's system in memory, not one a thread (on the full tree with two threads, 0.4 GB
+  // less at the run's start, then its largest moment).
+  const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
+  const HarmonicNetwork network = harmonic_network(net, boundaries);
+  HarmonicWorkspace work;
+  for (int k = 1; k <= harmonics; ++k) {
+    solve_harmonic(net, network, boundaries, series, along.lines(), k, along.omega(k), work, threads);
+    const std::vector<Complex>& p = work.current;
     const Complex turn = std::polar(1.0, along.omega(k) * time);
 #pragma omp parallel num_threads(threads) if (threads > 1)
     {
@@ -235,7 +249,7 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
     std::vector<Complex> kept(kept_node.size());
     for (std::size_t j = 0; j < kept_node.size(); ++j) kept[j] = p[kept_node[j]];
     along.node_pressure_.push_back(std::move(kept));
-  });
+  }
   return out;
 }
 
