@@ -109,7 +109,9 @@ class PulseSolver {
   int substeps() const { return substeps_; }
   double substep() const { return dt_ / substeps_; }
   bool is_lumped(std::size_t vessel) const { return zero_d_[vessel]; }
-  std::size_t lumped_count() const { return lumped_.vessel_count(); }
+  std::size_t lumped_count() const {
+    return lumped_count_after_release_ ? *lumped_count_after_release_ : lumped_.vessel_count();
+  }
   // What sets the step; a setting it names is a placeholder (core/setting_error.hpp), for the
   // caller to word: in_words(dt_reason(), words).
   const std::string& dt_reason() const { return dt_reason_; }
@@ -146,6 +148,13 @@ class PulseSolver {
   // pressure may be empty): the cycle statistics read the 0D vessels whole from lumped().
   void sample_one_d(double x, std::span<double> area, std::span<double> flow, std::span<double> pressure = {}) const;
   const LumpedVessels& lumped() const { return lumped_; }
+  // After the last step, once the state is saved and sampled: the 0D vessels' arrays freed
+  // (330 B a vessel) before the report, which reads the vessels' models, laws and degrees
+  // only. The solver takes no step after it; lumped_count() keeps its value.
+  void release_lumped_state() {
+    lumped_count_after_release_ = lumped_.vessel_count();
+    lumped_ = LumpedVessels();
+  }
   // The run's boundary conditions (pulse/network_boundaries.hpp: run_boundaries), and per
   // boundary whether its flow counts as "in"; the period of its waveforms.
   const std::vector<NodeBoundary>& boundary_list() const { return boundaries_.list; }
@@ -314,6 +323,7 @@ class PulseSolver {
   };
   std::vector<bool> zero_d_;               // per vessel
   LumpedVessels lumped_;
+  std::optional<std::size_t> lumped_count_after_release_;  // release_lumped_state()
   int substeps_ = 1;
   double stable_1d_ = 0;                   // the 1D vessels' stable step (inf without any)
   double step_start_ = 0;                  // time at the start of the 0D step being taken

@@ -377,6 +377,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   if (status == RunStatus::interrupted || config.checkpoint_every > 0) pulsatile.write_checkpoint();
   pulsatile.discard_snapshot();
   pulsatile.probes().write(dir / "probes.csv");
+  run.release_lumped_state();  // the time loop is over: on the full tree 1.2 GB less while the report is written
   {  // the table (0.9 GB on the full tree) is freed before the last cycle is copied below
     VesselTable results = last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(driving));
     if (transport && !last.vessels.empty())
