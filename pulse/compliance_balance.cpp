@@ -111,7 +111,9 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
     loads.capacitor_current[k] = outlet_capacitance_[k] * (capacitor_now[k] - cycle_capacitor_[k]) / period;
   }
   // move = delta = K^-1 I: the shifts that cancel the rates in the linear network (K its conductance).
-  TreePotentials move = solve_loaded_tree(net_, boundaries_.list, resistance, loads);
+  LoadedTree tree(net_, boundaries_.list, resistance);
+  std::vector<double>().swap(resistance);  // the tree holds the conductances
+  TreePotentials move = tree.solve(loads);
   // The distance still to go after a cycle that moved by the drift dP is f(Z) dP with
   // f(z) = e^(-z) / (1 - e^(-z)) = g(z) / z, g(z) = z / (e^z - 1), Z = C^-1 K T, and
   // Z^-1 dP = delta. g is taken as 1 / ((1 + a z)(1 + b z)), two solves of (C + a K T) y =
@@ -129,7 +131,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       loads.capacitor_shunt[k] = capacitor_compliance[k] / (a * period);
       loads.capacitor_current[k] = loads.capacitor_shunt[k] * move.capacitor[k];
     }
-    move = solve_loaded_tree(net_, boundaries_.list, resistance, loads);
+    move = tree.solve(loads);
   }
   // The linearisation holds for small moves: none may change a lumen by more than 20 %
   // (far from the periodic state, e.g. after a start at rest, the moves shrink to that).

@@ -8,9 +8,12 @@
 // m^3/s. Outflow pressures are zero: the tree is the network's response to disturbances.
 #pragma once
 
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "formats/network.hpp"
+#include "network_flow/nodal_system.hpp"
 
 namespace hemotree {
 
@@ -36,5 +39,27 @@ TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& 
 // million entries, not to be built again at every cycle end).
 TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBoundary>& boundaries,
                                  const std::vector<double>& resistance, const TreeLoads& loads);
+
+// The same network and resistances for several loads (the compliance balance solves three):
+// the graph, its conductances and the elimination's plan made once, each solve a
+// factorisation with its loads' shunts. The network and the boundaries must outlive it.
+class LoadedTree {
+ public:
+  LoadedTree(const Network& net, const std::vector<NodeBoundary>& boundaries, const std::vector<double>& resistance);
+  TreePotentials solve(const TreeLoads& loads);
+
+ private:
+  const NodeBoundary& outlet(std::size_t k) const { return boundaries_[static_cast<std::size_t>(outlet_boundary_[k])]; }
+  const Network& net_;
+  const std::vector<NodeBoundary>& boundaries_;
+  std::vector<std::int32_t> outlet_boundary_;  // per run outlet: its place in the boundaries
+  std::vector<std::int32_t> capacitor_node_;   // per run outlet: its capacitor's node, or -1
+  std::vector<double> conductance_;            // per edge of system_
+  // Shunts added whatever the loads: a vessel to a held node, at its other node; nodes held
+  // at 0 (a prescribed pressure, or no vessel there).
+  std::vector<std::pair<std::int32_t, double>> held_end_shunt_;
+  std::vector<std::int32_t> grounded_, untouched_;
+  NodalSystem system_;
+};
 
 }  // namespace hemotree

@@ -79,3 +79,26 @@ TEST(LoadedTree, RefusesATerminalVesselWithoutAnOutlet) {
   net.outlets = {resistance_outlet(1, 3, 1333)};
   EXPECT_THROW(solve_loaded_tree(net, resistance, no_loads(net)), InputError);
 }
+
+// One tree for several loads (the compliance balance's three solves): each solve is the
+// single call's, bit for bit, whatever came before it; and the loads' sizes are checked.
+TEST(LoadedTree, SolvesAgainWithOtherLoadsAsTheSingleCallDoes) {
+  Network net = bifurcation();
+  net.outlets = {rcr_outlet(1, 1, 1e-9, 7, 0), resistance_outlet(2, 6, 1333)};
+  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
+  LoadedTree tree(net, boundaries, resistance);
+  TreeLoads first = no_loads(net), second = no_loads(net);
+  first.capacitor_current[0] = 2.0;
+  second.node_shunt = {0.3, 0.1, 0.7, 0.05};
+  second.node_current = {0.2, -1.0, 0.4, 3.0};
+  second.capacitor_shunt[0] = 0.25;
+  second.capacitor_current[0] = -0.5;
+  for (const TreeLoads* loads : {&first, &second, &first}) {
+    const TreePotentials once = solve_loaded_tree(net, resistance, *loads), again = tree.solve(*loads);
+    EXPECT_EQ(again.node, once.node);
+    EXPECT_EQ(again.capacitor, once.capacitor);
+  }
+  TreeLoads short_loads = no_loads(net);
+  short_loads.node_current.pop_back();
+  EXPECT_THROW(tree.solve(short_loads), std::invalid_argument);
+}
