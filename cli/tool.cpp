@@ -9,6 +9,10 @@
 #include <string_view>
 #include <unistd.h>
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
 #include "cli/interrupt.hpp"
@@ -55,6 +59,13 @@ int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& b
 
 int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, const std::function<int()>& body) {
   tool_name = app.get_name();
+#ifdef __GLIBC__
+  // Blocks of a megabyte or more mapped on their own, and given back to the system when
+  // freed. Left to itself glibc raises this threshold to the largest block freed (up to
+  // 32 MB: a full tree's per-vessel arrays), keeps what each phase of a run frees in its
+  // heap, and the resident size never falls below the largest phase so far.
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
