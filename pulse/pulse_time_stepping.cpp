@@ -8,6 +8,7 @@
 #include <limits>
 #include <span>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "core/setting_error.hpp"
@@ -184,6 +185,7 @@ void PulseSolver::step_exponential(double h) {
 }
 
 void PulseSolver::step() {
+  if (lumped_count_after_release_) throw std::logic_error("PulseSolver::step after release_lumped_state");
   if (lumped_.empty()) {
     step_1d(dt_);
     time_ += dt_;

@@ -127,6 +127,26 @@ TEST(HybridModel, MassThroughEveryCouplingToRoundOff) {
   EXPECT_LT(worst, 1e-12 * in);
 }
 
+// After the run the report needs the vessels' models only: the 0D vessels' arrays are freed,
+// the count of 0D vessels and every vessel's model stay, and the solver refuses another step
+// (it would step the 1D vessels alone).
+TEST(HybridModel, TheZeroDStateReleasedForTheReport) {
+  Network net = network({{0, 1, 0.15}, {1, 2, 0.01}, {1, 3, 0.012}, {3, 4, 0.2}}, 5, 4e-3, 6.0);
+  net.inlet = Inlet{0, gaussian_pulse(8e-6, 0.4, 0.05, 0.8)};
+  SolverOptions options;
+  options.model = ModelChoice::automatic;
+  options.lumped_transit = 0.01;
+  PulseSolver solver(net, options);
+  solver.step();
+  std::vector<bool> lumped(net.vessel_count());
+  for (std::size_t v = 0; v < lumped.size(); ++v) lumped[v] = solver.is_lumped(v);
+  solver.release_lumped_state();
+  EXPECT_EQ(solver.lumped_count(), 2u);
+  EXPECT_TRUE(solver.lumped().empty());
+  for (std::size_t v = 0; v < lumped.size(); ++v) EXPECT_EQ(solver.is_lumped(v), lumped[v]);
+  EXPECT_THROW(solver.step(), std::logic_error);
+}
+
 // Fifty cycles of a coupled tree with 24 1D substeps per 0D step: the last cycle's pressures
 // repeat the tenth's (periodic, nothing grows; measured 1e-10 Pa from cycle to cycle).
 TEST(HybridModel, FiftyCyclesWithoutGrowth) {
