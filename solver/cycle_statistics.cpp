@@ -26,7 +26,6 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 
 CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, double analysis_frequency)
     : net_(net), omega_(2 * std::numbers::pi * analysis_frequency), one_d_(solver.one_d_vessels()) {
-  start_sums();
   const std::size_t n = one_d_.size();
   for (auto* sums : {&p_in_, &p_out_, &u_in_, &u_out_}) sums->assign(n, 0.0);
   first_.assign(4 * n, 0.0);

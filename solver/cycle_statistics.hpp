@@ -81,7 +81,9 @@ class CycleStatistics {
   Eigen::VectorXd boundary_start_;                               // at begin()
   double volume_start_ = 0;
   std::vector<double> flow_, pressure_, p_min_, p_max_, q_min_, q_max_, wss_, reynolds_;  // per vessel
-  void start_sums();  // the sums at their starts (0, the extremes at -+infinity)
+  // The sums at their starts (0, the extremes at -+infinity): made at a cycle's first sample
+  // (or its close, if none), freed when it closes.
+  void start_sums();
   // Per 1D vessel (one_d_, the solver's one_d_vessels(); a wave speed is measured only where a
   // wave travels, run_report.hpp): the Fourier sums at the ends, and each signal's first and
   // last sample of the cycle (a cycle that is not yet periodic drifts, and the drift's own

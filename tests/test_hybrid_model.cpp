@@ -71,6 +71,20 @@ double interpolate(const Samples& s, double t) {
   return s.p[k - 1] + w * (s.p[k] - s.p[k - 1]);
 }
 
+// A 1D trunk splitting into two 0D vessels, one of which feeds a 1D vessel again (three
+// coupled ends), pulsed once, and the options that make those two 0D.
+Network three_couplings() {
+  Network net = network({{0, 1, 0.15}, {1, 2, 0.01}, {1, 3, 0.012}, {3, 4, 0.2}}, 5, 4e-3, 6.0);
+  net.inlet = Inlet{0, gaussian_pulse(8e-6, 0.4, 0.05, 0.8)};
+  return net;
+}
+SolverOptions short_vessels_0d() {
+  SolverOptions options;
+  options.model = ModelChoice::automatic;
+  options.lumped_transit = 0.01;
+  return options;
+}
+
 }  // namespace
 
 // A 12 cm vessel and a 2 cm one in series (5 mm, c = 5 m/s) under a pulse of sigma = 0.1 s:
@@ -105,15 +119,10 @@ TEST(HybridModel, AShortHalfMade0dFollowsTheAll1dSolution) {
   }
 }
 
-// A 1D trunk splitting into two 0D vessels, one of which feeds a 1D vessel again: three
-// coupled ends, and the exchanged volumes against the stored one, every step.
+// Three coupled ends: the exchanged volumes against the stored one, every step.
 TEST(HybridModel, MassThroughEveryCouplingToRoundOff) {
-  Network net = network({{0, 1, 0.15}, {1, 2, 0.01}, {1, 3, 0.012}, {3, 4, 0.2}}, 5, 4e-3, 6.0);
-  net.inlet = Inlet{0, gaussian_pulse(8e-6, 0.4, 0.05, 0.8)};
-  SolverOptions options;
-  options.model = ModelChoice::automatic;
-  options.lumped_transit = 0.01;
-  PulseSolver solver(net, options);
+  const Network net = three_couplings();
+  PulseSolver solver(net, short_vessels_0d());
   ASSERT_EQ(solver.lumped_count(), 2u);
   const double v0 = solver.network_volume();
   double worst = 0, in = 0;
@@ -131,12 +140,8 @@ TEST(HybridModel, MassThroughEveryCouplingToRoundOff) {
 // the count of 0D vessels and every vessel's model stay, and the solver refuses another step
 // (it would step the 1D vessels alone).
 TEST(HybridModel, TheZeroDStateReleasedForTheReport) {
-  Network net = network({{0, 1, 0.15}, {1, 2, 0.01}, {1, 3, 0.012}, {3, 4, 0.2}}, 5, 4e-3, 6.0);
-  net.inlet = Inlet{0, gaussian_pulse(8e-6, 0.4, 0.05, 0.8)};
-  SolverOptions options;
-  options.model = ModelChoice::automatic;
-  options.lumped_transit = 0.01;
-  PulseSolver solver(net, options);
+  const Network net = three_couplings();
+  PulseSolver solver(net, short_vessels_0d());
   solver.step();
   std::vector<bool> lumped(net.vessel_count());
   for (std::size_t v = 0; v < lumped.size(); ++v) lumped[v] = solver.is_lumped(v);
