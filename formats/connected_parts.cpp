@@ -8,7 +8,19 @@
 
 namespace hemotree {
 
-ConnectedParts connected_parts(const Network& net, std::span<const NodeBoundary> boundaries) {
+namespace {
+
+// A list of NodeBoundary values and the run's list, read alike.
+struct NodeBoundaryList {
+  std::span<const NodeBoundary> list;
+  std::size_t size() const { return list.size(); }
+  std::int32_t node(std::size_t i) const { return list[i].node; }
+  BoundaryType type(std::size_t i) const { return list[i].type; }
+  const Waveform& waveform(std::size_t i) const { return list[i].waveform; }
+};
+
+template <class Boundaries>
+ConnectedParts parts_of(const Network& net, const Boundaries& boundaries) {
   const std::size_t nodes = net.node_count(), n = net.vessel_count();
   NodeParts roots(net);
   // Parts numbered as their roots are first met along the vessels, then sorted.
@@ -32,19 +44,20 @@ ConnectedParts connected_parts(const Network& net, std::span<const NodeBoundary>
       }
     }
   }
-  for (const NodeBoundary& b : boundaries) {
-    const std::int32_t k = part_of_node[static_cast<std::size_t>(b.node)];
+  for (std::size_t i = 0; i < boundaries.size(); ++i) {
+    const std::int32_t node = boundaries.node(i), k = part_of_node[static_cast<std::size_t>(node)];
     if (k < 0) continue;
     ConnectedPart& part = parts[static_cast<std::size_t>(k)];
-    part.boundary_nodes.push_back(b.node);
-    if (b.type != BoundaryType::flow) {
+    part.boundary_nodes.push_back(node);
+    if (boundaries.type(i) != BoundaryType::flow) {
       part.pressure_reference = true;
       continue;
     }
-    const double q = b.waveform.mean_value();
+    const Waveform& wave = boundaries.waveform(i);
+    const double q = wave.mean_value();
     part.net_inflow += q;
     part.largest_flow = std::max(part.largest_flow, std::abs(q));
-    if (b.waveform.shape != Waveform::Shape::constant) part.time_varying_flows = true;
+    if (wave.shape != Waveform::Shape::constant) part.time_varying_flows = true;
   }
 
   std::vector<std::int32_t> order(parts.size());
@@ -67,13 +80,22 @@ ConnectedParts connected_parts(const Network& net, std::span<const NodeBoundary>
   return out;
 }
 
+}  // namespace
+
+ConnectedParts connected_parts(const Network& net, std::span<const NodeBoundary> boundaries) {
+  return parts_of(net, NodeBoundaryList{boundaries});
+}
+
+ConnectedParts connected_parts(const Network& net, const RunBoundaries& boundaries) { return parts_of(net, boundaries); }
+
 ConnectedParts connected_parts(const Network& net) {
   const std::vector<NodeBoundary> boundaries = node_boundaries(net);
   return connected_parts(net, boundaries);
 }
 
-std::string pressure_reference_refusal(const Network& net, std::span<const NodeBoundary> boundaries) {
-  const ConnectedParts parts = connected_parts(net, boundaries);
+namespace {
+
+std::string refusal_of(const Network& net, const ConnectedParts& parts) {
   std::vector<const ConnectedPart*> floating;
   for (const ConnectedPart& part : parts.parts)
     if (!part.pressure_reference) floating.push_back(&part);
@@ -103,6 +125,16 @@ std::string pressure_reference_refusal(const Network& net, std::span<const NodeB
                                                   : " (give a node of each a pressure or an outlet; where a part's flows "
                                                     "balance, " + pressure_at + " fixes its level): ";
   return which + remedy + why;
+}
+
+}  // namespace
+
+std::string pressure_reference_refusal(const Network& net, std::span<const NodeBoundary> boundaries) {
+  return refusal_of(net, connected_parts(net, boundaries));
+}
+
+std::string pressure_reference_refusal(const Network& net, const RunBoundaries& boundaries) {
+  return refusal_of(net, connected_parts(net, boundaries));
 }
 
 std::string part_name(const ConnectedPart& part) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "formats/network.hpp"
+#include "formats/run_boundaries.hpp"
 
 namespace hemotree {
 
@@ -68,6 +69,7 @@ struct ConnectedParts {
 // The parts of the network with its boundary conditions (node_boundaries(net) unless given);
 // a boundary at a node no vessel meets belongs to no part. O(vessels + nodes + boundaries).
 ConnectedParts connected_parts(const Network& net, std::span<const NodeBoundary> boundaries);
+ConnectedParts connected_parts(const Network& net, const RunBoundaries& boundaries);
 ConnectedParts connected_parts(const Network& net);
 
 // Empty where every part has a pressure to refer to (a prescribed pressure or an outlet of any
@@ -76,6 +78,7 @@ ConnectedParts connected_parts(const Network& net);
 // pressure_at: core/setting_error.hpp). The steady solve and the pulsatile run refuse with it
 // alike.
 std::string pressure_reference_refusal(const Network& net, std::span<const NodeBoundary> boundaries);
+std::string pressure_reference_refusal(const Network& net, const RunBoundaries& boundaries);
 
 // "the part with vessel 12 (340 vessels)"
 std::string part_name(const ConnectedPart& part);

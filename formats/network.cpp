@@ -137,11 +137,7 @@ NodeBoundary as_node_boundary(const Network& net, const Inlet& inlet) {
   return b;
 }
 
-namespace {
-
-// Refuses two conditions at one node (naming the lowest such node and its first two
-// conditions in node_boundaries' order: net.boundaries, the inlet, the outlets) and an inlet
-// of no vessel, with one byte per node rather than a sort of the conditions.
+// One byte per node rather than a sort of the conditions.
 void check_one_boundary_per_node(const Network& net) {
   constexpr unsigned char none = 0xff;
   std::vector<unsigned char> type_at(net.node_count(), none);
@@ -164,8 +160,6 @@ void check_one_boundary_per_node(const Network& net) {
                      std::string(to_string(second)) + "): one per node");
 }
 
-}  // namespace
-
 std::vector<NodeBoundary> node_boundaries(const Network& net) {
   check_one_boundary_per_node(net);
   std::vector<NodeBoundary> all = net.boundaries;
@@ -185,26 +179,9 @@ std::vector<NodeBoundary> node_boundaries(const Network& net) {
   return all;
 }
 
-std::vector<NodeBoundary> run_boundaries(const Network& net) {
-  check_one_boundary_per_node(net);
-  std::vector<NodeBoundary> list;
-  list.reserve(net.outlets.size() + 1 + net.boundaries.size());
-  for (const Outlet& o : net.outlets) list.push_back(as_node_boundary(net, o));
-  if (net.inlet) list.push_back(as_node_boundary(net, *net.inlet));
-  list.insert(list.end(), net.boundaries.begin(), net.boundaries.end());
-  return list;
-}
-
-std::vector<Outlet> run_outlets(const std::vector<NodeBoundary>& boundaries) {
-  std::vector<Outlet> outlets;
-  for (const NodeBoundary& b : boundaries)
-    if (b.is_outlet()) outlets.push_back(b.outlet);
-  return outlets;
-}
-
 Waveform driving_waveform(const Network& net) {
   check_one_boundary_per_node(net);
-  // run_boundaries' conditions that are not outlets, in its order.
+  // The run's conditions that are not outlets, in its order (formats/run_boundaries.hpp).
   std::vector<NodeBoundary> list;
   if (net.inlet) list.push_back(as_node_boundary(net, *net.inlet));
   list.insert(list.end(), net.boundaries.begin(), net.boundaries.end());

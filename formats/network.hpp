@@ -111,13 +111,10 @@ NodeBoundary as_node_boundary(const Network& net, const Inlet& inlet);
 // vessels' `to` nodes). Throws InputError when two land on one node.
 std::vector<NodeBoundary> node_boundaries(const Network& net);
 
-// The network's boundary conditions as the pulsatile run takes them, in one fixed order: the
-// tree form's outlets (in net.outlets' order), its inlet, then net.boundaries. "Outlet k"
-// everywhere in the run (capacitors, TreeLoads) is the k-th outlet of this list: for a tree,
-// net.outlets[k]. Throws InputError where node_boundaries does (two at one node).
-std::vector<NodeBoundary> run_boundaries(const Network& net);
-// The outlets of run_boundaries, in its order.
-std::vector<Outlet> run_outlets(const std::vector<NodeBoundary>& boundaries);
+// Throws InputError when two boundary conditions land on one node (naming the lowest such
+// node and its first two in node_boundaries' order), or for an inlet of no vessel. The run's
+// list of them, in its order: formats/run_boundaries.hpp.
+void check_one_boundary_per_node(const Network& net);
 
 // The waveform that sets the run's period and pulse: the tree form's inlet, else the first
 // time-varying flow or pressure of run_boundaries, else a constant of period 1 s. Throws

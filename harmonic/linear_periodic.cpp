@@ -27,11 +27,11 @@ struct HarmonicNetwork {
   HarmonicSystem system;
 };
 
-HarmonicNetwork harmonic_network(const Network& net, const std::vector<NodeBoundary>& boundaries) {
+HarmonicNetwork harmonic_network(const Network& net, const RunBoundaries& boundaries) {
   const std::size_t nodes = net.node_count(), n = net.vessel_count();
   std::vector<unsigned char> held(nodes, 0), touched(nodes, 0);  // a node no vessel reaches stays at 0
-  for (const NodeBoundary& b : boundaries)
-    if (b.type == BoundaryType::pressure) held[static_cast<std::size_t>(b.node)] = 1;
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    if (boundaries.type(i) == BoundaryType::pressure) held[static_cast<std::size_t>(boundaries.node(i))] = 1;
   std::vector<std::int32_t> a, b, edge_vessel, held_end_vessel;
   for (std::size_t v = 0; v < n; ++v) {
     const auto i = static_cast<std::size_t>(net.from[v]), j = static_cast<std::size_t>(net.to[v]);
@@ -59,7 +59,7 @@ struct HarmonicWorkspace {
 // The network's oscillation at one angular frequency w: every node's pressure amplitude,
 // left in work.current. threads: the vessels' two-ports built in parallel (each its own:
 // the same numbers for any count).
-void solve_harmonic(const Network& net, const HarmonicNetwork& h, const std::vector<NodeBoundary>& boundaries,
+void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBoundaries& boundaries,
                     const std::vector<FourierSeries>& series, const std::vector<VesselLine>& lines, int k, double w,
                     HarmonicWorkspace& work, int threads = 1) {
   const std::size_t nodes = net.node_count();
@@ -69,16 +69,14 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const std::vec
   shunt.assign(nodes, 0.0), current.assign(nodes, 0.0);
   std::size_t next = 0;  // series holds the boundaries' that are not outlets, in their order
   for (std::size_t i = 0; i < boundaries.size(); ++i) {
-    const NodeBoundary& b = boundaries[i];
-    const auto node = static_cast<std::size_t>(b.node);
-    const Complex amplitude = b.is_outlet() ? Complex(0.0) : series[next++].amplitude[static_cast<std::size_t>(k)];
-    switch (b.type) {
+    const auto node = static_cast<std::size_t>(boundaries.node(i));
+    const Complex amplitude = boundaries.is_outlet(i) ? Complex(0.0) : series[next++].amplitude[static_cast<std::size_t>(k)];
+    const Outlet& o = boundaries.outlet(i);
+    switch (boundaries.type(i)) {
       case BoundaryType::flow: current[node] += amplitude; break;
       case BoundaryType::pressure: current[node] = amplitude; break;
-      case BoundaryType::resistance: shunt[node] += 1.0 / ResistanceOutlet{b.outlet.r, b.outlet.p_out}.impedance(w); break;
-      case BoundaryType::rcr:
-        shunt[node] += 1.0 / RcrOutlet{b.outlet.r1, b.outlet.c, b.outlet.r2, b.outlet.p_out}.impedance(w);
-        break;
+      case BoundaryType::resistance: shunt[node] += 1.0 / ResistanceOutlet{o.r, o.p_out}.impedance(w); break;
+      case BoundaryType::rcr: shunt[node] += 1.0 / RcrOutlet{o.r1, o.c, o.r2, o.p_out}.impedance(w); break;
       case BoundaryType::reflection:
         throw InputError("node " + std::to_string(net.node_id[node]) +
                          ": a reflection outlet has no steady state to linearise about");
@@ -120,7 +118,7 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
                                      const ViscosityTable& viscosity, int harmonics, int threads) {
   const SteadyFlow steady =
       solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
-  return solve_linear_periodic(net, blood, laws, viscosity, steady, run_boundaries(net), harmonics, threads);
+  return solve_linear_periodic(net, blood, laws, viscosity, steady, RunBoundaries(net), harmonics, threads);
 }
 
 LinearPeriodic LinearPeriodic::about(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
@@ -151,10 +149,10 @@ LinearPeriodic LinearPeriodic::about(const Network& net, const Blood& blood, std
 namespace {
 
 // The boundaries' Fourier series (an outlet's pressure beyond does not oscillate: none).
-std::vector<FourierSeries> boundary_series(const std::vector<NodeBoundary>& boundaries, int harmonics) {
+std::vector<FourierSeries> boundary_series(const RunBoundaries& boundaries, int harmonics) {
   std::vector<FourierSeries> series;
-  for (const NodeBoundary& b : boundaries)
-    if (!b.is_outlet()) series.push_back(fourier_series(b.waveform, harmonics));
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    if (!boundaries.is_outlet(i)) series.push_back(fourier_series(boundaries.waveform(i), harmonics));
   return series;
 }
 
@@ -163,7 +161,7 @@ std::vector<FourierSeries> boundary_series(const std::vector<NodeBoundary>& boun
 // the caller keeps is in one order whatever the threads. The lowest harmonic that fails is
 // the one thrown.
 template <class Consume>
-void solve_harmonics(const Network& net, const LinearPeriodic& lines, const std::vector<NodeBoundary>& boundaries,
+void solve_harmonics(const Network& net, const LinearPeriodic& lines, const RunBoundaries& boundaries,
                      int harmonics, int threads, Consume&& consume) {
   const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
   const HarmonicNetwork network = harmonic_network(net, boundaries);
@@ -192,7 +190,7 @@ void solve_harmonics(const Network& net, const LinearPeriodic& lines, const std:
 
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, const SteadyFlow& steady,
-                                     const std::vector<NodeBoundary>& boundaries, int harmonics, int threads) {
+                                     const RunBoundaries& boundaries, int harmonics, int threads) {
   if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
   LinearPeriodic out = LinearPeriodic::about(net, blood, laws, viscosity, steady, threads);
   // Every harmonic kept: all of them at once, one to a thread.
@@ -203,7 +201,7 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
 
 PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, const SteadyFlow& steady,
-                                       const std::vector<NodeBoundary>& boundaries, int harmonics, double time,
+                                       const RunBoundaries& boundaries, int harmonics, double time,
                                        const std::vector<bool>& keep, int threads) {
   if (harmonics < 1) throw std::invalid_argument("solve_periodic_instant: at least one harmonic");
   PeriodicInstant out{steady.node_pressure, steady.flow,

@@ -27,6 +27,7 @@
 #include "harmonic/fourier_series.hpp"
 #include "harmonic/vessel_line.hpp"
 #include "formats/network.hpp"
+#include "formats/run_boundaries.hpp"
 #include "physics/blood.hpp"
 #include "physics/tube_law.hpp"
 #include "physics/viscosity_table.hpp"
@@ -65,10 +66,10 @@ class LinearPeriodic {
 
   friend LinearPeriodic solve_linear_periodic(const Network&, const Blood&, std::span<const TubeLaw>,
                                               const ViscosityTable&, const SteadyFlow&,
-                                              const std::vector<NodeBoundary>&, int, int);
+                                              const RunBoundaries&, int, int);
   friend PeriodicInstant solve_periodic_instant(const Network&, const Blood&, std::span<const TubeLaw>,
                                                 const ViscosityTable&, const SteadyFlow&,
-                                                const std::vector<NodeBoundary>&, int, double,
+                                                const RunBoundaries&, int, double,
                                                 const std::vector<bool>&, int);
 
  private:
@@ -92,11 +93,11 @@ class LinearPeriodic {
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, int harmonics, int threads = 1);
 // The same about a steady state already solved (solve_distended_steady_flow with the same
-// blood, laws and viscosity), with the network's boundary list (run_boundaries(net)) where the
-// caller holds it: on the full tree a copy is two million entries, 0.3 GB.
+// blood, laws and viscosity), with the network's boundary list (formats/run_boundaries.hpp) where the caller
+// holds it.
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, const SteadyFlow& steady,
-                                     const std::vector<NodeBoundary>& boundaries, int harmonics, int threads = 1);
+                                     const RunBoundaries& boundaries, int harmonics, int threads = 1);
 
 // The linear periodic state at one instant t: every node's pressure and every vessel's flow
 // at its middle, summed harmonic by harmonic as each is solved, and the whole state (`along`)
@@ -110,7 +111,7 @@ struct PeriodicInstant {
 };
 PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, const SteadyFlow& steady,
-                                       const std::vector<NodeBoundary>& boundaries, int harmonics, double time,
+                                       const RunBoundaries& boundaries, int harmonics, double time,
                                        const std::vector<bool>& keep, int threads = 1);
 
 }  // namespace hemotree

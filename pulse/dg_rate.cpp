@@ -196,7 +196,7 @@ void PulseSolver::prescribed_end_fluxes(double t) {
   for (const auto& f : boundaries_.flows) {
     double a, q;
     trace(f.end, a, q);
-    const double q_in = boundaries_.list[static_cast<std::size_t>(f.index)].waveform(t);
+    const double q_in = boundaries_.list.waveform(static_cast<std::size_t>(f.index))(t);
     const TubeLaw& law = end_law(static_cast<std::size_t>(f.end.vessel), f.end.distal);
     set_end_flux(f.end, FlowInlet{q_in}.end_state(law, a, q, f.end.distal));
   }
@@ -204,7 +204,7 @@ void PulseSolver::prescribed_end_fluxes(double t) {
   for (const auto& g : boundaries_.pressures) {
     double a, q;
     trace(g.end, a, q);
-    const double p = boundaries_.list[static_cast<std::size_t>(g.index)].waveform(t);
+    const double p = boundaries_.list.waveform(static_cast<std::size_t>(g.index))(t);
     set_end_flux(g.end, PressureEnd{p}.end_state(end_law(static_cast<std::size_t>(g.end.vessel), g.end.distal), a, q,
                                                  g.end.distal));
   }

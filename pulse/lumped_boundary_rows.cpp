@@ -32,13 +32,13 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
     vessel_at[static_cast<std::size_t>(net.to[v])] = static_cast<std::int32_t>(v);
     end_sign[static_cast<std::size_t>(net.to[v])] = 1;
   }
-  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
+  const RunBoundaries boundaries(net);
   std::size_t outlet_count = 0;
-  for (const NodeBoundary& b : boundaries) outlet_count += b.is_outlet() ? 1 : 0;
+  for (std::size_t i = 0; i < boundaries.size(); ++i) outlet_count += boundaries.is_outlet(i) ? 1 : 0;
   capacitor_of_outlet_.assign(outlet_count, -1);
   std::int32_t k = -1;  // outlet index
   for (std::size_t i = 0; i < boundaries.size(); ++i) {
-    const NodeBoundary& bc = boundaries[i];
+    const NodeBoundary bc = boundaries[i];
     if (bc.is_outlet()) ++k;
     const auto network_node = static_cast<std::size_t>(bc.node);
     if (node_of_[network_node] < 0) continue;

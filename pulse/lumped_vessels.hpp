@@ -70,11 +70,11 @@ class LumpedVessels {
   std::size_t node_count() const { return nodes_; }  // network nodes of 0D vessels, then capacitors
   // Its node for a network node, or -1 where no 0D vessel ends.
   std::int32_t node_of(std::int64_t network_node) const { return node_of_[static_cast<std::size_t>(network_node)]; }
-  // The boundary flows and pressures at its nodes, by their places in run_boundaries(net)
-  // (pulse/network_boundaries.hpp): predict() takes their values in these orders.
+  // The boundary flows and pressures at its nodes, by their places in the run's list
+  // (formats/run_boundaries.hpp): predict() takes their values in these orders.
   const std::vector<std::int32_t>& inflow_boundaries() const { return inflow_boundary_; }
   const std::vector<std::int32_t>& held_boundaries() const { return held_boundary_; }
-  // Per boundary of run_boundaries: whether its flow counts as "in" (else "out") in
+  // Per boundary of the run's list: whether its flow counts as "in" (else "out") in
   // complete()'s exchanged volumes. By default a flow by the sign of its mean, a pressure in.
   void set_entering(std::span<const unsigned char> entering);
 
@@ -116,7 +116,7 @@ class LumpedVessels {
   // nodes' paths, then one backward half for every node), the flows, then the node volumes
   // from them and the pressures from the tube laws. Adds what crossed the network's boundary
   // (flows, pressures, outlets) to exchanged (in, out) [m^3], and, where boundary_volume is
-  // given (per boundary of run_boundaries), what went in through each.
+  // given (per boundary of the run's list), what went in through each.
   void complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
                 std::span<double> boundary_volume = {});
 
@@ -270,7 +270,7 @@ class LumpedVessels {
   std::vector<std::int32_t> index_of_vessel_;  // per network vessel
   std::vector<std::int32_t> vessels_;          // per 0D vessel: its network index
   // Boundary flows (currents into their nodes) and held pressures: node, place in
-  // run_boundaries, whether "in"; a held node's conductance scale (its vessel's at rest).
+  // the run's list, whether "in"; a held node's conductance scale (its vessel's at rest).
   std::vector<std::int32_t> inflow_node_, inflow_boundary_, held_node_, held_boundary_;
   std::vector<unsigned char> inflow_entering_, held_entering_;
   std::vector<std::int32_t> held_;  // per node: 1 + its place in held_node_, or 0 (empty: none held)
@@ -294,7 +294,7 @@ class LumpedVessels {
   // Shunts to ground: conductance and the pressure behind it (outlets, R2).
   std::vector<double> shunt_, shunt_pressure_, shunt_current_;  // current: shunt x pressure
   std::vector<std::int32_t> outlet_of_capacitor_;  // per capacitor node
-  std::vector<std::int32_t> capacitor_of_outlet_;  // per run outlet (run_outlets), -1 if none here
+  std::vector<std::int32_t> capacitor_of_outlet_;  // per run outlet, -1 if none here
 
   NodalSystem system_;
   // State: node volumes (W, above c) and pressures, edge flows, and the last step's (BDF2 history and

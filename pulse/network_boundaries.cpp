@@ -18,7 +18,7 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
     throw InputError("the network has no inlet (vprune adds one; see docs/network-format.md)");
 
   NetworkBoundaries b;
-  b.list = run_boundaries(net);
+  b.list = RunBoundaries(net);
   std::int32_t elements = 0;
   for (std::size_t v = 0; v < n; ++v)
     if (!zero_d[v]) elements = std::max(elements, first_element[v] + elements_per_vessel);
@@ -29,7 +29,7 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
   std::vector<std::int32_t> boundary_at(net.node_count(), -1), outlet_index(b.list.size(), -1);
   std::int32_t outlets = 0;
   for (std::size_t i = 0; i < b.list.size(); ++i) {
-    const NodeBoundary& c = b.list[i];
+    const NodeBoundary c = b.list[i];
     boundary_at[static_cast<std::size_t>(c.node)] = static_cast<std::int32_t>(i);
     if (c.is_outlet()) outlet_index[i] = outlets++;
     b.entering.push_back(c.type == BoundaryType::flow ? c.waveform.mean_value() >= 0 : c.type == BoundaryType::pressure);
@@ -77,7 +77,7 @@ NetworkBoundaries build_boundaries(const Network& net, const std::vector<std::in
         throw InputError(name(v) + " starts at " + node_name(node) + ", which no vessel feeds and which is not the inlet");
       }
       if (lumped) continue;  // the 0D vessel's boundary: pulse/lumped_vessels
-      const NodeBoundary& c = b.list[static_cast<std::size_t>(bi)];
+      const NodeBoundary c = b.list[static_cast<std::size_t>(bi)];
       const auto slot = static_cast<std::int32_t>(b.one_d_boundary.size());
       b.one_d_boundary.push_back(bi);
       if (c.type == BoundaryType::flow) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "formats/network.hpp"
+#include "formats/run_boundaries.hpp"
 #include "physics/riemann.hpp"
 
 namespace hemotree {
@@ -31,10 +32,10 @@ struct NetworkBoundaries {
   std::vector<std::int64_t> junction_node;  // node id, for messages
   std::vector<VesselEnd> junction_ends;
 
-  // The run's boundary conditions (run_boundaries), and per boundary whether its flow counts
+  // The run's boundary conditions (formats/run_boundaries.hpp), and per boundary whether its flow counts
   // as entering the network (the cycle's "in") or leaving it ("out"): a flow by the sign of
   // its mean, a pressure by its steady flow (PulseSolver sets it), an outlet always out.
-  std::vector<NodeBoundary> list;
+  RunBoundaries list;
   std::vector<unsigned char> entering;
 
   // Prescribed flows and pressures at 1D ends (index: the boundary's place in list; slot: its
@@ -56,7 +57,7 @@ struct NetworkBoundaries {
   struct OutletEnd {
     VesselEnd end;
     Outlet outlet;
-    std::int32_t index = -1;      // its place among the run's outlets (run_outlets)
+    std::int32_t index = -1;      // its place among the run's outlets
     std::int32_t boundary = -1;   // its place in list
     std::int32_t slot = -1;       // its place in one_d_boundary
     std::int32_t capacitor = -1;  // index of its RCR state, or -1

@@ -94,7 +94,9 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   }
 
   period_ = driving_waveform(net).period;
-  for (const Outlet& o : run_outlets(run_boundaries(net))) outlet_capacitance_.push_back(o.type == BoundaryType::rcr ? o.c : 0.0);
+  const RunBoundaries boundaries(net);
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    if (const Outlet& o = boundaries.outlet(i); boundaries.is_outlet(i)) outlet_capacitance_.push_back(o.type == BoundaryType::rcr ? o.c : 0.0);
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_);
   lumped_.set_passes(options.lumped_passes);
@@ -174,8 +176,8 @@ void PulseSolver::orient_pressure_boundaries(const std::optional<SteadyFlow>& st
       inflow[static_cast<std::size_t>(net.to[v])] -= steady->flow[v];
     }
     for (std::size_t i = 0; i < boundaries_.list.size(); ++i)
-      if (boundaries_.list[i].type == BoundaryType::pressure)
-        boundaries_.entering[i] = inflow[static_cast<std::size_t>(boundaries_.list[i].node)] >= 0;
+      if (boundaries_.list.type(i) == BoundaryType::pressure)
+        boundaries_.entering[i] = inflow[static_cast<std::size_t>(boundaries_.list.node(i))] >= 0;
   }
 }
 
@@ -227,8 +229,9 @@ void PulseSolver::choose_models(const SolverOptions& options) {
   // diffusion along the vessel, bounded at the fundamental by --lumped-rc (docs/solver.md §10
   // gives the measurements behind both).
   std::vector<bool> reflecting(n, false), reflecting_node(net_.node_count(), false);
-  for (const NodeBoundary& b : run_boundaries(net_))
-    if (b.type == BoundaryType::reflection) reflecting_node[static_cast<std::size_t>(b.node)] = true;
+  const RunBoundaries boundaries(net_);  // before build_boundaries
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    if (boundaries.type(i) == BoundaryType::reflection) reflecting_node[static_cast<std::size_t>(boundaries.node(i))] = true;
   for (std::size_t v = 0; v < n; ++v)
     reflecting[v] = reflecting_node[static_cast<std::size_t>(net_.from[v])] || reflecting_node[static_cast<std::size_t>(net_.to[v])];
   const double period = period_, omega = 2 * std::numbers::pi / period;

@@ -155,9 +155,9 @@ class PulseSolver {
     lumped_count_after_release_ = lumped_.vessel_count();
     lumped_ = LumpedVessels();
   }
-  // The run's boundary conditions (pulse/network_boundaries.hpp: run_boundaries), and per
+  // The run's boundary conditions (formats/run_boundaries.hpp), and per
   // boundary whether its flow counts as "in"; the period of its waveforms.
-  const std::vector<NodeBoundary>& boundary_list() const { return boundaries_.list; }
+  const RunBoundaries& boundary_list() const { return boundaries_.list; }
   const std::vector<unsigned char>& boundary_entering() const { return boundaries_.entering; }
   double period() const { return period_; }
   // From now on the state sums the volume through every element's left face (state().faces)
@@ -191,7 +191,7 @@ class PulseSolver {
   int max_degree() const { return static_cast<int>(bases_.size()) - 1; }
   std::size_t element_count() const { return static_cast<std::size_t>(state_.area.rows()); }
   const PulseState& state() const { return state_; }
-  // The volume in through boundary b (run_boundaries' order: boundary_list()) since the start
+  // The volume in through boundary b (the run's order: boundary_list()) since the start
   // [m^3], and every boundary's.
   double boundary_volume(std::size_t b) const {
     const std::int32_t slot = boundary_slot_[b];
@@ -289,7 +289,7 @@ class PulseSolver {
 
   const Network& net_;
   double period_ = 1;                      // driving_waveform(net)'s
-  // Per run outlet (run_outlets(run_boundaries(net))): its capacitance (an RCR's C, else 0)
+  // Per run outlet (formats/run_boundaries.hpp): its capacitance (an RCR's C, else 0)
   // [m^3/Pa]; the outlets themselves are in boundaries_.list.
   std::vector<double> outlet_capacitance_;
   std::vector<double> lumped_inflow_, lumped_held_;  // the 0D nodes' boundary values at a step's end

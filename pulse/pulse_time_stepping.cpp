@@ -213,9 +213,9 @@ void PulseSolver::step_coupled() {
   const double t1 = time_ + dt_;
   // The boundary flows and pressures at the 0D vessels' nodes, at the step's end.
   for (std::size_t j = 0; j < lumped_inflow_.size(); ++j)
-    lumped_inflow_[j] = boundaries_.list[static_cast<std::size_t>(lumped_.inflow_boundaries()[j])].waveform(t1);
+    lumped_inflow_[j] = boundaries_.list.waveform(static_cast<std::size_t>(lumped_.inflow_boundaries()[j]))(t1);
   for (std::size_t j = 0; j < lumped_held_.size(); ++j)
-    lumped_held_[j] = boundaries_.list[static_cast<std::size_t>(lumped_.held_boundaries()[j])].waveform(t1);
+    lumped_held_[j] = boundaries_.list.waveform(static_cast<std::size_t>(lumped_.held_boundaries()[j]))(t1);
   lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
   if (element_count() > 0) {

@@ -42,7 +42,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   solver_.track_face_volumes();
   const LumpedVessels& lumped = solver.lumped();
   const NetworkBoundaries& ends = solver.network_boundaries();
-  const std::vector<NodeBoundary>& boundaries = solver.boundary_list();
+  const RunBoundaries& boundaries = solver.boundary_list();
   const Blood blood = solver.blood();
   const double scale = blood.pries_diameter_scale();
   auto fahraeus = [&](double diameter) { return options_.fahraeus ? fahraeus_parameter(diameter, scale) : 1.0; };
@@ -129,7 +129,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     grid.add_face(lumped.from_node(i), lumped.to_node(i), static_cast<std::int32_t>(v), mean_diameter(net, v));
   }
   for (std::size_t b = 0; b < boundaries.size(); ++b) {
-    const std::int32_t k = lumped.empty() ? -1 : lumped.node_of(boundaries[b].node);
+    const std::int32_t k = lumped.empty() ? -1 : lumped.node_of(boundaries.node(b));
     if (k < 0) continue;
     node_boundary_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
     node_boundary_.push_back(static_cast<std::int32_t>(b));
@@ -180,7 +180,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
                                   : lumped_face_[static_cast<std::size_t>(lumped.vessel_index(v))];
     } else {
       for (std::size_t b = 0; b < boundaries.size(); ++b) {
-        if (!boundaries[b].is_outlet() && (spec.place == TracerSpec::Place::inlet || boundaries[b].node == spec.at))
+        if (!boundaries.is_outlet(b) && (spec.place == TracerSpec::Place::inlet || boundaries.node(b) == spec.at))
           given.push_back(static_cast<std::int32_t>(b));
       }
       if (given.empty())
@@ -199,14 +199,14 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
 }
 
 void FlowTransport::step_tracers(double t0, double t1) {
-  const std::vector<NodeBoundary>& boundaries = solver_.boundary_list();
+  const RunBoundaries& boundaries = solver_.boundary_list();
   const TransportGrid& grid = red_cells_->grid();
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const TracerSpec& spec = options_.tracers[k];
     const double given = spec.mean_over(t0, t1);
     tracer_inflow_.assign(boundaries.size(), 0.0);
     for (std::size_t b = 0; b < boundaries.size(); ++b)
-      if (boundaries[b].is_outlet())
+      if (boundaries.is_outlet(b))
         tracer_inflow_[b] = std::numeric_limits<double>::quiet_NaN();  // an outlet returns what it took
     for (const std::int32_t b : tracer_boundaries_[k]) tracer_inflow_[static_cast<std::size_t>(b)] = given;
     tracer_injected_.clear();

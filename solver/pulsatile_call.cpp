@@ -145,14 +145,14 @@ std::string check_results(const Network& net, const PulseSolver& run, const Puls
     return "the scheme lost mass: (in - out - stored) / in = " + format_rounded(last.conservation_error) +
            " over the last cycle, above " + format_rounded(conservation_tolerance);
   // Each prescribed flow's mean against what went through it (a zero mean within 1e-6 of the flow in).
-  const std::vector<NodeBoundary>& list = run.boundary_list();
+  const RunBoundaries& list = run.boundary_list();
   for (std::size_t i = 0; i < list.size() && i < last.boundary_mean_flow.size(); ++i) {
-    if (list[i].type != BoundaryType::flow) continue;
-    const double prescribed = list[i].waveform.mean_value(), got = last.boundary_mean_flow[i];
+    if (list.type(i) != BoundaryType::flow) continue;
+    const double prescribed = list.waveform(i).mean_value(), got = last.boundary_mean_flow[i];
     if (std::abs(got - prescribed) <= 1e-2 * std::abs(prescribed) + 1e-6 * std::abs(last.inlet_mean_flow)) continue;
     const bool inlet = net.inlet && net.boundaries.empty();
     return (inlet ? std::string("the inlet's mean flow")
-                  : "the mean flow into node " + std::to_string(net.node_id[static_cast<std::size_t>(list[i].node)])) +
+                  : "the mean flow into node " + std::to_string(net.node_id[static_cast<std::size_t>(list.node(i))])) +
            " over the last cycle is " + format_quantity(got, "ml/min") + " where the waveform prescribes " +
            format_quantity(prescribed, "ml/min") + ": the time step cannot follow the pulse";
   }
@@ -214,7 +214,7 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
 SummaryArray boundary_flows(const Network& net, const PulseSolver& run, const CycleSummary& last) {
   if (last.boundary_mean_flow.empty()) return {};
   return {"boundaries", run.boundary_list().size(), [&net, &run, &last](std::size_t i) {
-            const NodeBoundary& b = run.boundary_list()[i];
+            const NodeBoundary b = run.boundary_list()[i];
             nlohmann::json entry = {{"node", net.node_id[static_cast<std::size_t>(b.node)]},
                                     {"type", to_string(b.type)},
                                     {"flow", last.boundary_mean_flow[i]}};

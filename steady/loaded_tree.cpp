@@ -13,34 +13,33 @@ namespace hemotree {
 
 TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& resistance, const TreeLoads& loads) {
   if (net.vessel_count() == 0) throw InputError("the network has no vessels");
-  return solve_loaded_tree(net, run_boundaries(net), resistance, loads);
+  return solve_loaded_tree(net, RunBoundaries(net), resistance, loads);
 }
 
-TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBoundary>& boundaries,
+TreePotentials solve_loaded_tree(const Network& net, const RunBoundaries& boundaries,
                                  const std::vector<double>& resistance, const TreeLoads& loads) {
   return LoadedTree(net, boundaries, resistance).solve(loads);
 }
 
-LoadedTree::LoadedTree(const Network& net, const std::vector<NodeBoundary>& boundaries,
+LoadedTree::LoadedTree(const Network& net, const RunBoundaries& boundaries,
                        const std::vector<double>& resistance)
     : net_(net), boundaries_(boundaries) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   if (n == 0) throw InputError("the network has no vessels");
-  // The outlets in run_outlets' order, by their places in the list (not copied: a full tree
-  // has two million).
+  // The run's outlets, by their places in the list.
   for (std::size_t i = 0; i < boundaries.size(); ++i)
-    if (boundaries[i].is_outlet()) outlet_boundary_.push_back(static_cast<std::int32_t>(i));
+    if (boundaries.is_outlet(i)) outlet_boundary_.push_back(static_cast<std::int32_t>(i));
   const std::size_t outlets = outlet_boundary_.size();
   if (resistance.size() != n) throw std::invalid_argument("LoadedTree: resistances not sized to the network");
   if (net.boundaries.empty()) steady_outlets(net);  // the outlets sit on exactly the terminal vessels, none a reflection
-  for (const NodeBoundary& bc : boundaries)
-    if (bc.type == BoundaryType::reflection)
-      throw InputError("node " + std::to_string(net.node_id[static_cast<std::size_t>(bc.node)]) +
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    if (boundaries.type(i) == BoundaryType::reflection)
+      throw InputError("node " + std::to_string(net.node_id[static_cast<std::size_t>(boundaries.node(i))]) +
                        ": a reflection outlet has no resistance for the network's response");
   // The nodes a prescribed pressure holds: their disturbance is 0.
   std::vector<unsigned char> held(nodes, 0);
-  for (const NodeBoundary& bc : boundaries)
-    if (bc.type == BoundaryType::pressure) held[static_cast<std::size_t>(bc.node)] = 1;
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    if (boundaries.type(i) == BoundaryType::pressure) held[static_cast<std::size_t>(boundaries.node(i))] = 1;
 
   // The system's nodes: the network's, then a capacitor node per RCR outlet that has one
   // apart from both ends (R1 and R2 both positive). With R1 = 0 the capacitor sits on the
@@ -79,10 +78,10 @@ LoadedTree::LoadedTree(const Network& net, const std::vector<NodeBoundary>& boun
     if (!touched[i]) untouched_.push_back(static_cast<std::int32_t>(i));
   std::size_t size = nodes;
   for (std::size_t k = 0; k < outlets; ++k) {
-    const Outlet& o = outlet(k).outlet;
+    const Outlet& o = outlet(k);
     if (o.type == BoundaryType::rcr && o.r1 != 0 && o.r2 != 0) {
       capacitor_node_[k] = static_cast<std::int32_t>(size++);
-      a.push_back(outlet(k).node);
+      a.push_back(outlet_node(k));
       b.push_back(capacitor_node_[k]);
       conductance_.push_back(1 / o.r1);
     }
@@ -110,8 +109,8 @@ TreePotentials LoadedTree::solve(const TreeLoads& loads) {
       current[static_cast<std::size_t>(node)] = 0;
     }
   for (std::size_t k = 0; k < outlets; ++k) {
-    const Outlet& o = outlet(k).outlet;
-    const auto d = static_cast<std::size_t>(outlet(k).node);  // the tree form's: its vessel's `to`
+    const Outlet& o = outlet(k);
+    const auto d = static_cast<std::size_t>(outlet_node(k));  // the tree form's: its vessel's `to`
     if (o.type != BoundaryType::rcr) {
       shunt[d] += 1 / o.r;
     } else if (o.r1 == 0) {
@@ -137,9 +136,9 @@ TreePotentials LoadedTree::solve(const TreeLoads& loads) {
   p.node.assign(current.begin(), current.begin() + static_cast<std::ptrdiff_t>(nodes));
   p.capacitor.assign(outlets, 0.0);
   for (std::size_t k = 0; k < outlets; ++k) {
-    const Outlet& o = outlet(k).outlet;
+    const Outlet& o = outlet(k);
     if (capacitor_node_[k] >= 0) p.capacitor[k] = current[static_cast<std::size_t>(capacitor_node_[k])];
-    else if (o.type == BoundaryType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(outlet(k).node)];
+    else if (o.type == BoundaryType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(outlet_node(k))];
   }
   return p;
 }

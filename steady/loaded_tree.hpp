@@ -2,7 +2,7 @@
 // (Poiseuille resistances) and outlets (R to ground; RCR as R1 to a capacitor node and R2 to
 // ground, at the outlet's node), prescribed flows open (the inlet), prescribed pressures
 // held (potential 0), and at every node and every capacitor node a conductance to ground
-// and an injected current. The boundaries are pulse/network_boundaries.hpp's run_boundaries.
+// and an injected current. The boundaries are the run's (formats/run_boundaries.hpp).
 // Its potentials are what the slow drift of the network's compliances towards the periodic
 // state needs (PulseSolver::balance_compliances): pressure shifts in Pa for volume rates in
 // m^3/s. Outflow pressures are zero: the tree is the network's response to disturbances.
@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "formats/network.hpp"
+#include "formats/run_boundaries.hpp"
 #include "network_flow/nodal_system.hpp"
 
 namespace hemotree {
@@ -35,9 +36,8 @@ struct TreePotentials {
 // without an outlet, an outlet on a vessel that is not terminal), for a reflection outlet,
 // and where a part of the network has no path to ground.
 TreePotentials solve_loaded_tree(const Network& net, const std::vector<double>& resistance, const TreeLoads& loads);
-// The same with the network's run_boundaries(net) given (a run holds them: on a full tree two
-// million entries, not to be built again at every cycle end).
-TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBoundary>& boundaries,
+// The same with the network's boundary list given (a run holds one).
+TreePotentials solve_loaded_tree(const Network& net, const RunBoundaries& boundaries,
                                  const std::vector<double>& resistance, const TreeLoads& loads);
 
 // The same network and resistances for several loads (the compliance balance solves three):
@@ -45,13 +45,15 @@ TreePotentials solve_loaded_tree(const Network& net, const std::vector<NodeBound
 // factorisation with its loads' shunts. The network and the boundaries must outlive it.
 class LoadedTree {
  public:
-  LoadedTree(const Network& net, const std::vector<NodeBoundary>& boundaries, const std::vector<double>& resistance);
+  LoadedTree(const Network& net, const RunBoundaries& boundaries, const std::vector<double>& resistance);
   TreePotentials solve(const TreeLoads& loads);
 
  private:
-  const NodeBoundary& outlet(std::size_t k) const { return boundaries_[static_cast<std::size_t>(outlet_boundary_[k])]; }
+  // Run outlet k's parameters and its node.
+  const Outlet& outlet(std::size_t k) const { return boundaries_.outlet(static_cast<std::size_t>(outlet_boundary_[k])); }
+  std::int32_t outlet_node(std::size_t k) const { return boundaries_.node(static_cast<std::size_t>(outlet_boundary_[k])); }
   const Network& net_;
-  const std::vector<NodeBoundary>& boundaries_;
+  const RunBoundaries& boundaries_;
   std::vector<std::int32_t> outlet_boundary_;  // per run outlet: its place in the boundaries
   std::vector<std::int32_t> capacitor_node_;   // per run outlet: its capacitor's node, or -1
   std::vector<double> conductance_;            // per edge of system_

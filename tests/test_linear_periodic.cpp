@@ -216,7 +216,7 @@ TEST(LinearPeriodic, TheInstantIsTheWholeSolutionsBitForBit) {
   const ViscosityTable viscosity(blood);
   const SteadyFlow steady = solve_distended_steady_flow(cut.net, blood, cut.laws, viscosity,
                                                         cut.net.inlet->waveform.mean_value());
-  const std::vector<NodeBoundary> boundaries = run_boundaries(cut.net);
+  const RunBoundaries boundaries(cut.net);
   const LinearPeriodic whole = solve_linear_periodic(cut.net, blood, cut.laws, viscosity, steady, boundaries, 7, 1);
   std::vector<bool> keep(cut.net.vessel_count(), false);
   keep[1] = keep[3] = true;

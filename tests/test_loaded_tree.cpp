@@ -85,7 +85,7 @@ TEST(LoadedTree, RefusesATerminalVesselWithoutAnOutlet) {
 TEST(LoadedTree, SolvesAgainWithOtherLoadsAsTheSingleCallDoes) {
   Network net = bifurcation();
   net.outlets = {rcr_outlet(1, 1, 1e-9, 7, 0), resistance_outlet(2, 6, 1333)};
-  const std::vector<NodeBoundary> boundaries = run_boundaries(net);
+  const RunBoundaries boundaries(net);
   LoadedTree tree(net, boundaries, resistance);
   TreeLoads first = no_loads(net), second = no_loads(net);
   first.capacitor_current[0] = 2.0;

@@ -137,7 +137,7 @@ TEST(NetworkGraphsPulsatile, ConstantBoundariesSettleOnTheSteadySolution) {
                   "drop (%.3g Pa)\n",
                   name(model), reversed ? ", reversed" : "", solver.lumped_count(), q_error, p_error, drop);
       // What enters leaves: the boundary volumes of the run's last state.
-      const std::vector<NodeBoundary>& list = solver.boundary_list();
+      const RunBoundaries& list = solver.boundary_list();
       ASSERT_EQ(list.size(), 2u);
       EXPECT_EQ(solver.boundary_entering()[0], 1);  // the flow in (node 4)
       EXPECT_EQ(solver.boundary_entering()[1], 0);  // the pressure node lets it out
@@ -243,15 +243,15 @@ TEST(NetworkGraphsPulsatile, SeveralPulsatileInflowsBalanceOverAPeriodicCycle) {
     std::printf("[ inflows ] --model %s: mass balance %.2g, in %.4g, out %.4g m^3/s, volume change %.3g m^3\n",
                 name(model), last.conservation_error, last.inlet_mean_flow, last.outlets_mean_flow, last.volume_change);
     EXPECT_LT(std::abs(last.conservation_error), 1e-10);
-    const std::vector<NodeBoundary>& list = solver.boundary_list();
+    const RunBoundaries& list = solver.boundary_list();
     ASSERT_EQ(last.boundary_mean_flow.size(), list.size());
     double in = 0, net_in = 0;
     for (std::size_t i = 0; i < list.size(); ++i) {
       net_in += last.boundary_mean_flow[i];
       in += std::max(last.boundary_mean_flow[i], 0.0);
-      if (list[i].type != BoundaryType::flow) continue;
+      if (list.type(i) != BoundaryType::flow) continue;
       // The scheme's quadrature of the table over 1 000+ steps: 1e-4.
-      EXPECT_NEAR(last.boundary_mean_flow[i], list[i].waveform.mean_value(), 1e-4 * 3e-9) << "boundary " << i;
+      EXPECT_NEAR(last.boundary_mean_flow[i], list.waveform(i).mean_value(), 1e-4 * 3e-9) << "boundary " << i;
     }
     EXPECT_NEAR(last.inlet_mean_flow, in, 1e-6 * in);  // the flows and the pressure node (it lets blood in)
     EXPECT_NEAR(net_in, 0.0, 1e-4 * in);               // periodic: nothing stored over the cycle
