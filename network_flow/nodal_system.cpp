@@ -192,12 +192,26 @@ std::int64_t NodalSystem::factorize_forward(std::span<const double> conductance,
   return factorize(conductance, shunt, y.data());
 }
 
+void NodalSystem::release_factorization() {
+  factorized_ = false;
+  if (method_ == Method::tree_elimination) {
+    std::vector<double>().swap(inverse_pivot_);
+    std::vector<double>().swap(divider_);
+  }
+  std::vector<double>().swap(inverse_scratch_);
+  std::vector<std::int32_t>().swap(path_scratch_);
+}
+
 std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::span<const double> shunt, double* y) {
   if (conductance.size() != a_.size() || shunt.size() != nodes_)
     throw std::invalid_argument("NodalSystem::factorize: " + std::to_string(conductance.size()) +
                                 " conductances and " + std::to_string(shunt.size()) + " shunts for " +
                                 std::to_string(a_.size()) + " edges and " + std::to_string(nodes_) + " nodes");
   factorized_ = false;
+  if (method_ == Method::tree_elimination && inverse_pivot_.size() != nodes_) {  // released
+    inverse_pivot_.assign(nodes_, 0.0);
+    divider_.assign(nodes_, 0.0);
+  }
   auto bad_value = [](const char* what, std::size_t k, double v) {
     return std::invalid_argument("NodalSystem::factorize: " + std::string(what) + " " + std::to_string(k) +
                                  " is " + std::to_string(v));

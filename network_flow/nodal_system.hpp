@@ -62,6 +62,10 @@ class NodalSystem {
   std::int64_t factorize_forward(std::span<const double> conductance, std::span<const double> shunt,
                                  std::span<double> y);
   void forward(std::span<double> y) const;  // y = L^-1 P y, in place
+  // Frees a tree's factorisation and the inverse diagonal's scratch (16 and 8 bytes a node)
+  // until the next factorize: for a caller that holds a system across a phase that needs
+  // neither (a run's cycle end). Solves refuse until then, as before any factorisation.
+  void release_factorization();
   // y += L^-1 P b for b zero but at `nodes` (values[k] at nodes[k]; repeats add).
   void add_forward(std::span<const std::int32_t> nodes, std::span<const double> values, std::span<double> y) const;
   void backward(std::span<const double> y, std::span<double> x) const;  // x may alias y

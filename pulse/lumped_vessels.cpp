@@ -84,13 +84,11 @@ void LumpedVessels::allocate_system() {
   system_ = NodalSystem(nodes_, a_, b_);
   const std::size_t edges = a_.size();
   volume_.assign(nodes_, 0.0);
-  previous_volume_ = pressure_ = previous_pressure_ = predicted_ = system_shunt_ = rhs_ = volume_;
+  previous_volume_ = pressure_ = previous_pressure_ = volume_;
   flow_.assign(edges, 0.0);
-  previous_flow_ = conductance_ = history_ = flow_;
+  previous_flow_ = flow_;
   capacity_a_.assign(vessels_.size(), 0.0);
-  capacity_b_ = resistance_ = previous_resistance_ = capacity_a_;
-  // The R1 edges of RCR outlets keep their conductance, and have no inertance.
-  for (std::size_t e = vessels_.size(); e < edges; ++e) conductance_[e] = 1 / edge_fixed_resistance_[e - vessels_.size()];
+  capacity_b_ = resistance_ = previous_resistance_ = capacity_a_;  // the step's own arrays: at the first predict()
 
   if (2 * edges >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw InputError("too many 0D vessels for 32-bit indices");
@@ -110,6 +108,24 @@ void LumpedVessels::allocate_system() {
   shunt_current_.resize(nodes_);
   for (std::size_t k = 0; k < nodes_; ++k) shunt_current_[k] = shunt_[k] * shunt_pressure_[k];
   block_outflow_.assign((nodes_ + block - 1) / block, 0.0);
+}
+
+void LumpedVessels::allocate_step_arrays() {
+  if (rhs_.size() == nodes_) return;
+  const std::size_t edges = a_.size();
+  predicted_.resize(nodes_);  // a shift of the pressures may have set it since
+  system_shunt_.assign(nodes_, 0.0);
+  rhs_.assign(nodes_, 0.0);
+  conductance_.assign(edges, 0.0);
+  history_.assign(edges, 0.0);
+  // The R1 edges of RCR outlets keep their conductance, and have no inertance.
+  for (std::size_t e = vessels_.size(); e < edges; ++e) conductance_[e] = 1 / edge_fixed_resistance_[e - vessels_.size()];
+}
+
+void LumpedVessels::release_step_arrays() {
+  for (std::vector<double>* v : {&predicted_, &system_shunt_, &rhs_, &conductance_, &history_}) std::vector<double>().swap(*v);
+  linearised_dt_ = 0;  // the next step linearises its edges again
+  system_.release_factorization();
 }
 
 LumpedVessels::TaperedEdge LumpedVessels::describe_taper(const VesselTaper& taper, double alpha) {
@@ -441,6 +457,7 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
   if (inflow.size() != inflow_node_.size() || held_pressure.size() != held_node_.size())
     throw std::invalid_argument("LumpedVessels::predict: one value per boundary flow and pressure");
   dt_ = dt;
+  allocate_step_arrays();
   inflow_.assign(inflow.begin(), inflow.end());
   // A held node's shunt in the solve (boundaries/pressure_end.hpp), sized by what else
   // reaches it: its vessel's conductance at rest and its compliance's C / dt. complete() then

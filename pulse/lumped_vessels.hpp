@@ -119,6 +119,12 @@ class LumpedVessels {
   // given (per boundary of the run's list), what went in through each.
   void complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
                 std::span<double> boundary_volume = {});
+  // Frees what a step works in and leaves nothing in for the next (the edges' linearisation,
+  // the system's right-hand side, shunts and factorisation, the predicted pressures: about
+  // 70 bytes a vessel) until the next predict() makes it again, linearising every edge anew:
+  // for a phase between steps that needs none of it (a run's cycle end). They are first made
+  // at the first predict(), not before (a run's start needs none of them either).
+  void release_step_arrays();
 
   // The state a vessel's samples come from.
   double node_pressure(std::int32_t node) const { return pressure_[static_cast<std::size_t>(node)]; }
@@ -255,6 +261,7 @@ class LumpedVessels {
   // with the per-node and per-edge arrays and each node's incident edges.
   void add_boundary_rows(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity);
   void allocate_system();
+  void allocate_step_arrays();  // where released (or never made)
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R

@@ -155,6 +155,9 @@ class PulseSolver {
     lumped_count_after_release_ = lumped_.vessel_count();
     lumped_ = LumpedVessels();
   }
+  // Between steps: the 0D step's working arrays freed until the next step makes them again
+  // (LumpedVessels::release_step_arrays; the same numbers), for a phase that takes no step.
+  void release_step_arrays() { lumped_.release_step_arrays(); }
   // The run's boundary conditions (formats/run_boundaries.hpp), and per
   // boundary whether its flow counts as "in"; the period of its waveforms.
   const RunBoundaries& boundary_list() const { return boundaries_.list; }

@@ -287,6 +287,9 @@ RunStatus PulsatileRun::run(RunObserver& observer) {
         }
       }
       solver_.check_solution();
+      // The cycle end (statistics, compliance balance, snapshot) takes no step: on the full
+      // tree 0.26 GB of the step's arrays less at what is the run's largest moment.
+      solver_.release_step_arrays();
       previous_mean_pressure_.resize(last_.vessels.size());
       for (std::size_t v = 0; v < last_.vessels.size(); ++v) previous_mean_pressure_[v] = last_.vessels[v].mean_pressure;
       last_ = CycleSummary{};  // freed before the next is built
