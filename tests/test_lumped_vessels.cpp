@@ -147,28 +147,45 @@ TEST(LumpedVessels, FollowTheExactResponseOfAnRlcCircuit) {
 // A bifurcation of 0D vessels with an RCR and an R outlet under a pulsating inflow: what came
 // in, less what left, is what the vessels hold, to round-off, every step; and the nonlinear
 // tube law is exercised (pressures change by a tenth of beta sqrt(A)).
-TEST(LumpedVessels, ConserveMassToRoundOff) {
+namespace {
+
+// A root and two daughters, every one 0D, into an RCR outlet and an R outlet.
+struct ThreeVessels {
   Blood blood = newtonian(3.5e-3);
   Network net;
-  for (int k = 0; k < 4; ++k) net.add_node(k);
-  const double d = 1e-3, area = pi / 4 * d * d;
-  net.add_vessel(0, 0, 1, 0.02, d, 1e-4, 1e6, 0);
-  net.add_vessel(1, 1, 2, 0.01, 0.8 * d, 1e-4, 1e6, 1);
-  net.add_vessel(2, 1, 3, 0.015, 0.7 * d, 1e-4, 1e6, 1);
-  const double beta = beta_for_wave_speed(5, area);
-  net.beta.assign(3, beta);
-  net.reference_pressure.assign(3, 1e4);
-  net.blood = blood;
-  net.outlets.push_back(rcr_outlet(1, 1e8, 1e-10, 1e9, 1e3));
-  net.outlets.push_back(resistance_outlet(2, 2e9, 1e3));
-  net.inlet = Inlet{0, Waveform{}};
-  std::vector<TubeLaw> laws(3);
-  for (std::size_t v = 0; v < 3; ++v) {
-    laws[v].beta = beta;
-    laws[v].reference_area = pi / 4 * net.diameter[v] * net.diameter[v];
-    laws[v].reference_pressure = 1e4;
-    laws[v].density = blood.density;
+  std::vector<TubeLaw> laws = std::vector<TubeLaw>(3);
+  double area = 0, beta = 0;
+  ThreeVessels() {
+    for (int k = 0; k < 4; ++k) net.add_node(k);
+    const double d = 1e-3;
+    area = pi / 4 * d * d;
+    net.add_vessel(0, 0, 1, 0.02, d, 1e-4, 1e6, 0);
+    net.add_vessel(1, 1, 2, 0.01, 0.8 * d, 1e-4, 1e6, 1);
+    net.add_vessel(2, 1, 3, 0.015, 0.7 * d, 1e-4, 1e6, 1);
+    beta = beta_for_wave_speed(5, area);
+    net.beta.assign(3, beta);
+    net.reference_pressure.assign(3, 1e4);
+    net.blood = blood;
+    net.outlets.push_back(rcr_outlet(1, 1e8, 1e-10, 1e9, 1e3));
+    net.outlets.push_back(resistance_outlet(2, 2e9, 1e3));
+    net.inlet = Inlet{0, Waveform{}};
+    for (std::size_t v = 0; v < 3; ++v) {
+      laws[v].beta = beta;
+      laws[v].reference_area = pi / 4 * net.diameter[v] * net.diameter[v];
+      laws[v].reference_pressure = 1e4;
+      laws[v].density = blood.density;
+    }
   }
+};
+
+}  // namespace
+
+TEST(LumpedVessels, ConserveMassToRoundOff) {
+  const ThreeVessels three;
+  const Network& net = three.net;
+  const std::vector<TubeLaw>& laws = three.laws;
+  const Blood& blood = three.blood;
+  const double area = three.area, beta = three.beta;
   const ViscosityTable viscosity(blood);
   LumpedVessels lumped(net, laws, viscosity, blood, {true, true, true});
   lumped.start(std::vector<double>(net.node_count(), 1e4), {0.0, 0.0, 0.0});
@@ -184,6 +201,31 @@ TEST(LumpedVessels, ConserveMassToRoundOff) {
   std::printf("0D mass: largest |in - out - stored| / in %.3g; pressure swing %.3g of beta sqrt(A)\n", worst, swing);
   EXPECT_LT(worst, 1e-12);
   EXPECT_GT(swing, 0.05);
+}
+
+// The step's working arrays freed between steps (a run's cycle ends) and made again: the
+// same state, bit for bit, as never freeing them, the RCR outlet's R1 edge included.
+TEST(LumpedVessels, StepAfterReleasingTheStepArraysToTheSameBits) {
+  const ThreeVessels three;
+  const ViscosityTable viscosity(three.blood);
+  LumpedVessels kept(three.net, three.laws, viscosity, three.blood, {true, true, true});
+  LumpedVessels released(three.net, three.laws, viscosity, three.blood, {true, true, true});
+  for (LumpedVessels* l : {&kept, &released}) l->start(std::vector<double>(three.net.node_count(), 1e4), {0.0, 0.0, 0.0});
+  double in[2] = {0, 0}, out[2] = {0, 0};
+  for (int k = 0; k < 300; ++k) {
+    const double t = (k + 1) * 1e-3, inflow = 5e-6 * (1 + std::sin(2 * pi * t));
+    if (k % 7 == 3) released.release_step_arrays();
+    kept.predict(1e-3, {}, inflow);
+    kept.complete({}, in[0], out[0]);
+    released.predict(1e-3, {}, inflow);
+    released.complete({}, in[1], out[1]);
+  }
+  for (std::int32_t n = 0; n < static_cast<std::int32_t>(kept.node_count()); ++n)
+    EXPECT_EQ(released.node_pressure(n), kept.node_pressure(n)) << "node " << n;
+  for (std::int32_t e = 0; e < 3; ++e) EXPECT_EQ(released.flow(e), kept.flow(e)) << "vessel " << e;
+  EXPECT_EQ(in[1], in[0]);
+  EXPECT_EQ(out[1], out[0]);
+  EXPECT_GT(std::abs(kept.node_pressure(kept.node_of(0)) - 1e4), 100.0);  // it moved
 }
 
 // The pressure inside a capillary whose lumen narrows along it (a drop of a tenth of

@@ -296,6 +296,31 @@ TEST(NodalSystem, RefactorisingSolvesTheNewSystem) {
     }
 }
 
+// A released factorisation refuses solves until the next factorize, which gives the same
+// bits as before the release (the tree's arrays made again, the Cholesky's kept).
+TEST(NodalSystem, AReleasedFactorisationIsMadeAgainByTheNextFactorize) {
+  std::mt19937_64 rng(37);
+  const Graph tree = random_tree(200, rng);
+  const Graph ring = ring_with_chords();
+  for (const Graph* graph : {&tree, &ring}) {
+    NodalSystem system(graph->nodes, graph->a, graph->b);
+    const std::vector<double> rhs = uniform(graph->nodes, -1, 1, rng);
+    const std::vector<double> g = log_uniform(graph->a.size(), 1e-1, 1e1, rng);
+    const std::vector<double> s = uniform(graph->nodes, 0, 1, rng);
+    const std::vector<double> before = solved(system, g, s, rhs);
+    std::vector<double> diagonal_before(2), diagonal_after(2);
+    const std::vector<std::int32_t> nodes = {1, static_cast<std::int32_t>(graph->nodes - 1)};
+    system.inverse_diagonal(nodes, diagonal_before);
+    system.release_factorization();
+    std::vector<double> x = rhs;
+    EXPECT_THROW(system.solve(x, x), std::logic_error);
+    EXPECT_THROW(system.inverse_diagonal(nodes, diagonal_after), std::logic_error);
+    EXPECT_EQ(solved(system, g, s, rhs), before);
+    system.inverse_diagonal(nodes, diagonal_after);
+    EXPECT_EQ(diagonal_after, diagonal_before);
+  }
+}
+
 TEST(NodalSystem, MovesKeepTheFactorisation) {
   NodalSystem chain(3, {0, 1}, {1, 2});
   ASSERT_EQ(chain.factorize(std::vector<double>{1.0, 1.0}, std::vector<double>{0, 0, 1}), -1);
