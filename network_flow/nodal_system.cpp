@@ -45,7 +45,7 @@ std::int32_t find_root(std::vector<std::int32_t>& up, std::int32_t i) {
 
 NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::vector<std::int32_t> b,
                          Method method)
-    : nodes_(nodes), a_(std::move(a)), b_(std::move(b)) {
+    : nodes_(nodes), edges_(a.size()), a_(std::move(a)), b_(std::move(b)) {
   if (nodes_ > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw std::invalid_argument("NodalSystem: " + std::to_string(nodes_) + " nodes exceed 32-bit indices");
   if (a_.size() != b_.size())
@@ -132,6 +132,8 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
     inverse_pivot_.assign(nodes_, 0.0);
     divider_.assign(nodes_, 0.0);
     plan_subtrees();
+    std::vector<std::int32_t>().swap(a_);
+    std::vector<std::int32_t>().swap(b_);
   } else {
     order_ = {};
     parent_ = {};
@@ -203,10 +205,10 @@ void NodalSystem::release_factorization() {
 }
 
 std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::span<const double> shunt, double* y) {
-  if (conductance.size() != a_.size() || shunt.size() != nodes_)
+  if (conductance.size() != edges_ || shunt.size() != nodes_)
     throw std::invalid_argument("NodalSystem::factorize: " + std::to_string(conductance.size()) +
                                 " conductances and " + std::to_string(shunt.size()) + " shunts for " +
-                                std::to_string(a_.size()) + " edges and " + std::to_string(nodes_) + " nodes");
+                                std::to_string(edges_) + " edges and " + std::to_string(nodes_) + " nodes");
   factorized_ = false;
   if (method_ == Method::tree_elimination && inverse_pivot_.size() != nodes_) {  // released
     inverse_pivot_.assign(nodes_, 0.0);

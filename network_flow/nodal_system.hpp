@@ -39,9 +39,7 @@ class NodalSystem {
   NodalSystem& operator=(NodalSystem&&) noexcept;
 
   std::size_t node_count() const { return nodes_; }
-  std::size_t edge_count() const { return a_.size(); }
-  std::span<const std::int32_t> edge_a() const { return a_; }
-  std::span<const std::int32_t> edge_b() const { return b_; }
+  std::size_t edge_count() const { return edges_; }
   Method method() const { return method_; }  // the one in use: never automatic
 
   // conductance: per edge, > 0; shunt: per node, >= 0. Returns -1, or a node of a connected
@@ -104,7 +102,9 @@ class NodalSystem {
   void inverse_diagonal(std::span<const std::int32_t> nodes, std::span<double> out) const;
 
  private:
-  std::size_t nodes_ = 0;
+  std::size_t nodes_ = 0, edges_ = 0;
+  // The edges' nodes: kept for the sparse Cholesky's refill; a tree's elimination needs only
+  // each node's parent edge (below), and frees them once planned.
   std::vector<std::int32_t> a_, b_;
   Method method_ = Method::automatic;
   // Tree elimination: the nodes with every parent before its children (their own order where

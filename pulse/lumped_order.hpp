@@ -22,7 +22,7 @@ namespace hemotree {
 
 struct LumpedOrder {
   std::vector<std::int32_t> vessels;  // network vessel indices of the 0D vessels, in order
-  std::vector<std::int64_t> nodes;    // network node indices of their nodes, in order
+  std::vector<std::int32_t> nodes;    // network node indices of their nodes, in order
 };
 
 // The network's order of the nodes of the given vessels (their `from` and `to` nodes, in

@@ -273,7 +273,7 @@ class LumpedVessels {
 
   std::size_t nodes_ = 0, network_nodes_ = 0;  // network nodes first, then capacitor nodes
   std::vector<std::int32_t> node_of_;          // per network node
-  std::vector<std::int64_t> network_node_;     // per node below network_nodes_
+  std::vector<std::int32_t> network_node_;     // per node below network_nodes_
   std::vector<std::int32_t> index_of_vessel_;  // per network vessel
   std::vector<std::int32_t> vessels_;          // per 0D vessel: its network index
   // Boundary flows (currents into their nodes) and held pressures: node, place in
