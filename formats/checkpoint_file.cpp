@@ -144,8 +144,16 @@ void CheckpointWriter::put_part(std::span<const double> values) {
 void CheckpointWriter::raw(const void* data, std::size_t size) {
   if (section_start_ == std::string::npos) throw std::logic_error("checkpoint: a value written before any section");
   if (size == 0) return;  // an empty matrix's data() is null, which memcpy must not see
+  constexpr std::size_t piece = std::size_t{4} << 20;
+  if (fd_ >= 0 && bytes_.size() + size >= piece) {
+    // What would fill the buffer goes to the file after it, as it is: the buffer stays below
+    // a piece, where it grew to the largest array written (a full tree's are 30 MB).
+    spill();
+    write_all(fd_, static_cast<const char*>(data), size, file_);
+    written_ += size;
+    return;
+  }
   bytes_.append(static_cast<const char*>(data), size);
-  if (fd_ >= 0 && bytes_.size() >= (std::size_t{4} << 20)) spill();
 }
 
 // The section from start: its payload's length in the word after its name, its checksum after it.

@@ -107,6 +107,12 @@ TEST(Checkpoint, AFileWrittenBySectionsIsTheSameBytes) {
       out.put_part(part);
     }
     out.put_part(std::vector<double>{-1});
+    // One array larger than a piece, written at once: straight to the file after the buffer.
+    out.section("whole");
+    std::vector<double> whole(700'000);
+    for (std::size_t i = 0; i < whole.size(); ++i) whole[i] = static_cast<double>(i) * 0.25;
+    out.put(whole);
+    out.put(std::uint64_t{9});
     out.section("end");
   };
   CheckpointWriter memory;
@@ -129,6 +135,11 @@ TEST(Checkpoint, AFileWrittenBySectionsIsTheSameBytes) {
   ASSERT_EQ(large.size(), 1'300'001u);
   EXPECT_EQ(large[1'234'567], 1'234'567 * 0.5);
   EXPECT_EQ(large.back(), -1);
+  in.section("whole");
+  const std::vector<double> whole = in.get_vector();
+  ASSERT_EQ(whole.size(), 700'000u);
+  EXPECT_EQ(whole[654'321], 654'321 * 0.25);
+  EXPECT_EQ(in.get_u64(), 9u);
   write_checkpoint_file(dir / "checkpoint.bin", "old");
   promote_checkpoint_file(dir / "snapshot", dir / "checkpoint.bin");
   EXPECT_EQ(read_checkpoint_file(dir / "checkpoint.bin"), memory.bytes());
