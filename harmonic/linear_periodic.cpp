@@ -56,11 +56,30 @@ struct HarmonicWorkspace {
   std::vector<TwoPort> edge;
 };
 
+// Vessel v's line about the loaded state: its R', L', C' at the lumen of its mean pressure
+// (the mean of its nodes'), its length, mean velocity and profile.
+struct LineAbout {
+  const Network& net;
+  std::span<const TubeLaw> laws;
+  const ViscosityTable& viscosity;
+  const SteadyFlow& steady;
+  double k_friction, density;
+  VesselLine operator()(std::size_t v) const {
+    const TubeLaw& law = laws[v];
+    const double p = 0.5 * (steady.node_pressure[static_cast<std::size_t>(net.from[v])] +
+                            steady.node_pressure[static_cast<std::size_t>(net.to[v])]);
+    const double area = law.area(p);
+    return {k_friction * viscosity(area) / (area * area), density / area, law.compliance_per_length(area),
+            net.length[v], steady.flow[v] / area, law.alpha};
+  }
+};
+
 // The network's oscillation at one angular frequency w: every node's pressure amplitude,
-// left in work.current. threads: the vessels' two-ports built in parallel (each its own:
-// the same numbers for any count).
+// left in work.current; line_of(v) gives vessel v's line. threads: the vessels' two-ports
+// built in parallel (each its own: the same numbers for any count).
+template <class LineOf>
 void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBoundaries& boundaries,
-                    const std::vector<FourierSeries>& series, const std::vector<VesselLine>& lines, int k, double w,
+                    const std::vector<FourierSeries>& series, const LineOf& line_of, int k, double w,
                     HarmonicWorkspace& work, int threads = 1) {
   const std::size_t nodes = net.node_count();
   // A held node's current is its held pressure: nothing else flows into it (one boundary a
@@ -86,7 +105,7 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBound
   // shunt and the current the held pressure drives through it.
   for (const std::int32_t vessel : h.held_end_vessel) {
     const auto v = static_cast<std::size_t>(vessel);
-    const TwoPort y = lines[v].two_port(w);
+    const TwoPort y = line_of(v).two_port(w);
     const auto i = static_cast<std::size_t>(net.from[v]), j = static_cast<std::size_t>(net.to[v]);
     if (h.held[i]) {
       shunt[j] += y.bb;
@@ -101,7 +120,7 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBound
   const auto edges = static_cast<std::int64_t>(edge.size());
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
   for (std::int64_t e = 0; e < edges; ++e)
-    edge[static_cast<std::size_t>(e)] = lines[static_cast<std::size_t>(h.edge_vessel[static_cast<std::size_t>(e)])].two_port(w);
+    edge[static_cast<std::size_t>(e)] = line_of(static_cast<std::size_t>(h.edge_vessel[static_cast<std::size_t>(e)])).two_port(w);
   for (std::size_t node = 0; node < nodes; ++node) {
     if (h.held[node] || !h.touched[node]) shunt[node] = 1.0;
   }
@@ -129,20 +148,11 @@ LinearPeriodic LinearPeriodic::about(const Network& net, const Blood& blood, std
   out.period_ = driving_waveform(net).period;
   out.mean_node_pressure_ = steady.node_pressure;
   out.mean_flow_ = steady.flow;
-
-  const double k_friction = friction_coefficient(blood.alpha);
+  const LineAbout line_about{net, laws, viscosity, steady, friction_coefficient(blood.alpha), blood.density};
   out.line_.resize(n);
   const auto vessels = static_cast<std::int64_t>(n);
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::int64_t i = 0; i < vessels; ++i) {
-    const auto v = static_cast<std::size_t>(i);
-    const TubeLaw& law = laws[v];
-    const double p = 0.5 * (steady.node_pressure[static_cast<std::size_t>(net.from[v])] +
-                            steady.node_pressure[static_cast<std::size_t>(net.to[v])]);
-    const double area = law.area(p);
-    out.line_[v] = {k_friction * viscosity(area) / (area * area), blood.density / area, law.compliance_per_length(area),
-                    net.length[v], steady.flow[v] / area, law.alpha};
-  }
+  for (std::int64_t i = 0; i < vessels; ++i) out.line_[static_cast<std::size_t>(i)] = line_about(static_cast<std::size_t>(i));
   return out;
 }
 
@@ -174,7 +184,8 @@ void solve_harmonics(const Network& net, const LinearPeriodic& lines, const RunB
 #pragma omp for schedule(dynamic, 1)
     for (int k = 1; k <= harmonics; ++k) {
       try {
-        solve_harmonic(net, network, boundaries, series, lines.lines(), k, lines.omega(k), mine);
+        solve_harmonic(net, network, boundaries, series, [&](std::size_t v) -> const VesselLine& { return lines.line(v); },
+                       k, lines.omega(k), mine);
         solved[static_cast<std::size_t>(k - 1)] = mine.current;
       } catch (...) {
         failure[static_cast<std::size_t>(k - 1)] = std::current_exception();
@@ -204,18 +215,28 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
                                        const RunBoundaries& boundaries, int harmonics, double time,
                                        const std::vector<bool>& keep, int threads) {
   if (harmonics < 1) throw std::invalid_argument("solve_periodic_instant: at least one harmonic");
-  PeriodicInstant out{steady.node_pressure, steady.flow,
-                      LinearPeriodic::about(net, blood, laws, viscosity, steady, threads)};
+  PeriodicInstant out{steady.node_pressure, steady.flow, LinearPeriodic{}};
   LinearPeriodic& along = out.along;
+  along.net_ = &net;
+  along.period_ = driving_waveform(net).period;
+  // Every vessel's line is made again where a harmonic needs it (as LinearPeriodic::about
+  // makes it: the same numbers), not held: 48 B a vessel at the run's start; `along` keeps
+  // the kept vessels' and nodes' alone.
+  const LineAbout line_of{net, laws, viscosity, steady, friction_coefficient(blood.alpha), blood.density};
   along.kept_.assign(net.node_count(), -1);
+  along.kept_vessel_.assign(net.vessel_count(), -1);
   std::vector<std::size_t> kept_node;
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
     if (!keep[v]) continue;
+    along.kept_vessel_[v] = static_cast<std::int32_t>(along.line_.size());
+    along.line_.push_back(line_of(v));
+    along.mean_flow_.push_back(steady.flow[v]);
     for (const std::int64_t node : {net.from[v], net.to[v]}) {
       auto& slot = along.kept_[static_cast<std::size_t>(node)];
       if (slot >= 0) continue;
       slot = static_cast<std::int32_t>(kept_node.size());
       kept_node.push_back(static_cast<std::size_t>(node));
+      along.mean_node_pressure_.push_back(steady.node_pressure[static_cast<std::size_t>(node)]);
     }
   }
   const auto nodes = static_cast<std::int64_t>(net.node_count()), vessels = static_cast<std::int64_t>(net.vessel_count());
@@ -227,7 +248,7 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   const HarmonicNetwork network = harmonic_network(net, boundaries);
   HarmonicWorkspace work;
   for (int k = 1; k <= harmonics; ++k) {
-    solve_harmonic(net, network, boundaries, series, along.lines(), k, along.omega(k), work, threads);
+    solve_harmonic(net, network, boundaries, series, line_of, k, along.omega(k), work, threads);
     const std::vector<Complex>& p = work.current;
     const Complex turn = std::polar(1.0, along.omega(k) * time);
 #pragma omp parallel num_threads(threads) if (threads > 1)
@@ -238,7 +259,7 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
 #pragma omp for schedule(static)
       for (std::int64_t i = 0; i < vessels; ++i) {
         const auto v = static_cast<std::size_t>(i);
-        const VesselLine& line = along.line(v);
+        const VesselLine line = line_of(v);
         const Complex q = line.flow(along.omega(k), p[static_cast<std::size_t>(net.from[v])],
                                     p[static_cast<std::size_t>(net.to[v])], 0.5 * line.length);
         out.middle_flow[v] += (q * turn).real();
@@ -252,37 +273,37 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
 }
 
 LinearPeriodic::Complex LinearPeriodic::pressure(int k, std::size_t vessel, double s) const {
-  const VesselLine& line = line_[vessel];
+  const VesselLine& line = line_[vessel_place(vessel)];
   return line.pressure(omega(k), node_pressure(k, static_cast<std::size_t>(net_->from[vessel])),
                        node_pressure(k, static_cast<std::size_t>(net_->to[vessel])), s * line.length);
 }
 
 LinearPeriodic::Complex LinearPeriodic::flow(int k, std::size_t vessel, double s) const {
-  const VesselLine& line = line_[vessel];
+  const VesselLine& line = line_[vessel_place(vessel)];
   return line.flow(omega(k), node_pressure(k, static_cast<std::size_t>(net_->from[vessel])),
                    node_pressure(k, static_cast<std::size_t>(net_->to[vessel])), s * line.length);
 }
 
 std::array<VesselLine::Point, 3> LinearPeriodic::ends_and_middle(int k, std::size_t vessel) const {
-  return line_[vessel].ends_and_middle(omega(k), node_pressure(k, static_cast<std::size_t>(net_->from[vessel])),
+  return line_[vessel_place(vessel)].ends_and_middle(omega(k), node_pressure(k, static_cast<std::size_t>(net_->from[vessel])),
                                        node_pressure(k, static_cast<std::size_t>(net_->to[vessel])));
 }
 
 double LinearPeriodic::pressure_at(std::size_t vessel, double s, double t) const {
-  double p = (1 - s) * mean_node_pressure_[static_cast<std::size_t>(net_->from[vessel])] +
-             s * mean_node_pressure_[static_cast<std::size_t>(net_->to[vessel])];
+  double p = (1 - s) * mean_node_pressure_[node_place(static_cast<std::size_t>(net_->from[vessel]))] +
+             s * mean_node_pressure_[node_place(static_cast<std::size_t>(net_->to[vessel]))];
   for (int k = 1; k <= harmonics(); ++k) p += (pressure(k, vessel, s) * std::polar(1.0, omega(k) * t)).real();
   return p;
 }
 
 double LinearPeriodic::node_pressure_at(std::size_t node, double t) const {
-  double p = mean_node_pressure_[node];
+  double p = mean_node_pressure_[node_place(node)];
   for (int k = 1; k <= harmonics(); ++k) p += (node_pressure(k, node) * std::polar(1.0, omega(k) * t)).real();
   return p;
 }
 
 double LinearPeriodic::flow_at(std::size_t vessel, double s, double t) const {
-  double q = mean_flow_[vessel];
+  double q = mean_flow_[vessel_place(vessel)];
   for (int k = 1; k <= harmonics(); ++k) q += (flow(k, vessel, s) * std::polar(1.0, omega(k) * t)).real();
   return q;
 }

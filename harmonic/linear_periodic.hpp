@@ -44,15 +44,16 @@ class LinearPeriodic {
   double period() const { return period_; }
   int harmonics() const { return static_cast<int>(node_pressure_.size()); }
   double omega(int k) const { return 2 * std::numbers::pi * k / period_; }
-  const VesselLine& line(std::size_t vessel) const { return line_[vessel]; }
-  const std::vector<VesselLine>& lines() const { return line_; }  // per vessel
-  // The loaded (mean) state: per node [Pa], per vessel [m^3/s, from -> to].
+  // A vessel's line, one the solve kept (every one, or those of solve_periodic_instant's `keep`).
+  const VesselLine& line(std::size_t vessel) const { return line_[vessel_place(vessel)]; }
+  // The loaded (mean) state: per node [Pa], per vessel [m^3/s, from -> to] (a whole
+  // solution's; an instant's keeps its kept nodes and vessels only, by their places).
   const std::vector<double>& mean_node_pressure() const { return mean_node_pressure_; }
   const std::vector<double>& mean_flow() const { return mean_flow_; }
   // Harmonic k >= 1 at a node, and in a vessel at a fraction s of its length from `from`
-  // (one the solve kept: every one, or those of solve_periodic_instant's `keep`).
+  // (one the solve kept).
   Complex node_pressure(int k, std::size_t node) const {
-    return node_pressure_[static_cast<std::size_t>(k - 1)][kept_.empty() ? node : static_cast<std::size_t>(kept_[node])];
+    return node_pressure_[static_cast<std::size_t>(k - 1)][node_place(node)];
   }
   Complex pressure(int k, std::size_t vessel, double s) const;
   Complex flow(int k, std::size_t vessel, double s) const;
@@ -78,10 +79,15 @@ class LinearPeriodic {
                               const ViscosityTable& viscosity, const SteadyFlow& steady, int threads);
   const Network* net_ = nullptr;
   double period_ = 1.0;
-  std::vector<double> mean_node_pressure_, mean_flow_;
+  // Per node, or per kept node at its place in kept_: the mean pressure and each harmonic's.
+  std::vector<double> mean_node_pressure_;
+  std::vector<std::vector<Complex>> node_pressure_;  // [k - 1][place]
+  // Per vessel, or per kept vessel at its place in kept_vessel_: the mean flow and the line.
+  std::vector<double> mean_flow_;
   std::vector<VesselLine> line_;
-  std::vector<std::vector<Complex>> node_pressure_;  // [k - 1][node, or its place in kept_]
-  std::vector<std::int32_t> kept_;                   // per node: its place, -1 (empty: every node's own)
+  std::vector<std::int32_t> kept_, kept_vessel_;  // per node, per vessel: its place, -1 (empty: its own)
+  std::size_t node_place(std::size_t node) const { return kept_.empty() ? node : static_cast<std::size_t>(kept_[node]); }
+  std::size_t vessel_place(std::size_t v) const { return kept_vessel_.empty() ? v : static_cast<std::size_t>(kept_vessel_[v]); }
 };
 
 // The linear periodic state with the first `harmonics` harmonics of the network's boundary
