@@ -398,4 +398,76 @@ void Fingerprint::add(const void* data, std::size_t size) {
   }
 }
 
+// ---- reading from the file -------------------------------------------------------------------
+
+CheckpointStream::CheckpointStream(const std::filesystem::path& file) : path_(file) {
+  file_ = std::fopen(file.c_str(), "rb");
+  if (!file_) throw IoError("cannot read " + file.string() + ": " + std::strerror(errno));
+  std::string start(magic.size(), '\0');
+  std::uint64_t version = 0;
+  if (std::fread(start.data(), 1, start.size(), file_) != start.size() || start != magic) fail("not a hemosolve checkpoint");
+  read(&version, word, false);
+  if (version != format_version)
+    fail("checkpoint format " + std::to_string(version) + ", this build reads format " + std::to_string(format_version));
+}
+
+CheckpointStream::~CheckpointStream() {
+  if (file_) std::fclose(file_);
+}
+
+void CheckpointStream::fail(const std::string& message) const { throw InputError(path_.string() + ": " + message); }
+
+void CheckpointStream::read(void* data, std::size_t size, bool hashed) {
+  if (std::fread(data, 1, size, file_) != size) fail("truncated checkpoint");
+  if (hashed) hash_.add(data, size);
+}
+
+void CheckpointStream::close_section() {
+  char skipped[1 << 16];
+  while (left_ > 0) {
+    const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(left_, sizeof skipped));
+    read(skipped, n);
+    left_ -= n;
+  }
+  std::uint64_t sum = 0;
+  read(&sum, word, false);
+  if (sum != hash_.value()) fail("a section does not match its checksum: the file was changed or damaged");
+  hash_ = Fingerprint();
+  open_ = false;
+}
+
+void CheckpointStream::section(std::string_view name) {
+  if (open_) close_section();
+  std::uint64_t name_length = 0, length = 0;
+  read(&name_length, word);
+  if (name_length != name.size()) fail("no section \"" + std::string(name) + "\" where it was written");
+  std::string found(name.size(), '\0');
+  read(found.data(), found.size());
+  if (found != name) fail("no section \"" + std::string(name) + "\" where it was written");
+  read(&length, word);
+  left_ = length;
+  open_ = true;
+}
+
+std::uint64_t CheckpointStream::get_u64() {
+  std::uint64_t x = 0;
+  get_doubles({});  // checks a section is open
+  if (left_ < word) fail("a section shorter than this build reads");
+  read(&x, word);
+  left_ -= word;
+  return x;
+}
+
+void CheckpointStream::get_doubles(std::span<double> out) {
+  if (!open_) throw std::logic_error("CheckpointStream: a value read outside any section");
+  const std::size_t size = out.size() * sizeof(double);
+  if (left_ < size) fail("a section shorter than this build reads");
+  if (size > 0) read(out.data(), size);
+  left_ -= size;
+}
+
+void CheckpointStream::finish() {
+  if (open_) close_section();
+}
+
 }  // namespace hemotree

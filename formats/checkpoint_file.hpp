@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <span>
 #include <filesystem>
 #include <string>
@@ -137,6 +138,34 @@ class Fingerprint {
 
  private:
   std::uint64_t hash_ = 14695981039346656037ull;
+};
+
+// Sections of a checkpoint file read from the file itself, in order, without the file in
+// memory (a full tree's is a gigabyte): for what a run wants back from its own snapshot (the
+// last cycle's results, solver/pulsatile_run). Each section is checked against its checksum
+// when the next is opened or finish() is called; the file's own checksum is not (it needs the
+// whole file). InputError naming the file at anything else than what is asked for.
+class CheckpointStream {
+ public:
+  explicit CheckpointStream(const std::filesystem::path& file);
+  ~CheckpointStream();
+  CheckpointStream(const CheckpointStream&) = delete;
+  CheckpointStream& operator=(const CheckpointStream&) = delete;
+  // The next section, which must be this one; what was left of the one before is skipped.
+  void section(std::string_view name);
+  std::uint64_t get_u64();
+  void get_doubles(std::span<double> out);
+  void finish();  // what is left of the open section skipped, and its checksum checked
+
+ private:
+  void read(void* data, std::size_t size, bool hashed = true);
+  void close_section();
+  [[noreturn]] void fail(const std::string& message) const;
+  std::FILE* file_ = nullptr;
+  std::filesystem::path path_;
+  Fingerprint hash_;            // of the open section's bytes so far
+  std::uint64_t left_ = 0;      // of its payload
+  bool open_ = false;
 };
 
 }  // namespace hemotree

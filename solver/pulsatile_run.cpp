@@ -23,6 +23,7 @@ double seconds_since_epoch_start() {
 
 // A cycle's summary as numbers, for the checkpoint: given vessel by vessel, not assembled.
 constexpr std::size_t vessel_fields = 10;
+VesselCycle vessel_cycle(const double* f) { return {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], f[9]}; }
 void put_summary(CheckpointWriter& out, const CycleSummary& c) {
   out.begin_vector(4 + vessel_fields * c.vessels.size());
   out.put_part(std::vector<double>{c.inlet_mean_flow, c.outlets_mean_flow, c.volume_change, c.conservation_error});
@@ -43,10 +44,7 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
   c.volume_change = values[2];
   c.conservation_error = values[3];
   c.boundary_mean_flow = in.get_vector();
-  for (std::size_t k = 4; k < values.size(); k += vessel_fields) {
-    const double* f = &values[k];
-    c.vessels.push_back({f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], f[9]});
-  }
+  for (std::size_t k = 4; k < values.size(); k += vessel_fields) c.vessels.push_back(vessel_cycle(&values[k]));
   return c;
 }
 }  // namespace
@@ -70,9 +68,10 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
   });
 }
 
-void PulsatileRun::snapshot() {
+void PulsatileRun::begin_snapshot() {
   snapshot_pending_ = false;
-  CheckpointWriter out(pending());
+  snapshot_.emplace(pending());
+  CheckpointWriter& out = *snapshot_;
   out.section("identity");
   out.put(plan_.network_identity);
   out.put(plan_.state_shaping);
@@ -80,6 +79,10 @@ void PulsatileRun::snapshot() {
   put_summary(out, last_);
   out.section("previous cycle");
   out.put(previous_mean_pressure_);
+}
+
+void PulsatileRun::finish_snapshot() {
+  CheckpointWriter& out = *snapshot_;
   out.section("run");
   out.put(static_cast<std::uint64_t>(done_));
   out.put(static_cast<std::uint64_t>(balances_));
@@ -98,7 +101,35 @@ void PulsatileRun::snapshot() {
   }
   out.section("end");
   out.finish();
+  snapshot_.reset();
   snapshot_pending_ = true;
+}
+
+void PulsatileRun::set_aside_last_vessels() {
+  if (last_.vessels.empty()) return;
+  last_mean_pressure_.resize(last_.vessels.size());
+  for (std::size_t v = 0; v < last_.vessels.size(); ++v) last_mean_pressure_[v] = last_.vessels[v].mean_pressure;
+  std::vector<VesselCycle>().swap(last_.vessels);
+  last_vessels_aside_ = true;
+}
+
+void PulsatileRun::take_back_last_vessels() {
+  if (!last_vessels_aside_) return;
+  const std::filesystem::path file = latest_snapshot();
+  CheckpointStream in(file);
+  in.section("identity");
+  in.section("last cycle");
+  const std::size_t n = net_.vessel_count();
+  if (in.get_u64() != 4 + vessel_fields * n) throw InputError(file.string() + ": cycle results of another network");
+  double f[vessel_fields];
+  in.get_doubles(std::span<double>(f, 4));  // the totals, which the run kept
+  last_.vessels.resize(n);
+  for (VesselCycle& v : last_.vessels) {
+    in.get_doubles(f);
+    v = vessel_cycle(f);
+  }
+  in.finish();
+  last_vessels_aside_ = false;
 }
 
 void PulsatileRun::resume(std::string bytes, const std::string& source) {
@@ -223,6 +254,12 @@ void PulsatileRun::progress(RunObserver& observer, std::size_t k, double started
 }
 
 RunStatus PulsatileRun::run(RunObserver& observer) {
+  const RunStatus status = run_cycles(observer);
+  take_back_last_vessels();  // what the report describes, however the run stopped
+  return status;
+}
+
+RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
   const bool live = observer.progress_style() == ProgressStyle::live;
   const bool log = observer.progress_style() == ProgressStyle::log;
   const double period = solver_.period();
@@ -243,6 +280,7 @@ RunStatus PulsatileRun::run(RunObserver& observer) {
     write_checkpoint_file(pending(), resumed_bytes_);
     snapshot_pending_ = true;
     std::string().swap(resumed_bytes_);
+    set_aside_last_vessels();
   }
   try {
     while (cycles_left()) {
@@ -290,14 +328,23 @@ RunStatus PulsatileRun::run(RunObserver& observer) {
       // The cycle end (statistics, compliance balance, snapshot) takes no step: on the full
       // tree 0.26 GB of the step's arrays less at what is the run's largest moment.
       solver_.release_step_arrays();
-      previous_mean_pressure_.resize(last_.vessels.size());
-      for (std::size_t v = 0; v < last_.vessels.size(); ++v) previous_mean_pressure_[v] = last_.vessels[v].mean_pressure;
+      if (last_vessels_aside_) {
+        previous_mean_pressure_ = std::move(last_mean_pressure_);
+        last_mean_pressure_ = {};
+        last_vessels_aside_ = false;
+      } else {
+        previous_mean_pressure_.resize(last_.vessels.size());
+        for (std::size_t v = 0; v < last_.vessels.size(); ++v) previous_mean_pressure_[v] = last_.vessels[v].mean_pressure;
+      }
       last_ = CycleSummary{};  // freed before the next is built
       last_ = stats_.close(solver_);
       if (series) series->finish();
-      std::vector<double> mean_pressure(last_.vessels.size());
-      for (std::size_t v = 0; v < mean_pressure.size(); ++v) mean_pressure[v] = last_.vessels[v].mean_pressure;
-      if (plan_.balance_compliances && solver_.balance_compliances(period, &mean_pressure) > 0) ++balances_;
+      if (has_change()) change_ = cycle_change(previous_mean_pressure_, last_.vessels);
+      // The cycle's results go to the snapshot, and from memory (but their mean pressures,
+      // which the balance and the next cycle end read) before the balance.
+      begin_snapshot();
+      set_aside_last_vessels();
+      if (plan_.balance_compliances && solver_.balance_compliances(period, &last_mean_pressure_) > 0) ++balances_;
       if (transport_) {
         RedCellCycle cycle = transport_->close_cycle();
         if (!red_cells_last_.discharge.empty()) {
@@ -308,9 +355,8 @@ RunStatus PulsatileRun::run(RunObserver& observer) {
         red_cells_last_ = std::move(cycle);
         transport_->take_volumes();  // the balance's shifts, and the 0D nodes' round-off
       }
-      if (has_change()) change_ = cycle_change(previous_mean_pressure_, last_.vessels);
       ++done_;
-      snapshot();
+      finish_snapshot();
       if (plan_.checkpoint_every > 0 && done_ % plan_.checkpoint_every == 0) write_checkpoint();
       if (live) observer.clear_live_progress();
       if (log) {

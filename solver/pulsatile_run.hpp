@@ -92,7 +92,26 @@ class PulsatileRun {
   // --checkpoint-every makes it checkpoint.bin by a rename. On disk, not in memory: it is a
   // gigabyte on a full tree, which the run would otherwise hold throughout (and three times
   // over while building the next).
-  void snapshot();
+  // In two parts around the cycle end's balance: the cycle's results (begin_snapshot), then
+  // the state it leaves (finish_snapshot), in one file, the same bytes as written at once.
+  void snapshot() {
+    begin_snapshot();
+    finish_snapshot();
+  }
+  void begin_snapshot();
+  void finish_snapshot();
+  std::optional<CheckpointWriter> snapshot_;  // between the two
+  // While a cycle runs, the last cycle's per-vessel results are in its snapshot alone (80 B a
+  // vessel on the run's largest moments, the cycle end's balance and the cycles after the
+  // first): set aside once written, read back where a run stops within a cycle (an interrupt,
+  // a breakdown, a step too slow) and reports the last cycle end. last_mean_pressure_ keeps
+  // what the next cycle end compares.
+  void set_aside_last_vessels();
+  void take_back_last_vessels();
+  bool last_vessels_aside_ = false;
+  std::vector<double> last_mean_pressure_;
+  std::filesystem::path latest_snapshot() const { return snapshot_pending_ ? pending() : folder_ / "checkpoint.bin"; }
+  RunStatus run_cycles(RunObserver& observer);
   std::filesystem::path pending() const { return folder_ / "snapshot.pending"; }
   int planned() const { return plan_.until_periodic ? plan_.max_cycles : plan_.cycles; }
   bool periodic() const;

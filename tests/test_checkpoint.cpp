@@ -164,6 +164,66 @@ TEST(Checkpoint, AFileWrittenBySectionsIsTheSameBytes) {
   std::filesystem::remove_all(dir);
 }
 
+// A file's sections read back from the file in order, without the file in memory: values
+// as written, what is not read skipped and still checked against its checksum, a changed
+// byte and a section asked for out of order refused, naming the file.
+TEST(Checkpoint, AStreamReadsSectionsFromTheFile) {
+  const auto dir = std::filesystem::temp_directory_path() / ("checkpoint-stream-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto file = dir / "snapshot";
+  std::vector<double> large(300'000);
+  for (std::size_t i = 0; i < large.size(); ++i) large[i] = static_cast<double>(i) / 3;
+  {
+    CheckpointWriter out(file);
+    out.section("identity");
+    out.put(std::string("a network"));
+    out.section("large");
+    out.put(large);
+    out.put(std::uint64_t{11});
+    out.section("last");
+    out.put(std::vector<double>{2.5, -1});
+    out.section("end");
+    out.finish();
+  }
+  {
+    CheckpointStream in(file);
+    in.section("identity");  // not read: skipped, and checked
+    in.section("large");
+    ASSERT_EQ(in.get_u64(), large.size());
+    std::vector<double> first(3);
+    in.get_doubles(first);
+    EXPECT_EQ(first, (std::vector<double>{0.0, 1.0 / 3, 2.0 / 3}));
+    in.section("last");  // the rest of "large" skipped, and checked
+    ASSERT_EQ(in.get_u64(), 2u);
+    std::vector<double> last(2);
+    in.get_doubles(last);
+    EXPECT_EQ(last, (std::vector<double>{2.5, -1}));
+    EXPECT_THROW(in.get_u64(), InputError);  // past the section's end
+    in.finish();
+  }
+  {
+    CheckpointStream in(file);
+    EXPECT_THROW(in.section("large"), InputError);  // "identity" comes first
+  }
+  // One byte of "large" changed: found when the section is left.
+  std::string bytes = read_checkpoint_file(file);
+  bytes[bytes.size() / 2] ^= 0x10;
+  write_checkpoint_file(file, bytes);
+  {
+    CheckpointStream in(file);
+    in.section("identity");
+    in.section("large");
+    try {
+      in.section("last");
+      FAIL() << "a changed byte went unnoticed";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("checksum"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Checkpoint, RefusesAnEmptyFileAndAnEarlierFormat) {
   const auto file = std::filesystem::temp_directory_path() / ("checkpoint-empty-" + std::to_string(::getpid()));
   { std::ofstream touch(file); }

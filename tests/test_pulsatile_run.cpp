@@ -3,6 +3,7 @@
 // resume from its in-memory checkpoint that goes on as the run would have, a checkpoint
 // changed after it was written refused, and a resume with no cycle left to run.
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -89,6 +90,34 @@ TEST(PulsatileRun, AnswersAnInterruptAtAStepsEnd) {
   EXPECT_EQ(run.signal(), SIGTERM);
   EXPECT_EQ(run.cycles_done(), 0);
   EXPECT_EQ(interrupts.poll(), 0);  // consumed
+}
+
+// Stopped within its second cycle, a run reports its first: the per-vessel results it set
+// aside in its snapshot while the cycle ran, read back, are a one-cycle run's, bit for bit.
+TEST(PulsatileRun, StoppedWithinACycleReportsTheCycleBefore) {
+  Fixture f;
+  PulseSolver one(f.net, f.options);
+  PulsatileRun a(f.net, one, {}, f.plan(one, 1), f.folder);
+  Interrupts quiet;
+  ASSERT_EQ(a.run(quiet), RunStatus::complete);
+  const CycleSummary first = a.last_cycle();
+  PulseSolver three(f.net, f.options);
+  PulsatileRun b(f.net, three, {}, f.plan(three, 3), f.folder);
+  struct StopInTheSecond : RunObserver {
+    const PulsatileRun* run = nullptr;
+    int poll_interrupt() override { return run->cycles_done() >= 1 ? SIGINT : 0; }
+  } stop;
+  stop.run = &b;
+  ASSERT_EQ(b.run(stop), RunStatus::interrupted);
+  EXPECT_EQ(b.cycles_done(), 1);
+  ASSERT_EQ(b.last_cycle().vessels.size(), first.vessels.size());
+  ASSERT_FALSE(first.vessels.empty());
+  for (std::size_t v = 0; v < first.vessels.size(); ++v) {
+    const VesselCycle &got = b.last_cycle().vessels[v], &want = first.vessels[v];
+    EXPECT_EQ(std::memcmp(&got, &want, sizeof got), 0) << "vessel " << v;  // NaN wave speeds too
+    EXPECT_GT(want.mean_pressure, 0.0);
+  }
+  EXPECT_EQ(b.last_cycle().conservation_error, first.conservation_error);
 }
 
 TEST(PulsatileRun, ResumesFromItsCheckpointAsIfNeverStopped) {
