@@ -53,7 +53,8 @@ HarmonicNetwork harmonic_network(const Network& net, const RunBoundaries& bounda
 // more than the solve.
 struct HarmonicWorkspace {
   std::vector<Complex> shunt, current;
-  std::vector<TwoPort> edge;
+  std::vector<TwoPort> edge;  // a block of them on a forest, every one else
+  std::vector<HarmonicSystem::Coupling> coupling;  // on a forest
 };
 
 // Vessel v's line about the loaded state: its R', L', C' at the lumen of its mean pressure
@@ -115,17 +116,37 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBound
       current[i] -= y.ab * current[j];
     }
   }
-  std::vector<TwoPort>& edge = work.edge;
-  edge.resize(h.edge_vessel.size());
-  const auto edges = static_cast<std::int64_t>(edge.size());
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-  for (std::int64_t e = 0; e < edges; ++e)
-    edge[static_cast<std::size_t>(e)] = line_of(static_cast<std::size_t>(h.edge_vessel[static_cast<std::size_t>(e)])).two_port(w);
   for (std::size_t node = 0; node < nodes; ++node) {
-    if (h.held[node] || !h.touched[node]) shunt[node] = 1.0;
+    if (h.held[node] || !h.touched[node]) shunt[node] = 1.0;  // no edge of the system reaches it
+  }
+  std::vector<TwoPort>& edge = work.edge;
+  const std::size_t edges = h.edge_vessel.size();
+  // Two-ports built in parallel, a block of edges at a time on a forest (its elimination
+  // keeps 32 of their 64 bytes, the diagonals summed in the edges' order as the whole solve
+  // sums them: the same numbers), all at once on any other graph.
+  const std::size_t block = h.system.forest() ? std::min<std::size_t>(edges, 1 << 16) : edges;
+  edge.resize(block);
+  if (h.system.forest()) work.coupling.resize(edges);
+  const std::span<const std::int32_t> a = h.system.edge_a(), b = h.system.edge_b();
+  for (std::size_t first = 0; first < edges; first += block) {
+    const auto count = static_cast<std::int64_t>(std::min(block, edges - first));
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+    for (std::int64_t j = 0; j < count; ++j)
+      edge[static_cast<std::size_t>(j)] = line_of(static_cast<std::size_t>(h.edge_vessel[first + static_cast<std::size_t>(j)])).two_port(w);
+    if (!h.system.forest()) break;
+    for (std::size_t j = 0; j < static_cast<std::size_t>(count); ++j) {
+      const std::size_t e = first + j;
+      shunt[static_cast<std::size_t>(a[e])] += edge[j].aa;
+      shunt[static_cast<std::size_t>(b[e])] += edge[j].bb;
+      work.coupling[e] = {edge[j].ab, edge[j].ba};
+    }
   }
   try {
-    h.system.solve_in_place(edge, shunt, current);
+    if (h.system.forest()) {
+      h.system.solve_forest_in_place(work.coupling, shunt, current);
+    } else {
+      h.system.solve_in_place(edge, shunt, current);
+    }
   } catch (const std::invalid_argument&) {
     throw InputError("the linear periodic solution: a part of the network has no path to an outlet or a pressure");
   }

@@ -90,20 +90,17 @@ void HarmonicSystem::solve_in_place(std::span<const TwoPort> edge, std::span<Com
   }
 }
 
-void HarmonicSystem::solve_forest(std::span<const TwoPort> edge, std::span<Complex> pivot, std::span<Complex> x) const {
+template <class Couplings>
+void HarmonicSystem::eliminate_forest(const Couplings& y, std::span<Complex> pivot, std::span<Complex> x) const {
   const std::span<const std::int32_t> a = a_, b = b_;
-  for (std::size_t e = 0; e < a.size(); ++e) {
-    pivot[static_cast<std::size_t>(a[e])] += edge[e].aa;
-    pivot[static_cast<std::size_t>(b[e])] += edge[e].bb;
-  }
   // Leaves up: node i, its pivot final, hands its parent p m_pi m_ip / d_i of the pivot and
   // m_pi B_i / d_i of the current (m_pi: the entry in p's row and i's column).
-  auto couplings = [&](std::size_t i, std::int32_t e, std::size_t& p, Complex& m_ip, Complex& m_pi) {
-    const TwoPort& y = edge[static_cast<std::size_t>(e)];
-    const bool i_is_a = a[static_cast<std::size_t>(e)] == static_cast<std::int32_t>(i);
-    p = static_cast<std::size_t>(i_is_a ? b[static_cast<std::size_t>(e)] : a[static_cast<std::size_t>(e)]);
-    m_ip = i_is_a ? y.ab : y.ba;
-    m_pi = i_is_a ? y.ba : y.ab;
+  auto couplings = [&](std::size_t i, std::int32_t edge, std::size_t& p, Complex& m_ip, Complex& m_pi) {
+    const auto e = static_cast<std::size_t>(edge);
+    const bool i_is_a = a[e] == static_cast<std::int32_t>(i);
+    p = static_cast<std::size_t>(i_is_a ? b[e] : a[e]);
+    m_ip = i_is_a ? y.ab(e) : y.ba(e);
+    m_pi = i_is_a ? y.ba(e) : y.ab(e);
   };
   for (const std::int32_t node : order_) {
     const auto i = static_cast<std::size_t>(node);
@@ -130,6 +127,33 @@ void HarmonicSystem::solve_forest(std::span<const TwoPort> edge, std::span<Compl
     couplings(i, e, p, m_ip, m_pi);
     x[i] = (x[i] - m_ip * x[p]) / pivot[i];
   }
+}
+
+void HarmonicSystem::solve_forest(std::span<const TwoPort> edge, std::span<Complex> pivot, std::span<Complex> x) const {
+  const std::span<const std::int32_t> a = a_, b = b_;
+  for (std::size_t e = 0; e < a.size(); ++e) {
+    pivot[static_cast<std::size_t>(a[e])] += edge[e].aa;
+    pivot[static_cast<std::size_t>(b[e])] += edge[e].bb;
+  }
+  struct {
+    std::span<const TwoPort> edge;
+    const Complex& ab(std::size_t e) const { return edge[e].ab; }
+    const Complex& ba(std::size_t e) const { return edge[e].ba; }
+  } couplings{edge};
+  eliminate_forest(couplings, pivot, x);
+}
+
+void HarmonicSystem::solve_forest_in_place(std::span<const Coupling> coupling, std::span<Complex> diagonal,
+                                           std::span<Complex> current) const {
+  if (!forest_) throw std::logic_error("HarmonicSystem::solve_forest_in_place: the graph is not a forest");
+  if (coupling.size() != a_.size() || diagonal.size() != nodes_ || current.size() != nodes_)
+    throw std::invalid_argument("harmonic system: one coupling per edge, one diagonal and current per node");
+  struct {
+    std::span<const Coupling> coupling;
+    const Complex& ab(std::size_t e) const { return coupling[e].ab; }
+    const Complex& ba(std::size_t e) const { return coupling[e].ba; }
+  } couplings{coupling};
+  eliminate_forest(couplings, diagonal, current);
 }
 
 // Loops: the assembled matrix and a sparse LU.

@@ -46,8 +46,24 @@ class HarmonicSystem {
   // the potentials.
   void solve_in_place(std::span<const TwoPort> edge, std::span<Complex> shunt, std::span<Complex> current) const;
 
+  // A forest's solve from what its elimination reads of each edge once the diagonal is summed:
+  // the caller adds every edge's y_aa to shunt[a] and y_bb to shunt[b], edge by edge in their
+  // order (as solve_in_place does first), and keeps only (y_ab, y_ba): half the two-ports'
+  // memory, and the same numbers. std::logic_error on a graph that is not a forest.
+  struct Coupling {
+    Complex ab, ba;
+  };
+  bool forest() const { return forest_; }
+  std::span<const std::int32_t> edge_a() const { return a_; }
+  std::span<const std::int32_t> edge_b() const { return b_; }
+  void solve_forest_in_place(std::span<const Coupling> coupling, std::span<Complex> diagonal,
+                             std::span<Complex> current) const;
+
  private:
   void solve_forest(std::span<const TwoPort> edge, std::span<Complex> pivot, std::span<Complex> x) const;
+  // The elimination itself, the diagonal summed: ab(e), ba(e) an edge's couplings.
+  template <class Couplings>
+  void eliminate_forest(const Couplings& couplings, std::span<Complex> pivot, std::span<Complex> x) const;
   void solve_sparse(std::span<const TwoPort> edge, std::span<const Complex> shunt, std::span<Complex> x) const;
 
   std::size_t nodes_;

@@ -58,6 +58,35 @@ TEST(HarmonicSystem, TreeEliminationAndSparseLuMatchADenseSolve) {
   }
 }
 
+// The forest's solve from couplings alone, the diagonals summed by the caller in the edges'
+// order: the whole solve's numbers, bit for bit; refused on a graph with a loop.
+TEST(HarmonicSystem, AForestSolvedFromItsCouplingsIsTheWholeSolveBitForBit) {
+  std::vector<std::int32_t> a{0, 0, 1, 1, 2, 2}, b{1, 2, 3, 4, 5, 6};
+  const std::vector<TwoPort> y{TwoPort::series({2, -1}), {{1.6, -0.2}, {-1.5, 0.3}, {-1.4, 0.1}, {1.5, -0.3}},
+                               TwoPort::series({0.7, -0.2}), {{3.1, -2}, {-3, 2.1}, {-2.9, 1.8}, {3, -1.9}},
+                               TwoPort::series({1, -0.1}), TwoPort::series({0.4, -0.4})};
+  const std::vector<C> s{{0, 0.1}, {0, 0.05}, {0, 0.2}, {0.5, 0.1}, {0.8, 0.02}, {0.3, 0.3}, {1.2, 0}};
+  const std::vector<C> rhs{{1, 0}, {0, 0}, {0, 0.5}, {0, 0}, {-0.2, 0}, {0, 0}, {0.1, -0.1}};
+  const HarmonicSystem tree(7, a, b);
+  ASSERT_TRUE(tree.forest());
+  std::vector<C> diagonal = s, x = rhs;
+  std::vector<HarmonicSystem::Coupling> coupling;
+  for (std::size_t e = 0; e < y.size(); ++e) {
+    diagonal[static_cast<std::size_t>(a[e])] += y[e].aa;
+    diagonal[static_cast<std::size_t>(b[e])] += y[e].bb;
+    coupling.push_back({y[e].ab, y[e].ba});
+  }
+  tree.solve_forest_in_place(coupling, diagonal, x);
+  const std::vector<C> whole = tree.solve(y, s, rhs);
+  for (std::size_t i = 0; i < 7; ++i) EXPECT_EQ(x[i], whole[i]) << "node " << i;
+  a.push_back(3);
+  b.push_back(6);
+  coupling.push_back({-1.0, -1.0});
+  const HarmonicSystem looped(7, a, b);
+  EXPECT_FALSE(looped.forest());
+  EXPECT_THROW(looped.solve_forest_in_place(coupling, diagonal, x), std::logic_error);
+}
+
 TEST(HarmonicSystem, APartWithNoPathToGroundIsRefused) {
   const std::vector<std::int32_t> a{0}, b{1};
   const std::vector<TwoPort> y{TwoPort::series({1, -1})};
