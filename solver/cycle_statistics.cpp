@@ -37,11 +37,10 @@ CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, 
 void CycleStatistics::start_sums() {
   const std::size_t n = net_.vessel_count();
   constexpr double infinity = std::numeric_limits<double>::infinity();
-  for (auto* sum : {&flow_, &pressure_, &wss_, &reynolds_}) sum->assign(n, 0.0);
-  p_min_.assign(n, infinity);
-  q_min_.assign(n, infinity);
-  p_max_.assign(n, -infinity);
-  q_max_.assign(n, -infinity);
+  VesselCycle start;
+  start.systolic_pressure = start.peak_flow = -infinity;
+  start.diastolic_pressure = start.least_flow = infinity;
+  sums_.assign(n, start);
 }
 
 void CycleStatistics::begin(const PulseSolver& solver) {
@@ -56,7 +55,7 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
   const int threads = solver.threads();
   const std::complex<double> phase = weight * std::polar(1.0, -omega_ * t);
   if (duration_ == 0) {
-    if (flow_.empty()) start_sums();
+    if (sums_.empty()) start_sums();
     first_time_ = t;
     record_ends(solver, first_);
   }
@@ -67,14 +66,15 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     const double u = q / a;
     const double mu = solver.viscosity(v, a);
     const double radius = std::sqrt(a / std::numbers::pi);
-    flow_[v] += weight * mean_q;
-    pressure_[v] += weight * p;
-    p_min_[v] = std::min(p_min_[v], p);
-    p_max_[v] = std::max(p_max_[v], p);
-    q_min_[v] = std::min(q_min_[v], q);
-    q_max_[v] = std::max(q_max_[v], q);
-    wss_[v] += weight * wall_shear_stress(mu, u, radius, alpha);
-    reynolds_[v] += weight * rho * u * 2 * radius / mu;
+    VesselCycle& s = sums_[v];
+    s.mean_flow += weight * mean_q;
+    s.mean_pressure += weight * p;
+    s.diastolic_pressure = std::min(s.diastolic_pressure, p);
+    s.systolic_pressure = std::max(s.systolic_pressure, p);
+    s.least_flow = std::min(s.least_flow, q);
+    s.peak_flow = std::max(s.peak_flow, q);
+    s.mean_wss += weight * wall_shear_stress(mu, u, radius, alpha);
+    s.reynolds += weight * rho * u * 2 * radius / mu;
   };
   // The 1D vessels through the solver's arrays, three points each; at the ends the Fourier
   // sums of pressure and velocity.
@@ -113,7 +113,7 @@ void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>
 
 CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   CycleSummary summary;
-  if (flow_.empty()) start_sums();  // no sample since the last close
+  if (sums_.empty()) start_sums();  // no sample since the last close
   const Eigen::Vector2d exchanged = solver.state().exchanged - exchanged_start_;
   summary.inlet_mean_flow = exchanged(0) / duration_;
   summary.outlets_mean_flow = exchanged(1) / duration_;
@@ -125,28 +125,21 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   if (duration_ > 0) record_ends(solver, last_);  // the state of the cycle's last sample
   begin(solver);  // the next cycle starts here unless begin() is called again
   std::vector<VesselCycle>& out = summary.vessels;
-  out.resize(flow_.size());
+  out = std::move(sums_);  // the results where the sums lie; made again at the next cycle's first sample
+  sums_ = {};
   // A linear drift s(t) = slope (t - t0) over the cycle [t0, t0 + T] has the Fourier sum
   // slope e^(-i omega t0) i T / omega at a harmonic omega = 2 pi k / T; it is taken out.
   const double slope_span = last_time_ > first_time_ ? duration_ / (last_time_ - first_time_) : 0.0;
   const std::complex<double> drift = std::polar(1.0, -omega_ * (last_time_ - duration_)) * std::complex<double>(0, 1 / omega_);
   auto detrended = [&](std::complex<double> sum, std::size_t k) { return sum - (last_[k] - first_[k]) * slope_span * drift; };
   for (std::size_t v = 0; v < out.size(); ++v) {
-    VesselCycle& c = out[v];
-    c.mean_flow = flow_[v] / duration_;
-    c.mean_pressure = pressure_[v] / duration_;
-    c.systolic_pressure = p_max_[v];
-    c.diastolic_pressure = p_min_[v];
-    c.peak_flow = q_max_[v];
-    c.least_flow = q_min_[v];
-    c.mean_wss = wss_[v] / duration_;
-    c.reynolds = reynolds_[v] / duration_;
+    VesselCycle& c = out[v];  // the extremes are already what they are
+    c.mean_flow = c.mean_flow / duration_;
+    c.mean_pressure = c.mean_pressure / duration_;
+    c.mean_wss = c.mean_wss / duration_;
+    c.reynolds = c.reynolds / duration_;
     c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();  // 0D: no wave (below: 1D)
   }
-  // The sums are freed until the next cycle's first sample (start_sums): the cycle's end (the
-  // compliance balance, the checkpoint, the report) runs without them, 64 B a vessel.
-  for (auto* sum : {&flow_, &pressure_, &p_min_, &p_max_, &q_min_, &q_max_, &wss_, &reynolds_})
-    std::vector<double>().swap(*sum);
   for (std::size_t j = 0; j < one_d_.size(); ++j) {
     VesselCycle& c = out[static_cast<std::size_t>(one_d_[j])];
     const double length = net_.length[static_cast<std::size_t>(one_d_[j])];

@@ -80,9 +80,13 @@ class CycleStatistics {
   Eigen::Vector2d exchanged_start_ = Eigen::Vector2d::Zero();  // at begin()
   Eigen::VectorXd boundary_start_;                               // at begin()
   double volume_start_ = 0;
-  std::vector<double> flow_, pressure_, p_min_, p_max_, q_min_, q_max_, wss_, reynolds_;  // per vessel
+  // Per vessel, the cycle's results as they are gathered: the means' fields hold their
+  // sums until close() divides them by the duration, the extremes their extremes so far. The
+  // sums become the results where they lie: no second per-vessel array at the cycle's end,
+  // the run's largest moment (80 B a vessel on it).
+  std::vector<VesselCycle> sums_;
   // The sums at their starts (0, the extremes at -+infinity): made at a cycle's first sample
-  // (or its close, if none), freed when it closes.
+  // (or its close, if none), handed over as the results when it closes.
   void start_sums();
   // Per 1D vessel (one_d_, the solver's one_d_vessels(); a wave speed is measured only where a
   // wave travels, run_report.hpp): the Fourier sums at the ends, and each signal's first and
