@@ -110,6 +110,7 @@ void PulsatileRun::set_aside_last_vessels() {
   last_mean_pressure_.resize(last_.vessels.size());
   for (std::size_t v = 0; v < last_.vessels.size(); ++v) last_mean_pressure_[v] = last_.vessels[v].mean_pressure;
   std::vector<VesselCycle>().swap(last_.vessels);
+  std::vector<double>().swap(last_.boundary_mean_flow);
   last_vessels_aside_ = true;
 }
 
@@ -128,6 +129,9 @@ void PulsatileRun::take_back_last_vessels() {
     in.get_doubles(f);
     v = vessel_cycle(f);
   }
+  if (in.get_u64() != solver_.boundary_list().size()) throw InputError(file.string() + ": cycle results of another network");
+  last_.boundary_mean_flow.resize(solver_.boundary_list().size());
+  in.get_doubles(last_.boundary_mean_flow);
   in.finish();
   last_vessels_aside_ = false;
 }
@@ -145,6 +149,7 @@ void PulsatileRun::resume(std::string bytes, const std::string& source) {
   previous_mean_pressure_ = in.get_vector();
   if (!previous_mean_pressure_.empty() && previous_mean_pressure_.size() != net_.vessel_count())
     in.fail("cycle results of another network");
+  has_previous_ = !previous_mean_pressure_.empty();
   in.section("run");
   done_ = static_cast<int>(in.get_u64());
   balances_ = static_cast<int>(in.get_u64());
@@ -339,10 +344,13 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       last_ = CycleSummary{};  // freed before the next is built
       last_ = stats_.close(solver_);
       if (series) series->finish();
+      has_previous_ = !previous_mean_pressure_.empty();
       if (has_change()) change_ = cycle_change(previous_mean_pressure_, last_.vessels);
       // The cycle's results go to the snapshot, and from memory (but their mean pressures,
-      // which the balance and the next cycle end read) before the balance.
+      // which the balance and the next cycle end read) before the balance; the previous
+      // cycle's mean pressures have served.
       begin_snapshot();
+      std::vector<double>().swap(previous_mean_pressure_);
       set_aside_last_vessels();
       if (plan_.balance_compliances && solver_.balance_compliances(period, &last_mean_pressure_) > 0) ++balances_;
       if (transport_) {

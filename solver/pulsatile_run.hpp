@@ -74,7 +74,7 @@ class PulsatileRun {
   // largest change of a vessel's discharge hematocrit from the cycle before (NaN before two).
   const RedCellCycle& last_red_cells() const { return red_cells_last_; }
   double red_cell_change() const { return red_cell_change_; }
-  bool has_change() const { return !previous_mean_pressure_.empty(); }
+  bool has_change() const { return has_previous_; }
   const PeriodicityChange& change() const { return change_; }
   int signal() const { return signal_; }                    // after an interrupt (RunObserver::poll_interrupt's)
   const std::string& breakdown() const { return breakdown_; }  // after a breakdown; settings as placeholders
@@ -128,7 +128,9 @@ class PulsatileRun {
   CycleSummary last_;
   // The cycle before: its vessels' mean pressures, all the periodicity test compares (the
   // whole summary was 80 B a vessel more at every cycle's end).
+  // Held at a cycle end until the snapshot has them; has_previous_ says there was one.
   std::vector<double> previous_mean_pressure_;
+  bool has_previous_ = false;
   PeriodicityChange change_;
   int done_ = 0, balances_ = 0, signal_ = 0;
   bool resumed_ = false;

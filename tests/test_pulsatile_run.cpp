@@ -118,6 +118,8 @@ TEST(PulsatileRun, StoppedWithinACycleReportsTheCycleBefore) {
     EXPECT_GT(want.mean_pressure, 0.0);
   }
   EXPECT_EQ(b.last_cycle().conservation_error, first.conservation_error);
+  EXPECT_EQ(b.last_cycle().boundary_mean_flow, first.boundary_mean_flow);
+  ASSERT_FALSE(first.boundary_mean_flow.empty());
 }
 
 TEST(PulsatileRun, ResumesFromItsCheckpointAsIfNeverStopped) {
