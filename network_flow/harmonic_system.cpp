@@ -90,8 +90,8 @@ void HarmonicSystem::solve_in_place(std::span<const TwoPort> edge, std::span<Com
   }
 }
 
-template <class Couplings>
-void HarmonicSystem::eliminate_forest(const Couplings& y, std::span<Complex> pivot, std::span<Complex> x) const {
+template <class Edge>
+void HarmonicSystem::eliminate_forest(std::span<const Edge> y, std::span<Complex> pivot, std::span<Complex> x) const {
   const std::span<const std::int32_t> a = a_, b = b_;
   // Leaves up: node i, its pivot final, hands its parent p m_pi m_ip / d_i of the pivot and
   // m_pi B_i / d_i of the current (m_pi: the entry in p's row and i's column).
@@ -99,8 +99,8 @@ void HarmonicSystem::eliminate_forest(const Couplings& y, std::span<Complex> piv
     const auto e = static_cast<std::size_t>(edge);
     const bool i_is_a = a[e] == static_cast<std::int32_t>(i);
     p = static_cast<std::size_t>(i_is_a ? b[e] : a[e]);
-    m_ip = i_is_a ? y.ab(e) : y.ba(e);
-    m_pi = i_is_a ? y.ba(e) : y.ab(e);
+    m_ip = i_is_a ? y[e].ab : y[e].ba;
+    m_pi = i_is_a ? y[e].ba : y[e].ab;
   };
   for (const std::int32_t node : order_) {
     const auto i = static_cast<std::size_t>(node);
@@ -135,12 +135,7 @@ void HarmonicSystem::solve_forest(std::span<const TwoPort> edge, std::span<Compl
     pivot[static_cast<std::size_t>(a[e])] += edge[e].aa;
     pivot[static_cast<std::size_t>(b[e])] += edge[e].bb;
   }
-  struct {
-    std::span<const TwoPort> edge;
-    const Complex& ab(std::size_t e) const { return edge[e].ab; }
-    const Complex& ba(std::size_t e) const { return edge[e].ba; }
-  } couplings{edge};
-  eliminate_forest(couplings, pivot, x);
+  eliminate_forest(edge, pivot, x);
 }
 
 void HarmonicSystem::solve_forest_in_place(std::span<const Coupling> coupling, std::span<Complex> diagonal,
@@ -148,12 +143,7 @@ void HarmonicSystem::solve_forest_in_place(std::span<const Coupling> coupling, s
   if (!forest_) throw std::logic_error("HarmonicSystem::solve_forest_in_place: the graph is not a forest");
   if (coupling.size() != a_.size() || diagonal.size() != nodes_ || current.size() != nodes_)
     throw std::invalid_argument("harmonic system: one coupling per edge, one diagonal and current per node");
-  struct {
-    std::span<const Coupling> coupling;
-    const Complex& ab(std::size_t e) const { return coupling[e].ab; }
-    const Complex& ba(std::size_t e) const { return coupling[e].ba; }
-  } couplings{coupling};
-  eliminate_forest(couplings, diagonal, current);
+  eliminate_forest(coupling, diagonal, current);
 }
 
 // Loops: the assembled matrix and a sparse LU.

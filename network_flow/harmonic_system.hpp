@@ -61,9 +61,10 @@ class HarmonicSystem {
 
  private:
   void solve_forest(std::span<const TwoPort> edge, std::span<Complex> pivot, std::span<Complex> x) const;
-  // The elimination itself, the diagonal summed: ab(e), ba(e) an edge's couplings.
-  template <class Couplings>
-  void eliminate_forest(const Couplings& couplings, std::span<Complex> pivot, std::span<Complex> x) const;
+  // The elimination itself, the diagonal summed: of each edge (a TwoPort or a Coupling) it
+  // reads ab and ba.
+  template <class Edge>
+  void eliminate_forest(std::span<const Edge> edge, std::span<Complex> pivot, std::span<Complex> x) const;
   void solve_sparse(std::span<const TwoPort> edge, std::span<const Complex> shunt, std::span<Complex> x) const;
 
   std::size_t nodes_;

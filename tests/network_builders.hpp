@@ -55,6 +55,17 @@ inline Waveform tabulate(const std::function<double(double)>& f, double duration
   return w;
 }
 
+// root 0 -> 1, daughters 1 -> 2 and 1 -> 3 (1 cm, 0.1 mm), node ids first_id to first_id + 3;
+// no boundary conditions.
+inline Network bifurcation(std::int64_t first_id = 0) {
+  Network net;
+  for (int n = 0; n < 4; ++n) net.add_node(first_id + n);
+  net.add_vessel(0, 0, 1, 0.01, 1e-4, 1e-5, 2e5, 0);
+  net.add_vessel(1, 1, 2, 0.01, 1e-4, 1e-5, 2e5, 1);
+  net.add_vessel(2, 1, 3, 0.01, 1e-4, 1e-5, 2e5, 1);
+  return net;
+}
+
 inline Outlet reflection_outlet(std::int32_t vessel, double coefficient) {
   Outlet o;
   o.vessel = vessel;

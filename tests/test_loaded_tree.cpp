@@ -7,20 +7,13 @@
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;
+using test_networks::bifurcation;
 using test_networks::rcr_outlet;
 using test_networks::resistance_outlet;
 
 namespace {
 
-// root 0 -> 1, daughters 1 -> 2 and 1 -> 3; vessel resistances 1, 2, 4.
-Network bifurcation() {
-  Network net;
-  for (int n = 0; n < 4; ++n) net.add_node(n);
-  net.add_vessel(0, 0, 1, 0.01, 1e-4, 1e-5, 2e5, 0);
-  net.add_vessel(1, 1, 2, 0.01, 1e-4, 1e-5, 2e5, 1);
-  net.add_vessel(2, 1, 3, 0.01, 1e-4, 1e-5, 2e5, 1);
-  return net;
-}
+// The network: test_networks::bifurcation(), with vessel resistances 1, 2, 4 below.
 
 TreeLoads no_loads(const Network& net) {
   TreeLoads l;

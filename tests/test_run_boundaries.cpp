@@ -13,16 +13,6 @@ using test_networks::resistance_outlet;
 
 namespace {
 
-// root 0 -> 1, daughters 1 -> 2 and 1 -> 3; node ids 10 to 13.
-Network bifurcation() {
-  Network net;
-  for (int n = 0; n < 4; ++n) net.add_node(10 + n);
-  net.add_vessel(0, 0, 1, 0.01, 1e-4, 1e-5, 2e5, 0);
-  net.add_vessel(1, 1, 2, 0.01, 1e-4, 1e-5, 2e5, 1);
-  net.add_vessel(2, 1, 3, 0.01, 1e-4, 1e-5, 2e5, 1);
-  return net;
-}
-
 Waveform table_flow() {
   Waveform w;
   w.shape = Waveform::Shape::table;
@@ -69,7 +59,7 @@ void expect_parts_agree(const RunBoundaries& list) {
 // The tree form: its outlets in net.outlets' order (at their vessels' `to` nodes, each with
 // its vessel), then its inlet (a flow into its vessel's `from` node, with its waveform).
 TEST(RunBoundaries, TheTreeFormsOutletsThenItsInlet) {
-  Network net = bifurcation();
+  Network net = test_networks::bifurcation(10);  // node ids 10 to 13
   net.outlets = {rcr_outlet(2, 1e8, 1e-11, 7e8, 500), resistance_outlet(1, 6e8, 1333)};
   net.inlet = Inlet{0, table_flow()};
   const RunBoundaries list(net);
@@ -89,7 +79,7 @@ TEST(RunBoundaries, TheTreeFormsOutletsThenItsInlet) {
 
 // The node form: net.boundaries as they are, in their order.
 TEST(RunBoundaries, TheNodeFormsBoundariesInTheirOrder) {
-  Network net = bifurcation();
+  Network net = test_networks::bifurcation(10);  // node ids 10 to 13
   NodeBoundary in, out, held;
   in.node = 0, in.type = BoundaryType::flow, in.waveform = table_flow();
   out.node = 3, out.type = BoundaryType::resistance, out.outlet.type = BoundaryType::resistance, out.outlet.r = 5e8;
@@ -103,7 +93,7 @@ TEST(RunBoundaries, TheNodeFormsBoundariesInTheirOrder) {
 
 // Two conditions at one node are refused, naming the node, as node_boundaries refuses them.
 TEST(RunBoundaries, RefusesTwoConditionsAtOneNode) {
-  Network net = bifurcation();
+  Network net = test_networks::bifurcation(10);  // node ids 10 to 13
   net.outlets = {resistance_outlet(1, 6e8, 1333), resistance_outlet(2, 6e8, 1333)};
   NodeBoundary extra;
   extra.node = 2, extra.type = BoundaryType::pressure, extra.waveform = Waveform::constant_value(1000);
