@@ -107,33 +107,48 @@ void PulsatileRun::finish_snapshot() {
 
 void PulsatileRun::set_aside_last_vessels() {
   if (last_.vessels.empty()) return;
-  last_mean_pressure_.resize(last_.vessels.size());
-  for (std::size_t v = 0; v < last_.vessels.size(); ++v) last_mean_pressure_[v] = last_.vessels[v].mean_pressure;
   std::vector<VesselCycle>().swap(last_.vessels);
   std::vector<double>().swap(last_.boundary_mean_flow);
   last_vessels_aside_ = true;
 }
 
-void PulsatileRun::take_back_last_vessels() {
-  if (!last_vessels_aside_) return;
-  const std::filesystem::path file = latest_snapshot();
-  CheckpointStream in(file);
+// The "last cycle" section of the latest snapshot, each vessel's results handed to
+// per_vessel(v, results) in the network's order, the section's totals skipped; the stream is
+// left after the vessels (at the boundary flows).
+template <class PerVessel>
+void PulsatileRun::read_last_vessels(CheckpointStream& in, PerVessel&& per_vessel) const {
   in.section("identity");
   in.section("last cycle");
   const std::size_t n = net_.vessel_count();
-  if (in.get_u64() != 4 + vessel_fields * n) throw InputError(file.string() + ": cycle results of another network");
+  if (in.get_u64() != 4 + vessel_fields * n)
+    throw InputError(latest_snapshot().string() + ": cycle results of another network");
   double f[vessel_fields];
   in.get_doubles(std::span<double>(f, 4));  // the totals, which the run kept
-  last_.vessels.resize(n);
-  for (VesselCycle& v : last_.vessels) {
+  for (std::size_t v = 0; v < n; ++v) {
     in.get_doubles(f);
-    v = vessel_cycle(f);
+    per_vessel(v, vessel_cycle(f));
   }
-  if (in.get_u64() != solver_.boundary_list().size()) throw InputError(file.string() + ": cycle results of another network");
+}
+
+void PulsatileRun::take_back_last_vessels() {
+  if (!last_vessels_aside_) return;
+  CheckpointStream in(latest_snapshot());
+  last_.vessels.resize(net_.vessel_count());
+  read_last_vessels(in, [&](std::size_t v, const VesselCycle& c) { last_.vessels[v] = c; });
+  if (in.get_u64() != solver_.boundary_list().size())
+    throw InputError(latest_snapshot().string() + ": cycle results of another network");
   last_.boundary_mean_flow.resize(solver_.boundary_list().size());
   in.get_doubles(last_.boundary_mean_flow);
   in.finish();
   last_vessels_aside_ = false;
+}
+
+std::vector<double> PulsatileRun::last_mean_pressures() const {
+  std::vector<double> p(net_.vessel_count());
+  CheckpointStream in(latest_snapshot());
+  read_last_vessels(in, [&](std::size_t v, const VesselCycle& c) { p[v] = c.mean_pressure; });
+  in.finish();
+  return p;
 }
 
 void PulsatileRun::resume(std::string bytes, const std::string& source) {
@@ -334,8 +349,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       // tree 0.26 GB of the step's arrays less at what is the run's largest moment.
       solver_.release_step_arrays();
       if (last_vessels_aside_) {
-        previous_mean_pressure_ = std::move(last_mean_pressure_);
-        last_mean_pressure_ = {};
+        previous_mean_pressure_ = last_mean_pressures();  // before this cycle end's snapshot replaces it
         last_vessels_aside_ = false;
       } else {
         previous_mean_pressure_.resize(last_.vessels.size());
@@ -351,8 +365,14 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       // cycle's mean pressures have served.
       begin_snapshot();
       std::vector<double>().swap(previous_mean_pressure_);
-      set_aside_last_vessels();
-      if (plan_.balance_compliances && solver_.balance_compliances(period, &last_mean_pressure_) > 0) ++balances_;
+      if (plan_.balance_compliances) {
+        std::vector<double> mean_pressure(last_.vessels.size());
+        for (std::size_t v = 0; v < last_.vessels.size(); ++v) mean_pressure[v] = last_.vessels[v].mean_pressure;
+        set_aside_last_vessels();
+        if (solver_.balance_compliances(period, &mean_pressure) > 0) ++balances_;
+      } else {
+        set_aside_last_vessels();
+      }
       if (transport_) {
         RedCellCycle cycle = transport_->close_cycle();
         if (!red_cells_last_.discharge.empty()) {

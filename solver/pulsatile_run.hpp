@@ -104,12 +104,14 @@ class PulsatileRun {
   // While a cycle runs, the last cycle's per-vessel results are in its snapshot alone (80 B a
   // vessel on the run's largest moments, the cycle end's balance and the cycles after the
   // first): set aside once written, read back where a run stops within a cycle (an interrupt,
-  // a breakdown, a step too slow) and reports the last cycle end. last_mean_pressure_ keeps
-  // what the next cycle end compares.
+  // a breakdown, a step too slow) and reports the last cycle end; their mean pressures are
+  // read back at the next cycle end, which compares them (8 B a vessel not held in between).
   void set_aside_last_vessels();
   void take_back_last_vessels();
+  std::vector<double> last_mean_pressures() const;
+  template <class PerVessel>
+  void read_last_vessels(CheckpointStream& in, PerVessel&& per_vessel) const;
   bool last_vessels_aside_ = false;
-  std::vector<double> last_mean_pressure_;
   std::filesystem::path latest_snapshot() const { return snapshot_pending_ ? pending() : folder_ / "checkpoint.bin"; }
   RunStatus run_cycles(RunObserver& observer);
   std::filesystem::path pending() const { return folder_ / "snapshot.pending"; }

@@ -122,6 +122,27 @@ TEST(PulsatileRun, StoppedWithinACycleReportsTheCycleBefore) {
   ASSERT_FALSE(first.boundary_mean_flow.empty());
 }
 
+// The cycle before the last's mean pressures are not held while a cycle runs but read back
+// from the last cycle end's snapshot: the change after cycle 3 is that of cycle 2's results
+// (as a run of two cycles reports them) against cycle 3's, to the bit.
+TEST(PulsatileRun, ComparesEachCycleWithTheOneBefore) {
+  Fixture f;
+  Interrupts interrupts;
+  PulseSolver two(f.net, f.options);
+  PulsatileRun a(f.net, two, {}, f.plan(two, 2), f.folder);
+  ASSERT_EQ(a.run(interrupts), RunStatus::complete);
+  std::vector<double> second;
+  for (const VesselCycle& v : a.last_cycle().vessels) second.push_back(v.mean_pressure);
+  PulseSolver three(f.net, f.options);
+  PulsatileRun b(f.net, three, {}, f.plan(three, 3), f.folder);
+  ASSERT_EQ(b.run(interrupts), RunStatus::complete);
+  ASSERT_TRUE(b.has_change());
+  const PeriodicityChange want = cycle_change(second, b.last_cycle().vessels);
+  EXPECT_GT(want.change, 0.0);
+  EXPECT_EQ(b.change().change, want.change);
+  EXPECT_EQ(b.change().vessel, want.vessel);
+}
+
 TEST(PulsatileRun, ResumesFromItsCheckpointAsIfNeverStopped) {
   Fixture f;
   PulseSolver whole(f.net, f.options);
