@@ -243,30 +243,76 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
   // One pass where two read each vessel's ends and law: the resistances at the new pressures,
   // then the next step's edges at the state extrapolated from them (linearise's first pass,
   // the same arithmetic), should that step be as long as this one.
+  if (!tapered_.empty()) {
+    parallel_blocks(static_cast<std::int64_t>(vessels_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
+      for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
+        const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
+        resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
+        linearise_edge(e, 2 * pressure_[a] - previous_pressure_[a], 2 * pressure_[b] - previous_pressure_[b], true, dt);
+      }
+    });
+    linearised_dt_ = dt;
+    return;
+  }
+  // Uniform vessels, a batch at a time, stage by stage: a vessel's arithmetic is a chain of
+  // dependent operations (three table look-ups, then divisions), which the processor overlaps
+  // across vessels only where their stages sit side by side in the code. Each vessel's
+  // operations are those of resistance() and linearise_edge(): the same bits.
+  const ViscosityTable& viscosity = *viscosity_;
   parallel_blocks(static_cast<std::int64_t>(vessels_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
-    for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
-      const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
-      resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
-      linearise_edge(e, 2 * pressure_[a] - previous_pressure_[a], 2 * pressure_[b] - previous_pressure_[b], true, dt);
+    constexpr std::size_t width = 8;
+    double aa[width], ab[width], am[width], mu_a[width], mu_b[width], mu_m[width];
+    for (auto e0 = static_cast<std::size_t>(first); e0 < static_cast<std::size_t>(last); e0 += width) {
+      const std::size_t n = std::min(width, static_cast<std::size_t>(last) - e0);
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t e = e0 + i;
+        const double pa = pressure_[static_cast<std::size_t>(a_[e])], pb = pressure_[static_cast<std::size_t>(b_[e])];
+        const double c = edge_root_intercept_[e], d = edge_root_slope_[e];
+        const double sa = c + d * pa, sb = c + d * pb, sm = c + d * 0.5 * (pa + pb);
+        aa[i] = sa * sa;
+        ab[i] = sb * sb;
+        am[i] = sm * sm;
+      }
+      for (std::size_t i = 0; i < n; ++i) mu_a[i] = viscosity(aa[i]);
+      for (std::size_t i = 0; i < n; ++i) mu_b[i] = viscosity(ab[i]);
+      for (std::size_t i = 0; i < n; ++i) mu_m[i] = viscosity(am[i]);
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t e = e0 + i;
+        const SimpsonResistance r =
+            simpson_resistance(friction_k_, edge_length_[e], viscosity_factor_.empty() ? 1.0 : viscosity_factor_[e], aa[i],
+                               ab[i], am[i], mu_a[i], mu_b[i], mu_m[i]);
+        resistance_[e] = r.resistance;
+        capacity_a_[e] = r.capacity_a;
+        capacity_b_[e] = r.capacity_b;
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t e = e0 + i;
+        const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
+        const double pa = 2 * pressure_[a] - previous_pressure_[a], pb = 2 * pressure_[b] - previous_pressure_[b];
+        const double s = edge_root_intercept_[e] + edge_root_slope_[e] * 0.5 * (pa + pb);
+        const EdgeLine line = bdf2_edge(extrapolated_resistance(resistance_[e], previous_resistance_[e]),
+                                        density_ * edge_length_[e] / (s * s), flow_[e], previous_flow_[e], dt);
+        conductance_[e] = line.conductance;
+        history_[e] = line.history;
+      }
     }
   });
   linearised_dt_ = dt;
 }
 
 void LumpedVessels::linearise_edge(std::size_t e, double pa, double pb, bool extrapolated, double dt) {
-  // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
-  // Q = g (p_a - p_b) + f with g = 1 / (R + 3 L / (2 dt)), f = g L (4 Q^n - Q^(n-1)) / (2 dt).
   double r;
   if (extrapolated) {
-    r = std::clamp(2 * resistance_[e] - previous_resistance_[e], 0.5 * resistance_[e], 2 * resistance_[e]);
+    r = extrapolated_resistance(resistance_[e], previous_resistance_[e]);
   } else {
     double capacity_a, capacity_b;
     r = resistance(e, pa, pb, capacity_a, capacity_b);
   }
   const double s = edge_root_intercept_[e] + edge_root_slope_[e] * 0.5 * (pa + pb);
   const double inertance = tapered(e) ? tapered_inertance(static_cast<std::int32_t>(e), pa, pb) : density_ * edge_length_[e] / (s * s);
-  conductance_[e] = 1 / (r + 1.5 * inertance / dt);
-  history_[e] = conductance_[e] * inertance * (4 * flow_[e] - previous_flow_[e]) / (2 * dt);
+  const EdgeLine line = bdf2_edge(r, inertance, flow_[e], previous_flow_[e], dt);
+  conductance_[e] = line.conductance;
+  history_[e] = line.history;
 }
 
 double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const {
@@ -277,18 +323,12 @@ double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& ca
   const double c = edge_root_intercept_[e], d = edge_root_slope_[e];
   const double sa = c + d * pa, sb = c + d * pb, sm = c + d * 0.5 * (pa + pb);
   const double aa = sa * sa, ab = sb * sb, am = sm * sm;
-  const double mu_a = (*viscosity_)(aa), mu_b = (*viscosity_)(ab), mu_m = (*viscosity_)(am);
-  const double ga = aa * aa * mu_b * mu_m, gb = ab * ab * mu_a * mu_m, gm = am * am * mu_a * mu_b;  // x k mu_a mu_b mu_m
-  // One division: with D = product (ga + gb + 4 gm), 1 / product = sum / D and
-  // product / sum = product^2 / D (D stays far inside the doubles' range: ~1e-60 in a 3 um
-  // capillary).
-  const double product = friction_k_ * mu_a * mu_b * mu_m, sum = ga + gb + 4 * gm;
-  const double inverse_d = 1 / (product * sum), inverse = sum * inverse_d;
-  // The vessel's own hematocrit scales mu along all of it: R by f, the capacities by 1 / f.
-  const double f = viscosity_factor_.empty() ? 1.0 : viscosity_factor_[e];
-  capacity_a = ga * inverse / f;
-  capacity_b = gb * inverse / f;
-  return f * 6 * edge_length_[e] * product * product * inverse_d;
+  const SimpsonResistance r =
+      simpson_resistance(friction_k_, edge_length_[e], viscosity_factor_.empty() ? 1.0 : viscosity_factor_[e], aa, ab,
+                         am, (*viscosity_)(aa), (*viscosity_)(ab), (*viscosity_)(am));
+  capacity_a = r.capacity_a;
+  capacity_b = r.capacity_b;
+  return r.resistance;
 }
 
 void LumpedVessels::set_viscosity_factors(std::span<const double> per_vessel) {

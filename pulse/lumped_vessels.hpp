@@ -242,6 +242,34 @@ class LumpedVessels {
   // from pb to pa), and G at the two ends (the interior profile reads them). Over one common
   // denominator: one division, not four (they were most of a step's evaluation).
   double resistance(std::size_t e, double pa, double pb, double& capacity_a, double& capacity_b) const;
+  // The same from the lumen's area at its ends and middle and the viscosity there (length l,
+  // the vessel's own viscosity factor f): what resistance() and the batched pass of
+  // update_resistances_and_linearise share. Over one common denominator: one division, not
+  // four (D stays far inside the doubles' range: ~1e-60 in a 3 um capillary).
+  struct SimpsonResistance {
+    double resistance, capacity_a, capacity_b;
+  };
+  static SimpsonResistance simpson_resistance(double k, double l, double f, double aa, double ab, double am,
+                                              double mu_a, double mu_b, double mu_m) {
+    const double ga = aa * aa * mu_b * mu_m, gb = ab * ab * mu_a * mu_m, gm = am * am * mu_a * mu_b;  // x k mu_a mu_b mu_m
+    // With D = product (ga + gb + 4 gm): 1 / product = sum / D and product / sum = product^2 / D.
+    const double product = k * mu_a * mu_b * mu_m, sum = ga + gb + 4 * gm;
+    const double inverse_d = 1 / (product * sum), inverse = sum * inverse_d;
+    // The vessel's own hematocrit scales mu along all of it: R by f, the capacities by 1 / f.
+    return {f * 6 * l * product * product * inverse_d, ga * inverse / f, gb * inverse / f};
+  }
+  // The step's resistance from the last two: extrapolated to the step's end, kept within a
+  // factor of two of the last.
+  static double extrapolated_resistance(double r, double previous) { return std::clamp(2 * r - previous, 0.5 * r, 2 * r); }
+  // BDF2 for an edge: L (3 Q - 4 Q^n + Q^(n-1)) / (2 dt) + R Q = p_a - p_b, so
+  // Q = g (p_a - p_b) + h with g = 1 / (R + 3 L / (2 dt)), h = g L (4 Q^n - Q^(n-1)) / (2 dt).
+  struct EdgeLine {
+    double conductance, history;
+  };
+  static EdgeLine bdf2_edge(double r, double inertance, double flow, double previous_flow, double dt) {
+    const double g = 1 / (r + 1.5 * inertance / dt);
+    return {g, g * inertance * (4 * flow - previous_flow) / (2 * dt)};
+  }
   // The linearisation of a step: edge conductances and history terms, node shunts and
   // right-hand sides (with the coupled inflows and the inlet's), at the state extrapolated to
   // the step's end (extrapolated) or at the pressures predicted_ (a Picard pass).
