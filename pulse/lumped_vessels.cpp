@@ -656,6 +656,18 @@ void LumpedVessels::sample(double x, std::span<double> area, std::span<double> f
   }
 }
 
+void LumpedVessels::centre_batch(std::size_t first, std::size_t n, CentreBatch& batch) const {
+  batch.n = n;
+  for (std::size_t i = 0; i < n; ++i) batch.pressure[i] = pressure_at(static_cast<std::int32_t>(first + i), 0.5);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t e = first + i;
+    const double root = lumen_root(e, batch.pressure[i], 0.5);
+    batch.area[i] = root * root;
+    batch.flow[i] = flow_[e];
+    batch.vessel[i] = static_cast<std::size_t>(vessels_[e]);
+  }
+}
+
 double LumpedVessels::stored_volume() const {
   // Summed in the network's order: the same bits whatever the arrays' order.
   double v = 0;

@@ -61,11 +61,15 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
   }
   last_time_ = t;
   duration_ += weight;
-  // At the centre: means, extrema, wall shear stress, Reynolds number.
-  auto centre = [&](std::size_t v, double a, double q, double p, double mean_q) {
-    const double u = q / a;
-    const double mu = solver.viscosity(v, a);
-    const double radius = std::sqrt(a / std::numbers::pi);
+  // At the centre: means, extrema, wall shear stress, Reynolds number; u, mu and the radius
+  // from the sample (centre_values), then added to the vessel's sums (add_centre).
+  struct CentreValues {
+    double u, mu, radius;
+  };
+  auto centre_values = [&](std::size_t v, double a, double q) {
+    return CentreValues{q / a, solver.viscosity(v, a), std::sqrt(a / std::numbers::pi)};
+  };
+  auto add_centre = [&](std::size_t v, const CentreValues& c, double q, double p, double mean_q) {
     VesselCycle& s = sums_[v];
     s.mean_flow += weight * mean_q;
     s.mean_pressure += weight * p;
@@ -73,8 +77,8 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     s.systolic_pressure = std::max(s.systolic_pressure, p);
     s.least_flow = std::min(s.least_flow, q);
     s.peak_flow = std::max(s.peak_flow, q);
-    s.mean_wss += weight * wall_shear_stress(mu, u, radius, alpha);
-    s.reynolds += weight * rho * u * 2 * radius / mu;
+    s.mean_wss += weight * wall_shear_stress(c.mu, c.u, c.radius, alpha);
+    s.reynolds += weight * rho * c.u * 2 * c.radius / c.mu;
   };
   // The 1D vessels through the solver's arrays, three points each; at the ends the Fourier
   // sums of pressure and velocity.
@@ -85,7 +89,7 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     parallel_blocks(static_cast<std::int64_t>(one_d_.size()), threads, [&](std::int64_t first, std::int64_t last) {
       for (auto j = static_cast<std::size_t>(first); j < static_cast<std::size_t>(last); ++j) {
         const auto v = static_cast<std::size_t>(one_d_[j]);
-        centre(v, area_[j], q_[j], p_[j], solver.mean_flow(v));
+        add_centre(v, centre_values(v, area_[j], q_[j]), q_[j], p_[j], solver.mean_flow(v));
         p_in_[j] += phase * p_end_[j];
         u_in_[j] += phase * (q_end_[j] / area_end_[j]);
         p_out_[j] += phase * p_out_end_[j];
@@ -94,9 +98,14 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     });
   }
   // The 0D vessels straight from their state, in one pass (their flow is one along the
-  // vessel: its mean).
-  solver.lumped().for_each_centre_sample(
-      [&](std::size_t v, const LumpedVessels::Sample& s) { centre(v, s.area, s.flow, s.pressure, s.flow); }, threads);
+  // vessel: its mean), a batch at a time, stage by stage.
+  solver.lumped().for_each_centre_batch(
+      [&](const LumpedVessels::CentreBatch& b) {
+        CentreValues c[LumpedVessels::CentreBatch::width];
+        for (std::size_t i = 0; i < b.n; ++i) c[i] = centre_values(b.vessel[i], b.area[i], b.flow[i]);
+        for (std::size_t i = 0; i < b.n; ++i) add_centre(b.vessel[i], c[i], b.flow[i], b.pressure[i], b.flow[i]);
+      },
+      threads);
 }
 
 void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>& values) {
