@@ -617,11 +617,15 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     boundary_volume[static_cast<std::size_t>(inflow_boundary_[j])] += dt * inflow_[j];
   for (std::size_t j = 0; j < held_node_.size(); ++j)
     boundary_volume[static_cast<std::size_t>(held_boundary_[j])] -= dt * held_outflow(j);
-  for (const OutletNode& o : outlet_boundary_) {
-    const auto k = static_cast<std::size_t>(o.node);
-    const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * predicted_[k] - shunt_current_[k];
-    boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * out;
-  }
+  // Each outlet its own boundary: in parallel (a tree's two million, every step).
+  parallel_blocks(static_cast<std::int64_t>(outlet_boundary_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
+    for (auto j = static_cast<std::size_t>(first); j < static_cast<std::size_t>(last); ++j) {
+      const OutletNode& o = outlet_boundary_[j];
+      const auto k = static_cast<std::size_t>(o.node);
+      const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * predicted_[k] - shunt_current_[k];
+      boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * out;
+    }
+  });
 }
 
 // ---- what the rest of the solver reads -------------------------------------------------------
