@@ -121,6 +121,12 @@ class PulseSolver {
   double stable_dt() const { return stable_dt_; }
   const std::string& stable_dt_reason() const { return stable_dt_reason_; }
   std::size_t steps() const { return steps_; }
+  // Sets the clock back to t = 0 and the step count to 0, the state as it is: after a cycle
+  // that only settles the state (solver/settling_cycle.hpp), whose boundaries are periodic.
+  void restart_clock() {
+    time_ = 0;
+    steps_ = 0;
+  }
 
   // The solution at fraction x in [0, 1] along a vessel (index).
   double area_at(std::size_t vessel, double x) const;

@@ -135,6 +135,10 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
       "--until-periodic", periodic_tol,
       "run until every vessel's mean pressure changes less than this (relative, in (0, 1)) from one cycle to the next");
   app.add_option("--max-cycles", max_cycles, "upper bound for --until-periodic, in [1, 100000]")->capture_default_str();
+  app.add_option("--settling-step", config.settling_step,
+                 "with --until-periodic and 0D vessels: first one settling cycle, not reported, with the 0D step N "
+                 "times --lumped-step, and the compliance balance after it (docs/solver.md §6a); 0 or 1: none, in [0, 20]")
+      ->capture_default_str();
   app.add_option("--probe", probe_texts, "record p, Q, A, u at vessel ID, fraction x in [0, 1] along it (ID[:x], x 0.5 by default)");
   app.add_option("--sample-interval", sample_text, "time between probe samples, in (0, the period]")
       ->capture_default_str();
@@ -240,10 +244,10 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
   for (const char* pulsatile_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
-                                     "--probe", "--frames", "--dt", "--start", "--transport-step", "--tracer"})
+                                     "--settling-step", "--probe", "--frames", "--dt", "--start", "--transport-step", "--tracer"})
     steady_flag->excludes(app.get_option(pulsatile_only));
   for (const char* time_stepped_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
-                                        "--frames", "--dt", "--start", "--transport-step", "--tracer", "--steady",
+                                        "--settling-step", "--frames", "--dt", "--start", "--transport-step", "--tracer", "--steady",
                                         "--red-cells"})
     linear_flag->excludes(app.get_option(time_stepped_only));
 }

@@ -200,6 +200,8 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
                          {"steps", static_cast<std::uint64_t>(pulsatile.cycles_done()) * steps_per_cycle},
                          {"compliance_balances", pulsatile.compliance_balances()},
                          {"wall_time", wall}};
+  if (pulsatile.settling().steps > 0)
+    info["settling_cycle"] = {{"steps", pulsatile.settling().steps}, {"seconds", pulsatile.settling().seconds}};
   if (!steady_start && options.start != StartChoice::rest) info["steady_refusal"] = run.steady_refusal();
   if (!run.periodic_refusal().empty()) info["periodic_refusal"] = run.periodic_refusal();
   for (const auto& [p, count] : d.degrees) info["elements_of_degree"][std::to_string(p)] = count;
@@ -317,6 +319,11 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   plan.network_identity = identity.network;
   plan.state_shaping = identity.shaping;
   plan.longest_cycle = config.force ? 0 : one_day;
+  // The settling cycle, where the run seeks the periodic state and its 0D vessels can take a
+  // longer step (solver/settling_cycle.hpp): as many of its steps as fill a period.
+  if (config.until_periodic && config.settling_step > 1 && run.lumped_count() > 0 && config.balance_compliances &&
+      run.started_from_steady())
+    plan.settling_steps = std::max<std::size_t>(1, steps_per_cycle / static_cast<std::size_t>(config.settling_step));
   std::optional<FlowTransport> transport;
   if (config.carries_transport()) {
     const bool red = config.red_cells == RedCells::transport;
@@ -346,6 +353,14 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   const auto started = std::chrono::steady_clock::now();
   const RunStatus status = pulsatile.run(observer);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (pulsatile.stopped_settling()) {  // no cycle end yet: nothing to keep, as before the first step
+    folder.discard();
+    result.signal = pulsatile.signal();
+    observer.warn("interrupted by " + observer.signal_name(result.signal) + " in the settling cycle: nothing written");
+    result.outcome = RunOutcome::interrupted;
+    result.started = false;
+    return result;
+  }
   const CycleSummary& last = pulsatile.last_cycle();
 
   const std::string failure = check_results(net, run, pulsatile, status, d.step.beyond_limit);

@@ -292,8 +292,22 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
   const auto stats_every = std::max<std::size_t>(
       1, static_cast<std::size_t>(static_cast<double>(plan_.steps_per_cycle) / samples_per_cycle));
   if (!resumed_) {
+    if (plan_.settling_steps > 0) {
+      // Not a cycle of the run's: nothing of it is reported or kept, and an interrupt
+      // within it leaves nothing to resume from.
+      observer.note("settling cycle: " + std::to_string(plan_.settling_steps) + " steps, then the compliance balance");
+      try {
+        settling_ = settle(net_, solver_, plan_.settling_steps, observer);
+      } catch (const SolutionBreakdown& e) {
+        breakdown_ = e.message();
+        return RunStatus::broken_down;
+      }
+      if ((signal_ = settling_.signal) != 0) return RunStatus::interrupted;
+      observer.note("settling cycle done in " + std::to_string(std::lround(settling_.seconds)) + " s");
+    } else if (plan_.balance_compliances) {
+      solver_.balance_compliances(period);  // the first cycle's start
+    }
     probes_.sample(solver_);
-    if (plan_.balance_compliances) solver_.balance_compliances(period);
     if (transport_) transport_->take_volumes();
     snapshot();
   } else if (!resumed_bytes_.empty()) {

@@ -18,6 +18,7 @@
 #include "solver/flow_transport.hpp"
 #include "solver/probes.hpp"
 #include "solver/run_observer.hpp"
+#include "solver/settling_cycle.hpp"
 #include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
@@ -40,6 +41,8 @@ struct RunPlan {
   // would take longer than this [s]; 0: never (--force).
   double longest_cycle = 0;
   std::size_t transport_every = 1;  // solver steps between red-cell transport steps
+  // Steps of a settling cycle before the first (solver/settling_cycle.hpp); 0: none.
+  std::size_t settling_steps = 0;
 };
 
 // How the time loop ended; what a run reports of it, with the checks on its numbers, is a
@@ -75,6 +78,10 @@ class PulsatileRun {
   const RedCellCycle& last_red_cells() const { return red_cells_last_; }
   double red_cell_change() const { return red_cell_change_; }
   bool has_change() const { return has_previous_; }
+  // The settling cycle taken before the first (steps 0: none), and whether an interrupt
+  // stopped the run within it (nothing to keep then).
+  const Settling& settling() const { return settling_; }
+  bool stopped_settling() const { return settling_.signal != 0; }
   const PeriodicityChange& change() const { return change_; }
   int signal() const { return signal_; }                    // after an interrupt (RunObserver::poll_interrupt's)
   const std::string& breakdown() const { return breakdown_; }  // after a breakdown; settings as placeholders
@@ -134,6 +141,7 @@ class PulsatileRun {
   std::vector<double> previous_mean_pressure_;
   bool has_previous_ = false;
   PeriodicityChange change_;
+  Settling settling_;
   int done_ = 0, balances_ = 0, signal_ = 0;
   bool resumed_ = false;
   double measured_step_ = 0;

@@ -112,6 +112,7 @@ RedCells red_cells_named(const std::string& name) { return named(name, red_cell_
 void check_configuration(const RunConfiguration& c) {
   check_count(c.cycles, 1, 100000, "cycles");
   check_count(c.max_cycles, 1, 100000, "max_cycles");
+  check_count(c.settling_step, 0, 20, "settling_step");
   check_count(c.checkpoint_every, 0, 100000, "checkpoint_every");
   check_count(c.frames, 0, 10000, "frames");
   check_count(c.solver.periodic_harmonics, 1, 1000, "periodic_harmonics");

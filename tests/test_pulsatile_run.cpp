@@ -143,6 +143,35 @@ TEST(PulsatileRun, ComparesEachCycleWithTheOneBefore) {
   EXPECT_EQ(b.change().vessel, want.vessel);
 }
 
+// A settling cycle (solver/settling_cycle.hpp) is not one of the run's: the run's cycles
+// start after it at t = 0, and an interrupt within it stops the run with nothing kept.
+TEST(PulsatileRun, TakesItsSettlingCycleBeforeItsOwn) {
+  Fixture f;
+  Interrupts quiet;
+  PulseSolver settled(f.net, f.options);
+  RunPlan plan = f.plan(settled, 1);
+  plan.settling_steps = plan.steps_per_cycle;
+  PulsatileRun a(f.net, settled, {}, plan, f.folder);
+  ASSERT_EQ(a.run(quiet), RunStatus::complete);
+  EXPECT_EQ(a.cycles_done(), 1);
+  EXPECT_EQ(a.settling().steps, plan.steps_per_cycle);
+  EXPECT_FALSE(a.stopped_settling());
+  EXPECT_EQ(settled.steps(), plan.steps_per_cycle);  // the run's own steps alone
+  EXPECT_NEAR(settled.time(), f.net.inlet->waveform.period, 1e-12);
+  a.discard_snapshot();
+
+  PulseSolver stopped(f.net, f.options);
+  PulsatileRun b(f.net, stopped, {}, plan, f.folder);
+  struct StopAtOnce : RunObserver {
+    int poll_interrupt() override { return SIGINT; }
+  } stop;
+  ASSERT_EQ(b.run(stop), RunStatus::interrupted);
+  EXPECT_TRUE(b.stopped_settling());
+  EXPECT_EQ(b.signal(), SIGINT);
+  EXPECT_EQ(b.cycles_done(), 0);
+  EXPECT_FALSE(std::filesystem::exists(f.folder / "snapshot.pending"));
+}
+
 TEST(PulsatileRun, ResumesFromItsCheckpointAsIfNeverStopped) {
   Fixture f;
   PulseSolver whole(f.net, f.options);

@@ -1,0 +1,41 @@
+#include "solver/settling_cycle.hpp"
+
+#include <chrono>
+#include <vector>
+
+#include "solver/cycle_statistics.hpp"
+
+namespace hemotree {
+
+Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunObserver& observer) {
+  const auto started = std::chrono::steady_clock::now();
+  Settling s;
+  s.steps = steps;
+  const double period = solver.period(), run_step = solver.dt();
+  solver.set_time_step(period / static_cast<double>(steps));
+  solver.balance_compliances(period);  // the cycle's start
+  CycleStatistics stats(net, solver, 1 / period);
+  stats.begin(solver);
+  double sampled_until = solver.time();
+  for (std::size_t k = 0; k < steps; ++k) {
+    solver.step();
+    stats.sample(solver, solver.time(), solver.time() - sampled_until);
+    sampled_until = solver.time();
+    if (k % 256 == 0 && (s.signal = observer.poll_interrupt()) != 0) return s;
+  }
+  solver.check_solution();
+  solver.release_step_arrays();
+  std::vector<double> mean_pressure;
+  {
+    const CycleSummary cycle = stats.close(solver);
+    mean_pressure.reserve(cycle.vessels.size());
+    for (const VesselCycle& v : cycle.vessels) mean_pressure.push_back(v.mean_pressure);
+  }
+  solver.balance_compliances(period, &mean_pressure);
+  solver.set_time_step(run_step);
+  solver.restart_clock();
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return s;
+}
+
+}  // namespace hemotree

@@ -1,0 +1,34 @@
+// The settling cycle (docs/solver.md §6a): before a run that seeks the periodic state, one
+// cycle of the whole network with the 0D step `settling_step` times as long as the run's,
+// then the compliance balance at that cycle's mean pressures.
+//
+// From the linear periodic start the first cycle's mean lies about 1e-3 above the periodic
+// one across the whole network (the 1D arteries' nonlinear mean shift, which the linear state
+// lacks, drains through it); the balance after that cycle then lands within about 2e-5, so a
+// run's first two cycles differ by the first's transient alone. The settling cycle takes that
+// transient where the 0D vessels cost a third as much: its own mean differs from the run's
+// step's by about 2e-4 (the 1D-0D coupling's error grows with the step), and the run's
+// first two cycles then differ by less than 1e-3 (docs/solver.md §6a).
+#pragma once
+
+#include <cstddef>
+
+#include "formats/network.hpp"
+#include "pulse/pulse_solver.hpp"
+#include "solver/run_observer.hpp"
+
+namespace hemotree {
+
+struct Settling {
+  std::size_t steps = 0;  // of the settling cycle (0: none taken)
+  double seconds = 0;     // its wall time, the balance included
+  int signal = 0;         // an interrupt request that stopped it (the state is then mid-cycle)
+};
+
+// One cycle of `steps` equal steps and the compliance balance after it; the solver's step and
+// clock are then the run's again (its step as it was, t = 0). The balance is first called
+// here at the cycle's start (it records the volumes the rates are taken from). Interrupt
+// requests are polled every 256 steps; a breakdown throws SolutionBreakdown.
+Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunObserver& observer);
+
+}  // namespace hemotree
