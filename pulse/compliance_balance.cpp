@@ -85,7 +85,10 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       area_per_pressure[v] = sum;
     }
   }
-  const std::vector<double> capacitor_now = capacitor_pressures();
+  // Without RCR outlets no capacitor is balanced: their arrays stay empty (a tree's two
+  // million capillary outlets would hold 15 MB of NaN or 0 in each).
+  const bool capacitors = rcr_outlets_;
+  const std::vector<double> capacitor_now = capacitors ? capacitor_pressures() : std::vector<double>();
   if (cycle_volume_.empty()) {
     cycle_volume_ = volume;
     cycle_capacitor_ = capacitor_now;
@@ -95,9 +98,9 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   TreeLoads loads;
   loads.node_shunt.assign(net_.node_count(), 0.0);
   loads.node_current.assign(net_.node_count(), 0.0);
-  loads.capacitor_shunt.assign(outlet_capacitance_.size(), 0.0);
-  loads.capacitor_current.assign(outlet_capacitance_.size(), 0.0);
-  std::vector<double> node_compliance(net_.node_count(), 0.0), capacitor_compliance(outlet_capacitance_.size(), 0.0);
+  loads.capacitor_shunt.assign(capacitor_now.size(), 0.0);
+  loads.capacitor_current.assign(capacitor_now.size(), 0.0);
+  std::vector<double> node_compliance(net_.node_count(), 0.0), capacitor_compliance(capacitor_now.size(), 0.0);
   for (std::size_t v = 0; v < n; ++v) {
     const double rate = (volume[v] - cycle_volume_[v]) / period, compliance = area_per_pressure[v] * net_.length[v];
     for (const auto node : {net_.from[v], net_.to[v]}) {
@@ -105,7 +108,8 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       node_compliance[static_cast<std::size_t>(node)] += compliance / 2;
     }
   }
-  for (std::size_t k = 0; k < outlet_capacitance_.size(); ++k) {
+  std::vector<double>().swap(cycle_volume_);  // its rates taken; made again after the move
+  for (std::size_t k = 0; k < capacitor_now.size(); ++k) {
     if (std::isnan(capacitor_now[k])) continue;
     capacitor_compliance[k] = outlet_capacitance_[k];
     loads.capacitor_current[k] = outlet_capacitance_[k] * (capacitor_now[k] - cycle_capacitor_[k]) / period;
@@ -159,7 +163,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) += move.capacitor[static_cast<std::size_t>(o.index)];
   lumped_.shift_pressures(move.node, move.capacitor);
   cycle_volume_ = vessel_volumes();
-  cycle_capacitor_ = capacitor_pressures();
+  cycle_capacitor_ = capacitors ? capacitor_pressures() : std::vector<double>();
   have_previous_rate_ = false;  // the multistep history belongs to the state before the move
   return n;
 }

@@ -96,7 +96,10 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   period_ = driving_waveform(net).period;
   const RunBoundaries boundaries(net);
   for (std::size_t i = 0; i < boundaries.size(); ++i)
-    if (const Outlet& o = boundaries.outlet(i); boundaries.is_outlet(i)) outlet_capacitance_.push_back(o.type == BoundaryType::rcr ? o.c : 0.0);
+    if (const Outlet& o = boundaries.outlet(i); boundaries.is_outlet(i)) {
+      outlet_capacitance_.push_back(o.type == BoundaryType::rcr ? o.c : 0.0);
+      rcr_outlets_ = rcr_outlets_ || o.type == BoundaryType::rcr;
+    }
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_);
   lumped_.set_passes(options.lumped_passes);

@@ -301,6 +301,7 @@ class PulseSolver {
   // Per run outlet (formats/run_boundaries.hpp): its capacitance (an RCR's C, else 0)
   // [m^3/Pa]; the outlets themselves are in boundaries_.list.
   std::vector<double> outlet_capacitance_;
+  bool rcr_outlets_ = false;  // any outlet RCR: the compliance balance moves capacitors
   std::vector<double> lumped_inflow_, lumped_held_;  // the 0D nodes' boundary values at a step's end
   Blood blood_;
   ViscosityTable viscosity_;

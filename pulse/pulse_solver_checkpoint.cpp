@@ -99,6 +99,11 @@ void PulseSolver::restore(CheckpointReader& in) {
   lumped_boundary_volume_ = std::move(lumped_boundary_volume);
   cycle_volume_ = in.get_vector();
   cycle_capacitor_ = in.get_vector();
+  // Per outlet, or none where no outlet is RCR (the balance then reads none).
+  if (!cycle_capacitor_.empty() && cycle_capacitor_.size() != outlet_capacitance_.size())
+    in.fail("outlets of another network");
+  if (rcr_outlets_ && !cycle_volume_.empty() && cycle_capacitor_.size() != outlet_capacitance_.size())
+    in.fail("outlets of another network");
   const std::vector<double> ends = in.get_vector();
   if (ends.size() != 4 * first_element_.size()) in.fail("vessel ends of another network");
   for (std::size_t v = 0; v < first_element_.size(); ++v)

@@ -79,6 +79,7 @@ LoadedTree::LoadedTree(const Network& net, const RunBoundaries& boundaries,
   std::size_t size = nodes;
   for (std::size_t k = 0; k < outlets; ++k) {
     const Outlet& o = outlet(k);
+    if (o.type == BoundaryType::rcr) rcr_outlets_ = true;
     if (o.type == BoundaryType::rcr && o.r1 != 0 && o.r2 != 0) {
       capacitor_node_[k] = static_cast<std::int32_t>(size++);
       a.push_back(outlet_node(k));
@@ -92,8 +93,9 @@ LoadedTree::LoadedTree(const Network& net, const RunBoundaries& boundaries,
 
 TreePotentials LoadedTree::solve(const TreeLoads& loads) {
   const std::size_t nodes = net_.node_count(), outlets = outlet_boundary_.size();
+  const bool no_capacitor_loads = !rcr_outlets_ && loads.capacitor_shunt.empty() && loads.capacitor_current.empty();
   if (loads.node_shunt.size() != nodes || loads.node_current.size() != nodes ||
-      loads.capacitor_shunt.size() != outlets || loads.capacitor_current.size() != outlets)
+      (!no_capacitor_loads && (loads.capacitor_shunt.size() != outlets || loads.capacitor_current.size() != outlets)))
     throw std::invalid_argument("LoadedTree: loads not sized to the network");
   // Each node's shunt and current in the order the single solve had always added them: the
   // loads, the vessels to held nodes, the held and the untouched nodes, the outlets.

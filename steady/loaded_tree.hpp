@@ -20,7 +20,9 @@ namespace hemotree {
 
 struct TreeLoads {
   std::vector<double> node_shunt, node_current;            // per node [m^3/(s Pa)], [m^3/s]
-  std::vector<double> capacitor_shunt, capacitor_current;  // per run outlet (RCR only; a tree's: net.outlets)
+  // Per run outlet (RCR only; a tree's: net.outlets); both may be empty where no outlet is RCR
+  // (a tree's two million capillary outlets: 30 MB of zeros).
+  std::vector<double> capacitor_shunt, capacitor_current;
 };
 
 struct TreePotentials {
@@ -56,6 +58,7 @@ class LoadedTree {
   const RunBoundaries& boundaries_;
   std::vector<std::int32_t> outlet_boundary_;  // per run outlet: its place in the boundaries
   std::vector<std::int32_t> capacitor_node_;   // per run outlet: its capacitor's node, or -1
+  bool rcr_outlets_ = false;                   // whether any outlet is RCR (capacitor loads read)
   std::vector<double> conductance_;            // per edge of system_
   // Shunts added whatever the loads: a vessel to a held node, at its other node; nodes held
   // at 0 (a prescribed pressure, or no vessel there).

@@ -67,6 +67,22 @@ TEST(LoadedTree, ACapacitorNodeOfAnRcrOutlet) {
   for (const double v : solve_loaded_tree(net, resistance, no_loads(net)).node) EXPECT_EQ(v, 0.0);
 }
 
+// Without RCR outlets the capacitor loads may be left empty (a tree's two million capillary
+// outlets): the same potentials, to the bit; with one, empty loads are refused.
+TEST(LoadedTree, TakesNoCapacitorLoadsWithoutRcrOutlets) {
+  Network net = bifurcation();
+  net.outlets = {resistance_outlet(1, 3, 1333), resistance_outlet(2, 6, 1333)};
+  TreeLoads full = no_loads(net);
+  full.node_current[1] = 1.5;
+  full.node_shunt[2] = 0.1;
+  TreeLoads empty = full;
+  empty.capacitor_shunt.clear();
+  empty.capacitor_current.clear();
+  EXPECT_EQ(solve_loaded_tree(net, resistance, empty).node, solve_loaded_tree(net, resistance, full).node);
+  net.outlets[0] = rcr_outlet(1, 1, 1e-9, 7, 0);
+  EXPECT_THROW(solve_loaded_tree(net, resistance, empty), std::invalid_argument);
+}
+
 TEST(LoadedTree, RefusesATerminalVesselWithoutAnOutlet) {
   Network net = bifurcation();
   net.outlets = {resistance_outlet(1, 3, 1333)};
