@@ -16,6 +16,7 @@
 #include "boundaries/system_rows.hpp"
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
+#include "formats/run_boundaries.hpp"
 #include "formats/connected_parts.hpp"
 #include "formats/topology.hpp"
 #include "network_flow/flow_network.hpp"
@@ -147,6 +148,8 @@ class SteadySystem {
  private:
   void check_tree_form();
   void check_node_form(const std::vector<NodeBoundary>& boundaries);
+  template <class Conditions>
+  void add_rows(const Conditions& conditions);
 
   const Network& net_;
   std::int64_t inlet_node_ = -1;  // where the tree's inflow (solve's inlet_flow) enters
@@ -157,27 +160,12 @@ class SteadySystem {
   std::unique_ptr<FlowNetwork> system_;
 };
 
-SteadySystem::SteadySystem(const Network& net) : net_(net) {
-  const std::size_t n = net.vessel_count(), nodes = net.node_count();
-  if (n == 0) throw InputError("the network has no vessels");
-  shunt_.assign(nodes, 0.0);
-  inflow_.assign(nodes, 0.0);
-  pressure_.assign(nodes, 0.0);
-  prescribed_.assign(nodes, 0);
-  // A tree's boundaries (an inlet, outlets on its terminal vessels) keep the tree's checks
-  // and messages; boundaries at nodes make any connected graph solvable.
-  std::vector<NodeBoundary> boundaries;
-  if (net.boundaries.empty()) {
-    check_tree_form();
-    boundaries = node_boundaries(net);
-  } else {
-    boundaries = node_boundaries(net);
-    check_node_form(boundaries);
-  }
-  if (net.inlet) inlet_node_ = net.from[static_cast<std::size_t>(net.index_of(net.inlet->vessel))];
-  // Each condition's row (boundaries/).
+// Each condition's row (boundaries/), the tree's inflow left to solve()'s inlet_flow.
+template <class Conditions>
+void SteadySystem::add_rows(const Conditions& conditions) {
+  if (net_.inlet) inlet_node_ = net_.from[static_cast<std::size_t>(net_.index_of(net_.inlet->vessel))];
   NodalRows rows{shunt_, inflow_, pressure_, prescribed_};
-  for (const NodeBoundary& b : boundaries) {
+  for (const NodeBoundary& b : conditions) {
     const auto i = static_cast<std::size_t>(b.node);
     switch (b.type) {
       case BoundaryType::flow:
@@ -196,6 +184,29 @@ SteadySystem::SteadySystem(const Network& net) : net_(net) {
       case BoundaryType::reflection: break;  // no steady row: refused by the checks
     }
   }
+}
+
+SteadySystem::SteadySystem(const Network& net) : net_(net) {
+  const std::size_t n = net.vessel_count(), nodes = net.node_count();
+  if (n == 0) throw InputError("the network has no vessels");
+  shunt_.assign(nodes, 0.0);
+  inflow_.assign(nodes, 0.0);
+  pressure_.assign(nodes, 0.0);
+  prescribed_.assign(nodes, 0);
+  // A tree's boundaries (an inlet, outlets on its terminal vessels) keep the tree's checks
+  // and messages; boundaries at nodes make any connected graph solvable.
+  if (net.boundaries.empty()) {
+    check_tree_form();
+    // A view (formats/run_boundaries.hpp): a tree's two million outlets are not copied as
+    // conditions (twice over where node_boundaries sorts them: the run's set-up peak). One
+    // condition per node, each adding to its own node's row: the order does not matter.
+    add_rows(RunBoundaries(net));
+  } else {
+    const std::vector<NodeBoundary> boundaries = node_boundaries(net);
+    check_node_form(boundaries);
+    add_rows(boundaries);
+  }
+
   // A node that no vessel touches carries nothing: a unit shunt holds it at 0 Pa.
   std::vector<unsigned char> touched(nodes, 0);
   for (std::size_t v = 0; v < n; ++v) touched[static_cast<std::size_t>(net.from[v])] = touched[static_cast<std::size_t>(net.to[v])] = 1;
