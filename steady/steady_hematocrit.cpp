@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "formats/run_boundaries.hpp"
 #include "physics/phase_separation.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/rheology.hpp"
@@ -106,7 +107,8 @@ std::vector<double> distribute_hematocrit(const Network& net, std::span<const do
 
   std::vector<double> boundary_hematocrit(net.node_count(), std::numeric_limits<double>::quiet_NaN());
   std::vector<char> has_boundary(net.node_count(), 0);
-  for (const NodeBoundary& b : node_boundaries(net)) {
+  // Each node's own entry, whatever the order: the run's view (a tree's outlets not copied).
+  for (const NodeBoundary& b : RunBoundaries(net)) {
     has_boundary[static_cast<std::size_t>(b.node)] = 1;
     boundary_hematocrit[static_cast<std::size_t>(b.node)] =
         std::isnan(b.hematocrit) ? default_hematocrit : b.hematocrit;
