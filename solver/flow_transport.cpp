@@ -273,6 +273,11 @@ void FlowTransport::mark() {
   boundary_mark_ = solver_.boundary_volumes();
 }
 
+void FlowTransport::restart() {
+  last_time_ = solver_.time();
+  mark();
+}
+
 void FlowTransport::take_volumes() {
   now_.assign(red_cells_->volume().begin(), red_cells_->volume().end());
   solver_volumes(now_);

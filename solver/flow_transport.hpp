@@ -68,6 +68,9 @@ class FlowTransport {
   void advance();
   // After the solver's compliance balance moved its volumes: the cells take them.
   void take_volumes();
+  // After the solver stepped without it (a settling cycle, solver/settling_cycle.hpp, whose
+  // clock restarts at 0): the next advance counts from the solver's state and time now.
+  void restart();
   void begin_cycle();
   RedCellCycle close_cycle() const;
 

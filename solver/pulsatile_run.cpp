@@ -303,6 +303,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
         return RunStatus::broken_down;
       }
       if ((signal_ = settling_.signal) != 0) return RunStatus::interrupted;
+      if (transport_) transport_->restart();  // the cells did not move with it
       observer.note("settling cycle done in " + std::to_string(std::lround(settling_.seconds)) + " s");
     } else if (plan_.balance_compliances) {
       solver_.balance_compliances(period);  // the first cycle's start
