@@ -87,8 +87,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   }
   // Without RCR outlets no capacitor is balanced: their arrays stay empty (a tree's two
   // million capillary outlets would hold 15 MB of NaN or 0 in each).
-  const bool capacitors = rcr_outlets_;
-  const std::vector<double> capacitor_now = capacitors ? capacitor_pressures() : std::vector<double>();
+  const std::vector<double> capacitor_now = rcr_outlets_ ? capacitor_pressures() : std::vector<double>();
   if (cycle_volume_.empty()) {
     cycle_volume_ = volume;
     cycle_capacitor_ = capacitor_now;
@@ -163,7 +162,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) += move.capacitor[static_cast<std::size_t>(o.index)];
   lumped_.shift_pressures(move.node, move.capacitor);
   cycle_volume_ = vessel_volumes();
-  cycle_capacitor_ = capacitors ? capacitor_pressures() : std::vector<double>();
+  cycle_capacitor_ = rcr_outlets_ ? capacitor_pressures() : std::vector<double>();
   have_previous_rate_ = false;  // the multistep history belongs to the state before the move
   return n;
 }

@@ -171,4 +171,10 @@ PeriodicityChange cycle_change(std::span<const double> previous_mean_pressure,
   return worst;
 }
 
+std::vector<double> mean_pressures(const std::vector<VesselCycle>& cycle) {
+  std::vector<double> p(cycle.size());
+  for (std::size_t v = 0; v < cycle.size(); ++v) p[v] = cycle[v].mean_pressure;
+  return p;
+}
+
 }  // namespace hemotree

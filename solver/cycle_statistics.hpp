@@ -109,5 +109,8 @@ struct PeriodicityChange {
 };
 PeriodicityChange cycle_change(std::span<const double> previous_mean_pressure,
                                const std::vector<VesselCycle>& current);
+// Each vessel's mean pressure of a cycle's results: what the periodicity test and the
+// compliance balance take of them.
+std::vector<double> mean_pressures(const std::vector<VesselCycle>& cycle);
 
 }  // namespace hemotree

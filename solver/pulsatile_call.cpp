@@ -277,12 +277,18 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   OutputFolder folder(config.out_dir);
   Checkpoint checkpoint = checkpoint_to_resume(folder, config);
   RunResult result;
-  auto interrupted_before_start = [&] {  // before the time loop nothing is written: just stop
-    if ((result.signal = observer.poll_interrupt()) == 0) return false;
-    observer.warn("interrupted by " + observer.signal_name(result.signal) + " before the first step: nothing written");
+  // Interrupted where no cycle has ended (before the time loop, or in a settling cycle):
+  // nothing is written, the run just stops.
+  auto stopped_unstarted = [&](int signal, const std::string& where) {
+    result.signal = signal;
+    observer.warn("interrupted by " + observer.signal_name(signal) + " " + where + ": nothing written");
     result.outcome = RunOutcome::interrupted;
     result.started = false;
-    return true;
+  };
+  auto interrupted_before_start = [&] {
+    const int signal = observer.poll_interrupt();
+    if (signal != 0) stopped_unstarted(signal, "before the first step");
+    return signal != 0;
   };
   if (interrupted_before_start()) return result;
 
@@ -353,12 +359,9 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   const auto started = std::chrono::steady_clock::now();
   const RunStatus status = pulsatile.run(observer);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  if (pulsatile.stopped_settling()) {  // no cycle end yet: nothing to keep, as before the first step
+  if (pulsatile.stopped_settling()) {
     folder.discard();
-    result.signal = pulsatile.signal();
-    observer.warn("interrupted by " + observer.signal_name(result.signal) + " in the settling cycle: nothing written");
-    result.outcome = RunOutcome::interrupted;
-    result.started = false;
+    stopped_unstarted(pulsatile.signal(), "in the settling cycle");
     return result;
   }
   const CycleSummary& last = pulsatile.last_cycle();

@@ -367,8 +367,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
         previous_mean_pressure_ = last_mean_pressures();  // before this cycle end's snapshot replaces it
         last_vessels_aside_ = false;
       } else {
-        previous_mean_pressure_.resize(last_.vessels.size());
-        for (std::size_t v = 0; v < last_.vessels.size(); ++v) previous_mean_pressure_[v] = last_.vessels[v].mean_pressure;
+        previous_mean_pressure_ = mean_pressures(last_.vessels);
       }
       last_ = CycleSummary{};  // freed before the next is built
       last_ = stats_.close(solver_);
@@ -381,8 +380,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       begin_snapshot();
       std::vector<double>().swap(previous_mean_pressure_);
       if (plan_.balance_compliances) {
-        std::vector<double> mean_pressure(last_.vessels.size());
-        for (std::size_t v = 0; v < last_.vessels.size(); ++v) mean_pressure[v] = last_.vessels[v].mean_pressure;
+        std::vector<double> mean_pressure = mean_pressures(last_.vessels);
         set_aside_last_vessels();
         if (solver_.balance_compliances(period, &mean_pressure) > 0) ++balances_;
       } else {

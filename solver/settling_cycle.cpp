@@ -25,12 +25,7 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   }
   solver.check_solution();
   solver.release_step_arrays();
-  std::vector<double> mean_pressure;
-  {
-    const CycleSummary cycle = stats.close(solver);
-    mean_pressure.reserve(cycle.vessels.size());
-    for (const VesselCycle& v : cycle.vessels) mean_pressure.push_back(v.mean_pressure);
-  }
+  std::vector<double> mean_pressure = mean_pressures(stats.close(solver).vessels);  // the rest freed here
   solver.balance_compliances(period, &mean_pressure);
   solver.set_time_step(run_step);
   solver.restart_clock();
