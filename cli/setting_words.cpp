@@ -7,6 +7,7 @@ const SettingWords& hemosolve_words() {
       {"cfl", "--cfl"},
       {"checkpoint_every", "--checkpoint-every"},
       {"cycles", "--cycles"},
+      {"coupling_passes", "--coupling-passes"},
       {"degree", "--degree"},
       {"dt", "--dt"},
       {"elements", "--elements"},

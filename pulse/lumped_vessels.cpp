@@ -523,10 +523,22 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
   std::copy(coupled_inflow.begin(), coupled_inflow.end(), held_inflow_.begin());
   // The predicted pressures where the 1D ends read them, and Z_i = (K^-1)_ii there: both
   // along the coupling nodes' paths to their roots only (selected inversion on a tree).
+  predict_coupling_pressures();
+  system_.inverse_diagonal(coupling_nodes_, impedance_);
+}
+
+void LumpedVessels::predict_again(std::span<const double> coupled_inflow) {
+  if (coupling_nodes_.empty()) return;
+  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_scratch_[j] = coupled_inflow[j] - held_inflow_[j];
+  system_.add_forward(coupling_nodes_, coupling_scratch_, rhs_);
+  std::copy(coupled_inflow.begin(), coupled_inflow.end(), held_inflow_.begin());
+  predict_coupling_pressures();
+}
+
+void LumpedVessels::predict_coupling_pressures() {
   system_.backward_at(coupling_nodes_, rhs_, coupling_scratch_);
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j)
     predicted_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_scratch_[j];
-  system_.inverse_diagonal(coupling_nodes_, impedance_);
 }
 
 void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,

@@ -110,6 +110,10 @@ class LumpedVessels {
     return pressure_[i] + s * (predicted_[i] - pressure_[i]);
   }
   double impedance(std::size_t j) const { return impedance_[j]; }  // at coupling node j
+  // predict()'s pressures at t1 at the coupling nodes again, for other held inflows (the same
+  // solve, linear in them: their departures from the last held added to its forward half);
+  // complete() then takes the departures from these.
+  void predict_again(std::span<const double> coupled_inflow);
   // Completes the step with the volumes the 1D ends actually let into each coupling node
   // (coupled_volume, in set_coupling_nodes' order): the pressures at t1 with the departure
   // from the predicted inflows (the same factorisation: its forward half along the coupling
@@ -298,6 +302,7 @@ class LumpedVessels {
   void add_boundary_rows(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity);
   void allocate_system();
   void allocate_step_arrays();  // where released (or never made)
+  void predict_coupling_pressures();  // predicted_ at the coupling nodes from the forward half rhs_
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R

@@ -46,7 +46,13 @@ struct SolverOptions {
   // (w R C < lumped_rc at the pulse's fundamental), unless it ends in a reflection outlet.
   double lumped_transit = 3e-3;
   double lumped_rc = 1.6;
-  double lumped_step = 1e-3;  // the 0D step, as a fraction of the period (at most)
+  // The 0D step, as a fraction of the period (at most); 0: a thousandth of the period for
+  // each coupling pass.
+  double lumped_step = 0;
+  // How many times a 0D step's 1D substeps are taken, each later pass with the 0D vessels'
+  // prediction from the inflows the one before let through (docs/solver.md §10); automatic:
+  // the number that costs least per cycle (pulse/step_cost.hpp), at most four.
+  int coupling_passes = automatic;
   int lumped_passes = 1;      // linear solves per 0D step (1: at the extrapolated state)
   int degree = automatic;   // p in every vessel, or chosen per vessel by degree_rule
   DegreeRule degree_rule;
@@ -107,6 +113,9 @@ class PulseSolver {
   void set_time_step(double dt);
   // The 1D substeps of a step (1 without 0D vessels), and their length.
   int substeps() const { return substeps_; }
+  int coupling_passes() const { return coupling_passes_; }  // 1 without 0D vessels or 1D ends on them
+  // Replaces the chosen passes (at least 1): a settling cycle takes one (solver/settling_cycle.hpp).
+  void set_coupling_passes(int passes) { coupling_passes_ = passes < 1 ? 1 : passes; }
   double substep() const { return dt_ / substeps_; }
   bool is_lumped(std::size_t vessel) const { return zero_d_[vessel]; }
   std::size_t lumped_count() const {
@@ -267,6 +276,10 @@ class PulseSolver {
   void step_exponential(double h);  // ETD2 in the friction, AB2 in the rest
   void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
   void step_coupled();     // a 0D step around its 1D substeps
+  void take_substeps();    // the 1D substeps of the 0D step being taken, from its start
+  // The passes that cost least per cycle with a 0D step of a thousandth of the period per
+  // pass (options' coupling_passes where given).
+  int choose_coupling_passes(const SolverOptions& options) const;
   // The constructor's steps (pulse_solver.cpp), after the tube laws and the models.
   std::optional<SteadyFlow> solve_steady_flow();  // none where the network has none: why kept
   // A pressure boundary counts as "in" or "out" by its steady flow (without one: as built).
@@ -335,6 +348,13 @@ class PulseSolver {
   LumpedVessels lumped_;
   std::optional<std::size_t> lumped_count_after_release_;  // release_lumped_state()
   int substeps_ = 1;
+  int coupling_passes_ = 1;
+  // The 1D vessels' state and their scheme's history at the 0D step's start, for a pass after
+  // the first to start from.
+  PulseState pass_start_, pass_start_rate_;
+  Eigen::MatrixXd pass_start_flow_;
+  std::vector<EndState> pass_start_ends_;  // the junctions' Newton guesses
+  bool pass_start_had_rate_ = false;
   double stable_1d_ = 0;                   // the 1D vessels' stable step (inf without any)
   double step_start_ = 0;                  // time at the start of the 0D step being taken
   std::vector<std::int32_t> coupled_node_; // per coupled end: its 0D node

@@ -1,6 +1,7 @@
 // The time step and the schemes that take it (docs/solver.md §5, §10): the step, decided here
 // alone (choose_time_step: the 1D stability limits, the 0D step and the 1D substeps in it, or
-// the step given; the run room only shortens it to a whole number per cycle); ETD2 (exponential in the friction), AB2 and classical RK4 on the
+// the step given, and the coupling passes that cost least; the run room only shortens the
+// step to a whole number per cycle); ETD2 (exponential in the friction), AB2 and classical RK4 on the
 // 1D vessels' state, each a sequence of DG rates (pulse/dg_rate.cpp); and the 1D-0D step: one
 // implicit 0D step of the lumped vessels around the 1D substeps inside it (step_coupled).
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include "core/setting_error.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "pulse/stability_limit.hpp"
+#include "pulse/step_cost.hpp"
 
 namespace hemotree {
 
@@ -32,11 +34,14 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
   if (!lumped_.empty()) {
     // The 0D step follows the pulse (it has no stability limit); the 1D vessels take as
     // many substeps of at most their own limit as fit in it.
-    const double target = options.lumped_step * period_;
+    coupling_passes_ = choose_coupling_passes(options);
+    const double fraction = options.lumped_step > 0 ? options.lumped_step : 1e-3 * coupling_passes_;
+    const double target = fraction * period_;
     const double substeps = std::isfinite(stable_1d_) ? std::max(1.0, std::floor(target / stable_1d_)) : 1.0;
     dt_ = std::isfinite(stable_1d_) ? std::min(target, substeps * stable_1d_) : target;
     std::ostringstream why;
-    why << "0D step of " << options.lumped_step << " of the period";
+    why << "0D step of " << fraction << " of the period";
+    if (coupling_passes_ > 1) why << " in " << coupling_passes_ << " coupling passes";
     if (std::isfinite(stable_1d_)) why << ", " << substeps << " 1D substeps set by the " << dt_reason_;
     dt_reason_ = why.str();
     // The implicit 0D step is stable at any length, but not accurate: BDF2 follows the pulse
@@ -44,7 +49,7 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
     // 16 % of the inflow and was called complete). The 1D substeps keep their own limit.
     stable_dt_ = target;
     std::ostringstream limit;
-    limit << placeholder("lumped_step") << " " << options.lumped_step << " of the period: BDF2 is stable at any step but follows "
+    limit << placeholder("lumped_step") << " " << fraction << " of the period: BDF2 is stable at any step but follows "
              "the pulse only at steps like it";
     stable_dt_reason_ = limit.str();
   }
@@ -53,6 +58,19 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
     set_time_step(options.dt);
     dt_reason_ = "given by " + placeholder("dt");
   }
+}
+
+int PulseSolver::choose_coupling_passes(const SolverOptions& options) const {
+  if (boundaries_.coupled.empty() || !std::isfinite(stable_1d_)) return 1;
+  if (options.coupling_passes != SolverOptions::automatic) return options.coupling_passes;
+  // A cycle's 1D substeps, the same work for each pass, against its 0D steps at a thousandth
+  // of the period. Four passes at 4e-3 of the period were measured within issue 5's
+  // tolerances of --model 1d (docs/solver.md §10); more were not.
+  double substep = step_cost::per_step;
+  for (const DegreeBlock& b : blocks_) substep += static_cast<double>(b.count) * step_cost::element_step_seconds(b.degree);
+  const double one_d = period_ / stable_1d_ * substep;
+  const double zero_d = 1000 * static_cast<double>(lumped_.vessel_count()) * step_cost::per_lumped_vessel;
+  return step_cost::cheapest_coupling_passes(one_d, zero_d, 4);
 }
 
 void PulseSolver::choose_stable_step(const SolverOptions& options) {
@@ -201,7 +219,9 @@ void PulseSolver::step_coupled() {
   // response to their departure from the held inflow: a Robin condition. Without it the
   // coupling is explicit, and unstable once the step exceeds the node's C / Y; with the
   // response of BDF2 (Z = (K^-1)_ii) it broke down at 4 substeps, with 3/2 Z, the backward
-  // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §10).
+  // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §10). With
+  // several coupling passes the substeps are taken again, each time with the inflows held at
+  // the means the pass before let through.
   std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
     const VesselEnd& end = boundaries_.coupled[k].end;
@@ -220,11 +240,32 @@ void PulseSolver::step_coupled() {
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
   if (element_count() > 0) {
     const Eigen::VectorXd before = state_.coupled;
-    const double h = dt_ / substeps_;
-    for (int k = 0; k < substeps_; ++k) {
-      step_1d(h);
-      time_ = step_start_ + (k + 1) * h;
+    if (coupling_passes_ > 1) {
+      pass_start_ = state_;
+      pass_start_rate_ = previous_rate_;
+      pass_start_flow_ = previous_flow_;
+      pass_start_ends_ = boundaries_.end_state;
+      pass_start_had_rate_ = have_previous_rate_;
     }
+    for (int pass = 1; pass < coupling_passes_; ++pass) {
+      // A pass before the last: its substeps, then the prediction again with each end's
+      // inflow held at the mean it let through, and the 1D vessels back at the step's start.
+      take_substeps();
+      std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
+      for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
+        const auto i = static_cast<Eigen::Index>(k);
+        held_end_flow_[k] = (state_.coupled(i) - before(i)) / dt_;
+        coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
+      }
+      lumped_.predict_again(coupled_inflow_);
+      state_ = pass_start_;
+      previous_rate_ = pass_start_rate_;
+      previous_flow_ = pass_start_flow_;
+      boundaries_.end_state = pass_start_ends_;
+      have_previous_rate_ = pass_start_had_rate_;
+      time_ = step_start_;
+    }
+    take_substeps();
     std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
     for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
       coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
@@ -234,6 +275,14 @@ void PulseSolver::step_coupled() {
   lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1),
                    lumped_boundary_volume_);
   time_ = t1;
+}
+
+void PulseSolver::take_substeps() {
+  const double h = dt_ / substeps_;
+  for (int k = 0; k < substeps_; ++k) {
+    step_1d(h);
+    time_ = step_start_ + (k + 1) * h;
+  }
 }
 
 void PulseSolver::step_1d(double dt) {

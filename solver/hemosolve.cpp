@@ -99,7 +99,7 @@ int finish(const RunResult& result, const RunConfiguration& config) {
 struct CommandLine {
   RunConfiguration config;
   std::string out_dir, resume_dir, rheology, scheme = "etd2", start = "periodic", dt_text, sample_text = "1ms",
-      external_text = "10mmHg", degree_text = "auto", model = "auto", vtk_min_text, red_cells = "fixed";
+      external_text = "10mmHg", degree_text = "auto", lumped_step_text = "auto", coupling_passes_text = "auto", model = "auto", vtk_min_text, red_cells = "fixed";
   std::vector<std::string> probe_texts, tracer_texts, pressure_at_texts;
   bool quiet = false, steady = false, linear = false;
   CLI::Option* until_periodic = nullptr;
@@ -111,6 +111,7 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
   std::string &input = config.network_name, &out_dir = line.out_dir, &resume_dir = line.resume_dir,
               &rheology = line.rheology, &scheme = line.scheme, &start = line.start, &dt_text = line.dt_text,
               &sample_text = line.sample_text, &external_text = line.external_text, &degree_text = line.degree_text,
+              &lumped_step_text = line.lumped_step_text, &coupling_passes_text = line.coupling_passes_text,
               &model = line.model, &vtk_min_text = line.vtk_min_text, &red_cells = line.red_cells;
   int &cycles = config.cycles, &max_cycles = config.max_cycles, &frames = config.frames,
       &checkpoint_every = config.checkpoint_every;
@@ -170,9 +171,14 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
                  "auto: the largest w R C (the vessel's resistance times its compliance at the pulse's "
                  "fundamental: the pressure's diffusion along a viscous vessel) of a 0D vessel, in [0, inf]")
       ->capture_default_str();
-  app.add_option("--lumped-step", options.lumped_step,
-                 "with 0D vessels: the step of the 0D vessels, as a fraction of the period, in (0, 0.1]; the 1D "
-                 "vessels take substeps within it")
+  app.add_option("--lumped-step", lumped_step_text,
+                 "with 0D vessels: the step of the 0D vessels, as a fraction of the period, in (0, 0.1], or auto: "
+                 "a thousandth for each coupling pass; the 1D vessels take substeps within it")
+      ->capture_default_str();
+  app.add_option("--coupling-passes", coupling_passes_text,
+                 "with 1D vessels ending on 0D ones: how many times a 0D step's 1D substeps are taken, each pass "
+                 "after the first with the 0D prediction from the inflows the one before let through, in [1, 10], "
+                 "or auto: the number that costs least per cycle, at most 4 (docs/solver.md §10)")
       ->capture_default_str();
   app.add_option("--lumped-passes", options.lumped_passes,
                  "with 0D vessels: linear solves per 0D step, in [1, 10]: 1 takes R, L and C at the state "
@@ -274,6 +280,8 @@ int run_command_line(CommandLine& line, int cores) {
   options.start = start_named(line.start);
   if (!line.rheology.empty()) options.rheology_override = static_cast<int>(rheology_named(line.rheology));
   options.degree = degree_named(line.degree_text);
+  options.lumped_step = lumped_step_named(line.lumped_step_text);
+  options.coupling_passes = coupling_passes_named(line.coupling_passes_text);
   if (!line.dt_text.empty()) options.dt = parse_quantity(line.dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");
   if (options.threads < 1 || options.threads > cores)
     throw InputError("--threads must lie in [1, " + std::to_string(cores) + "] (got " +

@@ -101,7 +101,7 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
     degree_list += (degree_list.empty() ? "" : ", ") + std::to_string(count) + " of degree " + std::to_string(p);
   }
   const int planned = config.planned_cycles(), threads = config.solver.threads;
-  const double lumped = static_cast<double>(run.lumped_count()), substeps = run.substeps();
+  const double lumped = static_cast<double>(run.lumped_count()), substeps = run.substeps() * run.coupling_passes();
   const RunEstimate per_cycle =
       estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), threads, substeps, lumped);
   const RunEstimate whole =
@@ -119,7 +119,9 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
                 to_string(config.solver.model) + ")" +
                 (run.lumped_count() > 0 && d.one_d > 0
                      ? "; " + std::to_string(run.substeps()) + " 1D substeps of " +
-                           format_quantity(run.substep(), "s") + " per step"
+                           format_quantity(run.substep(), "s") + " per step" +
+                           (run.coupling_passes() > 1 ? ", taken " + std::to_string(run.coupling_passes()) + " times"
+                                                      : std::string())
                      : std::string()));
   observer.note("time step " + format_quantity(dt, "s") + " (" + d.step.reason + "), " +
                 std::to_string(steps_per_cycle) + " steps per cycle, " + plural(run.element_count(), "element") +
@@ -183,6 +185,7 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
                          {"vessels_1d", d.one_d},
                          {"vessels_0d", run.lumped_count()},
                          {"substeps", run.substeps()},
+                         {"coupling_passes", run.coupling_passes()},
                          {"threads", options.threads},
                          {"rheology", to_string(run.blood().rheology)},
                          {"red_cells", to_string(config.red_cells)},
@@ -329,7 +332,8 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   // longer step (solver/settling_cycle.hpp): as many of its steps as fill a period.
   if (config.until_periodic && config.settling_step > 1 && run.lumped_count() > 0 && config.balance_compliances &&
       run.started_from_steady())
-    plan.settling_steps = std::max<std::size_t>(1, steps_per_cycle / static_cast<std::size_t>(config.settling_step));
+    plan.settling_steps = std::max<std::size_t>(
+        1, steps_per_cycle * static_cast<std::size_t>(run.coupling_passes()) / static_cast<std::size_t>(config.settling_step));
   std::optional<FlowTransport> transport;
   if (config.carries_transport()) {
     const bool red = config.red_cells == RedCells::transport;

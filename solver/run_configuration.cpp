@@ -92,18 +92,40 @@ StartChoice start_named(const std::string& name) { return named(name, start_name
 
 Rheology rheology_named(const std::string& name) { return named(name, rheology_names, "rheology"); }
 
-int degree_named(const std::string& name) {
+namespace {
+// "auto" (SolverOptions::automatic) or a whole number in [low, high].
+int automatic_or_count(const std::string& name, int low, int high, const char* setting) {
   if (name == "auto") return SolverOptions::automatic;
   std::size_t used = 0;
-  int degree = -1;
+  int count = -1;
   try {
-    degree = std::stoi(name, &used);
+    count = std::stoi(name, &used);
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != name.size() || degree < 0 || degree > 30)
-    refuse_choice("degree", "auto or a whole number in [0, 30]", name);
-  return degree;
+  if (used == 0 || used != name.size() || count < low || count > high)
+    refuse_choice(setting,
+                  ("auto or a whole number in [" + std::to_string(low) + ", " + std::to_string(high) + "]").c_str(), name);
+  return count;
+}
+}  // namespace
+
+int degree_named(const std::string& name) { return automatic_or_count(name, 0, 30, "degree"); }
+
+int coupling_passes_named(const std::string& name) { return automatic_or_count(name, 1, 10, "coupling_passes"); }
+
+double lumped_step_named(const std::string& name) {
+  if (name == "auto") return 0;
+  std::size_t used = 0;
+  double fraction = 0;
+  try {
+    fraction = std::stod(name, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != name.size() || !(fraction > 0 && fraction <= 0.1))
+    refuse_choice("lumped_step", "auto or a fraction of the period in (0, 0.1]", name);
+  return fraction;
 }
 
 RedCells red_cells_named(const std::string& name) { return named(name, red_cell_names, "red_cells"); }
@@ -120,7 +142,8 @@ void check_configuration(const RunConfiguration& c) {
   const SolverOptions& s = c.solver;
   check_range(s.lumped_transit, {0, 1}, "lumped_transit");
   check_range(s.lumped_rc, {0, INFINITY}, "lumped_rc");
-  check_range(s.lumped_step, {0, 0.1, true, false}, "lumped_step");
+  if (s.lumped_step != 0) check_range(s.lumped_step, {0, 0.1, true, false}, "lumped_step");  // 0: automatic
+  if (s.coupling_passes != SolverOptions::automatic) check_count(s.coupling_passes, 1, 10, "coupling_passes");
   check_count(s.lumped_passes, 1, 10, "lumped_passes");
   check_range(s.cfl, {0, c.force ? 100.0 : 1.0, true, false}, "cfl",
               c.force ? placeholder("cfl") + " (with " + placeholder("force") + ")" : placeholder("cfl"));

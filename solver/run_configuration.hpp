@@ -31,6 +31,8 @@ ModelChoice model_named(const std::string& name);
 StartChoice start_named(const std::string& name);
 Rheology rheology_named(const std::string& name);  // "pries" or "newtonian"
 int degree_named(const std::string& name);         // "auto" (SolverOptions::automatic) or 0 to 30
+int coupling_passes_named(const std::string& name);  // "auto" (SolverOptions::automatic) or 1 to 10
+double lumped_step_named(const std::string& name);   // "auto" (0) or a fraction in (0, 0.1]
 RedCells red_cells_named(const std::string& name);
 
 struct RunConfiguration {

@@ -20,9 +20,6 @@ struct RunEstimate {
 RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads,
                          double substeps = 1, double lumped_vessels = 0);
 
-// Seconds of one step of one element of degree p (the cost model).
-double element_step_seconds(int degree);
-
 // "3.2 s", "4.1 min", "2.5 h", "3.1 days", "2e+06 years".
 std::string describe_duration(double seconds);
 

@@ -12,7 +12,9 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   Settling s;
   s.steps = steps;
   const double period = solver.period(), run_step = solver.dt();
+  const int run_passes = solver.coupling_passes();
   solver.set_time_step(period / static_cast<double>(steps));
+  solver.set_coupling_passes(1);
   solver.balance_compliances(period);  // the cycle's start
   CycleStatistics stats(net, solver, 1 / period);
   stats.begin(solver);
@@ -28,6 +30,7 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   std::vector<double> mean_pressure = mean_pressures(stats.close(solver).vessels);  // the rest freed here
   solver.balance_compliances(period, &mean_pressure);
   solver.set_time_step(run_step);
+  solver.set_coupling_passes(run_passes);
   solver.restart_clock();
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return s;

@@ -13,6 +13,7 @@
 
 #include "core/errors.hpp"
 #include "pulse/pulse_solver.hpp"
+#include "pulse/step_cost.hpp"
 #include "tests/network_builders.hpp"
 
 using namespace hemotree;
@@ -85,6 +86,24 @@ SolverOptions short_vessels_0d() {
   return options;
 }
 
+// A 12 cm vessel and a 2 cm one in series (5 mm, c = 5 m/s), a pulse of width sigma at
+// t = 0.5 s of a period of 1 s; the options of a run from rest, with the short one 0D or not
+// (transits 0.024 s and 0.004 s).
+Network split_vessel(double sigma) {
+  Network net = network({{0, 1, 0.12}, {1, 2, 0.02}}, 3, 5e-3, 5.0);
+  net.inlet = Inlet{0, gaussian_pulse(5e-6, 0.5, sigma, 1.0)};
+  return net;
+}
+SolverOptions from_rest(bool short_half_0d) {
+  SolverOptions options;
+  options.start = StartChoice::rest;
+  if (short_half_0d) {
+    options.model = ModelChoice::automatic;
+    options.lumped_transit = 0.01;
+  }
+  return options;
+}
+
 }  // namespace
 
 // A 12 cm vessel and a 2 cm one in series (5 mm, c = 5 m/s) under a pulse of sigma = 0.1 s:
@@ -94,13 +113,8 @@ SolverOptions short_vessels_0d() {
 // where the pulse starts too: the steady state of the mean flow is not the state of the
 // pulse's first instant, and the two discretisations resolve that jump differently.
 TEST(HybridModel, AShortHalfMade0dFollowsTheAll1dSolution) {
-  Network net = network({{0, 1, 0.12}, {1, 2, 0.02}}, 3, 5e-3, 5.0);
-  net.inlet = Inlet{0, gaussian_pulse(5e-6, 0.5, 0.1, 1.0)};
-  SolverOptions one_d;
-  one_d.start = StartChoice::rest;
-  SolverOptions hybrid = one_d;
-  hybrid.model = ModelChoice::automatic;
-  hybrid.lumped_transit = 0.01;  // transits 0.024 s and 0.004 s
+  const Network net = split_vessel(0.1);
+  const SolverOptions one_d = from_rest(false), hybrid = from_rest(true);
   PulseSolver reference(net, one_d), coupled(net, hybrid);
   ASSERT_FALSE(reference.is_lumped(1));
   ASSERT_FALSE(coupled.is_lumped(0));
@@ -119,21 +133,86 @@ TEST(HybridModel, AShortHalfMade0dFollowsTheAll1dSolution) {
   }
 }
 
-// Three coupled ends: the exchanged volumes against the stored one, every step.
+// Three coupled ends: the exchanged volumes against the stored one, every step, with one
+// coupling pass and with three (the later passes start the 1D vessels again from the step's
+// start: what they let through is still what the 0D vessels receive).
 TEST(HybridModel, MassThroughEveryCouplingToRoundOff) {
   const Network net = three_couplings();
-  PulseSolver solver(net, short_vessels_0d());
-  ASSERT_EQ(solver.lumped_count(), 2u);
-  const double v0 = solver.network_volume();
-  double worst = 0, in = 0;
-  while (solver.time() < 0.8) {
-    solver.step();
-    in = solver.state().exchanged(0);
-    const double balance = in - solver.state().exchanged(1) - (solver.network_volume() - v0);
-    worst = std::max(worst, std::abs(balance));
+  for (const int passes : {1, 3}) {
+    SolverOptions options = short_vessels_0d();
+    options.coupling_passes = passes;
+    PulseSolver solver(net, options);
+    ASSERT_EQ(solver.lumped_count(), 2u);
+    ASSERT_EQ(solver.coupling_passes(), passes);
+    const double v0 = solver.network_volume();
+    double worst = 0, in = 0;
+    while (solver.time() < 0.8) {
+      solver.step();
+      in = solver.state().exchanged(0);
+      const double balance = in - solver.state().exchanged(1) - (solver.network_volume() - v0);
+      worst = std::max(worst, std::abs(balance));
+    }
+    std::printf("coupled mass, %d passes: largest |in - out - stored| %.3g m^3 against %.3g m^3 in\n", passes, worst,
+                in);
+    EXPECT_LT(worst, 1e-12 * in);
   }
-  std::printf("coupled mass: largest |in - out - stored| %.3g m^3 against %.3g m^3 in\n", worst, in);
-  EXPECT_LT(worst, 1e-12 * in);
+}
+
+// The coupling passes converge to the coupling's fixed point, where each 1D end's inflow held
+// by the 0D prediction is the mean it lets through: a vessel whose short half is 0D, at the
+// longest 0D step the passes are taken at by themselves (4e-3 of the period, 9 substeps).
+// The departure of the coupling node's pressure from the fixed point (taken with 12 passes)
+// falls by more than half with each pass (measured 0.31 to 0.37 a pass), and four passes
+// keep the pulse's amplitude there within issue 5's 2 % of the all-1D solution (measured
+// 1.1 %; one pass 0.2 %: at a single coupling the first pass's Robin response offsets the
+// lag of the 0D step's mean inflow, which the fixed point keeps; across a network's
+// couplings it does not, docs/solver.md §10).
+TEST(HybridModel, CouplingPassesConvergeToTheFixedPoint) {
+  const Network net = split_vessel(0.05);
+  const SolverOptions one_d = from_rest(false);
+  SolverOptions hybrid = from_rest(true);
+  hybrid.lumped_step = 4e-3;
+  auto pressures = [&](const SolverOptions& options) {
+    PulseSolver solver(net, options);
+    return record(solver, 0, 1.0, 0.8);
+  };
+  auto with_passes = [&](int passes) {
+    SolverOptions options = hybrid;
+    options.coupling_passes = passes;
+    return pressures(options);
+  };
+  auto amplitude = [](const Samples& a) {
+    const auto [low, high] = std::minmax_element(a.p.begin(), a.p.end());
+    return *high - *low;
+  };
+  const double pulse = amplitude(pressures(one_d));
+  const Samples fixed_point = with_passes(12);
+  double last = 0;
+  for (const int passes : {1, 2, 3, 4}) {
+    const Samples s = with_passes(passes);
+    double d = 0;
+    for (std::size_t k = 0; k < s.t.size(); ++k) d = std::max(d, std::abs(s.p[k] - fixed_point.p[k]) / pulse);
+    const double amplitude_error = std::abs(amplitude(s) - pulse) / pulse;
+    std::printf("%d passes: departure from the fixed point %.3g, amplitude against all-1D %.3g of the pulse\n", passes, d,
+                amplitude_error);
+    if (passes > 1) {
+      EXPECT_LT(d, 0.5 * last);
+    }
+    if (passes == 4) {
+      EXPECT_LT(amplitude_error, 0.02);
+    }
+    last = d;
+  }
+}
+
+// The passes a run takes by itself: as many as lower the cost of a cycle, N C_1D + C_0D / N.
+TEST(HybridModel, CouplingPassesThatCostLeast) {
+  using step_cost::cheapest_coupling_passes;
+  EXPECT_EQ(cheapest_coupling_passes(1.0, 1.0, 4), 1);    // 2 passes: 2 + 0.5 > 1 + 1
+  EXPECT_EQ(cheapest_coupling_passes(1.0, 2.5, 4), 2);    // 2 + 1.25 < 1 + 2.5
+  EXPECT_EQ(cheapest_coupling_passes(10.0, 118.0, 4), 3); // the full tree: 30 + 39 against 20 + 59 and 40 + 29.5
+  EXPECT_EQ(cheapest_coupling_passes(0.0, 1.0, 4), 4);    // no 1D work: the most allowed
+  EXPECT_EQ(cheapest_coupling_passes(1.0, 1e6, 1), 1);
 }
 
 // After the run the report needs the vessels' models only: the 0D vessels' arrays are freed,

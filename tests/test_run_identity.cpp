@@ -94,6 +94,7 @@ TEST(RunIdentity, EveryOptionThatShapesTheStateIsInIt) {
       {"lumped_rc", [](RunConfiguration& c) { nudge(c.solver.lumped_rc); }},
       {"lumped_step", [](RunConfiguration& c) { nudge(c.solver.lumped_step); }},
       {"lumped_passes", [](RunConfiguration& c) { c.solver.lumped_passes = 2; }},
+      {"coupling_passes", [](RunConfiguration& c) { c.solver.coupling_passes = 2; }},
       {"degree", [](RunConfiguration& c) { c.solver.degree = 3; }},
       {"low degree", [](RunConfiguration& c) { c.solver.degree_rule.low = 0; }},
       {"high degree", [](RunConfiguration& c) { c.solver.degree_rule.high = 6; }},

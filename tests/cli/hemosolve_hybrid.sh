@@ -113,6 +113,22 @@ grep -q "the VTK output shows" "$WORK/log" && pass "--vtk-min-diameter says what
   || fail "--lumped-passes 2 against 1: $(cat "$WORK/cmp")"
 expect_error "--lumped-passes 0" 2 "--lumped-passes must lie in [1, 10]" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --lumped-passes 0
+# Coupling passes (docs/solver.md §10): by themselves one on this network (its 1D vessels cost
+# more than its 0D ones); three, given, take a 0D step of 3e-3 of the period, say so, and
+# stay within issue 5's tolerances of --model 1d; the auto run's summary says one.
+"$HEMOSOLVE" "$WORK/net.json" --out "$WORK/passes" --model auto --lumped-transit 3e-4 --cycles 3 \
+  --coupling-passes 3 2>"$WORK/log" || fail "--coupling-passes 3: $(cat "$WORK/log")"
+grep -q "0D step of 0.003 of the period in 3 coupling passes" "$WORK/log" && grep -q "taken 3 times" "$WORK/log" \
+  && pass "--coupling-passes 3: a 0D step of 3e-3 of the period, said" || fail "passes not said: $(cat "$WORK/log")"
+"$PY" "$ROOT/bench/compare-summaries" "$WORK/one_d/summary.json" "$WORK/passes/summary.json" >"$WORK/cmp" \
+  && "$PY" -c 'import json, sys; a, b = (json.load(open(f)) for f in sys.argv[1:]); assert (a["coupling_passes"], b["coupling_passes"]) == (1, 3), (a["coupling_passes"], b["coupling_passes"])' \
+    "$WORK/auto/summary.json" "$WORK/passes/summary.json" \
+  && pass "three coupling passes against 1d: within issue 5's tolerances ($(grep 'pulsatility' "$WORK/cmp" | sed 's/ *tolerance.*//'))" \
+  || fail "three coupling passes against 1d: $(cat "$WORK/cmp")"
+expect_error "--coupling-passes 0" 2 "--coupling-passes must be auto or a whole number in [1, 10] (got '0')" -- \
+  "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --coupling-passes 0
+expect_error "--lumped-step 0" 2 "--lumped-step must be auto or a fraction of the period in (0, 0.1] (got '0')" -- \
+  "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --lumped-step 0
 expect_error "--vtk-min-diameter above every vessel" 2 "keeps no vessel" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --vtk --vtk-min-diameter 1mm
 expect_error "--vtk-min-diameter without --vtk" 2 "applies to --vtk and --frames only" -- \
