@@ -125,6 +125,17 @@ grep -q "0D step of 0.003 of the period in 3 coupling passes" "$WORK/log" && gre
     "$WORK/auto/summary.json" "$WORK/passes/summary.json" \
   && pass "three coupling passes against 1d: within issue 5's tolerances ($(grep 'pulsatility' "$WORK/cmp" | sed 's/ *tolerance.*//'))" \
   || fail "three coupling passes against 1d: $(cat "$WORK/cmp")"
+# A run of three passes resumed from its checkpoint goes on bit for bit too (a pass's start is
+# the step's, nothing of it outlives the step).
+"$HEMOSOLVE" "$WORK/net.json" --out "$WORK/passes_straight" --cycles 2 --coupling-passes 3 --quiet \
+  && "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/passes_resumed" --cycles 1 --coupling-passes 3 --checkpoint-every 1 --quiet \
+  && "$HEMOSOLVE" "$WORK/net.json" --resume "$WORK/passes_resumed" --cycles 2 --coupling-passes 3 --quiet \
+  && "$PY" - "$WORK/passes_straight/summary.json" "$WORK/passes_resumed/summary.json" <<'PY' \
+  && pass "three coupling passes resumed: the uninterrupted run's results, bit for bit" || fail "passes resume"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:])
+assert a["coupling_passes"] == b["coupling_passes"] == 3 and a["vessels"] == b["vessels"], "results differ"
+PY
 expect_error "--coupling-passes 0" 2 "--coupling-passes must be auto or a whole number in [1, 10] (got '0')" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --coupling-passes 0
 expect_error "--lumped-step 0" 2 "--lumped-step must be auto or a fraction of the period in (0, 0.1] (got '0')" -- \
