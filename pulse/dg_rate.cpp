@@ -129,14 +129,15 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
 }
 
 void PulseSolver::volume_terms(double t, const PulseState& s, PulseState& rate) {
-  // Element terms: each degree's block split into one part per thread.
+  // Element terms: each degree's block split into one part per thread, in one parallel
+  // region (a region per block cost more than the 1D vessels' work on a million-vessel tree).
   Eigen::Index bad = -1;
   ParallelErrors errors;
-  for (const DegreeBlock& b : blocks_) {
-    const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
-    {
-      const int threads = omp_get_num_threads(), me = omp_get_thread_num();
+  {
+    const int threads = omp_get_num_threads(), me = omp_get_thread_num();
+    for (const DegreeBlock& b : blocks_) {
+      const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
       const Eigen::Index first = b.first + b.count * me / threads, last = b.first + b.count * (me + 1) / threads;
       errors.guard(first, [&] {
         const Eigen::Index found = element_terms(s, rate, basis, first, last - first);
@@ -146,8 +147,8 @@ void PulseSolver::volume_terms(double t, const PulseState& s, PulseState& rate) 
         }
       });
     }
-    errors.rethrow();
   }
+  errors.rethrow();
   if (bad >= 0) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad])], t);
 }
 
@@ -352,14 +353,15 @@ void PulseSolver::junction_fluxes(double t) {
 
 void PulseSolver::lift_to_rate(PulseState& rate) const {
   // Surface term and scaling: dC/dt = (volume - M^-1 (phi(1) F*_R - phi(-1) F*_L)) / J + source.
-  for (const DegreeBlock& b : blocks_) {
-    const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
-    const auto right = basis.inverse_mass.cwiseProduct(basis.right);  // lifts of the end fluxes
-    const auto left = basis.inverse_mass.cwiseProduct(basis.left);
-    const Eigen::Index modes = b.degree + 1;
+  // Each degree's block split into one part per thread, in one parallel region.
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
-    {
-      const int threads = omp_get_num_threads(), me = omp_get_thread_num();
+  {
+    const int threads = omp_get_num_threads(), me = omp_get_thread_num();
+    for (const DegreeBlock& b : blocks_) {
+      const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
+      const auto right = basis.inverse_mass.cwiseProduct(basis.right);  // lifts of the end fluxes
+      const auto left = basis.inverse_mass.cwiseProduct(basis.left);
+      const Eigen::Index modes = b.degree + 1;
       const Eigen::Index first = b.first + b.count * me / threads,
                          count = b.first + b.count * (me + 1) / threads - first;
       auto ra = rate.area.block(first, 0, count, modes);
