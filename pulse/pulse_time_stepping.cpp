@@ -63,6 +63,8 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
 int PulseSolver::choose_coupling_passes(const SolverOptions& options) const {
   if (boundaries_.coupled.empty() || !std::isfinite(stable_1d_)) return 1;
   if (options.coupling_passes != SolverOptions::automatic) return options.coupling_passes;
+  // A step given takes the passes measured for it: one per thousandth of the period.
+  if (options.lumped_step > 0) return std::clamp(static_cast<int>(std::ceil(options.lumped_step * 1000 - 1e-9)), 1, 4);
   // A cycle's 1D substeps, the same work for each pass, against its 0D steps at a thousandth
   // of the period. Four passes at 4e-3 of the period were measured within issue 5's
   // tolerances of --model 1d (docs/solver.md §10); more were not.

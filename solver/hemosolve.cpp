@@ -178,7 +178,8 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
   app.add_option("--coupling-passes", coupling_passes_text,
                  "with 1D vessels ending on 0D ones: how many times a 0D step's 1D substeps are taken, each pass "
                  "after the first with the 0D prediction from the inflows the one before let through, in [1, 10], "
-                 "or auto: the number that costs least per cycle, at most 4 (docs/solver.md §10)")
+                 "or auto: the number that costs least per cycle, at most 4, or with --lumped-step given one per "
+                 "thousandth of the period (docs/solver.md §10)")
       ->capture_default_str();
   app.add_option("--lumped-passes", options.lumped_passes,
                  "with 0D vessels: linear solves per 0D step, in [1, 10]: 1 takes R, L and C at the state "

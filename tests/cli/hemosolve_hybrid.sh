@@ -125,6 +125,10 @@ grep -q "0D step of 0.003 of the period in 3 coupling passes" "$WORK/log" && gre
     "$WORK/auto/summary.json" "$WORK/passes/summary.json" \
   && pass "three coupling passes against 1d: within issue 5's tolerances ($(grep 'pulsatility' "$WORK/cmp" | sed 's/ *tolerance.*//'))" \
   || fail "three coupling passes against 1d: $(cat "$WORK/cmp")"
+# A --lumped-step given takes, by itself, the passes measured for it: one per thousandth begun.
+"$HEMOSOLVE" "$WORK/net.json" --out "$WORK/step_given" --model auto --lumped-transit 3e-4 --cycles 1 \
+  --lumped-step 2.5e-3 2>"$WORK/log" && grep -q "0D step of 0.0025 of the period in 3 coupling passes" "$WORK/log" \
+  && pass "--lumped-step 2.5e-3: three coupling passes by themselves" || fail "--lumped-step 2.5e-3: $(cat "$WORK/log")"
 # A run of three passes resumed from its checkpoint goes on bit for bit too (a pass's start is
 # the step's, nothing of it outlives the step).
 "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/passes_straight" --cycles 2 --coupling-passes 3 --quiet \
