@@ -277,6 +277,8 @@ class PulseSolver {
   void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
   void step_coupled();     // a 0D step around its 1D substeps
   void take_substeps();    // the 1D substeps of the 0D step being taken, from its start
+  void keep_pass_start();       // pass_start_ from the 1D vessels now (the step's start)
+  void return_to_pass_start();  // the 1D vessels, and the clock, back to pass_start_
   // The passes that cost least per cycle with a 0D step of a thousandth of the period per
   // pass (options' coupling_passes where given).
   int choose_coupling_passes(const SolverOptions& options) const;
@@ -350,11 +352,13 @@ class PulseSolver {
   int substeps_ = 1;
   int coupling_passes_ = 1;
   // The 1D vessels' state and their scheme's history at the 0D step's start, for a pass after
-  // the first to start from.
-  PulseState pass_start_, pass_start_rate_;
-  Eigen::MatrixXd pass_start_flow_;
-  std::vector<EndState> pass_start_ends_;  // the junctions' Newton guesses
-  bool pass_start_had_rate_ = false;
+  // the first to start from (keep_pass_start, return_to_pass_start).
+  struct PassStart {
+    PulseState state, previous_rate;
+    Eigen::MatrixXd previous_flow;
+    std::vector<EndState> ends;  // the junctions' Newton guesses
+    bool had_previous_rate = false;
+  } pass_start_;
   double stable_1d_ = 0;                   // the 1D vessels' stable step (inf without any)
   double step_start_ = 0;                  // time at the start of the 0D step being taken
   std::vector<std::int32_t> coupled_node_; // per coupled end: its 0D node

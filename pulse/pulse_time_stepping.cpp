@@ -35,7 +35,7 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
     // The 0D step follows the pulse (it has no stability limit); the 1D vessels take as
     // many substeps of at most their own limit as fit in it.
     coupling_passes_ = choose_coupling_passes(options);
-    const double fraction = options.lumped_step > 0 ? options.lumped_step : 1e-3 * coupling_passes_;
+    const double fraction = options.lumped_step > 0 ? options.lumped_step : step_cost::step_per_coupling_pass * coupling_passes_;
     const double target = fraction * period_;
     const double substeps = std::isfinite(stable_1d_) ? std::max(1.0, std::floor(target / stable_1d_)) : 1.0;
     dt_ = std::isfinite(stable_1d_) ? std::min(target, substeps * stable_1d_) : target;
@@ -63,16 +63,17 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
 int PulseSolver::choose_coupling_passes(const SolverOptions& options) const {
   if (boundaries_.coupled.empty() || !std::isfinite(stable_1d_)) return 1;
   if (options.coupling_passes != SolverOptions::automatic) return options.coupling_passes;
-  // A step given takes the passes measured for it: one per thousandth of the period.
-  if (options.lumped_step > 0) return std::clamp(static_cast<int>(std::ceil(options.lumped_step * 1000 - 1e-9)), 1, 4);
-  // A cycle's 1D substeps, the same work for each pass, against its 0D steps at a thousandth
-  // of the period. Four passes at 4e-3 of the period were measured within issue 5's
-  // tolerances of --model 1d (docs/solver.md §10); more were not.
+  using step_cost::most_coupling_passes, step_cost::step_per_coupling_pass;
+  // A step given takes the passes measured for it: one per thousandth of the period begun.
+  if (options.lumped_step > 0)
+    return std::clamp(static_cast<int>(std::ceil(options.lumped_step / step_per_coupling_pass - 1e-9)), 1,
+                      most_coupling_passes);
+  // A cycle's 1D substeps, the same work for each pass, against its 0D steps at one pass's step.
   double substep = step_cost::per_step;
   for (const DegreeBlock& b : blocks_) substep += static_cast<double>(b.count) * step_cost::element_step_seconds(b.degree);
   const double one_d = period_ / stable_1d_ * substep;
-  const double zero_d = 1000 * static_cast<double>(lumped_.vessel_count()) * step_cost::per_lumped_vessel;
-  return step_cost::cheapest_coupling_passes(one_d, zero_d, 4);
+  const double zero_d = static_cast<double>(lumped_.vessel_count()) * step_cost::per_lumped_vessel / step_per_coupling_pass;
+  return step_cost::cheapest_coupling_passes(one_d, zero_d, most_coupling_passes);
 }
 
 void PulseSolver::choose_stable_step(const SolverOptions& options) {
@@ -242,13 +243,7 @@ void PulseSolver::step_coupled() {
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
   if (element_count() > 0) {
     const Eigen::VectorXd before = state_.coupled;
-    if (coupling_passes_ > 1) {
-      pass_start_ = state_;
-      pass_start_rate_ = previous_rate_;
-      pass_start_flow_ = previous_flow_;
-      pass_start_ends_ = boundaries_.end_state;
-      pass_start_had_rate_ = have_previous_rate_;
-    }
+    if (coupling_passes_ > 1) keep_pass_start();
     for (int pass = 1; pass < coupling_passes_; ++pass) {
       // A pass before the last: its substeps, then the prediction again with each end's
       // inflow held at the mean it let through, and the 1D vessels back at the step's start.
@@ -260,12 +255,7 @@ void PulseSolver::step_coupled() {
         coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
       }
       lumped_.predict_again(coupled_inflow_);
-      state_ = pass_start_;
-      previous_rate_ = pass_start_rate_;
-      previous_flow_ = pass_start_flow_;
-      boundaries_.end_state = pass_start_ends_;
-      have_previous_rate_ = pass_start_had_rate_;
-      time_ = step_start_;
+      return_to_pass_start();
     }
     take_substeps();
     std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
@@ -277,6 +267,23 @@ void PulseSolver::step_coupled() {
   lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1),
                    lumped_boundary_volume_);
   time_ = t1;
+}
+
+void PulseSolver::keep_pass_start() {
+  pass_start_.state = state_;
+  pass_start_.previous_rate = previous_rate_;
+  pass_start_.previous_flow = previous_flow_;
+  pass_start_.ends = boundaries_.end_state;
+  pass_start_.had_previous_rate = have_previous_rate_;
+}
+
+void PulseSolver::return_to_pass_start() {
+  state_ = pass_start_.state;
+  previous_rate_ = pass_start_.previous_rate;
+  previous_flow_ = pass_start_.previous_flow;
+  boundaries_.end_state = pass_start_.ends;
+  have_previous_rate_ = pass_start_.had_previous_rate;
+  time_ = step_start_;
 }
 
 void PulseSolver::take_substeps() {

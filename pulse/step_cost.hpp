@@ -27,6 +27,11 @@ constexpr double element_step_seconds(int degree) {
   return per_element + per_mode_pair * modes * modes;
 }
 
+// Each coupling pass lengthens the 0D step by this fraction of the period, up to the most
+// passes measured within issue 5's tolerances of --model 1d (docs/solver.md §10).
+inline constexpr double step_per_coupling_pass = 1e-3;
+inline constexpr int most_coupling_passes = 4;
+
 // The 1D-0D coupling passes that cost least per cycle: the 1D substeps cost one_d per pass,
 // the 0D steps zero_d at a thousandth of the period, fewer as each pass lengthens the step by
 // another thousandth: N one_d + zero_d / N. One pass more pays while zero_d / (N (N + 1)) >
