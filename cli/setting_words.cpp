@@ -18,6 +18,7 @@ const SettingWords& hemosolve_words() {
       {"low_degree", "--low-degree"},
       {"lumped_passes", "--lumped-passes"},
       {"lumped_rc", "--lumped-rc"},
+      {"lumped_sections", "--lumped-sections"},
       {"lumped_step", "--lumped-step"},
       {"lumped_transit", "--lumped-transit"},
       {"max_cycles", "--max-cycles"},

@@ -72,9 +72,11 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
       const LumpedCapacitor rows = rcr.lumped_capacitor();
       capacitor_of_outlet_[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(outlet_of_capacitor_.size());
       const auto c = static_cast<std::int32_t>(nodes_++);
-      outlet_boundary_.back().r1_edge = static_cast<std::int32_t>(vessels_.size() + outlet_of_capacitor_.size());
+      outlet_boundary_.back().r1_edge = static_cast<std::int32_t>(vessel_edges_ + outlet_of_capacitor_.size());
       outlet_of_capacitor_.push_back(k);
-      capacitor_vessel_edge_.push_back(index_of_vessel_[v]);
+      // The vessel's section at the outlet: its first at `from`, its last at `to`.
+      const auto index = static_cast<std::size_t>(index_of_vessel_[v]);
+      capacitor_vessel_edge_.push_back(static_cast<std::int32_t>(end_sign[network_node] < 0 ? first_edge(index) : first_edge(index + 1) - 1));
       capacitor_edge_sign_.push_back(end_sign[network_node]);
       a_.push_back(static_cast<std::int32_t>(at));
       b_.push_back(c);

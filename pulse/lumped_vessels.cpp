@@ -20,7 +20,7 @@ namespace hemotree {
 
 LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                              const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of,
-                             std::span<const VesselTaper> tapers)
+                             std::span<const VesselTaper> tapers, std::span<const std::uint8_t> sections)
     : density_(blood.density), friction_k_(friction_coefficient(blood.alpha)), viscosity_(&viscosity) {
   const std::size_t n = net.vessel_count();
   node_of_.assign(net.node_count(), -1);
@@ -30,23 +30,45 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   network_node_ = std::move(order.nodes);
   for (std::size_t k = 0; k < network_node_.size(); ++k)
     node_of_[static_cast<std::size_t>(network_node_[k])] = static_cast<std::int32_t>(k);
+  auto sections_of = [&](std::size_t v) {
+    const bool is_tapered = !taper_of.empty() && taper_of[v] >= 0;
+    return sections.empty() || is_tapered ? std::size_t{1} : std::max<std::size_t>(sections[v], 1);
+  };
+  // The inner nodes of vessels in sections, numbered in the network's order of their vessels
+  // (a checkpoint's order; placed after the capacitors below): here ~j for the j-th.
+  std::vector<std::int32_t> inner_first;
+  std::int32_t inner = 0;
+  if (!sections.empty()) {
+    inner_first.assign(n, -1);
+    for (std::size_t v = 0; v < n; ++v)
+      if (zero_d[v] && sections_of(v) > 1) {
+        inner_first[v] = inner;
+        inner += static_cast<std::int32_t>(sections_of(v) - 1);
+      }
+    if (inner > 0) first_edge_.push_back(0);
+  }
   for (const std::int32_t vessel : order.vessels) {
     const auto v = static_cast<std::size_t>(vessel);
     index_of_vessel_[v] = static_cast<std::int32_t>(vessels_.size());
     vessels_.push_back(vessel);
-    a_.push_back(node_of_[static_cast<std::size_t>(net.from[v])]);
-    b_.push_back(node_of_[static_cast<std::size_t>(net.to[v])]);
+    const std::size_t count = sections_of(v);
     const TubeLaw& law = laws[v];
-    edge_length_.push_back(net.length[v]);
-    edge_root_slope_.push_back(law.lumen_root_slope());
-    edge_root_intercept_.push_back(law.lumen_root_intercept());
+    for (std::size_t s = 0; s < count; ++s) {
+      a_.push_back(s == 0 ? node_of_[static_cast<std::size_t>(net.from[v])] : ~(inner_first[v] + static_cast<std::int32_t>(s) - 1));
+      b_.push_back(s + 1 == count ? node_of_[static_cast<std::size_t>(net.to[v])] : ~(inner_first[v] + static_cast<std::int32_t>(s)));
+      edge_length_.push_back(count == 1 ? net.length[v] : net.length[v] / static_cast<double>(count));
+      edge_root_slope_.push_back(law.lumen_root_slope());
+      edge_root_intercept_.push_back(law.lumen_root_intercept());
+    }
+    if (!first_edge_.empty()) first_edge_.push_back(static_cast<std::int32_t>(a_.size()));
     if (!taper_of.empty() && taper_of[v] >= 0) {
-      if (taper_edge_.empty()) taper_edge_.assign(n, -1);  // sized for every vessel; shrunk below
-      taper_edge_[vessels_.size() - 1] = static_cast<std::int32_t>(tapered_.size());
+      if (taper_edge_.empty()) taper_edge_.assign(n + static_cast<std::size_t>(inner), -1);  // shrunk below
+      taper_edge_[a_.size() - 1] = static_cast<std::int32_t>(tapered_.size());
       tapered_.push_back(describe_taper(tapers[static_cast<std::size_t>(taper_of[v])], blood.alpha));
     }
   }
-  if (!taper_edge_.empty()) taper_edge_.resize(vessels_.size());
+  vessel_edges_ = a_.size();
+  if (!taper_edge_.empty()) taper_edge_.resize(vessel_edges_);
   if (vessels_.empty()) return;
   network_nodes_ = network_node_.size();
   nodes_ = network_nodes_;
@@ -56,11 +78,21 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
 
   add_boundary_rows(net, laws, viscosity);
 
-  // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes:
+  // The inner nodes after the capacitors: no shunt.
+  for (std::size_t e = 0; e < vessel_edges_; ++e)
+    for (std::int32_t* k : {&a_[e], &b_[e]})
+      if (*k < 0) *k = static_cast<std::int32_t>(nodes_) + ~*k;
+  nodes_ += static_cast<std::size_t>(inner);
+  shunt_.resize(nodes_, 0.0);
+  shunt_pressure_.resize(nodes_, 0.0);
+  volume_b_.resize(nodes_, 0.0);
+
+  // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes
+  // (of each section's, L / n):
   // (L / 2) (d^2 p^2 + 2 c d p + c^2).
   volume_a_.assign(nodes_, 0.0);
   volume_c_.assign(nodes_, 0.0);
-  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+  for (std::size_t e = 0; e < vessel_edges_; ++e) {
     const double w = edge_length_[e] / 2, c = edge_root_intercept_[e], d = edge_root_slope_[e];
     for (const std::int32_t k : {a_[e], b_[e]}) {
       const auto i = static_cast<std::size_t>(k);
@@ -87,7 +119,7 @@ void LumpedVessels::allocate_system() {
   previous_volume_ = pressure_ = previous_pressure_ = volume_;
   flow_.assign(edges, 0.0);
   previous_flow_ = flow_;
-  capacity_a_.assign(vessels_.size(), 0.0);
+  capacity_a_.assign(vessel_edges_, 0.0);
   capacity_b_ = resistance_ = previous_resistance_ = capacity_a_;  // the step's own arrays: at the first predict()
 
   if (2 * edges >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
@@ -119,7 +151,7 @@ void LumpedVessels::allocate_step_arrays() {
   conductance_.assign(edges, 0.0);
   history_.assign(edges, 0.0);
   // The R1 edges of RCR outlets keep their conductance, and have no inertance.
-  for (std::size_t e = vessels_.size(); e < edges; ++e) conductance_[e] = 1 / edge_fixed_resistance_[e - vessels_.size()];
+  for (std::size_t e = vessel_edges_; e < edges; ++e) conductance_[e] = 1 / edge_fixed_resistance_[e - vessel_edges_];
 }
 
 void LumpedVessels::release_step_arrays() {
@@ -217,13 +249,13 @@ void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
   std::vector<std::int32_t> slot(nodes_, -1);
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) slot[static_cast<std::size_t>(coupling_nodes_[j])] = static_cast<std::int32_t>(j);
   coupling_edge_offset_.assign(coupling_nodes_.size() + 1, 0);
-  for (std::size_t e = 0; e < vessels_.size(); ++e)
+  for (std::size_t e = 0; e < vessel_edges_; ++e)
     for (const std::int32_t k : {a_[e], b_[e]})
       if (slot[static_cast<std::size_t>(k)] >= 0) ++coupling_edge_offset_[static_cast<std::size_t>(slot[static_cast<std::size_t>(k)]) + 1];
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_edge_offset_[j + 1] += coupling_edge_offset_[j];
   coupling_edge_.resize(static_cast<std::size_t>(coupling_edge_offset_.back()));
   std::vector<std::int64_t> fill(coupling_edge_offset_.begin(), coupling_edge_offset_.end() - 1);
-  for (std::size_t e = 0; e < vessels_.size(); ++e)
+  for (std::size_t e = 0; e < vessel_edges_; ++e)
     for (const std::int32_t k : {a_[e], b_[e]})
       if (const auto j = slot[static_cast<std::size_t>(k)]; j >= 0)
         coupling_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(j)]++)] = static_cast<std::int32_t>(e);
@@ -232,7 +264,7 @@ void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
 
 void LumpedVessels::update_resistances() {
   linearised_dt_ = 0;
-  parallel_blocks(static_cast<std::int64_t>(vessels_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
+  parallel_blocks(static_cast<std::int64_t>(vessel_edges_), threads_, [&](std::int64_t first, std::int64_t last) {
     for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e)
       resistance_[e] = resistance(e, pressure_[static_cast<std::size_t>(a_[e])],
                                   pressure_[static_cast<std::size_t>(b_[e])], capacity_a_[e], capacity_b_[e]);
@@ -244,7 +276,7 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
   // then the next step's edges at the state extrapolated from them (linearise's first pass,
   // the same arithmetic), should that step be as long as this one.
   if (!tapered_.empty()) {
-    parallel_blocks(static_cast<std::int64_t>(vessels_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
+    parallel_blocks(static_cast<std::int64_t>(vessel_edges_), threads_, [&](std::int64_t first, std::int64_t last) {
       for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
         const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
         resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
@@ -259,7 +291,7 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
   // across vessels only where their stages sit side by side in the code. Each vessel's
   // operations are those of resistance() and linearise_edge(): the same bits.
   const ViscosityTable& viscosity = *viscosity_;
-  parallel_blocks(static_cast<std::int64_t>(vessels_.size()), threads_, [&](std::int64_t first, std::int64_t last) {
+  parallel_blocks(static_cast<std::int64_t>(vessel_edges_), threads_, [&](std::int64_t first, std::int64_t last) {
     constexpr std::size_t width = 8;
     double aa[width], ab[width], am[width], mu_a[width], mu_b[width], mu_m[width];
     for (auto e0 = static_cast<std::size_t>(first); e0 < static_cast<std::size_t>(last); e0 += width) {
@@ -333,22 +365,19 @@ double LumpedVessels::resistance(std::size_t e, double pa, double pb, double& ca
 
 void LumpedVessels::set_viscosity_factors(std::span<const double> per_vessel) {
   if (per_vessel.empty() && viscosity_factor_.empty()) return;
-  if (viscosity_factor_.empty()) viscosity_factor_.assign(vessels_.size(), 1.0);
-  const bool started = !resistance_.empty() && !previous_pressure_.empty();
-  for (std::size_t e = 0; e < vessels_.size(); ++e) {
-    const double f = per_vessel.empty() ? 1.0 : per_vessel[static_cast<std::size_t>(vessels_[e])];
-    if (f == viscosity_factor_[e]) continue;
-    viscosity_factor_[e] = f;
-    if (started) refresh_resistance(e);
-  }
+  for (std::size_t i = 0; i < vessels_.size(); ++i)
+    set_viscosity_factor(static_cast<std::int32_t>(i), per_vessel.empty() ? 1.0 : per_vessel[static_cast<std::size_t>(vessels_[i])]);
 }
 
 void LumpedVessels::set_viscosity_factor(std::int32_t index, double factor) {
-  const auto e = static_cast<std::size_t>(index);
-  if (viscosity_factor_.empty()) viscosity_factor_.assign(vessels_.size(), 1.0);
-  if (factor == viscosity_factor_[e]) return;
-  viscosity_factor_[e] = factor;
-  if (!resistance_.empty() && !previous_pressure_.empty()) refresh_resistance(e);
+  if (viscosity_factor_.empty()) viscosity_factor_.assign(vessel_edges_, 1.0);
+  const bool started = !resistance_.empty() && !previous_pressure_.empty();
+  const auto i = static_cast<std::size_t>(index);
+  for (std::size_t e = first_edge(i); e < first_edge(i + 1); ++e) {
+    if (factor == viscosity_factor_[e]) continue;
+    viscosity_factor_[e] = factor;
+    if (started) refresh_resistance(e);
+  }
 }
 
 void LumpedVessels::refresh_resistance(std::size_t e) {
@@ -398,10 +427,12 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
   if (empty()) return;
   for (std::size_t k = 0; k < network_nodes_; ++k)
     pressure_[k] = network_node_pressure[static_cast<std::size_t>(network_node_[k])];
-  for (std::size_t e = 0; e < vessels_.size(); ++e) flow_[e] = vessel_flow[static_cast<std::size_t>(vessels_[e])];
+  for (std::size_t i = 0; i < vessels_.size(); ++i)
+    for (std::size_t e = first_edge(i); e < first_edge(i + 1); ++e) flow_[e] = vessel_flow[static_cast<std::size_t>(vessels_[i])];
+  start_inner_nodes();
   for (std::size_t j = 0; j < outlet_of_capacitor_.size(); ++j) {
-    // R1 edges follow the vessels: edge vessels_.size() + j joins the vessel's end to capacitor j.
-    const std::size_t e = vessels_.size() + j;
+    // R1 edges follow the vessels: edge vessel_edges_ + j joins the vessel's end to capacitor j.
+    const std::size_t e = vessel_edges_ + j;
     const double q = capacitor_edge_sign_[j] * flow_[static_cast<std::size_t>(capacitor_vessel_edge_[j])];
     const double pc = pressure_[static_cast<std::size_t>(a_[e])] - edge_fixed_resistance_[j] * q;
     pressure_[static_cast<std::size_t>(b_[e])] = pc;
@@ -414,20 +445,37 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
   update_dynamic_pressures();
 }
 
+void LumpedVessels::start_inner_nodes() {
+  // A vessel in sections: its inner nodes on the steady profile of the whole vessel between
+  // its end pressures (the flow capacity G linear in p between its ends': pressure_at's).
+  if (!sectioned()) return;
+  for (std::size_t i = 0; i < vessels_.size(); ++i) {
+    const std::size_t first = first_edge(i), last = first_edge(i + 1);
+    if (last - first < 2) continue;
+    const double pa = pressure_[static_cast<std::size_t>(a_[first])], pb = pressure_[static_cast<std::size_t>(b_[last - 1])];
+    double ga, gb;
+    resistance(first, pa, pb, ga, gb);
+    for (std::size_t e = first + 1; e < last; ++e)
+      pressure_[static_cast<std::size_t>(a_[e])] =
+          steady_profile_pressure(pa, pb, ga, gb, static_cast<double>(e - first) / static_cast<double>(last - first));
+  }
+}
+
 void LumpedVessels::start_at_rest(std::span<const TubeLaw> laws) {
   if (empty()) return;
-  // Each node at the mean reference pressure of its vessels, no flow; capacitors at p_out.
-  std::vector<double> sum(network_nodes_, 0.0), count(network_nodes_, 0.0);
-  for (std::size_t e = 0; e < vessels_.size(); ++e)
-    for (const std::int32_t k : {a_[e], b_[e]}) {
-      const TubeLaw& law = laws[static_cast<std::size_t>(vessels_[e])];
-      // A tapered vessel rests at its measured lumen (physics/vessel_taper.hpp), at that pressure.
-      sum[static_cast<std::size_t>(k)] += tapered(e) ? law.pressure(tapered_[static_cast<std::size_t>(taper_edge_[e])].taper.rest_area(0))
-                                                     : law.reference_pressure;
-      count[static_cast<std::size_t>(k)] += 1;
-    }
-  for (std::size_t k = 0; k < network_nodes_; ++k) pressure_[k] = sum[k] / count[k];
-  for (std::size_t k = network_nodes_; k < nodes_; ++k) pressure_[k] = shunt_pressure_[k];
+  // Each node at the mean reference pressure of its vessels, no flow; capacitors at p_out;
+  // a vessel's inner nodes at its own.
+  std::vector<double> sum(nodes_, 0.0), count(nodes_, 0.0);
+  for (std::size_t i = 0; i < vessels_.size(); ++i)
+    for (std::size_t e = first_edge(i); e < first_edge(i + 1); ++e)
+      for (const std::int32_t k : {a_[e], b_[e]}) {
+        const TubeLaw& law = laws[static_cast<std::size_t>(vessels_[i])];
+        // A tapered vessel rests at its measured lumen (physics/vessel_taper.hpp), at that pressure.
+        sum[static_cast<std::size_t>(k)] += tapered(e) ? law.pressure(tapered_[static_cast<std::size_t>(taper_edge_[e])].taper.rest_area(0))
+                                                       : law.reference_pressure;
+        count[static_cast<std::size_t>(k)] += 1;
+      }
+  for (std::size_t k = 0; k < nodes_; ++k) pressure_[k] = is_capacitor(k) ? shunt_pressure_[k] : sum[k] / count[k];
   std::fill(flow_.begin(), flow_.end(), 0.0);
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
   predicted_ = pressure_;
@@ -449,7 +497,7 @@ void LumpedVessels::restart_history() {
 
 void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled_inflow) {
   const double dt = dt_;
-  const auto vessels_i = static_cast<std::int64_t>(vessels_.size()), nodes_i = static_cast<std::int64_t>(nodes_);
+  const auto vessels_i = static_cast<std::int64_t>(vessel_edges_), nodes_i = static_cast<std::int64_t>(nodes_);
   // The state the coefficients are taken at: the extrapolation x* = 2 x^n - x^(n-1) to t1 (an
   // error of O(dt^2) in the coefficients keeps BDF2 second order with one solve; the
   // resistance is extrapolated itself, no viscosity to evaluate, within a factor of two of
@@ -617,7 +665,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   }
   double outflow = 0;
   for (const double b : block_outflow_) outflow += b;
-  for (std::size_t e = vessels_.size(); e < a_.size(); ++e) outflow += flow_[e];
+  for (std::size_t e = vessel_edges_; e < a_.size(); ++e) outflow += flow_[e];
   exchanged_out += dt * outflow;
   for (std::size_t j = 0; j < held_node_.size(); ++j) {
     const double out = held_outflow(j);
@@ -642,19 +690,69 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
 
 // ---- what the rest of the solver reads -------------------------------------------------------
 
-double LumpedVessels::pressure_at(std::int32_t index, double x) const {
-  const auto e = static_cast<std::size_t>(index);
+double LumpedVessels::steady_profile_pressure(double pa, double pb, double ga, double gb, double x) {
+  const double drop = pa - pb;
+  if (drop == 0) return pa;
+  // With G = A^2 / (k mu) linear in p between G_a and G_b, int_p^pa G dp = x int_pb^pa G dp
+  // is a quadratic in d = pa - p: G_a d - g d^2 / 2 = x F, g = (G_a - G_b) / (pa - pb).
+  const double slope = (ga - gb) / drop, f = x * drop * 0.5 * (ga + gb);
+  const double disc = ga * ga - 2 * slope * f;
+  return pa - 2 * f / (ga + std::sqrt(std::max(disc, 0.0)));
+}
+
+double LumpedVessels::edge_pressure_at(std::size_t e, double x) const {
   const double pa = pressure_[static_cast<std::size_t>(a_[e])], pb = pressure_[static_cast<std::size_t>(b_[e])];
   const double drop = pa - pb;
   if (drop == 0 || x <= 0) return pa;
   if (x >= 1) return pb;
   if (tapered(e)) return pa - drop * resistance_fraction(e, x);  // the rigid taper's profile
-  // With G = A^2 / (k mu) linear in p between G_a and G_b, int_p^pa G dp = x int_pb^pa G dp
-  // is a quadratic in d = pa - p: G_a d - g d^2 / 2 = x F, g = (G_a - G_b) / (pa - pb).
-  const double ga = capacity_a_[e], gb = capacity_b_[e];
-  const double slope = (ga - gb) / drop, f = x * drop * 0.5 * (ga + gb);
-  const double disc = ga * ga - 2 * slope * f;
-  return pa - 2 * f / (ga + std::sqrt(std::max(disc, 0.0)));
+  return steady_profile_pressure(pa, pb, capacity_a_[e], capacity_b_[e], x);
+}
+
+std::size_t LumpedVessels::section_at(std::size_t i, double x, double& within) const {
+  const std::size_t first = first_edge(i), n = first_edge(i + 1) - first;
+  if (n == 1) {
+    within = x;
+    return first;
+  }
+  const double scaled = std::clamp(x, 0.0, 1.0) * static_cast<double>(n);
+  const std::size_t s = std::min(static_cast<std::size_t>(scaled), n - 1);
+  within = scaled - static_cast<double>(s);
+  return first + s;
+}
+
+double LumpedVessels::pressure_at(std::int32_t index, double x) const {
+  double within;
+  const std::size_t e = section_at(static_cast<std::size_t>(index), x, within);
+  return edge_pressure_at(e, within);
+}
+
+double LumpedVessels::flow(std::int32_t index) const {
+  const auto i = static_cast<std::size_t>(index);
+  const std::size_t first = first_edge(i), last = first_edge(i + 1);
+  if (last - first == 1) return flow_[first];
+  double sum = 0;
+  for (std::size_t e = first; e < last; ++e) sum += flow_[e];
+  return sum / static_cast<double>(last - first);
+}
+
+double LumpedVessels::flow_at(std::int32_t index, double x) const {
+  double within;
+  const auto i = static_cast<std::size_t>(index);
+  const std::size_t e = section_at(i, x, within);
+  // At a node between two sections, the flow is theirs in the mean (the node's compliance takes the difference).
+  if (within == 0 && e > first_edge(i)) return 0.5 * (flow_[e - 1] + flow_[e]);
+  return flow_[e];
+}
+
+double LumpedVessels::sectioned_volume(std::int32_t index) const {
+  const auto i = static_cast<std::size_t>(index);
+  double v = 0;
+  for (std::size_t e = first_edge(i); e < first_edge(i + 1); ++e) {
+    const double sa = lumen_root(e, pressure_[static_cast<std::size_t>(a_[e])]), sb = lumen_root(e, pressure_[static_cast<std::size_t>(b_[e])]);
+    v += edge_length_[e] * 0.5 * (sa * sa + sb * sb);
+  }
+  return v;
 }
 
 void LumpedVessels::sample(double x, std::span<double> area, std::span<double> flow, std::span<double> pressure,
@@ -662,19 +760,33 @@ void LumpedVessels::sample(double x, std::span<double> area, std::span<double> f
   const auto vessels = static_cast<std::int64_t>(vessels_.size());
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
   for (std::int64_t i = 0; i < vessels; ++i) {
-    const auto e = static_cast<std::size_t>(i);
-    const auto v = static_cast<std::size_t>(vessels_[e]);
-    const double p = pressure_at(static_cast<std::int32_t>(i), x);
-    const double s = lumen_root(e, p, x);
+    const auto v = static_cast<std::size_t>(vessels_[static_cast<std::size_t>(i)]);
+    double within;
+    const std::size_t e = section_at(static_cast<std::size_t>(i), x, within);
+    const double p = edge_pressure_at(e, within);
+    const double s = lumen_root(e, p, within);
     area[v] = s * s;
-    flow[v] = flow_[e];
+    flow[v] = sectioned() ? flow_at(static_cast<std::int32_t>(i), x) : flow_[e];
     if (!pressure.empty()) pressure[v] = p;
   }
 }
 
 void LumpedVessels::centre_batch(std::size_t first, std::size_t n, CentreBatch& batch) const {
   batch.n = n;
-  for (std::size_t i = 0; i < n; ++i) batch.pressure[i] = pressure_at(static_cast<std::int32_t>(first + i), 0.5);
+  if (sectioned()) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto index = static_cast<std::int32_t>(first + i);
+      double within;
+      const std::size_t e = section_at(first + i, 0.5, within);
+      batch.pressure[i] = edge_pressure_at(e, within);
+      const double root = lumen_root(e, batch.pressure[i], within);
+      batch.area[i] = root * root;
+      batch.flow[i] = flow_at(index, 0.5);
+      batch.vessel[i] = static_cast<std::size_t>(vessels_[first + i]);
+    }
+    return;
+  }
+  for (std::size_t i = 0; i < n; ++i) batch.pressure[i] = edge_pressure_at(first + i, 0.5);
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t e = first + i;
     const double root = lumen_root(e, batch.pressure[i], 0.5);
@@ -688,7 +800,7 @@ double LumpedVessels::stored_volume() const {
   // Summed in the network's order: the same bits whatever the arrays' order.
   double v = 0;
   for (const std::int32_t node : network_order_nodes())
-    if (const auto k = static_cast<std::size_t>(node); k < network_nodes_) v += volume_c_[k] + 0.5 * (3 * volume_[k] - previous_volume_[k]);
+    if (const auto k = static_cast<std::size_t>(node); !is_capacitor(k)) v += volume_c_[k] + 0.5 * (3 * volume_[k] - previous_volume_[k]);
   return v;
 }
 
@@ -699,12 +811,19 @@ double LumpedVessels::capacitor_pressure(std::size_t outlet) const {
 
 void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std::span<const double> outlet_dp) {
   if (empty()) return;
-  for (std::size_t k = 0; k < nodes_; ++k) {
+  for (std::size_t k = 0; k < network_nodes_ + outlet_of_capacitor_.size(); ++k)
     pressure_[k] += k < network_nodes_
                         ? network_node_dp[static_cast<std::size_t>(network_node_[k])]
                         : outlet_dp[static_cast<std::size_t>(outlet_of_capacitor_[k - network_nodes_])];
-    volume_[k] = node_excess(k, pressure_[k]);
+  // Inner nodes by their place between their vessel's ends.
+  for (std::size_t i = 0; sectioned() && i < vessels_.size(); ++i) {
+    const std::size_t first = first_edge(i), n = first_edge(i + 1) - first;
+    const double da = network_node_dp[static_cast<std::size_t>(network_node_[static_cast<std::size_t>(a_[first])])];
+    const double db = network_node_dp[static_cast<std::size_t>(network_node_[static_cast<std::size_t>(b_[first + n - 1])])];
+    for (std::size_t s = 1; s < n; ++s)
+      pressure_[static_cast<std::size_t>(a_[first + s])] += da + (db - da) * static_cast<double>(s) / static_cast<double>(n);
   }
+  for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
   predicted_ = pressure_;
   update_resistances();
   restart_history();
@@ -714,11 +833,13 @@ void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std
 void LumpedVessels::check(double time, std::span<const std::int64_t> vessel_id) const {
   for (const std::int32_t index : index_of_vessel_) {  // the first in the network's order is named
     if (index < 0) continue;
-    const auto e = static_cast<std::size_t>(index);
-    const double s_a = lumen_root(e, pressure_[static_cast<std::size_t>(a_[e])], 0.0);
-    const double s_b = lumen_root(e, pressure_[static_cast<std::size_t>(b_[e])], 1.0);
-    if (!(s_a > 0) || !(s_b > 0) || !std::isfinite(flow_[e]) || !std::isfinite(s_a * s_b))
-      throw SolutionBreakdown(vessel_id[static_cast<std::size_t>(vessels_[e])], time);
+    const auto i = static_cast<std::size_t>(index);
+    for (std::size_t e = first_edge(i); e < first_edge(i + 1); ++e) {
+      const double s_a = lumen_root(e, pressure_[static_cast<std::size_t>(a_[e])], 0.0);
+      const double s_b = lumen_root(e, pressure_[static_cast<std::size_t>(b_[e])], 1.0);
+      if (!(s_a > 0) || !(s_b > 0) || !std::isfinite(flow_[e]) || !std::isfinite(s_a * s_b))
+        throw SolutionBreakdown(vessel_id[static_cast<std::size_t>(vessels_[i])], time);
+    }
   }
 }
 
@@ -727,17 +848,20 @@ void LumpedVessels::check(double time, std::span<const std::int64_t> vessel_id) 
 std::vector<std::int32_t> LumpedVessels::network_order_edges() const {
   std::vector<std::int32_t> place;
   place.reserve(a_.size());
-  for (const std::int32_t e : index_of_vessel_)
-    if (e >= 0) place.push_back(e);
-  for (std::size_t e = vessels_.size(); e < a_.size(); ++e) place.push_back(static_cast<std::int32_t>(e));  // R1 edges
+  for (const std::int32_t i : index_of_vessel_)
+    if (i >= 0)
+      for (std::size_t e = first_edge(static_cast<std::size_t>(i)); e < first_edge(static_cast<std::size_t>(i) + 1); ++e)
+        place.push_back(static_cast<std::int32_t>(e));
+  for (std::size_t e = vessel_edges_; e < a_.size(); ++e) place.push_back(static_cast<std::int32_t>(e));  // R1 edges
   return place;
 }
 
 std::vector<std::int32_t> LumpedVessels::network_order_nodes() const {
   std::vector<std::int32_t> edges = network_order_edges();
-  edges.resize(vessels_.size());  // the vessels' ends, not the R1 edges'
-  std::vector<std::int32_t> place = nodes_by_first_appearance(edges, a_, b_, network_nodes_);
-  for (std::size_t k = network_nodes_; k < nodes_; ++k) place.push_back(static_cast<std::int32_t>(k));  // capacitors
+  edges.resize(vessel_edges_);  // the vessels' ends and inner nodes, not the R1 edges'
+  std::vector<std::int32_t> place = nodes_by_first_appearance(edges, a_, b_, nodes_);
+  for (std::size_t k = network_nodes_; k < nodes_; ++k)
+    if (is_capacitor(k)) place.push_back(static_cast<std::int32_t>(k));
   return place;
 }
 
@@ -770,7 +894,7 @@ void LumpedVessels::restore(CheckpointReader& in) {
   for (auto* v : {&flow_, &previous_flow_}) get(*v, edges);
   predicted_ = pressure_;
   // The resistances are functions of the pressures: the same bits as the run had.
-  for (std::size_t e = 0; e < vessels_.size(); ++e) {
+  for (std::size_t e = 0; e < vessel_edges_; ++e) {
     double capacity_a, capacity_b;
     previous_resistance_[e] = resistance(e, previous_pressure_[static_cast<std::size_t>(a_[e])],
                                          previous_pressure_[static_cast<std::size_t>(b_[e])], capacity_a, capacity_b);

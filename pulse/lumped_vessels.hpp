@@ -12,6 +12,12 @@
 // every vessel: volume is the conserved variable, so mass is conserved to round-off whatever
 // the nonlinear iteration leaves.
 //
+// A vessel along which the pressure diffuses (a long capillary: w R C above what one pi
+// circuit follows) may be a chain of n equal pi sections instead, with n - 1 nodes of its own
+// inside it: the same element on L / n, whose error falls as 1 / n^2 (docs/solver.md §10).
+// Its sections are edges side by side in the arrays (the first at `from`), its inner nodes
+// come after the capacitor nodes.
+//
 // BDF2 (L-stable: L / R, nanoseconds in a capillary, lies far below the step, and is damped
 // rather than resolved) with the flows eliminated leaves one system in the node pressures,
 // the weighted Laplacian plus C/dt of network_flow/nodal_system: on a tree, O(nodes) per
@@ -54,9 +60,11 @@ class LumpedVessels {
   // vessel (docs/solver.md §10) holds int A(p, x) dx, still a quadratic in p; its resistance
   // is int k mu(A) / A^2 dx along the rigid taper's pressure profile, its inertance
   // rho int dx / A.
+  // sections: per vessel, the pi sections of a 0D one (0 or 1: one; empty: all one). A
+  // tapered vessel takes one.
   LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                 const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of = {},
-                std::span<const VesselTaper> tapers = {});
+                std::span<const VesselTaper> tapers = {}, std::span<const std::uint8_t> sections = {});
   // Solves a step takes (1: the extrapolated linearisation alone), and the threads of its
   // loops over vessels and nodes and of the elimination's subtrees.
   void set_passes(int passes) { passes_ = passes; }
@@ -67,7 +75,15 @@ class LumpedVessels {
 
   bool empty() const { return vessels_.empty(); }
   std::size_t vessel_count() const { return vessels_.size(); }
-  std::size_t node_count() const { return nodes_; }  // network nodes of 0D vessels, then capacitors
+  std::size_t node_count() const { return nodes_; }  // network nodes of 0D vessels, capacitors, inner nodes
+  // Whether any 0D vessel is more than one pi section (then inner nodes hold volume that no
+  // network node does: a transport of the network's nodes cannot take it).
+  bool sectioned() const { return !first_edge_.empty(); }
+  // The pi sections of 0D vessel `index`.
+  std::size_t sections(std::int32_t index) const {
+    const auto i = static_cast<std::size_t>(index);
+    return first_edge_.empty() ? 1 : static_cast<std::size_t>(first_edge_[i + 1] - first_edge_[i]);
+  }
   // Its node for a network node, or -1 where no 0D vessel ends.
   std::int32_t node_of(std::int64_t network_node) const { return node_of_[static_cast<std::size_t>(network_node)]; }
   // The boundary flows and pressures at its nodes, by their places in the run's list
@@ -133,9 +149,17 @@ class LumpedVessels {
   // The state a vessel's samples come from.
   double node_pressure(std::int32_t node) const { return pressure_[static_cast<std::size_t>(node)]; }
   std::int32_t vessel_index(std::size_t vessel) const { return index_of_vessel_[vessel]; }  // -1: 1D
-  double flow(std::int32_t index) const { return flow_[static_cast<std::size_t>(index)]; }
+  // A 0D vessel's flow: its sections' mean (one section: its flow).
+  double flow(std::int32_t index) const;
+  // Its flow at fraction x along it: its section's there; at a node between two sections,
+  // their mean.
+  double flow_at(std::int32_t index, double x) const;
+  // The volume of a 0D vessel that is more than one section, each half at its nodes' pressures
+  // as they hold it [m^3].
+  double sectioned_volume(std::int32_t index) const;
   // The pressure at fraction x along a 0D vessel: on the steady profile of a compliant tube
-  // between its end pressures (the flow is quasi-steady there), not on a line.
+  // between its end pressures (the flow is quasi-steady there), not on a line; in sections,
+  // the section's there between its nodes.
   double pressure_at(std::int32_t index, double x) const;
   // Every 0D vessel's lumen area, flow and (unless empty) pressure at fraction x along it,
   // into the network's per-vessel arrays (the cycle statistics' samples).
@@ -182,17 +206,18 @@ class LumpedVessels {
   }
   std::size_t network_node_count() const { return network_nodes_; }
   // A 0D vessel's nodes (its `from`, its `to`).
-  std::int32_t from_node(std::int32_t index) const { return a_[static_cast<std::size_t>(index)]; }
-  std::int32_t to_node(std::int32_t index) const { return b_[static_cast<std::size_t>(index)]; }
+  std::int32_t from_node(std::int32_t index) const { return a_[first_edge(static_cast<std::size_t>(index))]; }
+  std::int32_t to_node(std::int32_t index) const { return b_[first_edge(static_cast<std::size_t>(index) + 1) - 1]; }
   // From now on, each 0D vessel sums the volume it passes from `from` to `to` (dt times its
-  // flow at each step's end, the flow BDF2 balances the nodes with) [m^3].
-  void track_passed_volumes() { passed_.assign(vessels_.size(), 0.0); }
+  // flow at each step's end, the flow BDF2 balances the nodes with; of a vessel in sections,
+  // the flow out of `from`) [m^3].
+  void track_passed_volumes() { passed_.assign(vessel_edges_, 0.0); }
   void clear_passed_volumes() { std::fill(passed_.begin(), passed_.end(), 0.0); }
   // Each 0D vessel's viscosity is the run's times its factor (per network vessel; the
   // vessel's own hematocrit against the blood's: red-cell transport). Empty: all 1.
   void set_viscosity_factors(std::span<const double> per_vessel);
   void set_viscosity_factor(std::int32_t index, double factor);  // one 0D vessel's
-  double passed_volume(std::int32_t index) const { return passed_[static_cast<std::size_t>(index)]; }
+  double passed_volume(std::int32_t index) const { return passed_[first_edge(static_cast<std::size_t>(index))]; }
   // A capacitor's pressure, by the network's outlet index, or NaN if that outlet is not here.
   double capacitor_pressure(std::size_t outlet) const;
   // Compliance of a node at its pressure now [m^3/Pa].
@@ -219,6 +244,19 @@ class LumpedVessels {
   // The batch of vessels first .. first + n - 1 (arrays' order) at their centres.
   void centre_batch(std::size_t first, std::size_t n, CentreBatch& batch) const;
 
+  // A vessel's sections are edges first_edge(i) .. first_edge(i + 1) - 1 (one edge each
+  // without sections, first_edge_ then empty); the section at fraction x of vessel i, and x
+  // within it.
+  std::size_t first_edge(std::size_t i) const { return first_edge_.empty() ? i : static_cast<std::size_t>(first_edge_[i]); }
+  std::size_t section_at(std::size_t i, double x, double& within) const;
+  // The pressure at fraction x of a compliant tube's steady profile between end pressures pa,
+  // pb where its flow capacity is ga, gb (linear in p between them).
+  static double steady_profile_pressure(double pa, double pb, double ga, double gb, double x);
+  void start_inner_nodes();  // on the steady profile of their vessels, from the end pressures
+  // The pressure at fraction x along edge e on the steady profile between its end pressures.
+  double edge_pressure_at(std::size_t e, double x) const;
+  bool is_capacitor(std::size_t k) const { return k >= network_nodes_ && k < network_nodes_ + outlet_of_capacitor_.size(); }
+
   // A node's volume is a quadratic in its pressure (each vessel's L A(p) / 2 is, with the
   // tube law's A = (c + p / beta)^2, and a capacitor's C p is linear): V = a p^2 + b p + c.
   // The state is the excess W = V - c = a p^2 + b p: c drops out of every step (BDF2 is
@@ -242,7 +280,7 @@ class LumpedVessels {
     double unit_resistance = 0;
   };
   std::vector<TaperedEdge> tapered_;
-  std::vector<std::int32_t> taper_edge_;  // per 0D vessel (empty without tapers)
+  std::vector<std::int32_t> taper_edge_;  // per 0D vessel edge (empty without tapers)
   bool tapered(std::size_t e) const { return !taper_edge_.empty() && taper_edge_[e] >= 0; }
   static TaperedEdge describe_taper(const VesselTaper& taper, double alpha);
   // Fraction of the rigid taper's resistance built by fraction x of its length.
@@ -312,11 +350,13 @@ class LumpedVessels {
   void linearise_edge(std::size_t e, double pa, double pb, bool extrapolated, double dt);
   double linearised_dt_ = 0;
 
-  std::size_t nodes_ = 0, network_nodes_ = 0;  // network nodes first, then capacitor nodes
+  std::size_t nodes_ = 0, network_nodes_ = 0;  // network nodes first, then capacitor nodes, then inner nodes
   std::vector<std::int32_t> node_of_;          // per network node
   std::vector<std::int32_t> network_node_;     // per node below network_nodes_
   std::vector<std::int32_t> index_of_vessel_;  // per network vessel
   std::vector<std::int32_t> vessels_;          // per 0D vessel: its network index
+  std::vector<std::int32_t> first_edge_;       // per 0D vessel and one more (empty: one section each)
+  std::size_t vessel_edges_ = 0;               // the 0D vessels' edges (their sections)
   // Boundary flows (currents into their nodes) and held pressures: node, place in
   // the run's list, whether "in"; a held node's conductance scale (its vessel's at rest).
   std::vector<std::int32_t> inflow_node_, inflow_boundary_, held_node_, held_boundary_;
@@ -328,9 +368,9 @@ class LumpedVessels {
   };
   std::vector<OutletNode> outlet_boundary_;
 
-  // Edges: the 0D vessels (first), then the R1 of every RCR outlet on them.
+  // Edges: the 0D vessels' sections (first), then the R1 of every RCR outlet on them.
   std::vector<std::int32_t> a_, b_;
-  std::vector<double> edge_length_, edge_root_intercept_, edge_root_slope_;  // vessels: L, s(p) = c + p / beta
+  std::vector<double> edge_length_, edge_root_intercept_, edge_root_slope_;  // sections: L / n, s(p) = c + p / beta
   std::vector<double> edge_fixed_resistance_;  // R1 edges
   double density_ = 0, friction_k_ = 0;
   const ViscosityTable* viscosity_ = nullptr;
@@ -351,14 +391,14 @@ class LumpedVessels {
   // The step being taken: predicted pressures, and the edges' conductances and history
   // terms of the last linearisation (Q = g (p_a - p_b) + f), the inflows and prediction.
   std::vector<double> predicted_, conductance_, history_, system_shunt_, rhs_;
-  std::vector<double> passed_;  // per 0D vessel, where tracked (track_passed_volumes)
-  std::vector<double> viscosity_factor_;  // per 0D vessel (empty: 1)
+  std::vector<double> passed_;  // per 0D vessel edge, where tracked (track_passed_volumes)
+  std::vector<double> viscosity_factor_;  // per 0D vessel edge (empty: 1)
   void refresh_resistance(std::size_t e);  // after its factor changed: what restore() computes
   std::vector<std::int32_t> coupling_nodes_;
   std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
   std::vector<std::int32_t> coupling_edge_;
   std::vector<double> dynamic_;  // per coupling node
-  // The flow capacity G at each 0D vessel's two ends at the pressures now (the interior profile
+  // The flow capacity G at each 0D vessel edge's two ends at the pressures now (the interior profile
   // reads them), and its resistance now and a step before (the next step's extrapolation):
   // the viscosity is most of the cost, three evaluations a vessel and step.
   std::vector<double> capacity_a_, capacity_b_, resistance_, previous_resistance_;

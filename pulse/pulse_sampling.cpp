@@ -36,7 +36,7 @@ double PulseSolver::area_at(std::size_t vessel, double x) const {
 }
 
 double PulseSolver::flow_at(std::size_t vessel, double x) const {
-  if (zero_d_[vessel]) return lumped_.flow(lumped_.vessel_index(vessel));
+  if (zero_d_[vessel]) return lumped_.flow_at(lumped_.vessel_index(vessel), std::clamp(x, 0.0, 1.0));
   std::size_t el;
   double xi;
   locate(vessel, x, el, xi);

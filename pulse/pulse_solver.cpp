@@ -101,7 +101,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
       rcr_outlets_ = rcr_outlets_ || o.type == BoundaryType::rcr;
     }
   choose_models(options);
-  lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_);
+  lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
   lumped_.set_passes(options.lumped_passes);
   lumped_.set_threads(threads_);
 
@@ -257,7 +257,14 @@ void PulseSolver::choose_models(const SolverOptions& options) {
       resistance = tapered_poiseuille_resistance(
           [&](double d) { return viscosity_(std::numbers::pi / 4 * d * d); }, length, taper.d0, taper.d1, blood_.alpha);
     }
-    zero_d_[v] = !reflecting[v] && options.moves_in_phase(transit, omega * resistance * compliance, period);
+    const int sections = reflecting[v] ? 0 : options.lumped_sections_of(transit, omega * resistance * compliance, period);
+    zero_d_[v] = sections > 0;
+    if (sections > 1 && !is_tapered(v)) {  // a tapered vessel stays one section: 1D where one is too few
+      if (lumped_sections_.empty()) lumped_sections_.assign(n, 1);
+      lumped_sections_[v] = static_cast<std::uint8_t>(sections);
+    } else if (sections > 1) {
+      zero_d_[v] = false;
+    }
   }
 }
 

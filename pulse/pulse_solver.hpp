@@ -8,6 +8,9 @@
 // implicit): then a step is one 0D step with several explicit 1D substeps inside it.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <span>
@@ -46,6 +49,11 @@ struct SolverOptions {
   // (w R C < lumped_rc at the pulse's fundamental), unless it ends in a reflection outlet.
   double lumped_transit = 3e-3;
   double lumped_rc = 1.6;
+  // The most pi sections a 0D vessel takes: one whose w R C exceeds lumped_rc (a long
+  // capillary: the pressure diffuses along it) is n = floor(sqrt(w R C / lumped_rc)) + 1
+  // sections, each below lumped_rc, where n is at most this; else it is 1D. 1: one section
+  // each, every such vessel 1D.
+  int lumped_sections = 8;
   // The 0D step, as a fraction of the period (at most); 0: a thousandth of the period for
   // each coupling pass.
   double lumped_step = 0;
@@ -76,6 +84,14 @@ struct SolverOptions {
   // and its w R C (at the fundamental) below their bounds, is 0D.
   bool moves_in_phase(double transit, double omega_rc, double period) const {
     return transit < lumped_transit * period && omega_rc < lumped_rc;
+  }
+  // And the pi sections it takes: those that bring each one's w R C (which falls as 1 / n^2)
+  // below lumped_rc, where its transit is below lumped_transit; 0: it is 1D.
+  int lumped_sections_of(double transit, double omega_rc, double period) const {
+    if (!(transit < lumped_transit * period)) return 0;
+    if (omega_rc < lumped_rc) return 1;
+    const double n = std::floor(std::sqrt(omega_rc / lumped_rc)) + 1;
+    return n <= lumped_sections ? static_cast<int>(n) : 0;
   }
 };
 
@@ -118,6 +134,10 @@ class PulseSolver {
   void set_coupling_passes(int passes) { coupling_passes_ = passes < 1 ? 1 : passes; }
   double substep() const { return dt_ / substeps_; }
   bool is_lumped(std::size_t vessel) const { return zero_d_[vessel]; }
+  // The 0D vessels in more than one pi section (their inner nodes are no network node's).
+  std::size_t sectioned_count() const {
+    return static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t n) { return n > 1; }));
+  }
   std::size_t lumped_count() const {
     return lumped_count_after_release_ ? *lumped_count_after_release_ : lumped_.vessel_count();
   }
@@ -347,6 +367,7 @@ class PulseSolver {
     Eigen::Index first, count;
   };
   std::vector<bool> zero_d_;               // per vessel
+  std::vector<std::uint8_t> lumped_sections_;  // per vessel, where a 0D vessel takes more than one (else empty)
   LumpedVessels lumped_;
   std::optional<std::size_t> lumped_count_after_release_;  // release_lumped_state()
   int substeps_ = 1;

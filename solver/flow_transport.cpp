@@ -39,8 +39,12 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     : net_(net), solver_(solver), options_(options) {
   if (solver.steps() != 0)
     throw InputError("red-cell transport: set up before the solver's first step (its face volumes start then)");
-  solver_.track_face_volumes();
   const LumpedVessels& lumped = solver.lumped();
+  // Its cells at 0D nodes are the network's nodes: the inner nodes of a vessel in sections
+  // would hold volume no cell does (solver_options() keeps every 0D vessel one section).
+  if (lumped.sectioned())
+    throw InputError("red-cell and tracer transport: the 0D vessels must be one pi section each (--lumped-sections 1)");
+  solver_.track_face_volumes();
   const NetworkBoundaries& ends = solver.network_boundaries();
   const RunBoundaries& boundaries = solver.boundary_list();
   const Blood blood = solver.blood();

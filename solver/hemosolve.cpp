@@ -171,6 +171,11 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
                  "auto: the largest w R C (the vessel's resistance times its compliance at the pulse's "
                  "fundamental: the pressure's diffusion along a viscous vessel) of a 0D vessel, in [0, inf]")
       ->capture_default_str();
+  app.add_option("--lumped-sections", options.lumped_sections,
+                 "auto: the most pi sections of a 0D vessel, in [1, 64]: a vessel whose w R C exceeds "
+                 "--lumped-rc is cut into sections that each keep below it, where this many suffice, else it is "
+                 "1D; 1: every such vessel 1D (with red cells or tracers: always 1)")
+      ->capture_default_str();
   app.add_option("--lumped-step", lumped_step_text,
                  "with 0D vessels: the step of the 0D vessels, as a fraction of the period, in (0, 0.1], or auto: "
                  "a thousandth for each coupling pass; the 1D vessels take substeps within it")

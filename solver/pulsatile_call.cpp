@@ -114,9 +114,10 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
                      "flow, use fewer " + placeholder("elements") + " or a lower " + placeholder("degree") + ", or " +
                      placeholder("force") + " to run it anyway");
   d.one_d = net.vessel_count() - run.lumped_count();
+  const std::size_t sectioned = run.sectioned_count();
   observer.note(plural(d.one_d, "vessel") + " 1D, " + std::to_string(run.lumped_count()) + " 0D (" +
-                in_words(placeholder("model"), config.words) + " " +
-                to_string(config.solver.model) + ")" +
+                in_words(placeholder("model"), config.words) + " " + to_string(config.solver.model) +
+                (sectioned > 0 ? ", " + std::to_string(sectioned) + " of them in pi sections" : std::string()) + ")" +
                 (run.lumped_count() > 0 && d.one_d > 0
                      ? "; " + std::to_string(run.substeps()) + " 1D substeps of " +
                            format_quantity(run.substep(), "s") + " per step" +
@@ -184,6 +185,7 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
                          {"model", to_string(options.model)},
                          {"vessels_1d", d.one_d},
                          {"vessels_0d", run.lumped_count()},
+                         {"vessels_0d_in_sections", run.sectioned_count()},
                          {"substeps", run.substeps()},
                          {"coupling_passes", run.coupling_passes()},
                          {"threads", options.threads},
@@ -296,7 +298,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   if (interrupted_before_start()) return result;
 
   // ---- the discretisation, its step and its cost ---------------------------------------
-  PulseSolver run(net, config.solver);  // the steady solve: minutes on the full tree
+  PulseSolver run(net, solver_options(config));  // the steady solve: minutes on the full tree
   if (interrupted_before_start()) return result;
   const Discretisation d = decide_discretisation(net, run, config, period, observer);
   const std::size_t steps_per_cycle = d.step.cycle.steps_per_cycle;

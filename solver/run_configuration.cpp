@@ -131,6 +131,12 @@ double lumped_step_named(const std::string& name) {
 RedCells red_cells_named(const std::string& name) { return named(name, red_cell_names, "red_cells"); }
 
 // In the order hemosolve has always checked them, so that its first complaint is the same.
+SolverOptions solver_options(const RunConfiguration& config) {
+  SolverOptions options = config.solver;
+  if (config.carries_transport()) options.lumped_sections = 1;
+  return options;
+}
+
 void check_configuration(const RunConfiguration& c) {
   check_count(c.cycles, 1, 100000, "cycles");
   check_count(c.max_cycles, 1, 100000, "max_cycles");
@@ -142,6 +148,7 @@ void check_configuration(const RunConfiguration& c) {
   const SolverOptions& s = c.solver;
   check_range(s.lumped_transit, {0, 1}, "lumped_transit");
   check_range(s.lumped_rc, {0, INFINITY}, "lumped_rc");
+  check_count(s.lumped_sections, 1, 64, "lumped_sections");
   if (s.lumped_step != 0) check_range(s.lumped_step, {0, 0.1, true, false}, "lumped_step");  // 0: automatic
   if (s.coupling_passes != SolverOptions::automatic) check_count(s.coupling_passes, 1, 10, "coupling_passes");
   check_count(s.lumped_passes, 1, 10, "lumped_passes");

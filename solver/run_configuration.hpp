@@ -75,6 +75,11 @@ struct RunConfiguration {
 // which the caller words (hemosolve: its flags, cli/setting_words.cpp).
 void check_configuration(const RunConfiguration& config);
 
+// The solver's options as the run takes them: with red cells or tracers, every 0D vessel one
+// pi section (their cells are the network's nodes; a vessel in sections holds volume at inner
+// nodes of its own), so a vessel that needs more is 1D, as it is with --lumped-sections 1.
+SolverOptions solver_options(const RunConfiguration& config);
+
 // A cycle of N steps of dt = T / N: the step no longer than the solver's, N = ceil(T / step)
 // (less 1e-9 of a step, so that a step that divides the period is kept), so that every
 // cycle ends exactly on a step. InputError when N is beyond any machine's reach.

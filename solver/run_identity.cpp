@@ -78,7 +78,7 @@ std::string state_shaping(const RunConfiguration& config, const Network& net, do
   // The settling cycle is taken before the run's first (a resume continues after it).
   (void)network_name, (void)out_dir, (void)cycles, (void)until_periodic, (void)periodic_tolerance,
       (void)max_cycles, (void)settling_step, (void)checkpoint_every, (void)resume, (void)frames, (void)vtk, (void)vtk_keep, (void)force, (void)words;
-  const auto& [model, lumped_transit, lumped_rc, lumped_step, coupling_passes, lumped_passes, degree, degree_rule, elements,
+  const auto& [model, lumped_transit, lumped_rc, lumped_sections, lumped_step, coupling_passes, lumped_passes, degree, degree_rule, elements,
                quadrature_points, scheme, asked_dt, cfl, friction_safety, external_pressure, thick_wall_ratio,
                start, periodic_harmonics, rheology_override, threads] = solver;
   // The step taken is dt (asked_dt only proposes it); the rheology taken is `rheology`
@@ -90,7 +90,7 @@ std::string state_shaping(const RunConfiguration& config, const Network& net, do
   std::ostringstream s;
   s.precision(std::numeric_limits<double>::max_digits10);  // every bit: 6 digits let 0.10000001 pass as 0.1
   s << "model " << to_string(model) << " (" << lumped_transit << ", " << lumped_rc << ", " << lumped_step << ", "
-    << lumped_passes << " passes, " << coupling_passes << " coupling passes), scheme " << to_string(scheme) << ", degree "
+    << lumped_passes << " passes, " << coupling_passes << " coupling passes, " << lumped_sections << " sections), scheme " << to_string(scheme) << ", degree "
     << (degree == SolverOptions::automatic ? std::string("auto") : std::to_string(degree)) << " (" << low << "/"
     << raise_to << "/" << high << ", linear error " << linear_error << ", short " << short_vessel << " of harmonic "
     << harmonics << "), elements " << elements << ", quadrature " << quadrature_points << ", time step " << dt

@@ -5,6 +5,7 @@
 // second order. Mass through a 0D network to round-off, and the steady
 // pressure profile inside a narrowing capillary against a quadrature of its ODE.
 #include <cmath>
+#include <cstdint>
 #include <complex>
 #include <numbers>
 #include <vector>
@@ -144,6 +145,55 @@ TEST(LumpedVessels, FollowTheExactResponseOfAnRlcCircuit) {
   EXPECT_LT(coarse / fine, 4.5);
 }
 
+// A vessel along which the pressure diffuses (an RC line, w R C = 6 at the drive, the
+// inertance negligible) in n pi sections, driven by a small sinusoidal inflow into a
+// resistance outlet as large as its own: the inlet pressure's complex amplitude in the
+// periodic state against the uniform line's input impedance,
+// Z = Z_c (R_out + Z_c tanh(g)) / (Z_c + R_out tanh(g)), g = sqrt(i w R C), Z_c = sqrt(R / (i w C)).
+// A pi section is the line to second order in its length: the error falls as 1 / n^2.
+namespace {
+
+double sectioned_line_error(int sections) {
+  const double c = 1e-10, r = 1e9, omega = 6 / (r * c), period = 2 * pi / omega;
+  const double viscosity = r * std::pow(pi / 4 * 1e-6, 2) / (8 * pi * 0.01);
+  const OneVessel line(c, viscosity, 1e-9, r);
+  const ViscosityTable mu(*line.net.blood);
+  const std::vector<std::uint8_t> cut{static_cast<std::uint8_t>(sections)};
+  LumpedVessels lumped(line.net, line.laws, mu, *line.net.blood, {true}, {}, {}, cut);
+  EXPECT_EQ(lumped.sections(0), static_cast<std::size_t>(sections));
+  EXPECT_EQ(lumped.node_count(), static_cast<std::size_t>(1 + sections));
+  lumped.start(std::vector<double>(line.net.node_count(), line.p0), {0.0});
+  const int per_period = 1000, periods = 24;
+  const double dt = period / per_period, q = 1e-3 / r;
+  double in = 0, out = 0;
+  std::complex<double> sum = 0;
+  for (int k = 1; k <= periods * per_period; ++k) {
+    const double t = k * dt;
+    lumped.predict(dt, {}, q * std::sin(omega * t));
+    lumped.complete({}, in, out);
+    if (k > (periods - 1) * per_period)
+      sum += (lumped.node_pressure(lumped.node_of(0)) - line.p0) * std::exp(std::complex<double>(0, -omega * t));
+  }
+  const std::complex<double> amplitude = std::complex<double>(0, 2) * sum / static_cast<double>(per_period);
+  const std::complex<double> i(0, 1), g = std::sqrt(i * omega * r * c), zc = std::sqrt(r / (i * omega * c));
+  const std::complex<double> z = zc * (line.r_out + zc * std::tanh(g)) / (zc + line.r_out * std::tanh(g));
+  return std::abs(amplitude - z * q) / std::abs(z * q);
+}
+
+}  // namespace
+
+TEST(LumpedVessels, ADiffusiveVesselInSectionsFollowsItsLine) {
+  double error[4];
+  for (int j = 0; j < 4; ++j) error[j] = sectioned_line_error(1 << j);
+  std::printf("RC line, w R C = 6: inlet impedance off by %.3g (1 section), %.3g (2), %.3g (4), %.3g (8)\n", error[0],
+              error[1], error[2], error[3]);
+  EXPECT_LT(error[3], 0.02);  // measured 0.0123; one section 0.51
+  for (int j = 1; j < 3; ++j) {  // second order: a quarter with each halving
+    EXPECT_GT(error[j] / error[j + 1], 3.5) << j;
+    EXPECT_LT(error[j] / error[j + 1], 4.5) << j;
+  }
+}
+
 // A bifurcation of 0D vessels with an RCR and an R outlet under a pulsating inflow: what came
 // in, less what left, is what the vessels hold, to round-off, every step; and the nonlinear
 // tube law is exercised (pressures change by a tenth of beta sqrt(A)).
@@ -201,6 +251,37 @@ TEST(LumpedVessels, ConserveMassToRoundOff) {
   std::printf("0D mass: largest |in - out - stored| / in %.3g; pressure swing %.3g of beta sqrt(A)\n", worst, swing);
   EXPECT_LT(worst, 1e-12);
   EXPECT_GT(swing, 0.05);
+}
+
+// The same with the vessels in 3, 1 and 2 sections (inner nodes hold volume of their own;
+// the RCR outlet sits at the last section of the first daughter): the stored volume counts
+// them, and the pressure and flow along a vessel read its sections.
+TEST(LumpedVessels, ConserveMassToRoundOffInSections) {
+  const ThreeVessels three;
+  const ViscosityTable viscosity(three.blood);
+  const std::vector<std::uint8_t> cut{3, 1, 2};
+  LumpedVessels lumped(three.net, three.laws, viscosity, three.blood, {true, true, true}, {}, {}, cut);
+  EXPECT_TRUE(lumped.sectioned());
+  EXPECT_EQ(lumped.node_count(), 4u + 1u + 3u);  // network nodes, the capacitor, inner nodes
+  lumped.start(std::vector<double>(three.net.node_count(), 1e4), {0.0, 0.0, 0.0});
+  const double v0 = lumped.stored_volume();
+  double in = 0, out = 0, worst = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const double t = (k + 1) * 1e-3;
+    lumped.predict(1e-3, {}, 5e-6 * (1 + std::sin(2 * pi * t)));
+    lumped.complete({}, in, out);
+    worst = std::max(worst, std::abs(in - out - (lumped.stored_volume() - v0)) / in);
+  }
+  std::printf("0D mass in sections: largest |in - out - stored| / in %.3g\n", worst);
+  EXPECT_LT(worst, 1e-12);
+  const std::int32_t root = lumped.vessel_index(0);
+  EXPECT_EQ(lumped.pressure_at(root, 0), lumped.node_pressure(lumped.from_node(root)));
+  EXPECT_EQ(lumped.pressure_at(root, 1), lumped.node_pressure(lumped.to_node(root)));
+  const double p_first = lumped.pressure_at(root, 1.0 / 3), p_second = lumped.pressure_at(root, 2.0 / 3);
+  EXPECT_GT(lumped.pressure_at(root, 0), p_first);  // falling along it, through its inner nodes
+  EXPECT_GT(p_first, p_second);
+  EXPECT_GT(p_second, lumped.pressure_at(root, 1));
+  EXPECT_GT(lumped.flow(root), 0.0);
 }
 
 // The step's working arrays freed between steps (a run's cycle ends) and made again: the

@@ -92,6 +92,7 @@ TEST(RunIdentity, EveryOptionThatShapesTheStateIsInIt) {
       {"model", [](RunConfiguration& c) { c.solver.model = ModelChoice::automatic; }},
       {"lumped_transit", [](RunConfiguration& c) { nudge(c.solver.lumped_transit); }},
       {"lumped_rc", [](RunConfiguration& c) { nudge(c.solver.lumped_rc); }},
+      {"lumped_sections", [](RunConfiguration& c) { c.solver.lumped_sections = 2; }},
       {"lumped_step", [](RunConfiguration& c) { nudge(c.solver.lumped_step); }},
       {"lumped_passes", [](RunConfiguration& c) { c.solver.lumped_passes = 2; }},
       {"coupling_passes", [](RunConfiguration& c) { c.solver.coupling_passes = 2; }},
