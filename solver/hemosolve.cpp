@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -320,7 +321,7 @@ int run_command_line(CommandLine& line, int cores) {
     run_linear(net, config, observer);
     return 0;
   }
-  return finish(run_pulsatile(net, config, observer), config);
+  return finish(run_pulsatile(std::move(net), config, observer), config);
 }
 
 }  // namespace

@@ -274,9 +274,16 @@ void check_pulsatile(const Network& net, const RunConfiguration& config) {
                                               format_quantity(config.sample_interval, "s") + ")");
 }
 
-RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunObserver& observer) {
+namespace {
+
+// given_up: the same network where the caller gave it up (its coordinates may go), else null.
+RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObserver& observer, Network* given_up) {
   check_configuration(config);
   check_pulsatile(net, config);
+  // The network's identity (its coordinates included) before anything of it is freed.
+  const std::uint64_t network = network_identity(net);
+  if (given_up && !config.vtk && config.frames == 0)
+    for (std::vector<double>* c : {&given_up->x, &given_up->y, &given_up->z}) std::vector<double>().swap(*c);
   const Waveform driving = driving_waveform(net);
   const double period = driving.period;
   OutputFolder folder(config.out_dir);
@@ -315,7 +322,7 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
                        net, "steady pressures", config.words, observer);
 
   // ---- the run ------------------------------------------------------------------------------
-  const RunIdentity identity = run_identity(net, config, dt, run.blood().rheology);
+  const RunIdentity identity{network, state_shaping(config, net, dt, run.blood().rheology)};
   RunPlan plan;
   plan.cycles = config.cycles;
   plan.until_periodic = config.until_periodic;
@@ -427,6 +434,16 @@ RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunO
   const bool with_numbers = result.outcome == RunOutcome::complete || result.outcome == RunOutcome::not_periodic;
   if (with_numbers) say_results(net, run, config, pulsatile, transport ? &*transport : nullptr, wall, observer);
   return result;
+}
+
+}  // namespace
+
+RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunObserver& observer) {
+  return pulsatile(net, config, observer, nullptr);
+}
+
+RunResult run_pulsatile(Network&& net, const RunConfiguration& config, RunObserver& observer) {
+  return pulsatile(net, config, observer, &net);
 }
 
 void run_steady(const Network& net, const RunConfiguration& config, RunObserver& observer) {

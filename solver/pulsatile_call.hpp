@@ -40,6 +40,10 @@ void check_pulsatile(const Network& net, const RunConfiguration& config);
 // run that cannot start or that breaks down before a whole cycle (nothing kept), a cycle
 // estimated or measured above a day (unless forced) or a checkpoint of another run.
 RunResult run_pulsatile(const Network& net, const RunConfiguration& config, RunObserver& observer);
+// The same over a network the caller gives up (hemosolve's): once its identity is taken, what
+// no output of this run reads is freed (the node coordinates, 24 B a node, without --vtk and
+// --frames), and the network is left so.
+RunResult run_pulsatile(Network&& net, const RunConfiguration& config, RunObserver& observer);
 
 // The steady state alone (steady_run.hpp): the same folder's files, no time loop.
 void run_steady(const Network& net, const RunConfiguration& config, RunObserver& observer);
