@@ -89,9 +89,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
 
   // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes
   // (of each section's, L / n):
-  // (L / 2) (d^2 p^2 + 2 c d p + c^2).
+  // (L / 2) (d^2 p^2 + 2 c d p + c^2); the constant term only when asked (node_constant).
   volume_a_.assign(nodes_, 0.0);
-  volume_c_.assign(nodes_, 0.0);
   for (std::size_t e = 0; e < vessel_edges_; ++e) {
     const double w = edge_length_[e] / 2, c = edge_root_intercept_[e], d = edge_root_slope_[e];
     for (const std::int32_t k : {a_[e], b_[e]}) {
@@ -100,12 +99,10 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
         const TaperedEdge& t = tapered_[static_cast<std::size_t>(taper_edge_[e])];
         volume_a_[i] += t.volume_a / 2;
         volume_b_[i] += t.volume_b / 2;
-        volume_c_[i] += t.volume_c / 2;
         continue;
       }
       volume_a_[i] += w * d * d;
       volume_b_[i] += 2 * w * c * d;
-      volume_c_[i] += w * c * c;
     }
   }
 
@@ -119,8 +116,8 @@ void LumpedVessels::allocate_system() {
   previous_volume_ = pressure_ = previous_pressure_ = volume_;
   flow_.assign(edges, 0.0);
   previous_flow_ = flow_;
-  capacity_a_.assign(vessel_edges_, 0.0);
-  capacity_b_ = resistance_ = previous_resistance_ = capacity_a_;  // the step's own arrays: at the first predict()
+  centre_pressure_.assign(vessel_edges_, 0.0);
+  resistance_ = previous_resistance_ = centre_pressure_;  // the step's own arrays: at the first predict()
 
   if (2 * edges >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw InputError("too many 0D vessels for 32-bit indices");
@@ -137,8 +134,6 @@ void LumpedVessels::allocate_system() {
     incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(a_[e])]++)] = edge;
     incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(b_[e])]++)] = ~edge;
   }
-  shunt_current_.resize(nodes_);
-  for (std::size_t k = 0; k < nodes_; ++k) shunt_current_[k] = shunt_[k] * shunt_pressure_[k];
   block_outflow_.assign((nodes_ + block - 1) / block, 0.0);
 }
 
@@ -265,9 +260,7 @@ void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
 void LumpedVessels::update_resistances() {
   linearised_dt_ = 0;
   parallel_blocks(static_cast<std::int64_t>(vessel_edges_), threads_, [&](std::int64_t first, std::int64_t last) {
-    for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e)
-      resistance_[e] = resistance(e, pressure_[static_cast<std::size_t>(a_[e])],
-                                  pressure_[static_cast<std::size_t>(b_[e])], capacity_a_[e], capacity_b_[e]);
+    for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) update_resistance(e);
   });
 }
 
@@ -279,7 +272,7 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
     parallel_blocks(static_cast<std::int64_t>(vessel_edges_), threads_, [&](std::int64_t first, std::int64_t last) {
       for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
         const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
-        resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
+        update_resistance(e);
         linearise_edge(e, 2 * pressure_[a] - previous_pressure_[a], 2 * pressure_[b] - previous_pressure_[b], true, dt);
       }
     });
@@ -314,8 +307,8 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
             simpson_resistance(friction_k_, edge_length_[e], viscosity_factor_.empty() ? 1.0 : viscosity_factor_[e], aa[i],
                                ab[i], am[i], mu_a[i], mu_b[i], mu_m[i]);
         resistance_[e] = r.resistance;
-        capacity_a_[e] = r.capacity_a;
-        capacity_b_[e] = r.capacity_b;
+        centre_pressure_[e] = centre_pressure(e, pressure_[static_cast<std::size_t>(a_[e])],
+                                              pressure_[static_cast<std::size_t>(b_[e])], r.capacity_a, r.capacity_b);
       }
       for (std::size_t i = 0; i < n; ++i) {
         const std::size_t e = e0 + i;
@@ -387,7 +380,7 @@ void LumpedVessels::refresh_resistance(std::size_t e) {
   double capacity_a, capacity_b;
   const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
   previous_resistance_[e] = resistance(e, previous_pressure_[a], previous_pressure_[b], capacity_a, capacity_b);
-  resistance_[e] = resistance(e, pressure_[a], pressure_[b], capacity_a_[e], capacity_b_[e]);
+  update_resistance(e);
 }
 
 void LumpedVessels::update_dynamic_pressures() {
@@ -524,7 +517,7 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
       const double ps = at(static_cast<std::int32_t>(i)), c = node_compliance(k, ps);
       system_shunt_[k] = 1.5 * c / dt + shunt_[k];
       double rhs =
-          (1.5 * (c * ps - node_excess(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt + shunt_current_[k];
+          (1.5 * (c * ps - node_excess(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt + shunt_current(k);
       for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
         const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
         rhs += e >= 0 ? -history_[static_cast<std::size_t>(e)] : history_[static_cast<std::size_t>(~e)];
@@ -556,7 +549,6 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
         held_reference_conductance_[j] + 1.5 * node_compliance(k, pressure_[k]) / dt);
     shunt_[k] = held.conductance;
     shunt_pressure_[k] = held.pressure;
-    shunt_current_[k] = shunt_[k] * held_pressure[j];
   }
   for (int pass = 0; pass < passes_; ++pass) {
     // Each further (Picard) pass takes the coefficients again at the last solution.
@@ -620,7 +612,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
       const std::size_t first = static_cast<std::size_t>(b) * block, last = std::min(first + block, nodes_);
       double outflow = 0;
       for (std::size_t k = first; k < last; ++k) {
-        const double shunted = shunt_[k] * predicted_[k] - shunt_current_[k];
+        const double shunted = shunt_[k] * predicted_[k] - shunt_current(k);
         // A capacitor's R2 is not the network's; a held pressure's flow is counted below.
         if (k < network_nodes_ && (held_.empty() || !held_[k])) outflow += shunted;
         double inflow = -shunted;
@@ -682,7 +674,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     for (auto j = static_cast<std::size_t>(first); j < static_cast<std::size_t>(last); ++j) {
       const OutletNode& o = outlet_boundary_[j];
       const auto k = static_cast<std::size_t>(o.node);
-      const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * predicted_[k] - shunt_current_[k];
+      const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * predicted_[k] - shunt_current(k);
       boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * out;
     }
   });
@@ -706,7 +698,44 @@ double LumpedVessels::edge_pressure_at(std::size_t e, double x) const {
   if (drop == 0 || x <= 0) return pa;
   if (x >= 1) return pb;
   if (tapered(e)) return pa - drop * resistance_fraction(e, x);  // the rigid taper's profile
-  return steady_profile_pressure(pa, pb, capacity_a_[e], capacity_b_[e], x);
+  if (x == 0.5) return centre_pressure_[e];
+  // The flow capacities at the ends, as the last update of the resistances had them (the
+  // same arithmetic on the same pressures: the same bits).
+  double ga, gb;
+  resistance(e, pa, pb, ga, gb);
+  return steady_profile_pressure(pa, pb, ga, gb, x);
+}
+
+double LumpedVessels::centre_pressure(std::size_t e, double pa, double pb, double ga, double gb) const {
+  const double drop = pa - pb;
+  if (drop == 0) return pa;
+  if (tapered(e)) return pa - drop * resistance_fraction(e, 0.5);
+  return steady_profile_pressure(pa, pb, ga, gb, 0.5);
+}
+
+void LumpedVessels::update_resistance(std::size_t e) {
+  const double pa = pressure_[static_cast<std::size_t>(a_[e])], pb = pressure_[static_cast<std::size_t>(b_[e])];
+  double ga, gb;
+  resistance_[e] = resistance(e, pa, pb, ga, gb);
+  centre_pressure_[e] = centre_pressure(e, pa, pb, ga, gb);
+}
+
+double LumpedVessels::node_constant(std::size_t k) const {
+  // Half of each adjacent section's L c^2 (a tapered vessel's int c^2 dx), in the order of
+  // its edges, as the constructor summed a and b.
+  double constant = 0;
+  for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
+    const std::int32_t incident = incident_edge_[static_cast<std::size_t>(j)];
+    const auto e = static_cast<std::size_t>(incident >= 0 ? incident : ~incident);
+    if (e >= vessel_edges_) continue;  // an R1 edge
+    if (tapered(e)) {
+      constant += tapered_[static_cast<std::size_t>(taper_edge_[e])].volume_c / 2;
+      continue;
+    }
+    const double w = edge_length_[e] / 2, c = edge_root_intercept_[e];
+    constant += w * c * c;
+  }
+  return constant;
 }
 
 std::size_t LumpedVessels::section_at(std::size_t i, double x, double& within) const {
@@ -800,7 +829,7 @@ double LumpedVessels::stored_volume() const {
   // Summed in the network's order: the same bits whatever the arrays' order.
   double v = 0;
   for (const std::int32_t node : network_order_nodes())
-    if (const auto k = static_cast<std::size_t>(node); !is_capacitor(k)) v += volume_c_[k] + 0.5 * (3 * volume_[k] - previous_volume_[k]);
+    if (const auto k = static_cast<std::size_t>(node); !is_capacitor(k)) v += stored_volume(node);
   return v;
 }
 

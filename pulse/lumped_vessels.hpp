@@ -202,7 +202,7 @@ class LumpedVessels {
   // volumes: the volume a transport scheme's cell at this node holds (transport/).
   double stored_volume(std::int32_t node) const {
     const auto k = static_cast<std::size_t>(node);
-    return volume_c_[k] + 0.5 * (3 * volume_[k] - previous_volume_[k]);
+    return node_constant(k) + 0.5 * (3 * volume_[k] - previous_volume_[k]);
   }
   std::size_t network_node_count() const { return network_nodes_; }
   // A 0D vessel's nodes (its `from`, its `to`).
@@ -378,9 +378,11 @@ class LumpedVessels {
   std::vector<int> capacitor_edge_sign_;             // and +1 if it ends there at `to`, -1 at `from`
 
   // Node volume V(p) = a p^2 + b p + c (half of each 0D vessel, capacitors).
-  std::vector<double> volume_a_, volume_b_, volume_c_;  // c: only to report V
+  std::vector<double> volume_a_, volume_b_;
+  double node_constant(std::size_t k) const;  // c, from the node's edges: only to report V
   // Shunts to ground: conductance and the pressure behind it (outlets, R2).
-  std::vector<double> shunt_, shunt_pressure_, shunt_current_;  // current: shunt x pressure
+  std::vector<double> shunt_, shunt_pressure_;
+  double shunt_current(std::size_t k) const { return shunt_[k] * shunt_pressure_[k]; }
   std::vector<std::int32_t> outlet_of_capacitor_;  // per capacitor node
   std::vector<std::int32_t> capacitor_of_outlet_;  // per run outlet, -1 if none here
 
@@ -398,10 +400,15 @@ class LumpedVessels {
   std::vector<std::int64_t> coupling_edge_offset_;  // per coupling node: its 0D vessels
   std::vector<std::int32_t> coupling_edge_;
   std::vector<double> dynamic_;  // per coupling node
-  // The flow capacity G at each 0D vessel edge's two ends at the pressures now (the interior profile
-  // reads them), and its resistance now and a step before (the next step's extrapolation):
-  // the viscosity is most of the cost, three evaluations a vessel and step.
-  std::vector<double> capacity_a_, capacity_b_, resistance_, previous_resistance_;
+  // Each 0D vessel edge's pressure at its centre (what the statistics sample every step; other
+  // points of the profile take the resistance's flow capacities again), and its resistance
+  // now and a step before (the next step's extrapolation): the viscosity is most of the cost,
+  // three evaluations a vessel and step.
+  std::vector<double> centre_pressure_, resistance_, previous_resistance_;
+  // The pressure at the centre of edge e on its steady profile, from its end pressures and
+  // flow capacities there; and the resistance and centre pressure of edge e at the pressures now.
+  double centre_pressure(std::size_t e, double pa, double pb, double ga, double gb) const;
+  void update_resistance(std::size_t e);
   std::vector<double> impedance_;     // per coupling node: Z
   std::vector<double> held_inflow_;   // per coupling node: the inflows predicted with
   std::vector<double> coupling_scratch_;  // per coupling node
