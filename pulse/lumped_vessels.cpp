@@ -507,15 +507,17 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
         linearise_edge(e, at(a_[e]), at(b_[e]), extrapolated, dt);
     });
   linearised_dt_ = 0;
+  std::int64_t collapsed = nodes_i;
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
   {
     // BDF2 for a node's volume, V(p) linearised at p*:
     // (3 (V* + C* (p - p*)) - 4 V^n + V^(n-1)) / (2 dt) = inflows at t1.
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) reduction(min : collapsed)
     for (std::int64_t i = 0; i < nodes_i; ++i) {
       const auto k = static_cast<std::size_t>(i);
       const double ps = at(static_cast<std::int32_t>(i)), c = node_compliance(k, ps);
       system_shunt_[k] = 1.5 * c / dt + shunt_[k];
+      if (!(system_shunt_[k] > 0)) collapsed = std::min<std::int64_t>(collapsed, i);  // a lumen closing there
       double rhs =
           (1.5 * (c * ps - node_excess(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt + shunt_current(k);
       for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
@@ -525,6 +527,7 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
       rhs_[k] = rhs;
     }
   }
+  if (collapsed < nodes_i) throw CollapsedNode{vessel_at_node(static_cast<std::size_t>(collapsed))};
   for_each_source(coupled_inflow, 1.0, [&](std::size_t k, double inflow) { rhs_[k] += inflow; });
 }
 
@@ -718,6 +721,20 @@ void LumpedVessels::update_resistance(std::size_t e) {
   double ga, gb;
   resistance_[e] = resistance(e, pa, pb, ga, gb);
   centre_pressure_[e] = centre_pressure(e, pa, pb, ga, gb);
+}
+
+std::int32_t LumpedVessels::vessel_at_node(std::size_t k) const {
+  for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
+    const std::int32_t incident = incident_edge_[static_cast<std::size_t>(j)];
+    const auto e = static_cast<std::size_t>(incident >= 0 ? incident : ~incident);
+    const std::size_t vessel_edge = e < vessel_edges_ ? e : static_cast<std::size_t>(capacitor_vessel_edge_[e - vessel_edges_]);
+    const std::size_t slot = first_edge_.empty() ? vessel_edge
+                                                 : static_cast<std::size_t>(std::upper_bound(first_edge_.begin(), first_edge_.end(),
+                                                                                             static_cast<std::int32_t>(vessel_edge)) -
+                                                                            first_edge_.begin() - 1);
+    return vessels_[slot];
+  }
+  return vessels_.front();
 }
 
 double LumpedVessels::node_constant(std::size_t k) const {

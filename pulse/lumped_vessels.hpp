@@ -53,6 +53,11 @@ namespace hemotree {
 
 class LumpedVessels {
  public:
+  // A step's linearisation found a node whose compliance is not positive (a lumen closing
+  // at the state the step is taken at): the network vessel named, for the caller to report.
+  struct CollapsedNode {
+    std::int32_t vessel;
+  };
   LumpedVessels() = default;  // none
   // zero_d: per vessel, whether it is 0D. Throws InputError for a reflection outlet on a 0D
   // vessel (it needs the waves of a 1D one).
@@ -380,6 +385,7 @@ class LumpedVessels {
   // Node volume V(p) = a p^2 + b p + c (half of each 0D vessel, capacitors).
   std::vector<double> volume_a_, volume_b_;
   double node_constant(std::size_t k) const;  // c, from the node's edges: only to report V
+  std::int32_t vessel_at_node(std::size_t k) const;  // a network vessel ending there (its R1's, at a capacitor)
   // Shunts to ground: conductance and the pressure behind it (outlets, R2).
   std::vector<double> shunt_, shunt_pressure_;
   double shunt_current(std::size_t k) const { return shunt_[k] * shunt_pressure_[k]; }

@@ -14,6 +14,7 @@
 
 #include "core/setting_error.hpp"
 #include "pulse/pulse_solver.hpp"
+#include "pulse/solution_breakdown.hpp"
 #include "pulse/stability_limit.hpp"
 #include "pulse/step_cost.hpp"
 
@@ -239,7 +240,11 @@ void PulseSolver::step_coupled() {
     lumped_inflow_[j] = boundaries_.list.waveform(static_cast<std::size_t>(lumped_.inflow_boundaries()[j]))(t1);
   for (std::size_t j = 0; j < lumped_held_.size(); ++j)
     lumped_held_[j] = boundaries_.list.waveform(static_cast<std::size_t>(lumped_.held_boundaries()[j]))(t1);
-  lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
+  try {
+    lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
+  } catch (const LumpedVessels::CollapsedNode& collapsed) {
+    throw SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_);
+  }
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
   if (element_count() > 0) {
     const Eigen::VectorXd before = state_.coupled;

@@ -284,6 +284,29 @@ TEST(LumpedVessels, ConserveMassToRoundOffInSections) {
   EXPECT_GT(lumped.flow(root), 0.0);
 }
 
+// A vessel drained far faster than it fills (the outflow of a second's inflow each step): its
+// lumen closes, and the step that would linearise about a closed lumen says which vessel,
+// instead of handing the nodal system a negative compliance.
+TEST(LumpedVessels, NameTheVesselWhoseLumenCloses) {
+  const ThreeVessels three;
+  const ViscosityTable viscosity(three.blood);
+  LumpedVessels lumped(three.net, three.laws, viscosity, three.blood, {true, true, true});
+  lumped.start(std::vector<double>(three.net.node_count(), 1e4), {0.0, 0.0, 0.0});
+  double in = 0, out = 0;
+  bool named = false;
+  for (int k = 0; k < 50 && !named; ++k) {
+    try {
+      lumped.predict(1e-3, {}, -5e-3);
+      lumped.complete({}, in, out);
+    } catch (const LumpedVessels::CollapsedNode& collapsed) {
+      named = true;
+      EXPECT_EQ(collapsed.vessel, 0);  // the root, at the inlet's node
+      std::printf("lumen closed at step %d, vessel %d named\n", k, collapsed.vessel);
+    }
+  }
+  EXPECT_TRUE(named);
+}
+
 // The step's working arrays freed between steps (a run's cycle ends) and made again: the
 // same state, bit for bit, as never freeing them, the RCR outlet's R1 edge included.
 TEST(LumpedVessels, StepAfterReleasingTheStepArraysToTheSameBits) {
