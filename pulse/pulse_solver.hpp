@@ -135,9 +135,7 @@ class PulseSolver {
   double substep() const { return dt_ / substeps_; }
   bool is_lumped(std::size_t vessel) const { return zero_d_[vessel]; }
   // The 0D vessels in more than one pi section (their inner nodes are no network node's).
-  std::size_t sectioned_count() const {
-    return static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t n) { return n > 1; }));
-  }
+  std::size_t sectioned_count() const { return sectioned_count_; }
   std::size_t lumped_count() const {
     return lumped_count_after_release_ ? *lumped_count_after_release_ : lumped_.vessel_count();
   }
@@ -367,7 +365,8 @@ class PulseSolver {
     Eigen::Index first, count;
   };
   std::vector<bool> zero_d_;               // per vessel
-  std::vector<std::uint8_t> lumped_sections_;  // per vessel, where a 0D vessel takes more than one (else empty)
+  std::vector<std::uint8_t> lumped_sections_;  // per vessel, where a 0D vessel takes more than one (else empty), until lumped_ is built
+  std::size_t sectioned_count_ = 0;
   LumpedVessels lumped_;
   std::optional<std::size_t> lumped_count_after_release_;  // release_lumped_state()
   int substeps_ = 1;
