@@ -142,6 +142,8 @@ assert a["coupling_passes"] == b["coupling_passes"] == 3 and a["vessels"] == b["
 PY
 expect_error "--coupling-passes 0" 2 "--coupling-passes must be auto or a whole number in [1, 10] (got '0')" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --coupling-passes 0
+expect_error "--lumped-sections 0" 2 "--lumped-sections must lie in [1, 64] (got 0)" -- \
+  "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --lumped-sections 0
 expect_error "--lumped-step 0" 2 "--lumped-step must be auto or a fraction of the period in (0, 0.1] (got '0')" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --lumped-step 0
 expect_error "--vtk-min-diameter above every vessel" 2 "keeps no vessel" -- \
