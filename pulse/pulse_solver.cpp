@@ -103,7 +103,8 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   choose_models(options);
   lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
   sectioned_count_ = static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t s) { return s > 1; }));
-  std::vector<std::uint8_t>().swap(lumped_sections_);  // a byte a vessel the run no longer reads  lumped_.set_passes(options.lumped_passes);
+  std::vector<std::uint8_t>().swap(lumped_sections_);  // a byte a vessel the run no longer reads
+  lumped_.set_passes(options.lumped_passes);
   lumped_.set_threads(threads_);
 
   const std::optional<SteadyFlow> steady = solve_steady_flow();

@@ -111,6 +111,9 @@ grep -q "the VTK output shows" "$WORK/log" && pass "--vtk-min-diameter says what
     --mean-tol 5e-4 --pi-tol 5e-4 >"$WORK/cmp" \
   && pass "--lumped-passes 2 against 1: within 0.05 % ($(grep 'pulsatility' "$WORK/cmp" | sed 's/ *tolerance.*//'))" \
   || fail "--lumped-passes 2 against 1: $(cat "$WORK/cmp")"
+# ...and it is taken: close is not the same (a run that dropped the option gave the same bytes).
+cmp -s "$WORK/zero_d_2/vessels.csv" "$WORK/zero_d/vessels.csv" \
+  && fail "--lumped-passes 2 gives the bytes of 1: not taken" || pass "--lumped-passes 2 is taken (other bytes than 1)"
 expect_error "--lumped-passes 0" 2 "--lumped-passes must lie in [1, 10]" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/none" --lumped-passes 0
 # Coupling passes (docs/solver.md §10): by themselves one on this network (its 1D vessels cost
