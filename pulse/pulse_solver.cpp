@@ -259,13 +259,12 @@ void PulseSolver::choose_models(const SolverOptions& options) {
       resistance = tapered_poiseuille_resistance(
           [&](double d) { return viscosity_(std::numbers::pi / 4 * d * d); }, length, taper.d0, taper.d1, blood_.alpha);
     }
-    const int sections = reflecting[v] ? 0 : options.lumped_sections_of(transit, omega * resistance * compliance, period);
+    int sections = reflecting[v] ? 0 : options.lumped_sections_of(transit, omega * resistance * compliance, period);
+    if (sections > 1 && is_tapered(v)) sections = 0;  // a tapered vessel stays one section: 1D where one is too few
     zero_d_[v] = sections > 0;
-    if (sections > 1 && !is_tapered(v)) {  // a tapered vessel stays one section: 1D where one is too few
+    if (sections > 1) {
       if (lumped_sections_.empty()) lumped_sections_.assign(n, 1);
       lumped_sections_[v] = static_cast<std::uint8_t>(sections);
-    } else if (sections > 1) {
-      zero_d_[v] = false;
     }
   }
 }
