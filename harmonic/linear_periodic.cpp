@@ -69,9 +69,13 @@ struct LineAbout {
     const TubeLaw& law = laws[v];
     const double p = 0.5 * (steady.node_pressure[static_cast<std::size_t>(net.from[v])] +
                             steady.node_pressure[static_cast<std::size_t>(net.to[v])]);
-    const double area = law.area(p);
-    return {k_friction * viscosity(area) / (area * area), density / area, law.compliance_per_length(area),
-            net.length[v], steady.flow[v] / area, law.alpha};
+    const double area = law.area(p), mu = viscosity(area), compliance = law.compliance_per_length(area);
+    const double resistance = k_friction * mu / (area * area), velocity = steady.flow[v] / area;
+    // mu'(A) by a central difference over 1e-4 of the lumen (the table is a smooth cubic;
+    // Newtonian blood: 0).
+    const double h = 1e-4 * area, mu_slope = (viscosity(area + h) - viscosity(area - h)) / (2 * h);
+    const double kappa = resistance * velocity * compliance * (2 - area * mu_slope / mu);
+    return {resistance, density / area, compliance, net.length[v], velocity, law.alpha, kappa};
   }
 };
 

@@ -4,15 +4,19 @@
 // a = C' p,
 //
 //   i w C' P + dQ/dx = 0,
-//   i w Q + alpha d/dx (2 U Q - U^2 a) + (A / rho) dP/dx = -(k nu / A) Q,
+//   i w Q + alpha d/dx (2 U Q - U^2 a) + (A / rho) (dP/dx + R' Q - kappa P) = 0,
 //
-//   C' = dA/dp (tube law),  L' = rho / A,  R' = k mu(A) / A^2 (the 1D model's friction,
-//   k = 2 pi alpha / (alpha - 1)),  c^2 = 1 / (L' C').
-// (Linearising the friction -k nu Q / A about the mean flow gives also + k nu Q_mean a / A^2,
-// which the steady pressure gradient's own term (a / rho) dp_mean/dx cancels exactly.) So
+//   C' = dA/dp (tube law),  L' = rho / A,  R'(A) = k mu(A) / A^2 (the 1D model's friction
+//   -k mu Q / (rho A) = -(A / rho) R' Q, k = 2 pi alpha / (alpha - 1)),  c^2 = 1 / (L' C'),
+//   kappa = -Q_mean C' dR'/dA = R' U C' (2 - A mu'(A) / mu).
+// kappa is the friction's lumen: where a mean flow runs, a higher pressure widens the lumen
+// and eases the mean flow's gradient -R'(A) Q_mean. (Of the momentum equation's terms in a,
+// (a / rho)(dp_mean/dx + R' Q_mean) vanishes in the steady state; (A / rho)(dR'/dA) a Q_mean
+// is left, first order in the pulse.) It makes a short vessel's line the linearisation of the
+// 0D vessel's flow (1/l) int A^2 / (k mu) dp (pulse/lumped_vessels.hpp). So
 // d/dx (P, Q) = M (P, Q) with
 //   M = [[tau, -z / D], [-i w C', 0]],  z = R' + i w L',  D = 1 - alpha U^2 / c^2,
-//   tau = 2 alpha i w U / (c^2 D),
+//   tau = (kappa + 2 alpha i w U / c^2) / D,
 // and the transfer from x = 0 to x is exp(M x) = e^{tau x / 2} (cosh(s x) I + sinh(s x) / s
 // (M - tau / 2 I)), s^2 = tau^2 / 4 + (z / D) i w C' (Re s >= 0). At rest (U = 0) it is the
 // classic line: s = gamma = sqrt(z i w C'), Z_c = z / gamma (Womersley 1957; Milnor,
@@ -24,9 +28,9 @@
 // of its `from` node (Q(0)) and its `to` node (-Q(l)),
 //   Y_aa = -(s coth(s l) + tau / 2) / m,   Y_ab = s csch(s l) / (E m),
 //   Y_ba = E s csch(s l) / m,              Y_bb = -(s coth(s l) - tau / 2) / m,
-// m = -z / D, E = e^{tau l / 2} (of modulus 1: tau is imaginary). Where |s l| is small (a vessel
-// the pulse crosses in phase: the run's 0D vessels) this is the vessel's R + i w L in series
-// with i w C / 2 at each end, the 0D vessel's own pi circuit.
+// m = -z / D, E = e^{tau l / 2}. Where |s l| is small (a vessel the pulse crosses in phase:
+// the run's 0D vessels) this is the vessel's R + i w L in series with i w C / 2 at each end,
+// the 0D vessel's own pi circuit, and kappa R l (P_a + P_b) / 2 more flow through it.
 #pragma once
 
 #include <array>
@@ -45,6 +49,7 @@ struct VesselLine {
   double length = 0;         // l [m]
   double mean_velocity = 0;  // U [m/s], from -> to
   double alpha = 4.0 / 3.0;  // momentum-flux factor
+  double kappa = 0;          // the friction's lumen, -Q_mean C' dR'/dA [1/m]
 
   struct Matrix {
     Complex tau, m12, m21, s2;  // M's entries (M_11 = tau, M_22 = 0) and s^2
@@ -56,7 +61,7 @@ struct VesselLine {
   Matrix matrix(double w) const {
     const double uc2 = mean_velocity * mean_velocity * inertance * compliance;  // U^2 / c^2
     const double d = 1 - alpha * uc2;
-    const Complex tau(0, 2 * alpha * w * mean_velocity * inertance * compliance / d);
+    const Complex tau(kappa / d, 2 * alpha * w * mean_velocity * inertance * compliance / d);
     const Complex m12 = -Complex(resistance, w * inertance) / d, m21(0, -w * compliance);
     return {tau, m12, m21, 0.25 * tau * tau + m12 * m21};
   }
@@ -86,13 +91,14 @@ struct VesselLine {
     }
     const double dx = 0.5 * length;
     const Hyperbolic half = hyperbolic(m, dx);
-    const Complex e_half = std::polar(1.0, 0.5 * m.tau.imag() * dx);
+    const Complex e_half = exponential(0.5 * m.tau * dx);
     const TwoPort y = two_port(m, {2.0 * half.cosh * half.cosh - 1.0, half.sinhc * half.cosh}, e_half * e_half);
     const Complex q0 = y.aa * p0 + y.ab * p1, q1 = -(y.ba * p0 + y.bb * p1);
     return {Point{p0, q0}, along(m, half, e_half, dx, p0, q0), Point{p1, q1}};
   }
 
  private:
+  static Complex exponential(Complex x) { return std::polar(std::exp(x.real()), x.imag()); }
   // cosh(s x) and sinh(s x) / (s x), both even in s x, from s^2: by their Taylor series
   // through (s x)^18 where |s x| <= 1 (the first term left out, (s x)^20 / 20!, is below
   // 1e-18, and no term exceeds cosh 1 = 1.54 for a sum of at least cos 1 = 0.54: rounding
@@ -120,7 +126,7 @@ struct VesselLine {
   }
 
   TwoPort two_port(const Matrix& m) const {
-    const Complex e = std::polar(1.0, 0.5 * m.tau.imag() * length);  // tau is imaginary
+    const Complex e = exponential(0.5 * m.tau * length);
     const Complex s2l2 = m.s2 * (length * length);
     if (std::norm(s2l2) <= 400 || m.s().real() * length < 20) return two_port(m, hyperbolic(m, length), e);
     // sinh would overflow: in e^{-2 s l}, which underflows harmlessly
@@ -134,7 +140,7 @@ struct VesselLine {
   }
   TwoPort two_port(const Matrix& m, Complex s_coth, Complex s_csch, Complex e) const {
     const Complex over_m12 = 1.0 / m.m12;
-    return {-(s_coth + 0.5 * m.tau) * over_m12, s_csch * std::conj(e) * over_m12, e * s_csch * over_m12,
+    return {-(s_coth + 0.5 * m.tau) * over_m12, s_csch / e * over_m12, e * s_csch * over_m12,
             -(s_coth - 0.5 * m.tau) * over_m12};
   }
 
@@ -160,7 +166,7 @@ struct VesselLine {
         out[i] = {p, q};
         continue;
       }
-      out[i] = along(m, hyperbolic(m, dx), std::polar(1.0, 0.5 * m.tau.imag() * dx), dx, p, q);
+      out[i] = along(m, hyperbolic(m, dx), exponential(0.5 * m.tau * dx), dx, p, q);
     }
     return out;
   }

@@ -2,9 +2,10 @@
 # starts from it) on a 201-vessel tree (400 um root, the paper's pulse): the linear run writes
 # every file a run writes, one period at the probes; it agrees with the time-stepped periodic
 # state per class to the nonlinear terms' size (measured: mean pressures to a median of
-# 3.6e-3, systolic 1.2e-2, pulsatility index 1.6e-2 in the worst class); the periodic start
-# reaches a change of 1e-3 in 2 cycles after its settling cycle (3 without it) where the steady
-# start takes 3 (4); the refusals are one line.
+# 3.6e-3, systolic 4.2e-3, pulsatility index 5.3e-4 in the worst class; 1.2e-2 and 1.6e-2
+# before the lines had their friction's lumen); the periodic start reaches a change of 1e-3 in
+# 2 cycles, with its settling cycle (3.8e-4) and without it (8.4e-4; 3 cycles before the
+# friction's lumen), where the steady start takes 3 (4); the refusals are one line.
 source "$(dirname "$0")/lib.sh"
 VPRUNE=$BUILD/pruner/vprune
 HEMOSOLVE=$BUILD/solver/hemosolve
@@ -24,7 +25,7 @@ for run in steady periodic; do
 done
 "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/unsettled" --until-periodic 1e-3 --max-cycles 10 --settling-step 0 --quiet \
   || fail "--settling-step 0"
-"$PY" - "$WORK" <<'PY' && pass "the settling cycle: periodic in 2 cycles (3 without it), steady start 3" || fail "settling cycle"
+"$PY" - "$WORK" <<'PY' && pass "periodic in 2 cycles with the settling cycle and without it, steady start 3" || fail "settling cycle"
 import json, sys
 work = sys.argv[1]
 run, steady, unsettled = (json.load(open(f"{work}/{r}/summary.json")) for r in ("periodic", "steady", "unsettled"))
@@ -32,7 +33,8 @@ run, steady, unsettled = (json.load(open(f"{work}/{r}/summary.json")) for r in (
 assert run["settling_cycle"]["steps"] == run["steps_per_cycle"] // 3, run["settling_cycle"]
 assert run["cycles"] == 2 and run["periodic_change"] < 1e-3, (run["cycles"], run["periodic_change"])
 assert steady["cycles"] == 3 and "settling_cycle" in steady, steady["cycles"]
-assert "settling_cycle" not in unsettled and unsettled["cycles"] == 3, unsettled["cycles"]
+assert "settling_cycle" not in unsettled and unsettled["cycles"] == 2, unsettled["cycles"]
+assert unsettled["periodic_change"] > run["periodic_change"], (unsettled["periodic_change"], run["periodic_change"])
 PY
 
 "$PY" - "$WORK" <<'PY' && pass "linear files, its probes a period, the periodic start ahead of the steady, agreement per class" || fail "linear run"
@@ -57,8 +59,8 @@ for cls in {v["class"] for v in lin["vessels"]}:
     pairs = [(v, by_id[v["id"]]) for v in lin["vessels"] if v["class"] == cls]
     rel = lambda key: statistics.median(abs(a[key] - b[key]) / abs(b[key]) for a, b in pairs)
     assert rel("mean_pressure") < 5e-3, (cls, rel("mean_pressure"))
-    assert rel("systolic_pressure") < 2e-2, (cls, rel("systolic_pressure"))
-    assert statistics.median(abs(a["pulsatility_index"] - b["pulsatility_index"]) for a, b in pairs) < 2.5e-2, cls
+    assert rel("systolic_pressure") < 1e-2, (cls, rel("systolic_pressure"))
+    assert statistics.median(abs(a["pulsatility_index"] - b["pulsatility_index"]) for a, b in pairs) < 5e-3, cls
 PY
 
 expect_error "--linear refuses a time-stepping option" 2 "--cycles excludes --linear" -- \
