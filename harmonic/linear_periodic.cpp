@@ -1,10 +1,15 @@
 #include "harmonic/linear_periodic.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstdlib>
 #include <cstdint>
 #include <exception>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 #include <omp.h>
@@ -12,6 +17,7 @@
 #include "boundaries/rcr_outlet.hpp"
 #include "boundaries/resistance_outlet.hpp"
 #include "core/errors.hpp"
+#include "harmonic/mean_shift.hpp"
 #include "network_flow/harmonic_system.hpp"
 #include "physics/poiseuille.hpp"
 
@@ -85,7 +91,7 @@ struct LineAbout {
 template <class LineOf>
 void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBoundaries& boundaries,
                     const std::vector<FourierSeries>& series, const LineOf& line_of, int k, double w,
-                    HarmonicWorkspace& work, int threads = 1) {
+                    HarmonicWorkspace& work, int threads = 1, std::span<const double> extra_current = {}) {
   const std::size_t nodes = net.node_count();
   // A held node's current is its held pressure: nothing else flows into it (one boundary a
   // node; a vessel to it draws its current at its other node), and its row is x = current.
@@ -106,6 +112,8 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBound
                          ": a reflection outlet has no steady state to linearise about");
     }
   }
+  for (std::size_t node = 0; node < extra_current.size(); ++node)
+    if (!h.held[node]) current[node] += extra_current[node];
   // Each vessel's two-port; a vessel ending at a held node becomes, at its other node, a
   // shunt and the current the held pressure drives through it.
   for (const std::int32_t vessel : h.held_end_vessel) {
@@ -159,10 +167,11 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBound
 }  // namespace
 
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
-                                     const ViscosityTable& viscosity, int harmonics, int threads) {
+                                     const ViscosityTable& viscosity, int harmonics, int threads,
+                                     const std::function<bool(const VesselLine&)>& shift_source) {
   const SteadyFlow steady =
       solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
-  return solve_linear_periodic(net, blood, laws, viscosity, steady, RunBoundaries(net), harmonics, threads);
+  return solve_linear_periodic(net, blood, laws, viscosity, steady, RunBoundaries(net), harmonics, threads, shift_source);
 }
 
 LinearPeriodic LinearPeriodic::about(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
@@ -224,21 +233,183 @@ void solve_harmonics(const Network& net, const LinearPeriodic& lines, const RunB
 
 }  // namespace
 
+namespace {
+
+// The tube law's curvature and the friction's lumen of vessel v at its line's lumen
+// (harmonic/mean_shift.hpp): R'(A) = k mu(A) / A^2 differentiated over 1e-3 of the lumen.
+LumenSlopes lumen_slopes(const TubeLaw& law, const ViscosityTable& viscosity, double k_friction, double area) {
+  auto resistance = [&](double a) { return k_friction * viscosity(a) / (a * a); };
+  const double h = 1e-3 * area, r = resistance(area), up = resistance(area + h), down = resistance(area - h);
+  const double root_slope = law.lumen_root_slope();  // the lumen's root is linear in p: A'' = 2 (d sqrt(A)/dp)^2
+  return {2 * root_slope * root_slope, (up - down) / (2 * h), (up - 2 * r + down) / (h * h)};
+}
+
+// The mean's second-order shift (harmonic/mean_shift.hpp): the forcing of
+// every vessel in `sourced` (the 1D ones) and their ends' kinetic pressures at junctions, in
+// one nodal system at w = 0 of every vessel's line and every outlet's resistance, the inflow
+// and the held pressures fixed. A node's unknown is its static pressure where a boundary or
+// a 0D vessel meets it (the 1D ends there add the 0D vessels' flow-weighted kinetic
+// pressure, as pulse/lumped_vessels does), else the total pressure its 1D ends share.
+// `along` holds the harmonics of the sourced vessels and of the 0D vessels beside their
+// ends. Adds each node's shift to node_pressure and hands every vessel's to
+// apply(v, dq, profile, dx_from, dx_to): its flow's, its static pressure's along it (sampled
+// evenly from `from` to `to`; empty for a vessel `along` does not hold) and its nodes'.
+template <class Apply>
+void solve_mean_shift(const Network& net, const Blood& blood, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                      const RunBoundaries& boundaries, const HarmonicNetwork& network, const std::vector<FourierSeries>& series,
+                      const LineAbout& line_of, const LinearPeriodic& along, const std::vector<bool>& sourced,
+                      std::span<const double> node_variance, std::vector<double>& node_pressure, HarmonicWorkspace& work,
+                      int threads, Apply&& apply) {
+  const std::size_t nodes = net.node_count(), n = net.vessel_count();
+  const double k_friction = friction_coefficient(blood.alpha), rho = blood.density;
+  // Per node, a byte: a junction (two ends or more, no boundary), and a 0D vessel there.
+  constexpr unsigned char ends_one = 1, ends_more = 2, bounded = 4, lumped = 8;
+  std::vector<unsigned char> kind(nodes, 0);
+  for (std::size_t v = 0; v < n; ++v)
+    for (const std::int64_t end : {net.from[v], net.to[v]}) {
+      unsigned char& k = kind[static_cast<std::size_t>(end)];
+      k |= (k & (ends_one | ends_more)) ? ends_more : ends_one;
+      if (!sourced[v]) k |= lumped;
+    }
+  for (std::size_t i = 0; i < boundaries.size(); ++i) kind[static_cast<std::size_t>(boundaries.node(i))] |= bounded;
+  auto junction = [&](std::size_t node) { return (kind[node] & ends_more) && !(kind[node] & bounded); };
+  const int harmonics = along.harmonics();
+  std::vector<double> omega(static_cast<std::size_t>(harmonics));
+  for (int k = 1; k <= harmonics; ++k) omega[static_cast<std::size_t>(k - 1)] = along.omega(k);
+  std::vector<Complex> at_from(omega.size()), at_to(omega.size());
+  auto pulse_of = [&](std::size_t v) {
+    for (int k = 1; k <= harmonics; ++k) {
+      at_from[static_cast<std::size_t>(k - 1)] = along.node_pressure(k, static_cast<std::size_t>(net.from[v]));
+      at_to[static_cast<std::size_t>(k - 1)] = along.node_pressure(k, static_cast<std::size_t>(net.to[v]));
+    }
+  };
+  auto slopes_of = [&](std::size_t v) { return lumen_slopes(laws[v], viscosity, k_friction, rho / along.line(v).inertance); };
+  auto kinetic = [&](std::size_t v, double x) {
+    pulse_of(v);
+    return mean_kinetic_pressure(along.line(v), slopes_of(v), rho, pulse_moments(along.line(v), omega, at_from, at_to, x));
+  };
+  // The 0D vessels' kinetic pressure at the junctions of 1D ends, weighted by their mean flows
+  // (the vessels `along` holds beside the 1D ends): sum and weight per node.
+  std::unordered_map<std::size_t, std::array<double, 2>> beside;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (sourced[v] || !along.holds(v)) continue;
+    for (const bool distal : {false, true}) {
+      const auto node = static_cast<std::size_t>(distal ? net.to[v] : net.from[v]);
+      if (!junction(node)) continue;
+      const double w = std::abs(along.line(v).mean_velocity) + 1e-300;
+      auto& [sum, weight] = beside[node];
+      sum += w * kinetic(v, distal ? along.line(v).length : 0.0);
+      weight += w;
+    }
+  }
+  // Each 1D vessel's offsets (static = node's - offset) and forcing drops; its currents.
+  struct Source {
+    double offset_from = 0, offset_to = 0;
+    std::vector<double> drops;  // G(x) along it
+  };
+  std::unordered_map<std::size_t, Source> source;
+  std::vector<double> current(nodes, 0.0);
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!sourced[v]) continue;
+    const VesselLine& line = along.line(v);
+    const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);
+    auto offset = [&](std::size_t node, double x) {
+      if (!junction(node)) return 0.0;
+      const auto other = beside.find(node);
+      return kinetic(v, x) - (other != beside.end() ? other->second[0] / other->second[1] : 0.0);
+    };
+    Source& s = source[v];
+    s.offset_from = offset(a, 0.0);
+    s.offset_to = offset(b, line.length);
+    pulse_of(v);
+    s.drops = forcing_drops(line, slopes_of(v), rho, omega, at_from, at_to);
+    // Flows out of a and b: Y (p_a, p_b + G) with p = X - offset; the part without X is a current.
+    const TwoPort y = line.two_port(0.0);
+    current[a] -= (-y.aa * s.offset_from + y.ab * (s.drops.back() - s.offset_to)).real();
+    current[b] -= (-y.ba * s.offset_from + y.bb * (s.drops.back() - s.offset_to)).real();
+  }
+  // Each 0D vessel's own: its flow (1/l) int_{p_b}^{p_a} G dp, G = A^2 / (k mu(A)), has the
+  // mean (1/l)(F(p_a) - F(p_b)) + (G'(p_a) <p_a1^2> - G'(p_b) <p_b1^2>) / (2 l): the second
+  // part a current through it, from a to b.
+  auto through = [&](std::size_t v) {
+    auto capacity_slope = [&](std::size_t node) {  // G'(p) at the node's mean pressure
+      const double area = laws[v].area(line_of.steady.node_pressure[node]), h = 1e-3 * area;
+      auto capacity = [&](double x) { return x * x / (k_friction * viscosity(x)); };
+      return (capacity(area + h) - capacity(area - h)) / (2 * h) * laws[v].compliance_per_length(area);
+    };
+    const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);
+    return (capacity_slope(a) * node_variance[a] - capacity_slope(b) * node_variance[b]) / (2 * net.length[v]);
+  };
+  for (std::size_t v = 0; v < n; ++v) {
+    if (sourced[v]) continue;
+    const double j = through(v);
+    current[static_cast<std::size_t>(net.from[v])] -= j;
+    current[static_cast<std::size_t>(net.to[v])] += j;
+  }
+  std::vector<FourierSeries> none = series;
+  for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
+  solve_harmonic(net, network, boundaries, none, line_of, 0, 0.0, work, threads, current);
+  std::vector<double>().swap(current);
+  const std::vector<Complex>& x = work.current;
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);
+    const auto found = sourced[v] ? source.find(v) : source.end();
+    const Source* s = found != source.end() ? &found->second : nullptr;
+    const double pa = x[a].real() - (s ? s->offset_from : 0.0), pb = x[b].real() - (s ? s->offset_to : 0.0);
+    const bool held = along.holds(v);
+    const TwoPort y = (held ? along.line(v) : line_of(v)).two_port(0.0);
+    const double dq = s ? (y.aa * pa + y.ab * (pb + s->drops.back())).real() : (y.aa * pa + y.ab * pb).real() + through(v);
+    // The static mean's shift along it: the forced line's where sourced, else its nodes'.
+    std::vector<double> profile;
+    if (s) profile = mean_shift_profile(along.line(v), pa, dq, s->drops);
+    else if (held) profile = {pa, pb};
+    apply(v, dq, std::move(profile), x[a].real(), x[b].real());
+  }
+  for (std::size_t node = 0; node < nodes; ++node) node_pressure[node] += x[node].real();
+}
+
+}  // namespace
+
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, const SteadyFlow& steady,
-                                     const RunBoundaries& boundaries, int harmonics, int threads) {
+                                     const RunBoundaries& boundaries, int harmonics, int threads,
+                                     const std::function<bool(const VesselLine&)>& shift_source) {
   if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
   LinearPeriodic out = LinearPeriodic::about(net, blood, laws, viscosity, steady, threads);
   // Every harmonic kept: all of them at once, one to a thread.
   solve_harmonics(net, out, boundaries, harmonics, threads,
                   [&](int, std::vector<Complex>&& p) { out.node_pressure_.push_back(std::move(p)); });
+  if (shift_source) {
+    std::vector<bool> shift_sources(net.vessel_count());
+    for (std::size_t v = 0; v < shift_sources.size(); ++v) shift_sources[v] = shift_source(out.line_[v]);
+    const LineAbout line_of{net, laws, viscosity, steady, friction_coefficient(blood.alpha), blood.density};
+    std::vector<double> node_shift(net.node_count(), 0.0);
+    std::vector<double> variance(net.node_count(), 0.0);  // <p1^2> at each node
+    for (const std::vector<Complex>& p : out.node_pressure_)
+      for (std::size_t node = 0; node < variance.size(); ++node) variance[node] += 0.5 * std::norm(p[node]);
+    HarmonicWorkspace work;
+    solve_mean_shift(net, blood, laws, viscosity, boundaries, harmonic_network(net, boundaries),
+                     boundary_series(boundaries, harmonics), line_of, out, shift_sources, variance, node_shift, work, threads,
+                     [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
+                       out.mean_flow_[v] += dq;
+                       if (!shift_sources[v]) return;  // its nodes' means move below, and it with them
+                       // What lies beyond its nodes' shift, which moves their means below.
+                       const double last = static_cast<double>(profile.size() - 1);
+                       for (std::size_t i = 0; i < profile.size(); ++i) {
+                         const double s = static_cast<double>(i) / last;
+                         profile[i] -= (1 - s) * dx_from + s * dx_to;
+                       }
+                       out.mean_shift_[v] = std::move(profile);
+                     });
+    for (std::size_t node = 0; node < node_shift.size(); ++node) out.mean_node_pressure_[node] += node_shift[node];
+  }
   return out;
 }
 
 PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, const SteadyFlow& steady,
                                        const RunBoundaries& boundaries, int harmonics, double time,
-                                       const std::vector<bool>& keep, int threads) {
+                                       const std::vector<bool>& keep, int threads, bool shift_mean) {
   if (harmonics < 1) throw std::invalid_argument("solve_periodic_instant: at least one harmonic");
   PeriodicInstant out{steady.node_pressure, steady.flow, LinearPeriodic{}};
   LinearPeriodic& along = out.along;
@@ -251,8 +422,17 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   along.kept_.assign(net.node_count(), -1);
   along.kept_vessel_.assign(net.vessel_count(), -1);
   std::vector<std::size_t> kept_node;
+  // The mean shift reads the pulse of the 0D vessels at the nodes where 1D ends meet them.
+  std::vector<bool> held = keep;
+  if (shift_mean) {
+    std::vector<unsigned char> one_d_end(net.node_count(), 0);
+    for (std::size_t v = 0; v < net.vessel_count(); ++v)
+      if (keep[v]) one_d_end[static_cast<std::size_t>(net.from[v])] = one_d_end[static_cast<std::size_t>(net.to[v])] = 1;
+    for (std::size_t v = 0; v < net.vessel_count(); ++v)
+      if (one_d_end[static_cast<std::size_t>(net.from[v])] || one_d_end[static_cast<std::size_t>(net.to[v])]) held[v] = true;
+  }
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    if (!keep[v]) continue;
+    if (!held[v]) continue;
     along.kept_vessel_[v] = static_cast<std::int32_t>(along.line_.size());
     along.line_.push_back(line_of(v));
     along.mean_flow_.push_back(steady.flow[v]);
@@ -272,6 +452,7 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
   const HarmonicNetwork network = harmonic_network(net, boundaries);
   HarmonicWorkspace work;
+  std::vector<double> variance(shift_mean ? net.node_count() : 0, 0.0);  // <p1^2> at each node, for the shift
   for (int k = 1; k <= harmonics; ++k) {
     solve_harmonic(net, network, boundaries, series, line_of, k, along.omega(k), work, threads);
     const std::vector<Complex>& p = work.current;
@@ -279,8 +460,10 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
 #pragma omp parallel num_threads(threads) if (threads > 1)
     {
 #pragma omp for schedule(static)
-      for (std::int64_t i = 0; i < nodes; ++i)
+      for (std::int64_t i = 0; i < nodes; ++i) {
         out.node_pressure[static_cast<std::size_t>(i)] += (p[static_cast<std::size_t>(i)] * turn).real();
+        if (shift_mean) variance[static_cast<std::size_t>(i)] += 0.5 * std::norm(p[static_cast<std::size_t>(i)]);
+      }
 #pragma omp for schedule(static)
       for (std::int64_t i = 0; i < vessels; ++i) {
         const auto v = static_cast<std::size_t>(i);
@@ -294,7 +477,18 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
     for (std::size_t j = 0; j < kept_node.size(); ++j) kept[j] = p[kept_node[j]];
     along.node_pressure_.push_back(std::move(kept));
   }
+  if (shift_mean)
+    solve_mean_shift(net, blood, laws, viscosity, boundaries, network, series, line_of, along, keep, variance, out.node_pressure, work, threads,
+                     [&](std::size_t v, double dq, std::vector<double>&& profile, double, double) {
+                       out.middle_flow[v] += dq;
+                       if (along.holds(v)) along.shift_mean(v, dq, std::move(profile));
+                     });
   return out;
+}
+
+void LinearPeriodic::shift_mean(std::size_t vessel, double dq, std::vector<double>&& shift) {
+  mean_flow_[vessel_place(vessel)] += dq;
+  mean_shift_[vessel] = std::move(shift);
 }
 
 LinearPeriodic::Complex LinearPeriodic::pressure(int k, std::size_t vessel, double s) const {
@@ -314,9 +508,20 @@ std::array<VesselLine::Point, 3> LinearPeriodic::ends_and_middle(int k, std::siz
                                        node_pressure(k, static_cast<std::size_t>(net_->to[vessel])));
 }
 
-double LinearPeriodic::pressure_at(std::size_t vessel, double s, double t) const {
+double LinearPeriodic::mean_pressure_at(std::size_t vessel, double s) const {
   double p = (1 - s) * mean_node_pressure_[node_place(static_cast<std::size_t>(net_->from[vessel]))] +
              s * mean_node_pressure_[node_place(static_cast<std::size_t>(net_->to[vessel]))];
+  if (const auto shifted = mean_shift_.find(vessel); shifted != mean_shift_.end()) {
+    const std::vector<double>& shift = shifted->second;
+    const double at = std::clamp(s, 0.0, 1.0) * static_cast<double>(shift.size() - 1);
+    const std::size_t i = std::min(static_cast<std::size_t>(at), shift.size() - 2);
+    p += shift[i] + (at - static_cast<double>(i)) * (shift[i + 1] - shift[i]);
+  }
+  return p;
+}
+
+double LinearPeriodic::pressure_at(std::size_t vessel, double s, double t) const {
+  double p = mean_pressure_at(vessel, s);
   for (int k = 1; k <= harmonics(); ++k) p += (pressure(k, vessel, s) * std::polar(1.0, omega(k) * t)).real();
   return p;
 }

@@ -17,11 +17,14 @@
 // the order of the square of the pulse's relative amplitude (tests/test_linear_periodic.cpp).
 #pragma once
 
+#include <array>
 #include <complex>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <numbers>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 #include "harmonic/fourier_series.hpp"
@@ -46,6 +49,11 @@ class LinearPeriodic {
   double omega(int k) const { return 2 * std::numbers::pi * k / period_; }
   // A vessel's line, one the solve kept (every one, or those of solve_periodic_instant's `keep`).
   const VesselLine& line(std::size_t vessel) const { return line_[vessel_place(vessel)]; }
+  bool holds(std::size_t vessel) const { return kept_vessel_.empty() || kept_vessel_[vessel] >= 0; }
+  // Moves a kept vessel's mean by the periodic state's second-order shift (harmonic/mean_shift.hpp):
+  // its flow by dq, its pressure by `shift`, sampled evenly from its start to its end (at least
+  // two samples; linear between them).
+  void shift_mean(std::size_t vessel, double dq, std::vector<double>&& shift);
   // The loaded (mean) state: per node [Pa], per vessel [m^3/s, from -> to] (a whole
   // solution's; an instant's keeps its kept nodes and vessels only, by their places).
   const std::vector<double>& mean_node_pressure() const { return mean_node_pressure_; }
@@ -62,16 +70,18 @@ class LinearPeriodic {
   // The periodic state at time t: the mean plus every harmonic. The mean pressure along a
   // vessel is taken linear between its nodes.
   double pressure_at(std::size_t vessel, double s, double t) const;
+  double mean_pressure_at(std::size_t vessel, double s) const;  // the mean alone
   double node_pressure_at(std::size_t node, double t) const;
   double flow_at(std::size_t vessel, double s, double t) const;
 
   friend LinearPeriodic solve_linear_periodic(const Network&, const Blood&, std::span<const TubeLaw>,
                                               const ViscosityTable&, const SteadyFlow&,
-                                              const RunBoundaries&, int, int);
+                                              const RunBoundaries&, int, int,
+                                              const std::function<bool(const VesselLine&)>&);
   friend PeriodicInstant solve_periodic_instant(const Network&, const Blood&, std::span<const TubeLaw>,
                                                 const ViscosityTable&, const SteadyFlow&,
                                                 const RunBoundaries&, int, double,
-                                                const std::vector<bool>&, int);
+                                                const std::vector<bool>&, int, bool);
 
  private:
   // The mean state and every vessel's line about it; no harmonic yet.
@@ -86,6 +96,8 @@ class LinearPeriodic {
   std::vector<double> mean_flow_;
   std::vector<VesselLine> line_;
   std::vector<std::int32_t> kept_, kept_vessel_;  // per node, per vessel: its place, -1 (empty: its own)
+  // Per vessel so moved, the mean pressure's second-order shift along it beyond its nodes' means.
+  std::unordered_map<std::size_t, std::vector<double>> mean_shift_;
   std::size_t node_place(std::size_t node) const { return kept_.empty() ? node : static_cast<std::size_t>(kept_[node]); }
   std::size_t vessel_place(std::size_t v) const { return kept_vessel_.empty() ? v : static_cast<std::size_t>(kept_vessel_[v]); }
 };
@@ -97,13 +109,17 @@ class LinearPeriodic {
 // no path to ground. threads: the harmonics one to a thread, and the vessels' lines (the
 // same numbers for any count).
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
-                                     const ViscosityTable& viscosity, int harmonics, int threads = 1);
+                                     const ViscosityTable& viscosity, int harmonics, int threads = 1,
+                                     const std::function<bool(const VesselLine&)>& shift_source = {});
 // The same about a steady state already solved (solve_distended_steady_flow with the same
 // blood, laws and viscosity), with the network's boundary list (formats/run_boundaries.hpp) where the caller
 // holds it.
+// shift_source: where given, the mean moves by its second-order shift
+// (harmonic/mean_shift.hpp) with the forcing of the vessels whose line it marks (the run's 1D ones).
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, const SteadyFlow& steady,
-                                     const RunBoundaries& boundaries, int harmonics, int threads = 1);
+                                     const RunBoundaries& boundaries, int harmonics, int threads = 1,
+                                     const std::function<bool(const VesselLine&)>& shift_source = {});
 
 // The linear periodic state at one instant t: every node's pressure and every vessel's flow
 // at its middle, summed harmonic by harmonic as each is solved, and the whole state (`along`)
@@ -118,6 +134,6 @@ struct PeriodicInstant {
 PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, const SteadyFlow& steady,
                                        const RunBoundaries& boundaries, int harmonics, double time,
-                                       const std::vector<bool>& keep, int threads = 1);
+                                       const std::vector<bool>& keep, int threads = 1, bool shift_mean = false);
 
 }  // namespace hemotree

@@ -132,7 +132,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
         std::vector<bool> one_d = zero_d_;  // the vessels whose whole state it keeps
         one_d.flip();
         start_from_periodic(solve_periodic_instant(net, blood_, laws_, viscosity_, *steady, boundaries_.list,
-                                                   options.periodic_harmonics, time_, one_d, threads_));
+                                                   options.periodic_harmonics, time_, one_d, threads_, true));
         started_from_ = StartChoice::periodic;
       } catch (const InputError& e) {
         periodic_refusal_ = e.what();

@@ -139,7 +139,8 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
   app.add_option("--max-cycles", max_cycles, "upper bound for --until-periodic, in [1, 100000]")->capture_default_str();
   app.add_option("--settling-step", config.settling_step,
                  "with --until-periodic and 0D vessels: first one settling cycle, not reported, with the 0D step N "
-                 "times --lumped-step, and the compliance balance after it (docs/solver.md §6a); 0 or 1: none, in [0, 20]")
+                 "times --lumped-step, and the compliance balance after it (docs/solver.md §6a); 0 or 1: none (the "
+                 "default: the periodic start leaves it nothing to settle), in [0, 20]")
       ->capture_default_str();
   app.add_option("--probe", probe_texts, "record p, Q, A, u at vessel ID, fraction x in [0, 1] along it (ID[:x], x 0.5 by default)");
   app.add_option("--sample-interval", sample_text, "time between probe samples, in (0, the period]")

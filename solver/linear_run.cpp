@@ -28,6 +28,13 @@ namespace {
 // harmonic/trigonometric_extremes.hpp).
 constexpr int samples_per_period = 256;
 
+// A wave travels where the run's --model auto would keep the vessel 1D.
+bool wave_travels(const VesselLine& line, const SolverOptions& options, double omega, double period) {
+  const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
+  const double rc = line.resistance * line.length * line.compliance * line.length;
+  return !options.moves_in_phase(line.length / c0, omega * rc, period);
+}
+
 struct LinearCycle {
   CycleSummary cycle;
   std::vector<std::uint8_t> wave_travels;
@@ -68,6 +75,8 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
       }
       const Extremes dp = extremes(p, scratch), dq = extremes(q, scratch);
       c.mean_flow = periodic.mean_flow()[v];
+      // The mean at the middle: the nodes' and, where the vessel is 1D, its ends' kinetic offsets.
+      c.mean_pressure = periodic.mean_pressure_at(v, 0.5);
       c.systolic_pressure = c.mean_pressure + dp.greatest;
       c.diastolic_pressure = c.mean_pressure + dp.least;
       c.peak_flow = c.mean_flow + dq.greatest;
@@ -75,10 +84,8 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
       const double u = c.mean_flow / area;
       c.mean_wss = wall_shear_stress(mu, u, radius, blood.alpha);  // linear in u: its cycle mean
       c.reynolds = blood.density * u * 2 * radius / mu;
-      // A wave travels where the run's --model auto would keep the vessel 1D.
       const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
-      const double rc = line.resistance * line.length * line.compliance * line.length;
-      out.wave_travels[v] = !options.moves_in_phase(line.length / c0, omega * rc, period);
+      out.wave_travels[v] = wave_travels(line, options, omega, period);
       c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();
       if (analysed >= 1 && analysed <= harmonics) {
         const double w = periodic.omega(analysed);
@@ -118,9 +125,12 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   const auto started = std::chrono::steady_clock::now();
   const ViscosityTable viscosity(blood);
   const std::vector<TubeLaw> laws = vessel_laws(net, blood, options.external_pressure, options.thick_wall_ratio);
-  const LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics, options.threads);
   const Waveform driving = driving_waveform(net);
-  const double analysis = analysis_frequency(driving);
+  const double analysis = analysis_frequency(driving), omega = 2 * std::numbers::pi / driving.period;
+  // The mean moves by its second-order shift, forced where a run's --model auto keeps a vessel 1D.
+  const LinearPeriodic periodic =
+      solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics, options.threads,
+                            [&](const VesselLine& line) { return wave_travels(line, options, omega, driving.period); });
   const LinearCycle linear = linear_cycle(net, blood, viscosity, periodic, options, analysis);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 

@@ -46,8 +46,9 @@ struct RunConfiguration {
   double periodic_tolerance = 0;
   int max_cycles = 50;
   // With until_periodic and 0D vessels: a settling cycle first, its 0D step this many times
-  // the run's (solver/settling_cycle.hpp); 0 or 1: none. In [0, 20].
-  int settling_step = 3;
+  // the run's (solver/settling_cycle.hpp); 0 or 1: none (the default since the periodic start
+  // took its mean's second-order shift, docs/solver.md §6a). In [0, 20].
+  int settling_step = 0;
   bool balance_compliances = true;
   int checkpoint_every = 0;       // cycles; 0: a checkpoint only when interrupted
   bool resume = false;            // continue from the latest checkpoint of out_dir

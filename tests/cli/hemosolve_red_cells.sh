@@ -116,12 +116,12 @@ expect_error "--transport-step out of range" 2 "--transport-step 0: accepted ran
   "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --transport-step 0 --out "$WORK/x"
 expect_error "--transport-step with --steady" 2 "--steady excludes --transport-step" -- \
   "$HEMOSOLVE" "$WORK/diamond.json" --steady --transport-step 0.01 --out "$WORK/x"
-# Seeking the periodic state, the run takes a settling cycle first (its 0D vessels at three
-# times the step); the cells do not move with it, and start counting after it: the red-cell
+# Seeking the periodic state with --settling-step 3, the run takes a settling cycle first (its
+# 0D vessels at three times the step); the cells do not move with it, and start counting after it: the red-cell
 # balance stays at round-off (the first transport step once took the settling cycle's
 # volumes too: a discharge hematocrit of -1.1, refused).
 "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --until-periodic 1e-3 --max-cycles 3 --tracer "$TRACER" \
-  --out "$WORK/settled" --quiet 2>"$WORK/err"
+  --settling-step 3 --out "$WORK/settled" --quiet 2>"$WORK/err"
 status=$?  # 3: not periodic within the 3 cycles, with its results
 [ $status -eq 0 ] || [ $status -eq 3 ] || fail "--red-cells transport --until-periodic: $(cat "$WORK/err")"
 "$PY" - "$WORK/settled/summary.json" <<'PY' && pass "red cells after a settling cycle: balanced to round-off" || fail "red cells after a settling cycle"
