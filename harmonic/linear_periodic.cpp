@@ -252,8 +252,8 @@ LumenSlopes lumen_slopes(const TubeLaw& law, const ViscosityTable& viscosity, do
 // pressure, as pulse/lumped_vessels does), else the total pressure its 1D ends share.
 // `along` holds the harmonics of the sourced vessels and of the 0D vessels beside their
 // ends. Adds each node's shift to node_pressure and hands every vessel's to
-// apply(v, dq, profile, dx_from, dx_to): its flow's, its static pressure's along it (sampled
-// evenly from `from` to `to`; empty for a vessel `along` does not hold) and its nodes'.
+// apply(v, dq, profile, dx_from, dx_to): its flow's, its static pressure's along it where it
+// is sourced (sampled evenly from `from` to `to`; else empty: its nodes') and its nodes'.
 template <class Apply>
 void solve_mean_shift(const Network& net, const Blood& blood, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                       const RunBoundaries& boundaries, const HarmonicNetwork& network, const std::vector<FourierSeries>& series,
@@ -262,14 +262,14 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
                       int threads, Apply&& apply) {
   const std::size_t nodes = net.node_count(), n = net.vessel_count();
   const double k_friction = friction_coefficient(blood.alpha), rho = blood.density;
-  // Per node, a byte: a junction (two ends or more, no boundary), and a 0D vessel there.
-  constexpr unsigned char ends_one = 1, ends_more = 2, bounded = 4, lumped = 8;
+  // Per node, a byte: a junction (two ends or more, no boundary), and a 1D end there.
+  constexpr unsigned char ends_one = 1, ends_more = 2, bounded = 4, one_d = 8;
   std::vector<unsigned char> kind(nodes, 0);
   for (std::size_t v = 0; v < n; ++v)
     for (const std::int64_t end : {net.from[v], net.to[v]}) {
       unsigned char& k = kind[static_cast<std::size_t>(end)];
       k |= (k & (ends_one | ends_more)) ? ends_more : ends_one;
-      if (!sourced[v]) k |= lumped;
+      if (sourced[v]) k |= one_d;
     }
   for (std::size_t i = 0; i < boundaries.size(); ++i) kind[static_cast<std::size_t>(boundaries.node(i))] |= bounded;
   auto junction = [&](std::size_t node) { return (kind[node] & ends_more) && !(kind[node] & bounded); };
@@ -295,7 +295,7 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
     if (sourced[v] || !along.holds(v)) continue;
     for (const bool distal : {false, true}) {
       const auto node = static_cast<std::size_t>(distal ? net.to[v] : net.from[v]);
-      if (!junction(node)) continue;
+      if (!junction(node) || !(kind[node] & one_d)) continue;
       const double w = std::abs(along.line(v).mean_velocity) + 1e-300;
       auto& [sum, weight] = beside[node];
       sum += w * kinetic(v, distal ? along.line(v).length : 0.0);
@@ -356,14 +356,10 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
     const auto found = sourced[v] ? source.find(v) : source.end();
     const Source* s = found != source.end() ? &found->second : nullptr;
     const double pa = x[a].real() - (s ? s->offset_from : 0.0), pb = x[b].real() - (s ? s->offset_to : 0.0);
-    const bool held = along.holds(v);
-    const TwoPort y = (held ? along.line(v) : line_of(v)).two_port(0.0);
+    const TwoPort y = (along.holds(v) ? along.line(v) : line_of(v)).two_port(0.0);
     const double dq = s ? (y.aa * pa + y.ab * (pb + s->drops.back())).real() : (y.aa * pa + y.ab * pb).real() + through(v);
     // The static mean's shift along it: the forced line's where sourced, else its nodes'.
-    std::vector<double> profile;
-    if (s) profile = mean_shift_profile(along.line(v), pa, dq, s->drops);
-    else if (held) profile = {pa, pb};
-    apply(v, dq, std::move(profile), x[a].real(), x[b].real());
+    apply(v, dq, s ? mean_shift_profile(along.line(v), pa, dq, s->drops) : std::vector<double>{}, x[a].real(), x[b].real());
   }
   for (std::size_t node = 0; node < nodes; ++node) node_pressure[node] += x[node].real();
 }
@@ -479,9 +475,11 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   }
   if (shift_mean)
     solve_mean_shift(net, blood, laws, viscosity, boundaries, network, series, line_of, along, keep, variance, out.node_pressure, work, threads,
-                     [&](std::size_t v, double dq, std::vector<double>&& profile, double, double) {
+                     [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
                        out.middle_flow[v] += dq;
-                       if (along.holds(v)) along.shift_mean(v, dq, std::move(profile));
+                       if (!along.holds(v)) return;
+                       if (profile.empty()) profile = {dx_from, dx_to};  // the kept 0D vessels: their nodes'
+                       along.shift_mean(v, dq, std::move(profile));
                      });
   return out;
 }
