@@ -99,6 +99,11 @@ class LumpedVessels {
   // complete()'s exchanged volumes. By default a flow by the sign of its mean, a pressure in.
   void set_entering(std::span<const unsigned char> entering);
 
+  // The pressure at fraction x of a compliant tube's steady profile between end pressures pa,
+  // pb where its flow capacity is ga, gb (linear in p between them): what a 0D vessel reports
+  // inside it, and --linear at a vessel's middle.
+  static double steady_profile_pressure(double pa, double pb, double ga, double gb, double x);
+
   // Initial states: every node at the given pressure of its network node (steady: the steady
   // solution; rest: reference pressures), vessels at the given flows; capacitors at
   // p - R1 Q of their vessel's end (R1 edges and outlets follow from the pressures).
@@ -254,9 +259,6 @@ class LumpedVessels {
   // within it.
   std::size_t first_edge(std::size_t i) const { return first_edge_.empty() ? i : static_cast<std::size_t>(first_edge_[i]); }
   std::size_t section_at(std::size_t i, double x, double& within) const;
-  // The pressure at fraction x of a compliant tube's steady profile between end pressures pa,
-  // pb where its flow capacity is ga, gb (linear in p between them).
-  static double steady_profile_pressure(double pa, double pb, double ga, double gb, double x);
   void start_inner_nodes();  // on the steady profile of their vessels, from the end pressures
   // The pressure at fraction x along edge e on the steady profile between its end pressures.
   double edge_pressure_at(std::size_t e, double x) const;

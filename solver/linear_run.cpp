@@ -7,12 +7,15 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "core/units.hpp"
 #include "harmonic/linear_periodic.hpp"
 #include "harmonic/trigonometric_extremes.hpp"
+#include "physics/poiseuille.hpp"
 #include "physics/womersley.hpp"
+#include "pulse/lumped_vessels.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/output_folder.hpp"
 #include "solver/probes.hpp"
@@ -41,8 +44,28 @@ struct LinearCycle {
   std::vector<double> womersley, pwv_elastic, pwv_theory;
 };
 
+// The mean pressure at a vessel's middle: on the compliant tube's steady profile between its
+// nodes' means (the lumen narrows along the pressure drop, so the middle lies below their
+// mean: pulse/lumped_vessels.hpp, steady_profile_pressure, as a 0D vessel reports it and a 1D
+// vessel's friction holds it), with the mean's second-order shift along it. A tapered
+// vessel's profile is its nodes' line, as before.
+double middle_mean_pressure(const Network& net, const TubeLaw& law, const ViscosityTable& viscosity, double k_friction,
+                            const LinearPeriodic& periodic, std::size_t v) {
+  const double shifted = periodic.mean_pressure_at(v, 0.5);
+  if (net.is_tapered(v)) return shifted;
+  const double pa = periodic.mean_node_pressure()[static_cast<std::size_t>(net.from[v])];
+  const double pb = periodic.mean_node_pressure()[static_cast<std::size_t>(net.to[v])];
+  auto capacity = [&](double p) {  // G = A^2 / (k mu(A))
+    const double a = law.area(p);
+    return a * a / (k_friction * viscosity(a));
+  };
+  return shifted + LumpedVessels::steady_profile_pressure(pa, pb, capacity(pa), capacity(pb), 0.5) - 0.5 * (pa + pb);
+}
+
 LinearCycle linear_cycle(const Network& net, const Blood& blood, const ViscosityTable& viscosity,
-                         const LinearPeriodic& periodic, const SolverOptions& options, double analysis) {
+                         std::span<const TubeLaw> laws, const LinearPeriodic& periodic, const SolverOptions& options,
+                         double analysis) {
+  const double k_friction = friction_coefficient(blood.alpha);
   const std::size_t n = net.vessel_count();
   LinearCycle out;
   out.cycle = steady_cycle(net, blood, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}, nullptr);
@@ -75,8 +98,7 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
       }
       const Extremes dp = extremes(p, scratch), dq = extremes(q, scratch);
       c.mean_flow = periodic.mean_flow()[v];
-      // The mean at the middle: the nodes' and, where the vessel is 1D, its ends' kinetic offsets.
-      c.mean_pressure = periodic.mean_pressure_at(v, 0.5);
+      c.mean_pressure = middle_mean_pressure(net, laws[v], viscosity, k_friction, periodic, v);
       c.systolic_pressure = c.mean_pressure + dp.greatest;
       c.diastolic_pressure = c.mean_pressure + dp.least;
       c.peak_flow = c.mean_flow + dq.greatest;
@@ -131,7 +153,7 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   const LinearPeriodic periodic =
       solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics, options.threads,
                             [&](const VesselLine& line) { return wave_travels(line, options, omega, driving.period); });
-  const LinearCycle linear = linear_cycle(net, blood, viscosity, periodic, options, analysis);
+  const LinearCycle linear = linear_cycle(net, blood, viscosity, laws, periodic, options, analysis);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   const std::size_t n = net.vessel_count();
