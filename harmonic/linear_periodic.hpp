@@ -126,7 +126,9 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
 // for the vessels marked in `keep` only (the amplitudes at their nodes): what a time-stepped
 // run starts from (pulse/pulse_solver.cpp), without every node's K amplitudes at once (16 B a
 // node and harmonic: 0.6 GB for ten on the full tree). The same numbers, bit for bit, as
-// LinearPeriodic's node_pressure_at(i, t) and flow_at(v, 0.5, t).
+// LinearPeriodic's node_pressure_at(i, t) and flow_at(v, 0.5, t). shift_mean: about the mean
+// moved by its second-order shift (harmonic/mean_shift.hpp), forced in the vessels of `keep`
+// (`along` then holds the 0D vessels beside their ends too).
 struct PeriodicInstant {
   std::vector<double> node_pressure, middle_flow;  // per node [Pa], per vessel [m^3/s]
   LinearPeriodic along;
