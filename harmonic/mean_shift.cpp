@@ -30,10 +30,11 @@ double mean_forcing(const VesselLine& line, const LumenSlopes& s, double density
   const double f_aa = q0 * (2 * s.resistance_slope + area * s.resistance_curvature) / density;
   const double f_aq = (r + area * s.resistance_slope) / density;
   const double a2 = area * area, a3 = a2 * area;
-  const double dt = line.alpha * (m.dqq / area - 2 * q0 * c1 * m.dpq / a2 + q0 * q0 * c1 * c1 * m.dpp / a3 -
+  // T' = d/dx of the mean momentum flux's pulse part
+  const double flux_slope = line.alpha * (m.dqq / area - 2 * q0 * c1 * m.dpq / a2 + q0 * q0 * c1 * c1 * m.dpp / a3 -
                                   0.5 * q0 * q0 * c2 * m.dpp / a2);
   const double n = (0.5 * c2 * m.pp * gradient + 0.5 * c1 * m.dpp) / density + 0.5 * f_a * c2 * m.pp +
-                   0.5 * f_aa * c1 * c1 * m.pp + f_aq * c1 * m.pq + dt;
+                   0.5 * f_aa * c1 * c1 * m.pp + f_aq * c1 * m.pq + flux_slope;
   return density / area * n;
 }
 
