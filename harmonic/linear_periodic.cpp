@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdio>
-#include <cstdlib>
 #include <cstdint>
 #include <exception>
 #include <functional>
@@ -331,10 +329,12 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
   // Each 0D vessel's own: its flow (1/l) int_{p_b}^{p_a} G dp, G = A^2 / (k mu(A)), has the
   // mean (1/l)(F(p_a) - F(p_b)) + (G'(p_a) <p_a1^2> - G'(p_b) <p_b1^2>) / (2 l): the second
   // part a current through it, from a to b.
+  // Computed again where each vessel's shift is handed out: a per-vessel array would add
+  // 8 B a vessel to the full tree's start.
   auto through = [&](std::size_t v) {
     auto capacity_slope = [&](std::size_t node) {  // G'(p) at the node's mean pressure
       const double area = laws[v].area(line_of.steady.node_pressure[node]), h = 1e-3 * area;
-      auto capacity = [&](double x) { return x * x / (k_friction * viscosity(x)); };
+      auto capacity = [&](double x) { return flow_capacity(x, viscosity(x), k_friction); };
       return (capacity(area + h) - capacity(area - h)) / (2 * h) * laws[v].compliance_per_length(area);
     };
     const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);

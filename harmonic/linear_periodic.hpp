@@ -68,7 +68,7 @@ class LinearPeriodic {
   // Harmonic k >= 1 at the vessel's start, middle and end.
   std::array<VesselLine::Point, 3> ends_and_middle(int k, std::size_t vessel) const;
   // The periodic state at time t: the mean plus every harmonic. The mean pressure along a
-  // vessel is taken linear between its nodes.
+  // vessel is taken linear between its nodes, plus its second-order shift where one was kept.
   double pressure_at(std::size_t vessel, double s, double t) const;
   double mean_pressure_at(std::size_t vessel, double s) const;  // the mean alone
   double node_pressure_at(std::size_t node, double t) const;

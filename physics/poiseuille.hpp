@@ -1,6 +1,7 @@
 // Steady viscous resistance of a vessel with the velocity profile of the 1D model.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -20,6 +21,23 @@ inline double poiseuille_resistance(double viscosity, double length, double diam
                                     double alpha) {
   const double area = std::numbers::pi / 4 * diameter * diameter;
   return 2 * std::numbers::pi * viscosity * alpha / (alpha - 1) * length / (area * area);
+}
+
+// A compliant tube's flow capacity G = A^2 / (k mu) [m^4/(Pa s)]:
+// its steady flow is (1/l) int_{p_b}^{p_a} G(p) dp, G at the lumen A(p) and viscosity mu(A).
+inline double flow_capacity(double area, double viscosity, double k_friction) { return area * area / (k_friction * viscosity); }
+
+// The pressure at fraction x of a compliant tube's steady profile between end pressures pa
+// and pb where its flow capacity is ga and gb (G linear in p between them): with
+// int_p^pa G dp = x int_pb^pa G dp a quadratic in d = pa - p, G_a d - g d^2 / 2 = x F,
+// g = (G_a - G_b) / (pa - pb). What a 0D vessel reports inside it (pulse/lumped_vessels.hpp)
+// and --linear at a vessel's middle.
+inline double steady_profile_pressure(double pa, double pb, double ga, double gb, double x) {
+  const double drop = pa - pb;
+  if (drop == 0) return pa;
+  const double slope = (ga - gb) / drop, f = x * drop * 0.5 * (ga + gb);
+  const double disc = ga * ga - 2 * slope * f;
+  return pa - 2 * f / (ga + std::sqrt(std::max(disc, 0.0)));
 }
 
 // A tapered vessel, its lumen diameter linear from d0 (at `from`) to d1 (at `to`), with a

@@ -685,16 +685,6 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
 
 // ---- what the rest of the solver reads -------------------------------------------------------
 
-double LumpedVessels::steady_profile_pressure(double pa, double pb, double ga, double gb, double x) {
-  const double drop = pa - pb;
-  if (drop == 0) return pa;
-  // With G = A^2 / (k mu) linear in p between G_a and G_b, int_p^pa G dp = x int_pb^pa G dp
-  // is a quadratic in d = pa - p: G_a d - g d^2 / 2 = x F, g = (G_a - G_b) / (pa - pb).
-  const double slope = (ga - gb) / drop, f = x * drop * 0.5 * (ga + gb);
-  const double disc = ga * ga - 2 * slope * f;
-  return pa - 2 * f / (ga + std::sqrt(std::max(disc, 0.0)));
-}
-
 double LumpedVessels::edge_pressure_at(std::size_t e, double x) const {
   const double pa = pressure_[static_cast<std::size_t>(a_[e])], pb = pressure_[static_cast<std::size_t>(b_[e])];
   const double drop = pa - pb;

@@ -99,10 +99,6 @@ class LumpedVessels {
   // complete()'s exchanged volumes. By default a flow by the sign of its mean, a pressure in.
   void set_entering(std::span<const unsigned char> entering);
 
-  // The pressure at fraction x of a compliant tube's steady profile between end pressures pa,
-  // pb where its flow capacity is ga, gb (linear in p between them): what a 0D vessel reports
-  // inside it, and --linear at a vessel's middle.
-  static double steady_profile_pressure(double pa, double pb, double ga, double gb, double x);
 
   // Initial states: every node at the given pressure of its network node (steady: the steady
   // solution; rest: reference pressures), vessels at the given flows; capacitors at

@@ -15,7 +15,6 @@
 #include "harmonic/trigonometric_extremes.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/womersley.hpp"
-#include "pulse/lumped_vessels.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/output_folder.hpp"
 #include "solver/probes.hpp"
@@ -46,7 +45,7 @@ struct LinearCycle {
 
 // The mean pressure at a vessel's middle: on the compliant tube's steady profile between its
 // nodes' means (the lumen narrows along the pressure drop, so the middle lies below their
-// mean: pulse/lumped_vessels.hpp, steady_profile_pressure, as a 0D vessel reports it and a 1D
+// mean: physics/poiseuille.hpp, steady_profile_pressure, as a 0D vessel reports it and a 1D
 // vessel's friction holds it), with the mean's second-order shift along it. A tapered
 // vessel's profile is its nodes' line, as before.
 double middle_mean_pressure(const Network& net, const TubeLaw& law, const ViscosityTable& viscosity, double k_friction,
@@ -55,11 +54,11 @@ double middle_mean_pressure(const Network& net, const TubeLaw& law, const Viscos
   if (net.is_tapered(v)) return shifted;
   const double pa = periodic.mean_node_pressure()[static_cast<std::size_t>(net.from[v])];
   const double pb = periodic.mean_node_pressure()[static_cast<std::size_t>(net.to[v])];
-  auto capacity = [&](double p) {  // G = A^2 / (k mu(A))
-    const double a = law.area(p);
-    return a * a / (k_friction * viscosity(a));
+  auto capacity = [&](double p) {
+    const double area = law.area(p);
+    return flow_capacity(area, viscosity(area), k_friction);
   };
-  return shifted + LumpedVessels::steady_profile_pressure(pa, pb, capacity(pa), capacity(pb), 0.5) - 0.5 * (pa + pb);
+  return shifted + steady_profile_pressure(pa, pb, capacity(pa), capacity(pb), 0.5) - 0.5 * (pa + pb);
 }
 
 LinearCycle linear_cycle(const Network& net, const Blood& blood, const ViscosityTable& viscosity,

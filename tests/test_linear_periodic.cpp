@@ -300,20 +300,32 @@ TEST(LinearPeriodic, AnyThreadCountGivesTheSameBits) {
 
 // The periodic start's instant (harmonics summed as they are solved, the series kept along
 // some vessels only) is the whole solution's at that instant, bit for bit, for any threads.
+// A TubeIntoWindkessel's blood, viscosity, steady state and boundaries: what the whole
+// solution and the instant are both solved about.
+struct SteadyAbout {
+  const TubeIntoWindkessel& tube;
+  Blood blood = newtonian(TubeIntoWindkessel::mu);
+  ViscosityTable viscosity{blood};
+  SteadyFlow steady = solve_distended_steady_flow(tube.net, blood, tube.laws, viscosity, tube.net.inlet->waveform.mean_value());
+  RunBoundaries boundaries{tube.net};
+  LinearPeriodic whole(int harmonics, const std::function<bool(const VesselLine&)>& shift_source = {}) const {
+    return solve_linear_periodic(tube.net, blood, tube.laws, viscosity, steady, boundaries, harmonics, 1, shift_source);
+  }
+  PeriodicInstant instant(int harmonics, double t, const std::vector<bool>& keep, int threads, bool shift_mean = false) const {
+    return solve_periodic_instant(tube.net, blood, tube.laws, viscosity, steady, boundaries, harmonics, t, keep, threads,
+                                  shift_mean);
+  }
+};
+
 TEST(LinearPeriodic, TheInstantIsTheWholeSolutionsBitForBit) {
   const TubeIntoWindkessel cut(5, 0.15, 4e-3, 6.0);
-  const Blood blood = newtonian(TubeIntoWindkessel::mu);
-  const ViscosityTable viscosity(blood);
-  const SteadyFlow steady = solve_distended_steady_flow(cut.net, blood, cut.laws, viscosity,
-                                                        cut.net.inlet->waveform.mean_value());
-  const RunBoundaries boundaries(cut.net);
-  const LinearPeriodic whole = solve_linear_periodic(cut.net, blood, cut.laws, viscosity, steady, boundaries, 7, 1);
+  const SteadyAbout about{cut};
+  const LinearPeriodic whole = about.whole(7);
   std::vector<bool> keep(cut.net.vessel_count(), false);
   keep[1] = keep[3] = true;
   const double t = 0.37 * whole.period();
   for (const int threads : {1, 2, 3}) {
-    const PeriodicInstant instant =
-        solve_periodic_instant(cut.net, blood, cut.laws, viscosity, steady, boundaries, 7, t, keep, threads);
+    const PeriodicInstant instant = about.instant(7, t, keep, threads);
     for (std::size_t node = 0; node < cut.net.node_count(); ++node)
       EXPECT_EQ(instant.node_pressure[node], whole.node_pressure_at(node, t)) << threads << " threads, node " << node;
     for (std::size_t v = 0; v < cut.net.vessel_count(); ++v)
@@ -380,18 +392,11 @@ TEST(LinearPeriodic, AHeldPressureDrivesTheLineFromItsEnd) {
 // (U = 0.4 m/s, U / c = 0.07).
 TEST(LinearPeriodic, TheShiftedInstantIsTheShiftedWholeSolution) {
   const TubeIntoWindkessel chain5(5, 0.6, 4e-3, 6.0, 1.0);
-  const Blood blood = newtonian(TubeIntoWindkessel::mu);
-  const ViscosityTable viscosity(blood);
-  const SteadyFlow steady = solve_distended_steady_flow(chain5.net, blood, chain5.laws, viscosity,
-                                                        chain5.net.inlet->waveform.mean_value());
-  const RunBoundaries boundaries(chain5.net);
-  const LinearPeriodic plain = solve_linear_periodic(chain5.net, blood, chain5.laws, viscosity, steady, boundaries, 7, 1);
-  const LinearPeriodic whole = solve_linear_periodic(chain5.net, blood, chain5.laws, viscosity, steady, boundaries, 7, 1,
-                                                     [](const VesselLine&) { return true; });
+  const SteadyAbout about{chain5};
+  const LinearPeriodic plain = about.whole(7), whole = about.whole(7, [](const VesselLine&) { return true; });
   const std::vector<bool> keep(chain5.net.vessel_count(), true);
   const double t = 0.37 * whole.period();
-  const PeriodicInstant instant =
-      solve_periodic_instant(chain5.net, blood, chain5.laws, viscosity, steady, boundaries, 7, t, keep, 1, true);
+  const PeriodicInstant instant = about.instant(7, t, keep, 1, true);
   double largest_shift = 0;
   for (std::size_t node = 0; node < chain5.net.node_count(); ++node) {
     const double scale = std::abs(whole.node_pressure_at(node, t));
