@@ -201,6 +201,7 @@ void NodalSystem::release_factorization() {
     std::vector<double>().swap(divider_);
   }
   std::vector<double>().swap(inverse_scratch_);
+  inverse_known_ = {};
   std::vector<std::int32_t>().swap(path_scratch_);
 }
 
@@ -607,25 +608,24 @@ void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::spa
       // for small systems, which are in cache), the walk gives way to the pass, so a call
       // costs at most about twice the cheaper of the two. Both compute each node by the same
       // expression from the same parent's value, so they agree to the bit.
-      auto& sigma = inverse_scratch_;
+      // The walk keeps the nodes it has computed in a small map (a dense array would hold 8 B
+      // a node through the whole run for the few hundred coupling nodes' paths); the pass
+      // takes a dense array for the call alone.
+      auto& known = inverse_known_;
       auto& path = path_scratch_;
-      if (sigma.size() != nodes_) sigma.assign(nodes_, -1.0);
       const std::size_t budget = nodes_ / 32 + 64;
-      auto own = [&](std::size_t c) {
+      auto own = [&](std::size_t c, auto&& sigma_of) {
         const std::int32_t p = parent_[c];
-        if (p < 0) {
-          sigma[c] = inverse_pivot_[c];
-        } else {
-          const double divider = divider_[c];
-          sigma[c] = inverse_pivot_[c] + divider * divider * sigma[static_cast<std::size_t>(p)];
-        }
+        if (p < 0) return inverse_pivot_[c];
+        const double divider = divider_[c];
+        return inverse_pivot_[c] + divider * divider * sigma_of(p);
       };
+      known.clear();
       path.clear();
       bool walked = true;
       for (std::size_t k = 0; k < nodes.size() && walked; ++k) {
         const std::size_t bottom = path.size();
-        for (std::int32_t j = nodes[k]; j >= 0 && sigma[static_cast<std::size_t>(j)] < 0;
-             j = parent_[static_cast<std::size_t>(j)]) {
+        for (std::int32_t j = nodes[k]; j >= 0 && !known.contains(j); j = parent_[static_cast<std::size_t>(j)]) {
           path.push_back(j);
           if (path.size() > budget) {
             walked = false;
@@ -633,16 +633,18 @@ void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::spa
           }
         }
         if (!walked) break;
-        for (std::size_t q = path.size(); q-- > bottom;) own(static_cast<std::size_t>(path[q]));
-        out[k] = sigma[static_cast<std::size_t>(nodes[k])];
+        for (std::size_t q = path.size(); q-- > bottom;)
+          known.emplace(path[q], own(static_cast<std::size_t>(path[q]), [&](std::int32_t p) { return known.at(p); }));
+        out[k] = known.at(nodes[k]);
       }
-      if (walked) {
-        for (const std::int32_t j : path) sigma[static_cast<std::size_t>(j)] = -1.0;
-      } else {
-        for (const std::int32_t c : order_) own(static_cast<std::size_t>(c));
+      if (!walked) {
+        std::vector<double> sigma(nodes_);
+        for (const std::int32_t c : order_)
+          sigma[static_cast<std::size_t>(c)] =
+              own(static_cast<std::size_t>(c), [&](std::int32_t p) { return sigma[static_cast<std::size_t>(p)]; });
         for (std::size_t k = 0; k < nodes.size(); ++k) out[k] = sigma[static_cast<std::size_t>(nodes[k])];
-        std::fill(sigma.begin(), sigma.end(), -1.0);
       }
+      known.clear();
       path.clear();
       return;
     }
@@ -682,6 +684,7 @@ void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::spa
     }
   } catch (...) {
     inverse_scratch_ = {};
+    inverse_known_ = {};
     path_scratch_ = {};
     throw;
   }

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 namespace hemotree {
@@ -143,10 +144,11 @@ class NodalSystem {
   std::vector<std::int32_t> component_;
   std::vector<unsigned char> grounded_;
   bool factorized_ = false;
-  // inverse_diagonal's scratch: per node (tree: Sigma_ii, -1 where not yet computed) or per
-  // position of the Cholesky order (the forward solve, 0 outside its path), back to that
-  // state after every call; and the tree's path stack.
+  // inverse_diagonal's scratch, empty or back to zero after every call: per position of the
+  // Cholesky order (the forward solve, 0 outside its path); on a tree Sigma_ii of the nodes
+  // walked, and the path stack.
   mutable std::vector<double> inverse_scratch_;
+  mutable std::unordered_map<std::int32_t, double> inverse_known_;
   mutable std::vector<std::int32_t> path_scratch_;
 };
 

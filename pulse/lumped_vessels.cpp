@@ -86,6 +86,14 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   shunt_.resize(nodes_, 0.0);
   shunt_pressure_.resize(nodes_, 0.0);
   volume_b_.resize(nodes_, 0.0);
+  // The arrays grown one vessel or outlet at a time hold up to twice their size (a
+  // capacitor's row appended to a per-node array doubles it; ten million vessels' edges
+  // reach 1.6 times): held for the whole run, they are cut to their sizes here.
+  auto fit = [](auto&... arrays) { (arrays.shrink_to_fit(), ...); };
+  fit(vessels_, first_edge_, a_, b_, edge_length_, edge_root_slope_, edge_root_intercept_, tapered_,
+      shunt_, shunt_pressure_, volume_b_, outlet_boundary_, outlet_of_capacitor_, capacitor_vessel_edge_,
+      capacitor_edge_sign_, edge_fixed_resistance_, inflow_node_, inflow_boundary_, inflow_entering_,
+      held_node_, held_boundary_, held_entering_, held_reference_conductance_);
 
   // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes
   // (of each section's, L / n):

@@ -306,6 +306,9 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
 
   // ---- the discretisation, its step and its cost ---------------------------------------
   PulseSolver run(net, solver_options(config));  // the steady solve: minutes on the full tree
+  // The walls are in the vessels' tube laws now; only a VTK file would write them again.
+  if (given_up && !config.vtk && config.frames == 0)
+    for (std::vector<double>* wall : {&given_up->wall_thickness, &given_up->youngs_modulus}) std::vector<double>().swap(*wall);
   if (interrupted_before_start()) return result;
   const Discretisation d = decide_discretisation(net, run, config, period, observer);
   const std::size_t steps_per_cycle = d.step.cycle.steps_per_cycle;
