@@ -101,11 +101,6 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
       rcr_outlets_ = rcr_outlets_ || o.type == BoundaryType::rcr;
     }
   choose_models(options);
-  lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
-  sectioned_count_ = static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t s) { return s > 1; }));
-  std::vector<std::uint8_t>().swap(lumped_sections_);  // a byte a vessel the run no longer reads
-  lumped_.set_passes(options.lumped_passes);
-  lumped_.set_threads(threads_);
 
   const std::optional<SteadyFlow> steady = solve_steady_flow();
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
@@ -116,27 +111,45 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   if (const std::string refusal = pressure_reference_refusal(net, boundaries_.list); !refusal.empty())
     throw SettingError("pressure_at", refusal);
   orient_pressure_boundaries(steady);
+
+  // The linear periodic state, before the 0D vessels' arrays exist: its harmonic workspace and
+  // those arrays are the set-up's two largest parts, and need not be held at once.
+  started_from_steady_ = options.start != StartChoice::rest && steady;
+  std::optional<PeriodicInstant> instant;
+  if (started_from_steady_ && options.start == StartChoice::periodic) {
+    // Where the linear periodic state cannot be formed (a harmonic's system singular where
+    // the steady one is not: no input is known to reach this, and the default start should
+    // not be what fails a run), the run keeps the steady start and says why.
+    try {
+      std::vector<bool> one_d = zero_d_;  // the vessels whose whole state it keeps
+      one_d.flip();
+      instant = solve_periodic_instant(net, blood_, laws_, viscosity_, *steady, boundaries_.list,
+                                       options.periodic_harmonics, time_, one_d, threads_, true);
+    } catch (const InputError& e) {
+      periodic_refusal_ = e.what();
+    }
+  }
+
+  lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
+  sectioned_count_ = static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t s) { return s > 1; }));
+  std::vector<std::uint8_t>().swap(lumped_sections_);  // a byte a vessel the run no longer reads
+  lumped_.set_passes(options.lumped_passes);
+  lumped_.set_threads(threads_);
   couple_lumped_ends();
   allocate_state();
 
   compute_rest_correction();
-  started_from_steady_ = options.start != StartChoice::rest && steady;
   if (started_from_steady_) {
     start_from_steady_flow(*steady);
     started_from_ = StartChoice::steady;
-    if (options.start == StartChoice::periodic) {
-      // Where the linear periodic state cannot be formed (a harmonic's system singular where
-      // the steady one is not: no input is known to reach this, and the default start should
-      // not be what fails a run), the run keeps the steady start and says why.
+    if (instant) {
       try {
-        std::vector<bool> one_d = zero_d_;  // the vessels whose whole state it keeps
-        one_d.flip();
-        start_from_periodic(solve_periodic_instant(net, blood_, laws_, viscosity_, *steady, boundaries_.list,
-                                                   options.periodic_harmonics, time_, one_d, threads_, true));
+        start_from_periodic(*instant);
         started_from_ = StartChoice::periodic;
       } catch (const InputError& e) {
         periodic_refusal_ = e.what();
       }
+      instant.reset();
     }
   } else {
     start_at_rest();
