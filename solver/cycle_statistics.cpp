@@ -147,17 +147,23 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
     c.mean_pressure = c.mean_pressure / duration_;
     c.mean_wss = c.mean_wss / duration_;
     c.reynolds = c.reynolds / duration_;
-    c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();  // 0D: no wave (below: 1D)
   }
   for (std::size_t j = 0; j < one_d_.size(); ++j) {
-    VesselCycle& c = out[static_cast<std::size_t>(one_d_[j])];
-    const double length = net_.length[static_cast<std::size_t>(one_d_[j])];
-    c.pwv_pressure = phase_velocity(detrended(p_in_[j], 4 * j), detrended(p_out_[j], 4 * j + 1), omega_, length);
-    c.pwv_velocity = phase_velocity(detrended(u_in_[j], 4 * j + 2), detrended(u_out_[j], 4 * j + 3), omega_, length);
+    const auto v = static_cast<std::size_t>(one_d_[j]);
+    const double length = net_.length[v];
+    summary.waves.emplace_back(
+        v, WaveSpeeds{phase_velocity(detrended(p_in_[j], 4 * j), detrended(p_out_[j], 4 * j + 1), omega_, length),
+                      phase_velocity(detrended(u_in_[j], 4 * j + 2), detrended(u_out_[j], 4 * j + 3), omega_, length)});
     p_in_[j] = p_out_[j] = u_in_[j] = u_out_[j] = 0;
   }
+  std::ranges::sort(summary.waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
   duration_ = 0;
   return summary;
+}
+
+WaveSpeeds CycleSummary::wave_speeds(std::size_t vessel) const {
+  const auto at = std::ranges::lower_bound(waves, vessel, {}, &std::pair<std::size_t, WaveSpeeds>::first);
+  return at != waves.end() && at->first == vessel ? at->second : WaveSpeeds{};
 }
 
 PeriodicityChange cycle_change(std::span<const double> previous_mean_pressure,

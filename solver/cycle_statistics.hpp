@@ -10,7 +10,9 @@
 
 #include <complex>
 #include <cstdint>
+#include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "pulse/pulse_solver.hpp"
@@ -23,9 +25,6 @@ struct VesselCycle {
   double peak_flow = 0, least_flow = 0;  // largest and smallest flow at the centre
   double mean_wss = 0;   // [Pa]
   double reynolds = 0;   // rho u D / mu, cycle mean
-  // Phase velocity omega L / (phase lag from inlet end to outlet end) at the analysis
-  // frequency [m/s]; NaN where the lag is not positive (standing or backward waves).
-  double pwv_pressure = 0, pwv_velocity = 0;
   double pulsatility_index() const {
     return (systolic_pressure - diastolic_pressure) / mean_pressure;
   }
@@ -40,8 +39,19 @@ double wall_shear_stress(double viscosity, double mean_velocity, double radius, 
 // two points dx apart are z0 (upstream) and z1; NaN unless the lag lies in (0, pi).
 double phase_velocity(std::complex<double> z0, std::complex<double> z1, double omega, double dx);
 
+// A vessel's measured pulse wave speeds: the phase velocity omega L / (phase lag from its
+// inlet end to its outlet end) of its pressure and its velocity at the analysis frequency
+// [m/s]; NaN where the lag is not positive (standing or backward waves) or no wave travels.
+struct WaveSpeeds {
+  double pressure = std::numeric_limits<double>::quiet_NaN(), velocity = std::numeric_limits<double>::quiet_NaN();
+};
+
 struct CycleSummary {
   std::vector<VesselCycle> vessels;
+  // The wave speeds where a wave travels (the 1D vessels: a few hundred of millions), by
+  // vessel index, increasing; wave_speeds(v) gives NaN for every other vessel.
+  std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
+  WaveSpeeds wave_speeds(std::size_t vessel) const;
   // Mean flow in through the boundaries that count as entering (the inlet; flows into the
   // network, pressures whose steady flow enters) and out through the others (outlets,
   // prescribed outflows), from the volume fluxes the solver exchanged there: over a periodic

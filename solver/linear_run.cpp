@@ -88,10 +88,8 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
       VesselCycle& c = out.cycle.vessels[v];
       const double area = blood.density / line.inertance, radius = std::sqrt(area / std::numbers::pi);
       const double mu = viscosity(area);
-      std::array<VesselLine::Point, 3> analysed_points{};
       for (int k = 1; k <= harmonics; ++k) {
         const auto points = periodic.ends_and_middle(k, v);
-        if (k == analysed) analysed_points = points;
         p[static_cast<std::size_t>(k - 1)] = points[1].pressure;
         q[static_cast<std::size_t>(k - 1)] = points[1].flow;
       }
@@ -107,18 +105,21 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
       c.reynolds = blood.density * u * 2 * radius / mu;
       const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
       out.wave_travels[v] = wave_travels(line, options, omega, period);
-      c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();
-      if (analysed >= 1 && analysed <= harmonics) {
-        const double w = periodic.omega(analysed);
-        c.pwv_pressure = phase_velocity(analysed_points[0].pressure, analysed_points[2].pressure, w, line.length);
-        c.pwv_velocity = phase_velocity(analysed_points[0].flow, analysed_points[2].flow, w, line.length);
-      }
       const double w = 2 * std::numbers::pi * analysis;
       out.pwv_elastic[v] = c0;
       out.womersley[v] = womersley_number(2 * radius, blood.density, mu, w);
       out.pwv_theory[v] = womersley_wave(c0, out.womersley[v], w).phase_velocity;
     }
   }
+  // The measured wave speeds where the report gives them: where a wave travels.
+  if (analysed >= 1 && analysed <= harmonics)
+    for (std::size_t v = 0; v < n; ++v)
+      if (out.wave_travels[v]) {
+        const auto points = periodic.ends_and_middle(analysed, v);
+        const double w = periodic.omega(analysed), length = periodic.line(v).length;
+        out.cycle.waves.emplace_back(v, WaveSpeeds{phase_velocity(points[0].pressure, points[2].pressure, w, length),
+                                                   phase_velocity(points[0].flow, points[2].flow, w, length)});
+      }
   return out;
 }
 

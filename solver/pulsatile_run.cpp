@@ -21,15 +21,20 @@ double seconds_since_epoch_start() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// A cycle's summary as numbers, for the checkpoint: given vessel by vessel, not assembled.
+// A cycle's summary as numbers, for the checkpoint: given vessel by vessel, not assembled,
+// each vessel's wave speeds after its statistics (NaN where none).
 constexpr std::size_t vessel_fields = 10;
-VesselCycle vessel_cycle(const double* f) { return {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8], f[9]}; }
+VesselCycle vessel_cycle(const double* f) { return {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]}; }
 void put_summary(CheckpointWriter& out, const CycleSummary& c) {
   out.begin_vector(4 + vessel_fields * c.vessels.size());
   out.put_part(std::vector<double>{c.inlet_mean_flow, c.outlets_mean_flow, c.volume_change, c.conservation_error});
-  for (const VesselCycle& v : c.vessels) {
+  auto wave = c.waves.begin();
+  for (std::size_t k = 0; k < c.vessels.size(); ++k) {
+    const VesselCycle& v = c.vessels[k];
+    WaveSpeeds speeds;
+    if (wave != c.waves.end() && wave->first == k) speeds = (wave++)->second;
     const double fields[vessel_fields] = {v.mean_flow, v.mean_pressure, v.systolic_pressure, v.diastolic_pressure,
-                                          v.peak_flow, v.least_flow, v.mean_wss, v.reynolds, v.pwv_pressure, v.pwv_velocity};
+                                          v.peak_flow, v.least_flow, v.mean_wss, v.reynolds, speeds.pressure, speeds.velocity};
     out.put_part(fields);
   }
   out.put(c.boundary_mean_flow);
@@ -44,7 +49,11 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
   c.volume_change = values[2];
   c.conservation_error = values[3];
   c.boundary_mean_flow = in.get_vector();
-  for (std::size_t k = 4; k < values.size(); k += vessel_fields) c.vessels.push_back(vessel_cycle(&values[k]));
+  for (std::size_t k = 4; k < values.size(); k += vessel_fields) {
+    c.vessels.push_back(vessel_cycle(&values[k]));
+    const WaveSpeeds speeds{values[k + 8], values[k + 9]};
+    if (!std::isnan(speeds.pressure) || !std::isnan(speeds.velocity)) c.waves.emplace_back(c.vessels.size() - 1, speeds);
+  }
   return c;
 }
 }  // namespace
@@ -107,7 +116,7 @@ void PulsatileRun::finish_snapshot() {
 
 void PulsatileRun::set_aside_last_vessels() {
   if (last_.vessels.empty()) return;
-  std::vector<VesselCycle>().swap(last_.vessels);
+  std::vector<VesselCycle>().swap(last_.vessels);  // its waves, a few hundred, stay
   std::vector<double>().swap(last_.boundary_mean_flow);
   last_vessels_aside_ = true;
 }

@@ -66,13 +66,14 @@ VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vect
   column("mean_wss", [](const VesselCycle& c) { return c.mean_wss; });
   column("reynolds", [](const VesselCycle& c) { return c.reynolds; });
   const double null = std::numeric_limits<double>::quiet_NaN();
-  auto measured = [&](double VesselCycle::*speed) {
-    std::vector<double> x(n);
-    for (std::size_t v = 0; v < n; ++v) x[v] = wave_travels.empty() || wave_travels[v] ? cycle.vessels[v].*speed : null;
+  auto measured = [&](double WaveSpeeds::*speed) {
+    std::vector<double> x(n, null);
+    for (const auto& [v, speeds] : cycle.waves)
+      if (wave_travels.empty() || wave_travels[v]) x[v] = speeds.*speed;
     return x;
   };
-  table.add_number("pwv_pressure", measured(&VesselCycle::pwv_pressure));
-  table.add_number("pwv_velocity", measured(&VesselCycle::pwv_velocity));
+  table.add_number("pwv_pressure", measured(&WaveSpeeds::pressure));
+  table.add_number("pwv_velocity", measured(&WaveSpeeds::velocity));
   return table;
 }
 

@@ -54,7 +54,6 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
                steady.node_pressure[static_cast<std::size_t>(net.to[v])]);
     c.mean_wss = wall_shear_stress(mu, u, radius, blood.alpha);
     c.reynolds = blood.density * u * 2 * radius / mu;
-    c.pwv_pressure = c.pwv_velocity = std::numeric_limits<double>::quiet_NaN();
   }
   const std::vector<double> inflow = boundary_inflow(net, steady);
   for (const NodeBoundary& b : node_boundaries(net)) {
