@@ -29,7 +29,7 @@ std::vector<double> PulseSolver::vessel_volumes() const {
       const std::int32_t e = lumped_.vessel_index(v);
       volume[v] = is_tapered(v)              ? lumped_.tapered_volume(e)
                   : lumped_.sections(e) > 1 ? lumped_.sectioned_volume(e)
-                                            : net_.length[v] * 0.5 * (laws_[v].area(lumped_.pressure_at(e, 0)) + laws_[v].area(lumped_.pressure_at(e, 1)));
+                                            : net_.length[v] * 0.5 * (law(v).area(lumped_.pressure_at(e, 0)) + law(v).area(lumped_.pressure_at(e, 1)));
     }
     for (auto el = first_element_[v]; el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
   }
@@ -45,7 +45,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   // steady pressures (9.8 mmHg at the root of the paper's tree).
   if (mean_pressure)
     for (std::size_t v = 0; v < n; ++v) {
-      const double area = laws_[v].area((*mean_pressure)[v]);
+      const double area = law(v).area((*mean_pressure)[v]);
       if (is_tapered(v)) {
         const double area_to = end_law(v, true).area((*mean_pressure)[v]);
         if (area > 0 && area_to > 0)
@@ -60,7 +60,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
   // Each vessel's volume and dA/dp at its mean area, now.
   const std::vector<double> volume = vessel_volumes();
   std::vector<double> area_per_pressure(n);
-  for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = laws_[v].compliance_per_length(volume[v] / net_.length[v]);
+  for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = law(v).compliance_per_length(volume[v] / net_.length[v]);
   // A tapered vessel's dA/dp changes along it: each element's at its mean area and centre
   // (a 0D one's, the mean of its ends'), and the vessel's the mean of those.
   std::vector<double> element_area_per_pressure;

@@ -164,7 +164,7 @@ void PulseSolver::interior_face_fluxes() {
       double fa, fq;
       // In a tapered vessel, the law at the interface itself.
       const TubeLaw& law = taper_row_.empty() || taper_row_[static_cast<std::size_t>(el)] < 0
-                                 ? laws_[static_cast<std::size_t>(v)]
+                                 ? element_law_[static_cast<std::size_t>(el)]
                                  : taper_right_law_[static_cast<std::size_t>(taper_row_[static_cast<std::size_t>(el)])];
       upwind_flux(law, area_right_(el), flow_right_(el), area_left_(el + 1), flow_left_(el + 1), fa, fq);
       flux_a_right_(el) = flux_a_left_(el + 1) = fa;

@@ -95,7 +95,7 @@ void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) con
       a += state_.area(el, m) * phi[static_cast<std::size_t>(m)];
       q += state_.flow(el, m) * phi[static_cast<std::size_t>(m)];
     }
-    const double p = with_pressure ? (is_tapered(v) ? law_at(v, x).pressure(a) : laws_[v].pressure(a)) : 0.0;
+    const double p = with_pressure ? (is_tapered(v) ? law_at(v, x).pressure(a) : element_law_[static_cast<std::size_t>(el)].pressure(a)) : 0.0;
     f(static_cast<std::size_t>(j), v, a, q, p);
   }
 }

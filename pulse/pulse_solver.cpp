@@ -157,6 +157,16 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   choose_time_step(options);
   // The coupled ends' first linearisation needs their end states.
   if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);
+
+  law_beta_.resize(n);
+  law_area_.resize(n);
+  law_pressure_.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    law_beta_[v] = laws_[v].beta;
+    law_area_[v] = laws_[v].reference_area;
+    law_pressure_[v] = laws_[v].reference_pressure;
+  }
+  std::vector<TubeLaw>().swap(laws_);
 }
 
 std::optional<SteadyFlow> PulseSolver::solve_steady_flow() {
@@ -323,6 +333,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
   element_vessel_.resize(one_d * static_cast<std::size_t>(e));
   half_length_.resize(static_cast<Eigen::Index>(element_vessel_.size()));
   element_beta_.resize(half_length_.size());
+  element_law_.resize(element_vessel_.size());
   blocks_.clear();
   one_d_vessels_.clear();
   std::int32_t next = 0;
@@ -335,6 +346,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
         element_vessel_[static_cast<std::size_t>(next)] = static_cast<std::int32_t>(v);
         half_length_(next) = net_.length[v] / (2.0 * e);
         element_beta_(next) = laws_[v].beta;
+        element_law_[static_cast<std::size_t>(next)] = laws_[v];
       }
     }
     if (next == first) continue;
@@ -381,7 +393,7 @@ void PulseSolver::build_taper_tables() {
 }
 
 TubeLaw PulseSolver::law_at(std::size_t vessel, double x) const {
-  if (!is_tapered(vessel)) return laws_[vessel];
+  if (!is_tapered(vessel)) return law(vessel);
   return tapers_[static_cast<std::size_t>(taper_of_[vessel])].at(std::clamp(x, 0.0, 1.0));
 }
 

@@ -215,10 +215,13 @@ class PulseSolver {
 
   // A vessel's tube law: at its `from` end (the whole vessel's unless it tapers), at one of
   // its ends, and at fraction x along it.
-  const TubeLaw& law(std::size_t vessel) const { return laws_[vessel]; }
-  const TubeLaw& end_law(std::size_t vessel, bool distal) const {
+  TubeLaw law(std::size_t vessel) const {
+    return laws_.empty() ? TubeLaw{law_beta_[vessel], law_area_[vessel], law_pressure_[vessel], blood_.density, blood_.momentum_alpha()}
+                         : laws_[vessel];
+  }
+  const TubeLaw& end_law(std::size_t vessel, bool distal) const {  // a 1D vessel's
     return distal && !taper_of_.empty() && taper_of_[vessel] >= 0 ? distal_laws_[static_cast<std::size_t>(taper_of_[vessel])]
-                                                                  : laws_[vessel];
+                                                                  : element_law_[static_cast<std::size_t>(first_element_[vessel])];
   }
   TubeLaw law_at(std::size_t vessel, double x) const;
   bool is_tapered(std::size_t vessel) const { return !taper_of_.empty() && taper_of_[vessel] >= 0; }
@@ -338,7 +341,13 @@ class PulseSolver {
   std::vector<double> lumped_inflow_, lumped_held_;  // the 0D nodes' boundary values at a step's end
   Blood blood_;
   ViscosityTable viscosity_;
-  std::vector<TubeLaw> laws_;            // per vessel (a tapered one's at its `from` end)
+  // Each vessel's tube law (a tapered one's at its `from` end): whole while the constructor
+  // sets up, then as its three numbers per vessel (the blood's density and momentum factor
+  // are every vessel's: 24 B a vessel where a TubeLaw takes 40), and whole again per 1D
+  // element, where the fluxes read it (law() and end_law() give them).
+  std::vector<TubeLaw> laws_;
+  std::vector<double> law_beta_, law_area_, law_pressure_;
+  std::vector<TubeLaw> element_law_;
   // Tapered vessels (none in most networks: then taper_of_ is empty and nothing below is
   // touched): per vessel its taper's index or -1; per taper its description and distal law.
   std::vector<std::int32_t> taper_of_;

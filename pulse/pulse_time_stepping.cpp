@@ -90,8 +90,8 @@ void PulseSolver::choose_stable_step(const SolverOptions& options) {
   std::size_t wave_vessel = 0, friction_vessel = 0;
   for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
     if (zero_d_[v]) continue;
-    const TubeLaw& law = laws_[v];
     const auto el = first_element_[v];
+    const TubeLaw& law = element_law_[static_cast<std::size_t>(el)];
     const double a = state_.area(el, 0), q = state_.flow(el, 0);
     const double h = 2 * half_length_(el);
     double lambda = std::max(std::abs(law.lambda_forward(a, q)), std::abs(law.lambda_backward(a, q)));
