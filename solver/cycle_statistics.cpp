@@ -14,7 +14,7 @@ double wall_shear_stress(double viscosity, double mean_velocity, double radius, 
 }
 
 double exchange_scale(double in, double out, double network_volume) {
-  return std::max({std::abs(in), std::abs(out), 1e-6 * network_volume});
+  return std::max({std::abs(in), std::abs(out), 1e-6 * network_volume});  // (CycleSummary::inflow_measured's floor)
 }
 
 double phase_velocity(std::complex<double> z0, std::complex<double> z1, double omega, double dx) {
@@ -128,6 +128,7 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   summary.outlets_mean_flow = exchanged(1) / duration_;
   const Eigen::VectorXd through = solver.boundary_volumes() - boundary_start_;
   for (Eigen::Index i = 0; i < through.size(); ++i) summary.boundary_mean_flow.push_back(through(i) / duration_);
+  summary.inflow_measured = exchanged(0) > 1e-6 * volume_start_;
   summary.volume_change = solver.network_volume() - volume_start_;
   summary.conservation_error =
       (exchanged(0) - exchanged(1) - summary.volume_change) / exchange_scale(exchanged(0), exchanged(1), volume_start_);

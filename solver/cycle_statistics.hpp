@@ -57,6 +57,10 @@ struct CycleSummary {
   // prescribed outflows), from the volume fluxes the solver exchanged there: over a periodic
   // cycle the compliances store nothing, and they agree.
   double inlet_mean_flow = 0, outlets_mean_flow = 0;
+  // Whether what came in is more than round-off: over a stepped cycle, more than the floor
+  // of exchange_scale (a millionth of the network's volume); a solved flow, any. Where it is
+  // not, there is no fraction of it to give (summary.json's mass_balance is null).
+  bool inflow_measured = true;
   // Per boundary (PulseSolver::boundary_list), the mean flow in through it [m^3/s].
   std::vector<double> boundary_mean_flow;
   // The change of the blood volume in the vessels over the cycle [m^3], and the scheme's

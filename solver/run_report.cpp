@@ -131,7 +131,7 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
   summary["inlet_mean_flow"] = cycle.inlet_mean_flow;
   summary["outlets_mean_flow"] = cycle.outlets_mean_flow;
   // Relative to the inflow: null where nothing flowed in (there is no fraction to give).
-  summary["mass_balance"] = cycle.inlet_mean_flow > 0
+  summary["mass_balance"] = cycle.inflow_measured && cycle.inlet_mean_flow > 0
                                 ? nlohmann::json((cycle.inlet_mean_flow - cycle.outlets_mean_flow) / cycle.inlet_mean_flow)
                                 : nlohmann::json(nullptr);
   summary["volume_change"] = cycle.volume_change;
