@@ -83,7 +83,7 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
       edge_fixed_resistance_.push_back(rows.edge_resistance);
       shunt_.push_back(rows.shunt.conductance);
       shunt_pressure_.push_back(rows.shunt.pressure);
-      volume_b_.push_back(rows.compliance);
+      volume_b_.push_back(static_cast<float>(rows.compliance));
     } else {
       const LumpedShunt row = o.type == BoundaryType::rcr ? rcr.series_lumped_shunt()
                                                           : ResistanceOutlet{o.r, o.p_out}.lumped_shunt();

@@ -98,21 +98,24 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes
   // (of each section's, L / n):
   // (L / 2) (d^2 p^2 + 2 c d p + c^2); the constant term only when asked (node_constant).
-  volume_a_.assign(nodes_, 0.0);
+  // (Summed in double, kept in float.)
+  std::vector<double> quadratic(nodes_, 0.0), linear(volume_b_.begin(), volume_b_.end());
   for (std::size_t e = 0; e < vessel_edges_; ++e) {
     const double w = edge_length_[e] / 2, c = edge_root_intercept_[e], d = edge_root_slope_[e];
     for (const std::int32_t k : {a_[e], b_[e]}) {
       const auto i = static_cast<std::size_t>(k);
       if (tapered(e)) {  // int A(p, x) dx, half at each node
         const TaperedEdge& t = tapered_[static_cast<std::size_t>(taper_edge_[e])];
-        volume_a_[i] += t.volume_a / 2;
-        volume_b_[i] += t.volume_b / 2;
+        quadratic[i] += t.volume_a / 2;
+        linear[i] += t.volume_b / 2;
         continue;
       }
-      volume_a_[i] += w * d * d;
-      volume_b_[i] += 2 * w * c * d;
+      quadratic[i] += w * d * d;
+      linear[i] += 2 * w * c * d;
     }
   }
+  volume_a_.assign(quadratic.begin(), quadratic.end());
+  volume_b_.assign(linear.begin(), linear.end());
 
   allocate_system();
 }

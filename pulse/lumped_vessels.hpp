@@ -381,7 +381,9 @@ class LumpedVessels {
   std::vector<int> capacitor_edge_sign_;             // and +1 if it ends there at `to`, -1 at `from`
 
   // Node volume V(p) = a p^2 + b p + c (half of each 0D vessel, capacitors).
-  std::vector<double> volume_a_, volume_b_;
+  // In float: the compliances shape the pulse, not the mean state, and move the results by
+  // less than 1e-6 of themselves (bench/README.md, "Coefficients in float").
+  std::vector<float> volume_a_, volume_b_;
   double node_constant(std::size_t k) const;  // c, from the node's edges: only to report V
   std::int32_t vessel_at_node(std::size_t k) const;  // a network vessel ending there (its R1's, at a capacitor)
   // Shunts to ground: conductance and the pressure behind it (outlets, R2).

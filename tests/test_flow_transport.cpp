@@ -114,13 +114,15 @@ TEST(FlowTransport, ConstantBoundariesSettleOnTheSteadyDistributionOfTheFlows) {
     }
     // Round-off over some 1e5 steps of sums (the red cells' own bookkeeping is exact).
     EXPECT_LT(std::abs(cycle.balance_error), 1e-11);
-    // The cells hold the solver's volumes.
+    // The cells hold the solver's volumes: the transport's from the vessels' tube laws, the
+    // solver's 0D nodes' from their compliance coefficients, which are in float (6e-8 of
+    // themselves): the two agree to that times the distended part of the volume (here 1.6e-12).
     const double held = [&] {
       double sum = 0;
       for (const double v : cells.volume()) sum += v;
       return sum;
     }();
-    EXPECT_NEAR(held, solver.network_volume(), 1e-12 * held);
+    EXPECT_NEAR(held, solver.network_volume(), 1e-11 * held);
   }
 }
 
