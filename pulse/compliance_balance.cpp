@@ -14,7 +14,7 @@
 namespace hemotree {
 
 std::vector<double> PulseSolver::capacitor_pressures() const {
-  std::vector<double> p(outlet_capacitance_.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> p(outlet_count_, std::numeric_limits<double>::quiet_NaN());
   for (const auto& o : boundaries_.outlets)
     if (o.capacitor >= 0) p[static_cast<std::size_t>(o.index)] = state_.capacitor(o.capacitor);
   for (std::size_t k = 0; k < p.size(); ++k)

@@ -96,10 +96,16 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   period_ = driving_waveform(net).period;
   const RunBoundaries boundaries(net);
   for (std::size_t i = 0; i < boundaries.size(); ++i)
-    if (const Outlet& o = boundaries.outlet(i); boundaries.is_outlet(i)) {
-      outlet_capacitance_.push_back(o.type == BoundaryType::rcr ? o.c : 0.0);
-      rcr_outlets_ = rcr_outlets_ || o.type == BoundaryType::rcr;
+    if (boundaries.is_outlet(i)) {
+      ++outlet_count_;
+      rcr_outlets_ = rcr_outlets_ || boundaries.outlet(i).type == BoundaryType::rcr;
     }
+  if (rcr_outlets_) {
+    outlet_capacitance_.reserve(outlet_count_);
+    for (std::size_t i = 0; i < boundaries.size(); ++i)
+      if (const Outlet& o = boundaries.outlet(i); boundaries.is_outlet(i))
+        outlet_capacitance_.push_back(o.type == BoundaryType::rcr ? o.c : 0.0);
+  }
   choose_models(options);
 
   const std::optional<SteadyFlow> steady = solve_steady_flow();

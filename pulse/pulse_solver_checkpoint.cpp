@@ -100,9 +100,9 @@ void PulseSolver::restore(CheckpointReader& in) {
   cycle_volume_ = in.get_vector();
   cycle_capacitor_ = in.get_vector();
   // Per outlet, or none where no outlet is RCR (the balance then reads none).
-  if (!cycle_capacitor_.empty() && cycle_capacitor_.size() != outlet_capacitance_.size())
+  if (!cycle_capacitor_.empty() && cycle_capacitor_.size() != outlet_count_)
     in.fail("outlets of another network");
-  if (rcr_outlets_ && !cycle_volume_.empty() && cycle_capacitor_.size() != outlet_capacitance_.size())
+  if (rcr_outlets_ && !cycle_volume_.empty() && cycle_capacitor_.size() != outlet_count_)
     in.fail("outlets of another network");
   const std::vector<double> ends = in.get_vector();
   if (ends.size() != 4 * first_element_.size()) in.fail("vessel ends of another network");
