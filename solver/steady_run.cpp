@@ -4,11 +4,14 @@
 #include <memory>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "core/units.hpp"
+#include "formats/run_boundaries.hpp"
 #include "physics/rheology.hpp"
 #include "solver/output_folder.hpp"
 #include "physics/phase_separation.hpp"
@@ -35,6 +38,18 @@ std::vector<double> boundary_inflow(const Network& net, const SteadyFlow& steady
   return inflow;
 }
 
+// The run's boundaries in node order (node_boundaries' order: summary.json's), as places in
+// the view: a tree's two million outlets are not copied as conditions (300 MB, and the
+// copying was a tenth of --linear's time on the full tree).
+std::vector<std::uint32_t> in_node_order(const RunBoundaries& boundaries) {
+  std::vector<std::pair<std::int32_t, std::uint32_t>> key(boundaries.size());
+  for (std::size_t i = 0; i < key.size(); ++i) key[i] = {boundaries.node(i), static_cast<std::uint32_t>(i)};
+  std::sort(key.begin(), key.end());  // one boundary a node (RunBoundaries checks it)
+  std::vector<std::uint32_t> order(key.size());
+  for (std::size_t k = 0; k < key.size(); ++k) order[k] = key[k].second;
+  return order;
+}
+
 }  // namespace
 
 CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFlow& steady,
@@ -56,8 +71,9 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
     c.reynolds = blood.density * u * 2 * radius / mu;
   }
   const std::vector<double> inflow = boundary_inflow(net, steady);
-  for (const NodeBoundary& b : node_boundaries(net)) {
-    const double q = inflow[static_cast<std::size_t>(b.node)];
+  const RunBoundaries boundaries(net);
+  for (const std::uint32_t i : in_node_order(boundaries)) {
+    const double q = inflow[static_cast<std::size_t>(boundaries.node(i))];
     (q > 0 ? cycle.inlet_mean_flow : cycle.outlets_mean_flow) += std::abs(q);
   }
   cycle.volume_change = 0;
@@ -69,12 +85,13 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
 
 SummaryArray boundary_results(const Network& net, const SteadyFlow& steady) {
   // Shared by the entries (the function outlives this call: write_summary calls it).
-  auto boundaries = std::make_shared<const std::vector<NodeBoundary>>(node_boundaries(net));
+  auto boundaries = std::make_shared<const RunBoundaries>(net);
+  auto order = std::make_shared<const std::vector<std::uint32_t>>(in_node_order(*boundaries));
   auto inflow = std::make_shared<const std::vector<double>>(boundary_inflow(net, steady));
   auto pressure = std::make_shared<const std::vector<double>>(steady.node_pressure);
   const Blood blood = net.blood.value_or(Blood{});
-  return {"boundaries", boundaries->size(), [&net, boundaries, inflow, pressure, blood](std::size_t k) {
-            const NodeBoundary& b = (*boundaries)[k];
+  return {"boundaries", order->size(), [&net, boundaries, order, inflow, pressure, blood](std::size_t k) {
+            const NodeBoundary b = (*boundaries)[(*order)[k]];
             const auto i = static_cast<std::size_t>(b.node);
             nlohmann::json entry = {{"node", net.node_id[i]},
                                     {"type", to_string(b.type)},
