@@ -27,9 +27,10 @@ std::vector<double> PulseSolver::vessel_volumes() const {
   for (std::size_t v = 0; v < volume.size(); ++v) {
     if (zero_d_[v]) {  // half at each node's pressure, as the 0D scheme holds it
       const std::int32_t e = lumped_.vessel_index(v);
+      const TubeLaw tube = law(v);
       volume[v] = is_tapered(v)              ? lumped_.tapered_volume(e)
                   : lumped_.sections(e) > 1 ? lumped_.sectioned_volume(e)
-                                            : net_.length[v] * 0.5 * (law(v).area(lumped_.pressure_at(e, 0)) + law(v).area(lumped_.pressure_at(e, 1)));
+                                            : net_.length[v] * 0.5 * (tube.area(lumped_.pressure_at(e, 0)) + tube.area(lumped_.pressure_at(e, 1)));
     }
     for (auto el = first_element_[v]; el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
   }

@@ -308,8 +308,9 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       try {
         settling_ = settle(net_, solver_, plan_.settling_steps, observer);
       } catch (const SolutionBreakdown& e) {
-        breakdown_ = e.message() + "; it broke down in the settling cycle, whose 0D step is longer than the run's (" +
-                     "without " + placeholder("settling_step") + ", the default, the run takes none)";
+        // The option is named through its placeholder (core/setting_error.hpp), which the tool words.
+        breakdown_ = e.message() + "; it broke down in the settling cycle, whose 0D step is longer than the run's (without " +
+                     placeholder("settling_step") + ", the default, the run takes none)";
         return RunStatus::broken_down;
       }
       if ((signal_ = settling_.signal) != 0) return RunStatus::interrupted;
