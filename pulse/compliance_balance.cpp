@@ -40,7 +40,7 @@ std::vector<double> PulseSolver::vessel_volumes() const {
 std::size_t PulseSolver::balance_compliances(double period, const std::vector<double>* mean_pressure) {
   if (steady_resistance_.empty()) return 0;
   const std::size_t n = net_.vessel_count();
-  std::vector<double> resistance = steady_resistance_;
+  std::vector<double> resistance(steady_resistance_.begin(), steady_resistance_.end());
   // The conductances at the last cycle's mean state, where the run has one: in a full tree
   // every resistance is a compliant vessel's, and the pulsatile means sit well below the
   // steady pressures (9.8 mmHg at the root of the paper's tree).

@@ -182,8 +182,10 @@ std::optional<SteadyFlow> PulseSolver::solve_steady_flow() {
   std::optional<SteadyFlow> steady;
   // (A network with node boundaries takes their means; a tree, its inlet's.)
   try {
+    std::vector<double> resistance;
     steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet ? net.inlet->waveform.mean_value() : 0.0,
-                                         &steady_resistance_);
+                                         &resistance);
+    steady_resistance_.assign(resistance.begin(), resistance.end());
   } catch (const InputError& e) {
     steady_refusal_ = e.what();
   }
@@ -319,11 +321,12 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
       }
     }
     const double period = period_;
-    vessel_degree_ = choose_degrees(transit, linear_error, period, options.degree_rule,
-                                    scheme_ == TimeScheme::runge_kutta4 ? TimeScheme::runge_kutta4
-                                                                        : TimeScheme::adams_bashforth2);
+    const std::vector<int> chosen = choose_degrees(transit, linear_error, period, options.degree_rule,
+                                                   scheme_ == TimeScheme::runge_kutta4 ? TimeScheme::runge_kutta4
+                                                                                       : TimeScheme::adams_bashforth2);
+    vessel_degree_.assign(chosen.begin(), chosen.end());
   } else {
-    vessel_degree_.assign(n, options.degree);
+    vessel_degree_.assign(n, static_cast<std::int8_t>(options.degree));
   }
   std::size_t one_d = 0;
   for (std::size_t v = 0; v < n; ++v) {
@@ -331,7 +334,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
     else ++one_d;
     // A tapered vessel's rest lumen pi D(x)^2 / 4 is quadratic in x: degree 2 holds it
     // exactly, and with it the rest state (well-balanced, docs/solver.md §1a).
-    if (!zero_d_[v] && is_tapered(v)) vessel_degree_[v] = std::max(vessel_degree_[v], 2);
+    if (!zero_d_[v] && is_tapered(v)) vessel_degree_[v] = std::max<std::int8_t>(vessel_degree_[v], 2);
   }
   const int top = std::max(0, n == 0 ? 0 : *std::max_element(vessel_degree_.begin(), vessel_degree_.end()));
   bases_.assign(static_cast<std::size_t>(top) + 1, ModalBasis{});

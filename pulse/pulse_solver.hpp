@@ -399,7 +399,7 @@ class PulseSolver {
   std::vector<std::int32_t> coupled_slot_;                 // per coupled end: its coupling node's place there
   std::vector<ModalBasis> bases_;          // by degree; empty where unused
   std::vector<DegreeBlock> blocks_;
-  std::vector<int> vessel_degree_;         // per vessel
+  std::vector<std::int8_t> vessel_degree_;  // per vessel: -1 (0D) to 30 (run_configuration)
   int elements_per_vessel_ = 1;
   std::vector<std::int32_t> first_element_;  // per vessel: its elements are consecutive
   std::vector<std::int32_t> element_vessel_; // per element
@@ -418,7 +418,10 @@ class PulseSolver {
   Eigen::VectorXd friction_rate_;
   std::vector<double> viscosity_factor_;  // per vessel (empty: 1)
   Eigen::VectorXd element_viscosity_factor_;  // per element (empty: 1)
-  std::vector<double> steady_resistance_;  // Poiseuille, per vessel; empty without a steady solution
+  // Poiseuille at the steady state, per vessel; empty without a steady solution. Only what
+  // the balance falls back on (before a cycle's mean, or for a lumen closed at it): a
+  // linearisation's conductance, in float.
+  std::vector<float> steady_resistance_;
   std::vector<double> cycle_volume_;       // per vessel, at the last cycle end
   std::vector<double> cycle_capacitor_;    // the capacitors there, per network outlet
   Eigen::VectorXd decay_, phi1_, phi2_, next_flow_;  // ETD2: e^(-r h), phi1, phi2 per element; scratch

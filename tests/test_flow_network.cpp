@@ -102,9 +102,9 @@ void expect_agreement(const Case& c) {
     net_out[static_cast<std::size_t>(c.b[e])] -= q[e];
     largest = std::max(largest, std::abs(q[e]));
   }
-  for (std::size_t i = 0; i < c.nodes; ++i)
-    if (!c.prescribed[i])
-      EXPECT_NEAR(net_out[i] + c.shunt[i] * p[i], c.inflow[i], 1e-9 * largest) << "node " << i;
+  for (std::size_t i = 0; i < c.nodes; ++i) {
+    if (!c.prescribed[i]) EXPECT_NEAR(net_out[i] + c.shunt[i] * p[i], c.inflow[i], 1e-9 * largest) << "node " << i;
+  }
 }
 
 }  // namespace
