@@ -82,10 +82,7 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
       parent_[high] = std::min(a_[e], b_[e]);
       parent_edge_[high] = static_cast<std::int32_t>(e);
     }
-    order_.resize(nodes_);
-    if (forest) {
-      std::iota(order_.begin(), order_.end(), 0);
-    } else {
+    if (!forest) {
       // Else peeling leaves: a node with one edge left hangs from that edge's other node, and
       // removing it may make that one a leaf in turn; the last node of each component is its
       // root, and the reverse of the peeling an order for the elimination. parent_ and
@@ -104,7 +101,6 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
         parent_edge_[ea] ^= static_cast<std::int32_t>(e);
         parent_edge_[eb] ^= static_cast<std::int32_t>(e);
       }
-      order_.clear();
       for (std::int32_t i = 0; i < n; ++i)
         if (degree[static_cast<std::size_t>(i)] <= 1) order_.push_back(i);
       for (std::size_t head = 0; head < order_.size(); ++head) {
@@ -129,6 +125,12 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
   method_ = method == Method::automatic ? (forest ? Method::tree_elimination : Method::sparse_cholesky) : method;
 
   if (method_ == Method::tree_elimination) {
+    // Edges numbered by the nodes they lead to (node c's edge to its parent is c - 1: a tree's
+    // vessels in the order of their distal nodes, as the 0D vessels' are) need no list.
+    bool edge_before = true;
+    for (std::size_t c = 0; c < nodes_ && edge_before; ++c)
+      edge_before = parent_[c] < 0 || static_cast<std::size_t>(parent_edge_[c]) + 1 == c;
+    if (edge_before) std::vector<std::int32_t>().swap(parent_edge_);
     inverse_pivot_.assign(nodes_, 0.0);
     divider_.assign(nodes_, 0.0);
     plan_subtrees();
@@ -194,6 +196,28 @@ std::int64_t NodalSystem::factorize_forward(std::span<const double> conductance,
   return factorize(conductance, shunt, y.data());
 }
 
+std::span<double> NodalSystem::shunt_workspace() {
+  if (method_ != Method::tree_elimination) {
+    shunt_workspace_.resize(nodes_);
+    return shunt_workspace_;
+  }
+  if (inverse_pivot_.size() != nodes_) {  // released
+    inverse_pivot_.assign(nodes_, 0.0);
+    divider_.assign(nodes_, 0.0);
+  }
+  return inverse_pivot_;
+}
+
+std::int64_t NodalSystem::factorize_forward_in_place(std::span<const double> conductance, std::span<double> y) {
+  if (y.size() != nodes_)
+    throw std::invalid_argument("NodalSystem::factorize_forward_in_place: right-hand side of " +
+                                std::to_string(y.size()) + " for " + std::to_string(nodes_) + " nodes");
+  if (method_ != Method::tree_elimination) return factorize(conductance, shunt_workspace_, y.data());
+  if (inverse_pivot_.size() != nodes_)
+    throw std::logic_error("NodalSystem::factorize_forward_in_place: no shunts written to shunt_workspace()");
+  return factorize(conductance, inverse_pivot_, y.data());
+}
+
 void NodalSystem::release_factorization() {
   factorized_ = false;
   if (method_ == Method::tree_elimination) {
@@ -201,6 +225,7 @@ void NodalSystem::release_factorization() {
     std::vector<double>().swap(divider_);
   }
   std::vector<double>().swap(inverse_scratch_);
+  std::vector<double>().swap(shunt_workspace_);
   inverse_known_ = {};
   std::vector<std::int32_t>().swap(path_scratch_);
 }
@@ -232,16 +257,19 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
     const Elimination elimination{conductance, shunt, inverse_pivot_.data(), divider_.data()};
     sweep_up(&elimination, y, valid, singular);
     if (!valid) {
-      // Named as a one-thread pass meets them: shunts by node, then edges leaves up.
-      for (std::size_t i = 0; i < nodes_; ++i)
+      // Named as a one-thread pass meets them: shunts by node, then edges leaves up. Shunts
+      // given in the pivots' array are gone: a bad one is named after the edges.
+      const bool shunts_kept = shunt.data() != inverse_pivot_.data();
+      for (std::size_t i = 0; i < nodes_ && shunts_kept; ++i)
         if (!(shunt[i] >= 0 && shunt[i] < std::numeric_limits<double>::infinity())) throw bad_value("shunt of node", i, shunt[i]);
       for (std::size_t k = nodes_; k-- > 0;) {
-        const auto c = static_cast<std::size_t>(order_[k]);
+        const auto c = static_cast<std::size_t>(ordered(k));
         if (parent_[c] < 0) continue;
-        const auto e = static_cast<std::size_t>(parent_edge_[c]);
+        const std::size_t e = edge_to_parent(c);
         if (!(conductance[e] > 0 && conductance[e] < std::numeric_limits<double>::infinity()))
           throw bad_value("conductance of edge", e, conductance[e]);
       }
+      if (!shunts_kept) throw std::invalid_argument("NodalSystem::factorize: a shunt is negative or not finite");
     }
     if (!singular) {
       factorized_ = true;
@@ -250,8 +278,8 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
     // Name a singular component by its lowest node (as the Cholesky path does): the lowest
     // node whose root is singular. Roots come before their descendants in order_.
     std::vector<std::int32_t> root(nodes_);
-    for (const std::int32_t i : order_) {
-      const std::int32_t p = parent_[static_cast<std::size_t>(i)];
+    for (std::size_t k = 0; k < nodes_; ++k) {
+      const std::int32_t i = ordered(k), p = parent_[static_cast<std::size_t>(i)];
       root[static_cast<std::size_t>(i)] = p < 0 ? i : root[static_cast<std::size_t>(p)];
     }
     for (std::size_t i = 0; i < nodes_; ++i)
@@ -466,9 +494,15 @@ std::vector<std::int32_t> NodalSystem::subtree_tasks(std::span<const std::int32_
 
 void NodalSystem::plan_subtrees() {
   if (task_size_limit(nodes_) == 0) return;
-  const std::vector<std::int32_t> task = subtree_tasks(parent_, order_);
+  std::vector<std::int32_t> identity;
+  if (order_.empty()) {
+    identity.resize(nodes_);
+    std::iota(identity.begin(), identity.end(), 0);
+  }
+  const std::vector<std::int32_t>& order = order_.empty() ? identity : order_;
+  const std::vector<std::int32_t> task = subtree_tasks(parent_, order);
   std::vector<std::int32_t> count;
-  for (const std::int32_t c : order_) {
+  for (const std::int32_t c : order) {
     const std::int32_t t = task[static_cast<std::size_t>(c)], p = parent_[static_cast<std::size_t>(c)];
     if (t < 0) {
       top_.push_back(c);
@@ -484,9 +518,23 @@ void NodalSystem::plan_subtrees() {
   for (std::size_t t = 0; t < count.size(); ++t) task_offset_[t + 1] = task_offset_[t] + count[t];
   task_nodes_.resize(static_cast<std::size_t>(task_offset_.back()));
   std::vector<std::int32_t> cursor(task_offset_.begin(), task_offset_.end() - 1);
-  for (const std::int32_t c : order_)
+  for (const std::int32_t c : order)
     if (const std::int32_t t = task[static_cast<std::size_t>(c)]; t >= 0)
       task_nodes_[static_cast<std::size_t>(cursor[static_cast<std::size_t>(t)]++)] = c;
+  // A task whose nodes are one run of consecutive numbers (the subtree order of
+  // pulse/lumped_order makes every task one) is that run: its first node is enough.
+  task_shift_.resize(count.size());
+  bool runs = true;
+  for (std::size_t t = 0; t < count.size() && runs; ++t) {
+    const auto first = static_cast<std::size_t>(task_offset_[t]), last = static_cast<std::size_t>(task_offset_[t + 1]);
+    task_shift_[t] = static_cast<std::int64_t>(task_nodes_[first]) - static_cast<std::int64_t>(first);
+    for (std::size_t j = first; j < last && runs; ++j)
+      runs = static_cast<std::int64_t>(task_nodes_[j]) == static_cast<std::int64_t>(j) + task_shift_[t];
+  }
+  if (runs)
+    std::vector<std::int32_t>().swap(task_nodes_);
+  else
+    std::vector<std::int64_t>().swap(task_shift_);
 }
 
 bool NodalSystem::parallel_sweeps() const { return threads_ > 1 && !task_offset_.empty(); }
@@ -512,7 +560,7 @@ void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& vali
       return;
     }
     if (el) {
-      const double g = el->conductance[static_cast<std::size_t>(parent_edge_[c])];
+      const double g = el->conductance[edge_to_parent(c)];
       ok &= g > 0 && g < infinity;
       const double s = el->inverse_pivot[c], inverse = 1 / (g + s);
       // What the sweeps multiply by: no division left in a solve.
@@ -526,7 +574,10 @@ void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& vali
   if (!parallel_sweeps()) {
     if (el)
       for (std::size_t i = 0; i < nodes_; ++i) start(i, ok);
-    for (std::size_t k = nodes_; k-- > 0;) up(static_cast<std::size_t>(order_[k]), ok, lost);
+    if (order_.empty())
+      for (std::size_t k = nodes_; k-- > 0;) up(k, ok, lost);
+    else
+      for (std::size_t k = nodes_; k-- > 0;) up(static_cast<std::size_t>(order_[k]), ok, lost);
   } else {
     // Each task's nodes but its root in parallel (a node's children are in its own task);
     // then the top and the tasks' roots, leaves up, serially: every pivot sums its children
@@ -541,9 +592,10 @@ void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& vali
       const auto first = static_cast<std::size_t>(task_offset_[static_cast<std::size_t>(t)]);
       const auto last = static_cast<std::size_t>(task_offset_[static_cast<std::size_t>(t) + 1]);
       bool task_ok = true, unused = false;
+      const TaskNodes nodes = task_nodes(static_cast<std::size_t>(t));
       if (el)
-        for (std::size_t j = first; j < last; ++j) start(static_cast<std::size_t>(task_nodes_[j]), task_ok);
-      for (std::size_t j = last; j-- > first + 1;) up(static_cast<std::size_t>(task_nodes_[j]), task_ok, unused);
+        for (std::size_t j = first; j < last; ++j) start(nodes[j], task_ok);
+      for (std::size_t j = last; j-- > first + 1;) up(nodes[j], task_ok, unused);
       tasks_ok = tasks_ok && task_ok;
     }
     ok &= tasks_ok;
@@ -562,7 +614,10 @@ void NodalSystem::sweep_down(double* x) const {
     x[i] = x[i] * inverse_pivot_[i] + (p >= 0 ? divider_[i] * x[static_cast<std::size_t>(p)] : 0.0);
   };
   if (!parallel_sweeps()) {
-    for (std::size_t k = 0; k < nodes_; ++k) down(static_cast<std::size_t>(order_[k]));
+    if (order_.empty())
+      for (std::size_t k = 0; k < nodes_; ++k) down(k);
+    else
+      for (std::size_t k = 0; k < nodes_; ++k) down(static_cast<std::size_t>(order_[k]));
     return;
   }
   for (const std::int32_t c : top_) down(static_cast<std::size_t>(c >= 0 ? c : ~c));
@@ -571,7 +626,8 @@ void NodalSystem::sweep_down(double* x) const {
   for (std::int64_t t = 0; t < tasks; ++t) {
     const auto first = static_cast<std::size_t>(task_offset_[static_cast<std::size_t>(t)]);
     const auto last = static_cast<std::size_t>(task_offset_[static_cast<std::size_t>(t) + 1]);
-    for (std::size_t j = first + 1; j < last; ++j) down(static_cast<std::size_t>(task_nodes_[j]));
+    const TaskNodes nodes = task_nodes(static_cast<std::size_t>(t));
+    for (std::size_t j = first + 1; j < last; ++j) down(nodes[j]);
   }
 }
 
@@ -639,9 +695,10 @@ void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::spa
       }
       if (!walked) {
         std::vector<double> sigma(nodes_);
-        for (const std::int32_t c : order_)
-          sigma[static_cast<std::size_t>(c)] =
-              own(static_cast<std::size_t>(c), [&](std::int32_t p) { return sigma[static_cast<std::size_t>(p)]; });
+        for (std::size_t k = 0; k < nodes_; ++k) {
+          const auto c = static_cast<std::size_t>(ordered(k));
+          sigma[c] = own(c, [&](std::int32_t p) { return sigma[static_cast<std::size_t>(p)]; });
+        }
         for (std::size_t k = 0; k < nodes.size(); ++k) out[k] = sigma[static_cast<std::size_t>(nodes[k])];
       }
       known.clear();

@@ -60,6 +60,12 @@ class NodalSystem {
   // factorize, and y = L^-1 P y in the same pass (in place; y of node_count()).
   std::int64_t factorize_forward(std::span<const double> conductance, std::span<const double> shunt,
                                  std::span<double> y);
+  // The same with shunts the caller wrote into shunt_workspace() (one per node) since the
+  // last factorisation: on a tree that is the pivots' own array, which the elimination starts
+  // from and overwrites, so a caller that forms its shunts anew for every factorisation (a
+  // 0D step) holds no array of them (8 bytes a node). Their values are gone after the call.
+  std::span<double> shunt_workspace();
+  std::int64_t factorize_forward_in_place(std::span<const double> conductance, std::span<double> y);
   void forward(std::span<double> y) const;  // y = L^-1 P y, in place
   // Frees a tree's factorisation and the inverse diagonal's scratch (16 and 8 bytes a node)
   // until the next factorize: for a caller that holds a system across a phase that needs
@@ -108,18 +114,38 @@ class NodalSystem {
   // each node's parent edge (below), and frees them once planned.
   std::vector<std::int32_t> a_, b_;
   Method method_ = Method::automatic;
-  // Tree elimination: the nodes with every parent before its children (their own order where
-  // every node hangs from a lower one, else the reverse of the order in which peeling leaves
-  // removes them), each node's parent and the edge to it (-1 at roots), and the pivots.
+  // Tree elimination: the nodes with every parent before its children (empty: their own
+  // order, where every node hangs from a lower one; else the reverse of the order in which
+  // peeling leaves removes them), each node's parent and the edge to it (-1 at roots; empty
+  // where every node's is the one numbered before it), and the pivots.
   std::vector<std::int32_t> order_, parent_, parent_edge_;
+  std::int32_t ordered(std::size_t k) const { return order_.empty() ? static_cast<std::int32_t>(k) : order_[k]; }
+  // The edge from non-root node c to its parent (parent_edge_ empty: c - 1).
+  std::size_t edge_to_parent(std::size_t c) const {
+    return parent_edge_.empty() ? c - 1 : static_cast<std::size_t>(parent_edge_[c]);
+  }
   // Per node: 1 / d_i, d_i its pivot after eliminating its subtree, and g_i / d_i (g_i its
   // edge to the parent: the voltage divider of that edge and the subtree).
   std::vector<double> inverse_pivot_, divider_;
+  std::vector<double> shunt_workspace_;  // shunt_workspace() where the pivots are not (sparse Cholesky)
   // The sweeps' parallel plan: subtrees of at most a few ten thousand nodes whose parent (if
   // any) roots a larger one are tasks, each with its nodes in elimination order (task_nodes_
   // from task_offset_[t], the task's root first); top_ lists, in elimination order, the nodes
   // of no task and (as ~node) the tasks' roots: what the serial part of a sweep visits.
+  // Where every task's nodes are consecutive numbers (the subtree order's tasks are),
+  // task_nodes_ is empty and task t's place j holds node j + task_shift_[t].
   std::vector<std::int32_t> task_nodes_, task_offset_, top_;
+  std::vector<std::int64_t> task_shift_;
+  struct TaskNodes {  // the node at place j of one task
+    const std::int32_t* listed;
+    std::int64_t shift;
+    std::size_t operator[](std::size_t j) const {
+      return static_cast<std::size_t>(listed ? listed[j] : static_cast<std::int64_t>(j) + shift);
+    }
+  };
+  TaskNodes task_nodes(std::size_t t) const {
+    return task_nodes_.empty() ? TaskNodes{nullptr, task_shift_[t]} : TaskNodes{task_nodes_.data(), 0};
+  }
   int threads_ = 1;
   bool parallel_sweeps() const;
   std::int64_t factorize(std::span<const double> conductance, std::span<const double> shunt, double* y);

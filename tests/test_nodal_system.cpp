@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <utility>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -642,3 +643,97 @@ TEST(NodalSystem, TwoThreadsEliminateATreeToTheBitsOfOne) {
     EXPECT_EQ(one_message, two_message);
   }
 }
+
+namespace hemotree {
+namespace {
+
+// A random tree relabelled depth first, each node's edge numbered one below it: every
+// subtree is a run of consecutive nodes, as the 0D vessels' subtree order makes them, so the
+// system keeps neither an order, nor task lists, nor parent edges. It must solve as the same
+// tree under other labels does, and give one thread's bits with two.
+TEST(NodalSystem, ATreeNumberedDepthFirstSolvesAsUnderAnyOtherLabels) {
+  std::mt19937_64 rng(11);
+  const std::size_t n = 200000;
+  const Graph grown = random_tree(n, rng, false);  // edge k - 1 hangs node k from grown.a[k - 1]
+  std::vector<std::vector<std::int32_t>> children(n);
+  for (std::size_t e = 0; e < grown.a.size(); ++e) children[static_cast<std::size_t>(grown.a[e])].push_back(grown.b[e]);
+  std::vector<std::int32_t> label(n, -1), stack = {0};
+  std::int32_t next = 0;
+  while (!stack.empty()) {
+    const std::int32_t k = stack.back();
+    stack.pop_back();
+    label[static_cast<std::size_t>(k)] = next++;
+    for (auto c = children[static_cast<std::size_t>(k)].rbegin(); c != children[static_cast<std::size_t>(k)].rend(); ++c)
+      stack.push_back(*c);
+  }
+  Graph depth_first{n, std::vector<std::int32_t>(n - 1), std::vector<std::int32_t>(n - 1)};
+  std::vector<std::size_t> edge_of(n - 1);  // grown's edge for each depth-first edge
+  for (std::size_t e = 0; e < grown.a.size(); ++e) {
+    const auto child = static_cast<std::size_t>(label[static_cast<std::size_t>(grown.b[e])]);
+    depth_first.a[child - 1] = label[static_cast<std::size_t>(grown.a[e])];
+    depth_first.b[child - 1] = static_cast<std::int32_t>(child);
+    edge_of[child - 1] = e;
+  }
+  const std::vector<double> g_grown = log_uniform(grown.a.size(), 1e-2, 1e2, rng);
+  const std::vector<double> s_grown = uniform(n, 1e-4, 1e-3, rng);
+  const std::vector<double> b_grown = uniform(n, -1, 1, rng);
+  std::vector<double> g(n - 1), s(n), b(n);
+  for (std::size_t e = 0; e + 1 < n; ++e) g[e] = g_grown[edge_of[e]];
+  for (std::size_t k = 0; k < n; ++k) {
+    s[static_cast<std::size_t>(label[k])] = s_grown[k];
+    b[static_cast<std::size_t>(label[k])] = b_grown[k];
+  }
+  NodalSystem reference(n, grown.a, grown.b), one(n, depth_first.a, depth_first.b), two(n, depth_first.a, depth_first.b);
+  two.set_threads(2);
+  const std::vector<double> x_grown = solved(reference, g_grown, s_grown, b_grown);
+  const std::vector<double> x1 = solved(one, g, s, b), x2 = solved(two, g, s, b);
+  EXPECT_EQ(x1, x2);
+  std::vector<double> relabelled(n);
+  for (std::size_t k = 0; k < n; ++k) relabelled[static_cast<std::size_t>(label[k])] = x_grown[k];
+  EXPECT_LT(relative_difference(x1, relabelled), 1e-12);
+  // A bad conductance is named by the edge's own number.
+  std::vector<double> bad = g;
+  bad[n / 3] = -1;
+  try {
+    two.factorize(bad, s);
+    ADD_FAILURE() << "a negative conductance was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("conductance of edge " + std::to_string(n / 3) + " "), std::string::npos) << e.what();
+  }
+}
+
+// Shunts written into the system's own workspace factorise as shunts given apart, to the bit,
+// on a tree (where the workspace is the pivots' array) and on a looped graph.
+TEST(NodalSystem, ShuntsInTheWorkspaceFactoriseAsShuntsGivenApart) {
+  std::mt19937_64 rng(3);
+  for (const Graph& graph : {random_tree(5000, rng, false), random_tree(5000, rng, true), ring_with_chords()}) {
+    const std::vector<double> g = log_uniform(graph.a.size(), 1e-1, 1e1, rng);
+    const std::vector<double> s = uniform(graph.nodes, 1e-2, 1e-1, rng);
+    const std::vector<double> rhs = uniform(graph.nodes, -1, 1, rng);
+    NodalSystem apart(graph.nodes, graph.a, graph.b), in_place(graph.nodes, graph.a, graph.b);
+    std::vector<double> y_apart = rhs, y_in_place = rhs;
+    ASSERT_EQ(apart.factorize_forward(g, s, y_apart), -1);
+    for (int round = 0; round < 2; ++round) {  // the second after a release
+      const std::span<double> w = in_place.shunt_workspace();
+      ASSERT_EQ(w.size(), graph.nodes);
+      std::copy(s.begin(), s.end(), w.begin());
+      y_in_place = rhs;
+      ASSERT_EQ(in_place.factorize_forward_in_place(g, y_in_place), -1);
+      EXPECT_EQ(y_in_place, y_apart);
+      std::vector<double> x_apart(graph.nodes), x_in_place(graph.nodes);
+      apart.backward(y_apart, x_apart);
+      in_place.backward(y_in_place, x_in_place);
+      EXPECT_EQ(x_in_place, x_apart);
+      in_place.release_factorization();
+    }
+    // A bad shunt is refused, though its value is gone.
+    const std::span<double> w = in_place.shunt_workspace();
+    std::copy(s.begin(), s.end(), w.begin());
+    w[graph.nodes / 2] = -1;
+    y_in_place = rhs;
+    EXPECT_THROW(in_place.factorize_forward_in_place(g, y_in_place), std::invalid_argument);
+  }
+}
+
+}  // namespace
+}  // namespace hemotree
