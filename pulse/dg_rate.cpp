@@ -220,10 +220,9 @@ void PulseSolver::coupled_end_fluxes(double t, PulseState& rate) {
     trace(c.end, a, q);
     // The node's response r = 3/2 Z (docs/solver.md §10), its pressure at this point of the step.
     const double s = dt_ > 0 ? std::clamp((t - step_start_) / dt_, 0.0, 1.0) : 0.0;
-    const std::int32_t node = coupled_node_[k];
     const auto slot = static_cast<std::size_t>(coupled_slot_[k]);
     const double r = 1.5 * lumped_.impedance(slot);
-    const CoupledNode coupled{lumped_.pressure_during_step(node, s), lumped_.dynamic_pressure(slot), r, held_end_flow_[k]};
+    const CoupledNode coupled{lumped_.pressure_during_step(slot, s), lumped_.dynamic_pressure(slot), r, held_end_flow_[k]};
     const EndState u = coupled.end_state(end_law(static_cast<std::size_t>(c.end.vessel), c.end.distal), a, q, c.end.distal);
     set_end_flux(c.end, u);
     rate.coupled(static_cast<Eigen::Index>(k)) = CoupledNode::flow_into_node(u, c.end.distal);

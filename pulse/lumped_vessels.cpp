@@ -27,9 +27,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   index_of_vessel_.assign(n, -1);
   // Every subtree contiguous (pulse/lumped_order.hpp): the elimination's tasks stream.
   LumpedOrder order = subtree_lumped_order(net, zero_d);
-  network_node_ = std::move(order.nodes);
-  for (std::size_t k = 0; k < network_node_.size(); ++k)
-    node_of_[static_cast<std::size_t>(network_node_[k])] = static_cast<std::int32_t>(k);
+  for (std::size_t k = 0; k < order.nodes.size(); ++k)
+    node_of_[static_cast<std::size_t>(order.nodes[k])] = static_cast<std::int32_t>(k);
   auto sections_of = [&](std::size_t v) {
     const bool is_tapered = !taper_of.empty() && taper_of[v] >= 0;
     return sections.empty() || is_tapered ? std::size_t{1} : std::max<std::size_t>(sections[v], 1);
@@ -70,7 +69,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   vessel_edges_ = a_.size();
   if (!taper_edge_.empty()) taper_edge_.resize(vessel_edges_);
   if (vessels_.empty()) return;
-  network_nodes_ = network_node_.size();
+  network_nodes_ = order.nodes.size();
+  std::vector<std::int32_t>().swap(order.nodes);
   nodes_ = network_nodes_;
   shunt_.assign(network_nodes_, 0.0);
   shunt_pressure_.assign(network_nodes_, 0.0);
@@ -128,7 +128,7 @@ void LumpedVessels::allocate_system() {
   flow_.assign(edges, 0.0);
   previous_flow_ = flow_;
   centre_pressure_.assign(vessel_edges_, 0.0);
-  resistance_ = previous_resistance_ = centre_pressure_;  // the step's own arrays: at the first predict()
+  resistance_ = centre_pressure_;
 
   if (2 * edges >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw InputError("too many 0D vessels for 32-bit indices");
@@ -151,8 +151,6 @@ void LumpedVessels::allocate_system() {
 void LumpedVessels::allocate_step_arrays() {
   if (rhs_.size() == nodes_) return;
   const std::size_t edges = a_.size();
-  predicted_.resize(nodes_);  // a shift of the pressures may have set it since
-  system_shunt_.assign(nodes_, 0.0);
   rhs_.assign(nodes_, 0.0);
   conductance_.assign(edges, 0.0);
   history_.assign(edges, 0.0);
@@ -161,7 +159,7 @@ void LumpedVessels::allocate_step_arrays() {
 }
 
 void LumpedVessels::release_step_arrays() {
-  for (std::vector<double>* v : {&predicted_, &system_shunt_, &rhs_, &conductance_, &history_}) std::vector<double>().swap(*v);
+  for (std::vector<double>* v : {&rhs_, &conductance_, &history_}) std::vector<double>().swap(*v);
   linearised_dt_ = 0;  // the next step linearises its edges again
   system_.release_factorization();
 }
@@ -252,6 +250,7 @@ void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
   impedance_.assign(coupling_nodes_.size(), 0.0);
   dynamic_.assign(coupling_nodes_.size(), 0.0);
   coupling_scratch_.assign(coupling_nodes_.size(), 0.0);
+  hold_coupling_pressures();
   std::vector<std::int32_t> slot(nodes_, -1);
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) slot[static_cast<std::size_t>(coupling_nodes_[j])] = static_cast<std::int32_t>(j);
   coupling_edge_offset_.assign(coupling_nodes_.size() + 1, 0);
@@ -283,8 +282,10 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
     parallel_blocks(static_cast<std::int64_t>(vessel_edges_), threads_, [&](std::int64_t first, std::int64_t last) {
       for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
         const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
+        const double before = resistance_[e];
         update_resistance(e);
-        linearise_edge(e, 2 * pressure_[a] - previous_pressure_[a], 2 * pressure_[b] - previous_pressure_[b], true, dt);
+        linearise_edge(e, 2 * pressure_[a] - previous_pressure_[a], 2 * pressure_[b] - previous_pressure_[b],
+                       extrapolated_resistance(resistance_[e], before), dt);
       }
     });
     linearised_dt_ = dt;
@@ -297,7 +298,7 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
   const ViscosityTable& viscosity = *viscosity_;
   parallel_blocks(static_cast<std::int64_t>(vessel_edges_), threads_, [&](std::int64_t first, std::int64_t last) {
     constexpr std::size_t width = 8;
-    double aa[width], ab[width], am[width], mu_a[width], mu_b[width], mu_m[width];
+    double aa[width], ab[width], am[width], mu_a[width], mu_b[width], mu_m[width], extrapolated[width];
     for (auto e0 = static_cast<std::size_t>(first); e0 < static_cast<std::size_t>(last); e0 += width) {
       const std::size_t n = std::min(width, static_cast<std::size_t>(last) - e0);
       for (std::size_t i = 0; i < n; ++i) {
@@ -317,6 +318,7 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
         const SimpsonResistance r =
             simpson_resistance(friction_k_, edge_length_[e], viscosity_factor_.empty() ? 1.0 : viscosity_factor_[e], aa[i],
                                ab[i], am[i], mu_a[i], mu_b[i], mu_m[i]);
+        extrapolated[i] = extrapolated_resistance(r.resistance, resistance_[e]);
         resistance_[e] = r.resistance;
         centre_pressure_[e] = centre_pressure(e, pressure_[static_cast<std::size_t>(a_[e])],
                                               pressure_[static_cast<std::size_t>(b_[e])], r.capacity_a, r.capacity_b);
@@ -326,8 +328,7 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
         const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
         const double pa = 2 * pressure_[a] - previous_pressure_[a], pb = 2 * pressure_[b] - previous_pressure_[b];
         const double s = edge_root_intercept_[e] + edge_root_slope_[e] * 0.5 * (pa + pb);
-        const EdgeLine line = bdf2_edge(extrapolated_resistance(resistance_[e], previous_resistance_[e]),
-                                        density_ * edge_length_[e] / (s * s), flow_[e], previous_flow_[e], dt);
+        const EdgeLine line = bdf2_edge(extrapolated[i], density_ * edge_length_[e] / (s * s), flow_[e], previous_flow_[e], dt);
         conductance_[e] = line.conductance;
         history_[e] = line.history;
       }
@@ -336,14 +337,7 @@ void LumpedVessels::update_resistances_and_linearise(double dt) {
   linearised_dt_ = dt;
 }
 
-void LumpedVessels::linearise_edge(std::size_t e, double pa, double pb, bool extrapolated, double dt) {
-  double r;
-  if (extrapolated) {
-    r = extrapolated_resistance(resistance_[e], previous_resistance_[e]);
-  } else {
-    double capacity_a, capacity_b;
-    r = resistance(e, pa, pb, capacity_a, capacity_b);
-  }
+void LumpedVessels::linearise_edge(std::size_t e, double pa, double pb, double r, double dt) {
   const double s = edge_root_intercept_[e] + edge_root_slope_[e] * 0.5 * (pa + pb);
   const double inertance = tapered(e) ? tapered_inertance(static_cast<std::int32_t>(e), pa, pb) : density_ * edge_length_[e] / (s * s);
   const EdgeLine line = bdf2_edge(r, inertance, flow_[e], previous_flow_[e], dt);
@@ -388,9 +382,6 @@ void LumpedVessels::refresh_resistance(std::size_t e) {
   linearised_dt_ = 0;
   // What restore() computes from the pressures: a run resumed from a checkpoint has the same
   // resistances, whenever the factors changed.
-  double capacity_a, capacity_b;
-  const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
-  previous_resistance_[e] = resistance(e, previous_pressure_[a], previous_pressure_[b], capacity_a, capacity_b);
   update_resistance(e);
 }
 
@@ -429,8 +420,8 @@ double LumpedVessels::pressure_from_excess(std::size_t k, double excess) const {
 
 void LumpedVessels::start(const std::vector<double>& network_node_pressure, const std::vector<double>& vessel_flow) {
   if (empty()) return;
-  for (std::size_t k = 0; k < network_nodes_; ++k)
-    pressure_[k] = network_node_pressure[static_cast<std::size_t>(network_node_[k])];
+  for (std::size_t n = 0; n < node_of_.size(); ++n)
+    if (const std::int32_t k = node_of_[n]; k >= 0) pressure_[static_cast<std::size_t>(k)] = network_node_pressure[n];
   for (std::size_t i = 0; i < vessels_.size(); ++i)
     for (std::size_t e = first_edge(i); e < first_edge(i + 1); ++e) flow_[e] = vessel_flow[static_cast<std::size_t>(vessels_[i])];
   start_inner_nodes();
@@ -443,7 +434,7 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
     flow_[e] = q;
   }
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
-  predicted_ = pressure_;
+  hold_coupling_pressures();
   update_resistances();
   restart_history();
   update_dynamic_pressures();
@@ -482,7 +473,7 @@ void LumpedVessels::start_at_rest(std::span<const TubeLaw> laws) {
   for (std::size_t k = 0; k < nodes_; ++k) pressure_[k] = is_capacitor(k) ? shunt_pressure_[k] : sum[k] / count[k];
   std::fill(flow_.begin(), flow_.end(), 0.0);
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
-  predicted_ = pressure_;
+  hold_coupling_pressures();
   update_resistances();
   restart_history();
   update_dynamic_pressures();
@@ -494,7 +485,6 @@ void LumpedVessels::restart_history() {
   previous_volume_ = volume_;
   previous_flow_ = flow_;
   previous_pressure_ = pressure_;
-  previous_resistance_ = resistance_;
 }
 
 // ---- a step -----------------------------------------------------------------------------------
@@ -508,17 +498,28 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
   // today's), or a Picard pass's last solution.
   auto at = [&](std::int32_t k) {
     const auto i = static_cast<std::size_t>(k);
-    return extrapolated ? 2 * pressure_[i] - previous_pressure_[i] : predicted_[i];
+    return extrapolated ? 2 * pressure_[i] - previous_pressure_[i] : rhs_[i];  // rhs_: the last pass's solution
   };
   // The edges of the extrapolated pass were linearised with the last step's completion
   // (complete(): update_resistances_and_linearise).
   if (!(extrapolated && linearised_dt_ == dt))
     parallel_blocks(vessels_i, threads_, [&](std::int64_t first, std::int64_t last) {
-      for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e)
-        linearise_edge(e, at(a_[e]), at(b_[e]), extrapolated, dt);
+      for (auto e = static_cast<std::size_t>(first); e < static_cast<std::size_t>(last); ++e) {
+        const double pa = at(a_[e]), pb = at(b_[e]);
+        double r, capacity_a, capacity_b;
+        if (extrapolated) {
+          // The last step's resistance is a function of its pressures (no array holds it).
+          const auto a = static_cast<std::size_t>(a_[e]), b = static_cast<std::size_t>(b_[e]);
+          r = extrapolated_resistance(resistance_[e], resistance(e, previous_pressure_[a], previous_pressure_[b], capacity_a, capacity_b));
+        } else {
+          r = resistance(e, pa, pb, capacity_a, capacity_b);
+        }
+        linearise_edge(e, pa, pb, r, dt);
+      }
     });
   linearised_dt_ = 0;
   std::int64_t collapsed = nodes_i;
+  double* const system_shunt = system_.shunt_workspace().data();
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
   {
     // BDF2 for a node's volume, V(p) linearised at p*:
@@ -527,8 +528,8 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
     for (std::int64_t i = 0; i < nodes_i; ++i) {
       const auto k = static_cast<std::size_t>(i);
       const double ps = at(static_cast<std::int32_t>(i)), c = node_compliance(k, ps);
-      system_shunt_[k] = 1.5 * c / dt + shunt_[k];
-      if (!(system_shunt_[k] > 0)) collapsed = std::min<std::int64_t>(collapsed, i);  // a lumen closing there
+      system_shunt[k] = 1.5 * c / dt + shunt_[k];
+      if (!(system_shunt[k] > 0)) collapsed = std::min<std::int64_t>(collapsed, i);  // a lumen closing there
       double rhs =
           (1.5 * (c * ps - node_excess(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt + shunt_current(k);
       for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
@@ -569,9 +570,9 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
     linearise(pass == 0, coupled_inflow);
     // The forward half of the solve goes with the factorisation; complete() adds the 1D
     // ends' departures from the held inflows to it and takes the backward half.
-    if (system_.factorize_forward(conductance_, system_shunt_, rhs_) >= 0)
+    if (system_.factorize_forward_in_place(conductance_, rhs_) >= 0)
       throw InputError("the 0D vessels have a part with no path to an outlet");
-    if (pass + 1 < passes_) system_.backward(rhs_, predicted_);
+    if (pass + 1 < passes_) system_.backward(rhs_, rhs_);
   }
   if (coupling_nodes_.empty()) return;
   std::copy(coupled_inflow.begin(), coupled_inflow.end(), held_inflow_.begin());
@@ -590,9 +591,13 @@ void LumpedVessels::predict_again(std::span<const double> coupled_inflow) {
 }
 
 void LumpedVessels::predict_coupling_pressures() {
-  system_.backward_at(coupling_nodes_, rhs_, coupling_scratch_);
+  system_.backward_at(coupling_nodes_, rhs_, coupling_predicted_);
+}
+
+void LumpedVessels::hold_coupling_pressures() {
+  coupling_predicted_.resize(coupling_nodes_.size());
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j)
-    predicted_[static_cast<std::size_t>(coupling_nodes_[j])] = coupling_scratch_[j];
+    coupling_predicted_[j] = pressure_.empty() ? 0.0 : pressure_[static_cast<std::size_t>(coupling_nodes_[j])];
 }
 
 void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
@@ -604,7 +609,9 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_scratch_[j] = coupled_volume[j] / dt - held_inflow_[j];
     system_.add_forward(coupling_nodes_, coupling_scratch_, rhs_);
   }
-  system_.backward(rhs_, predicted_);
+  system_.backward(rhs_, rhs_);
+  const std::vector<double>& p1 = rhs_;  // now the pressures at t1
+  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_predicted_[j] = p1[static_cast<std::size_t>(coupling_nodes_[j])];
   const auto edges = static_cast<std::int64_t>(a_.size());
   const auto blocks = static_cast<std::int64_t>(block_outflow_.size());
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
@@ -612,8 +619,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
 #pragma omp for schedule(static)
     for (std::int64_t i = 0; i < edges; ++i) {
       const auto e = static_cast<std::size_t>(i);
-      previous_flow_[e] = conductance_[e] * (predicted_[static_cast<std::size_t>(a_[e])] - predicted_[static_cast<std::size_t>(b_[e])]) +
-                      history_[e];
+      previous_flow_[e] = conductance_[e] * (p1[static_cast<std::size_t>(a_[e])] - p1[static_cast<std::size_t>(b_[e])]) + history_[e];
     }
     // Each node's net inflow at t1 (BDF2 takes the right-hand side there), as the solve had
     // it, and from it the volume: exactly what came in, (3 V - 4 V^n + V^(n-1)) / 2 =
@@ -626,7 +632,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
       const std::size_t first = static_cast<std::size_t>(b) * block, last = std::min(first + block, nodes_);
       double outflow = 0;
       for (std::size_t k = first; k < last; ++k) {
-        const double shunted = shunt_[k] * predicted_[k] - shunt_current(k);
+        const double shunted = shunt_[k] * p1[k] - shunt_current(k);
         // A capacitor's R2 is not the network's; a held pressure's flow is counted below.
         if (k < network_nodes_ && (held_.empty() || !held_[k])) outflow += shunted;
         double inflow = -shunted;
@@ -660,7 +666,6 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
   });
   previous_flow_.swap(flow_);  // the new flows went where the oldest were
   for (std::size_t e = 0; e < passed_.size(); ++e) passed_[e] += dt * flow_[e];
-  previous_resistance_.swap(resistance_);
   update_resistances_and_linearise(dt);
   update_dynamic_pressures();
   // Across the network's boundary: flows, outlet shunts and the R1 of RCR outlets, held
@@ -688,7 +693,7 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     for (auto j = static_cast<std::size_t>(first); j < static_cast<std::size_t>(last); ++j) {
       const OutletNode& o = outlet_boundary_[j];
       const auto k = static_cast<std::size_t>(o.node);
-      const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * predicted_[k] - shunt_current(k);
+      const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * p1[k] - shunt_current(k);
       boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * out;
     }
   });
@@ -858,20 +863,22 @@ double LumpedVessels::capacitor_pressure(std::size_t outlet) const {
 
 void LumpedVessels::shift_pressures(std::span<const double> network_node_dp, std::span<const double> outlet_dp) {
   if (empty()) return;
-  for (std::size_t k = 0; k < network_nodes_ + outlet_of_capacitor_.size(); ++k)
-    pressure_[k] += k < network_nodes_
-                        ? network_node_dp[static_cast<std::size_t>(network_node_[k])]
-                        : outlet_dp[static_cast<std::size_t>(outlet_of_capacitor_[k - network_nodes_])];
+  // Each node's shift goes in volume_ first (the volumes are made again from the pressures below).
+  std::vector<double>& dp = volume_;
+  for (std::size_t n = 0; n < node_of_.size(); ++n)
+    if (const std::int32_t k = node_of_[n]; k >= 0) dp[static_cast<std::size_t>(k)] = network_node_dp[n];
+  for (std::size_t j = 0; j < outlet_of_capacitor_.size(); ++j)
+    dp[network_nodes_ + j] = outlet_dp[static_cast<std::size_t>(outlet_of_capacitor_[j])];
+  for (std::size_t k = 0; k < network_nodes_ + outlet_of_capacitor_.size(); ++k) pressure_[k] += dp[k];
   // Inner nodes by their place between their vessel's ends.
   for (std::size_t i = 0; sectioned() && i < vessels_.size(); ++i) {
     const std::size_t first = first_edge(i), n = first_edge(i + 1) - first;
-    const double da = network_node_dp[static_cast<std::size_t>(network_node_[static_cast<std::size_t>(a_[first])])];
-    const double db = network_node_dp[static_cast<std::size_t>(network_node_[static_cast<std::size_t>(b_[first + n - 1])])];
+    const double da = dp[static_cast<std::size_t>(a_[first])], db = dp[static_cast<std::size_t>(b_[first + n - 1])];
     for (std::size_t s = 1; s < n; ++s)
       pressure_[static_cast<std::size_t>(a_[first + s])] += da + (db - da) * static_cast<double>(s) / static_cast<double>(n);
   }
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
-  predicted_ = pressure_;
+  hold_coupling_pressures();
   update_resistances();
   restart_history();
   update_dynamic_pressures();
@@ -939,13 +946,8 @@ void LumpedVessels::restore(CheckpointReader& in) {
   };
   for (auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) get(*v, nodes);
   for (auto* v : {&flow_, &previous_flow_}) get(*v, edges);
-  predicted_ = pressure_;
+  hold_coupling_pressures();
   // The resistances are functions of the pressures: the same bits as the run had.
-  for (std::size_t e = 0; e < vessel_edges_; ++e) {
-    double capacity_a, capacity_b;
-    previous_resistance_[e] = resistance(e, previous_pressure_[static_cast<std::size_t>(a_[e])],
-                                         previous_pressure_[static_cast<std::size_t>(b_[e])], capacity_a, capacity_b);
-  }
   update_resistances();
   update_dynamic_pressures();
 }

@@ -124,12 +124,12 @@ class LumpedVessels {
                std::span<const double> held_pressure);
   // The tree form's: inlet_flow at the inlet where the inlet vessel is 0D (else unused).
   void predict(double dt, std::span<const double> coupled_inflow, double inlet_flow);
-  // The pressure of a node at a fraction s in [0, 1] of the step being taken (linear
+  // The pressure of coupling node j at a fraction s in [0, 1] of the step being taken (linear
   // between the start and the prediction), and its impedance: a coupled end whose inflow
   // departs from the predicted by dQ sees p + s Z dQ (pulse/pulse_solver.cpp).
-  double pressure_during_step(std::int32_t node, double s) const {
-    const auto i = static_cast<std::size_t>(node);
-    return pressure_[i] + s * (predicted_[i] - pressure_[i]);
+  double pressure_during_step(std::size_t j, double s) const {
+    const double p0 = pressure_[static_cast<std::size_t>(coupling_nodes_[j])];
+    return p0 + s * (coupling_predicted_[j] - p0);
   }
   double impedance(std::size_t j) const { return impedance_[j]; }  // at coupling node j
   // predict()'s pressures at t1 at the coupling nodes again, for other held inflows (the same
@@ -146,8 +146,8 @@ class LumpedVessels {
   void complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
                 std::span<double> boundary_volume = {});
   // Frees what a step works in and leaves nothing in for the next (the edges' linearisation,
-  // the system's right-hand side, shunts and factorisation, the predicted pressures: about
-  // 70 bytes a vessel) until the next predict() makes it again, linearising every edge anew:
+  // the system's right-hand side and factorisation: about 40 bytes a vessel) until the next
+  // predict() makes it again, linearising every edge anew:
   // for a phase between steps that needs none of it (a run's cycle end). They are first made
   // at the first predict(), not before (a run's start needs none of them either).
   void release_step_arrays();
@@ -325,7 +325,7 @@ class LumpedVessels {
   }
   // The linearisation of a step: edge conductances and history terms, node shunts and
   // right-hand sides (with the coupled inflows and the inlet's), at the state extrapolated to
-  // the step's end (extrapolated) or at the pressures predicted_ (a Picard pass).
+  // the step's end (extrapolated) or at the last pass's solution (a Picard pass).
   void linearise(bool extrapolated, std::span<const double> coupled_inflow);
   // Calls f(node, value) for the coupling nodes' values (per coupling node) and the boundary
   // inflows' (scale times each).
@@ -343,19 +343,19 @@ class LumpedVessels {
   void add_boundary_rows(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity);
   void allocate_system();
   void allocate_step_arrays();  // where released (or never made)
-  void predict_coupling_pressures();  // predicted_ at the coupling nodes from the forward half rhs_
+  void predict_coupling_pressures();  // coupling_predicted_ from the forward half rhs_
+  void hold_coupling_pressures();     // coupling_predicted_ at the pressures now (no step taken)
   void restart_history();
   void update_dynamic_pressures();
   void update_resistances();  // after the pressures changed: capacities at the ends, R
   // The same after a step, and the next step's edges (linearise's extrapolated pass) for a
   // step of dt in the same pass; linearised_dt_ = dt says they are (0: not).
   void update_resistances_and_linearise(double dt);
-  void linearise_edge(std::size_t e, double pa, double pb, bool extrapolated, double dt);
+  void linearise_edge(std::size_t e, double pa, double pb, double r, double dt);  // with its resistance r
   double linearised_dt_ = 0;
 
   std::size_t nodes_ = 0, network_nodes_ = 0;  // network nodes first, then capacitor nodes, then inner nodes
   std::vector<std::int32_t> node_of_;          // per network node
-  std::vector<std::int32_t> network_node_;     // per node below network_nodes_
   std::vector<std::int32_t> index_of_vessel_;  // per network vessel
   std::vector<std::int32_t> vessels_;          // per 0D vessel: its network index
   std::vector<std::int32_t> first_edge_;       // per 0D vessel and one more (empty: one section each)
@@ -396,9 +396,12 @@ class LumpedVessels {
   // State: node volumes (W, above c) and pressures, edge flows, and the last step's (BDF2 history and
   // the extrapolation).
   std::vector<double> volume_, previous_volume_, pressure_, previous_pressure_, flow_, previous_flow_;
-  // The step being taken: predicted pressures, and the edges' conductances and history
-  // terms of the last linearisation (Q = g (p_a - p_b) + f), the inflows and prediction.
-  std::vector<double> predicted_, conductance_, history_, system_shunt_, rhs_;
+  // The step being taken: the edges' conductances and history terms of the last
+  // linearisation (Q = g (p_a - p_b) + f), and the nodes' right-hand side (their shunts go
+  // straight into the system's workspace). The solve works in place: rhs_ holds the forward
+  // half's y from predict() on, and the pressures at t1 once complete() (or a Picard pass)
+  // has taken the backward half.
+  std::vector<double> conductance_, history_, rhs_;
   std::vector<double> passed_;  // per 0D vessel edge, where tracked (track_passed_volumes)
   std::vector<double> viscosity_factor_;  // per 0D vessel edge (empty: 1)
   void refresh_resistance(std::size_t e);  // after its factor changed: what restore() computes
@@ -408,9 +411,11 @@ class LumpedVessels {
   std::vector<double> dynamic_;  // per coupling node
   // Each 0D vessel edge's pressure at its centre (what the statistics sample every step; other
   // points of the profile take the resistance's flow capacities again), and its resistance
-  // now and a step before (the next step's extrapolation): the viscosity is most of the cost,
-  // three evaluations a vessel and step.
-  std::vector<double> centre_pressure_, resistance_, previous_resistance_;
+  // now: the viscosity is most of the cost, three evaluations a vessel and step. The next
+  // step extrapolates from it and the last step's, which the step's completion has at hand
+  // as it replaces it; a step linearised anew (after a cycle end) computes the last one again
+  // from the previous pressures, the same bits (it is a function of them).
+  std::vector<double> centre_pressure_, resistance_;
   // The pressure at the centre of edge e on its steady profile, from its end pressures and
   // flow capacities there; and the resistance and centre pressure of edge e at the pressures now.
   double centre_pressure(std::size_t e, double pa, double pb, double ga, double gb) const;
@@ -418,6 +423,7 @@ class LumpedVessels {
   std::vector<double> impedance_;     // per coupling node: Z
   std::vector<double> held_inflow_;   // per coupling node: the inflows predicted with
   std::vector<double> coupling_scratch_;  // per coupling node
+  std::vector<double> coupling_predicted_;  // per coupling node: its pressure at t1, predicted (then solved)
   // Each node's edges, in increasing order (e where the edge leaves it, ~e where it enters):
   // the sums into a node are gathers, in parallel and in one order whatever the threads.
   std::vector<std::int32_t> incident_offset_, incident_edge_;
