@@ -208,14 +208,18 @@ std::span<double> NodalSystem::shunt_workspace() {
   return inverse_pivot_;
 }
 
+std::int64_t NodalSystem::factorize_in_place(std::span<const double> conductance) {
+  return factorize_forward_in_place(conductance, {});
+}
+
 std::int64_t NodalSystem::factorize_forward_in_place(std::span<const double> conductance, std::span<double> y) {
-  if (y.size() != nodes_)
+  if (y.data() && y.size() != nodes_)
     throw std::invalid_argument("NodalSystem::factorize_forward_in_place: right-hand side of " +
                                 std::to_string(y.size()) + " for " + std::to_string(nodes_) + " nodes");
-  if (method_ != Method::tree_elimination) return factorize(conductance, shunt_workspace_, y.data());
-  if (inverse_pivot_.size() != nodes_)
-    throw std::logic_error("NodalSystem::factorize_forward_in_place: no shunts written to shunt_workspace()");
-  return factorize(conductance, inverse_pivot_, y.data());
+  const std::vector<double>& shunt = method_ == Method::tree_elimination ? inverse_pivot_ : shunt_workspace_;
+  if (shunt.size() != nodes_)
+    throw std::logic_error("NodalSystem::factorize_in_place: no shunts written to shunt_workspace()");
+  return factorize(conductance, shunt, y.data());
 }
 
 void NodalSystem::release_factorization() {

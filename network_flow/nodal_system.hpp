@@ -65,6 +65,7 @@ class NodalSystem {
   // from and overwrites, so a caller that forms its shunts anew for every factorisation (a
   // 0D step) holds no array of them (8 bytes a node). Their values are gone after the call.
   std::span<double> shunt_workspace();
+  std::int64_t factorize_in_place(std::span<const double> conductance);
   std::int64_t factorize_forward_in_place(std::span<const double> conductance, std::span<double> y);
   void forward(std::span<double> y) const;  // y = L^-1 P y, in place
   // Frees a tree's factorisation and the inverse diagonal's scratch (16 and 8 bytes a node)

@@ -37,18 +37,18 @@ std::vector<double> PulseSolver::vessel_volumes() const {
   return volume;
 }
 
-std::size_t PulseSolver::balance_compliances(double period, const std::vector<double>* mean_pressure) {
+std::size_t PulseSolver::balance_compliances(double period, std::vector<double> mean_pressure) {
   if (steady_resistance_.empty()) return 0;
   const std::size_t n = net_.vessel_count();
   std::vector<double> resistance(steady_resistance_.begin(), steady_resistance_.end());
   // The conductances at the last cycle's mean state, where the run has one: in a full tree
   // every resistance is a compliant vessel's, and the pulsatile means sit well below the
   // steady pressures (9.8 mmHg at the root of the paper's tree).
-  if (mean_pressure)
+  if (!mean_pressure.empty())
     for (std::size_t v = 0; v < n; ++v) {
-      const double area = law(v).area((*mean_pressure)[v]);
+      const double area = law(v).area(mean_pressure[v]);
       if (is_tapered(v)) {
-        const double area_to = end_law(v, true).area((*mean_pressure)[v]);
+        const double area_to = end_law(v, true).area(mean_pressure[v]);
         if (area > 0 && area_to > 0)
           resistance[v] = tapered_poiseuille_resistance(
               [&](double d) { return viscosity_(std::numbers::pi / 4 * d * d); }, net_.length[v],
@@ -58,6 +58,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       if (area > 0)
         resistance[v] = poiseuille_resistance(viscosity_(area), net_.length[v], std::sqrt(4 / std::numbers::pi * area), blood_.alpha);
     }
+  std::vector<double>().swap(mean_pressure);
   // Each vessel's volume and dA/dp at its mean area, now.
   const std::vector<double> volume = vessel_volumes();
   std::vector<double> area_per_pressure(n);
@@ -136,6 +137,7 @@ std::size_t PulseSolver::balance_compliances(double period, const std::vector<do
       loads.capacitor_shunt[k] = capacitor_compliance[k] / (a * period);
       loads.capacitor_current[k] = loads.capacitor_shunt[k] * move.capacitor[k];
     }
+    move = {};  // in the loads now: freed before the solve makes the next
     move = tree.solve(loads);
   }
   // The linearisation holds for small moves: none may change a lumen by more than 20 %

@@ -271,9 +271,10 @@ class PulseSolver {
   // limit follow from two O(vessels) solves of that tree (docs/solver.md §6).
   // Every vessel's area and every capacitor moves by them. At the periodic state the rates
   // vanish and nothing moves. Returns the vessels moved (0 without a steady solution).
-  // mean_pressure (per vessel, the last cycle's), where given, is the state the network's
-  // conductances are taken at; else the steady solution's.
-  std::size_t balance_compliances(double period, const std::vector<double>* mean_pressure = nullptr);
+  // mean_pressure (per vessel, the last cycle's), where given (not empty), is the state the
+  // network's conductances are taken at; else the steady solution's. It is freed once they
+  // are (the balance's largest moment comes later).
+  std::size_t balance_compliances(double period, std::vector<double> mean_pressure = {});
 
  private:
   // The DG rate dU/dt of the 1D vessels at time t (pulse/dg_rate.cpp), and its steps in order.

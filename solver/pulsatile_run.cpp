@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
@@ -393,7 +394,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       if (plan_.balance_compliances) {
         std::vector<double> mean_pressure = mean_pressures(last_.vessels);
         set_aside_last_vessels();
-        if (solver_.balance_compliances(period, &mean_pressure) > 0) ++balances_;
+        if (solver_.balance_compliances(period, std::move(mean_pressure)) > 0) ++balances_;
       } else {
         set_aside_last_vessels();
       }

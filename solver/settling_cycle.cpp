@@ -1,6 +1,7 @@
 #include "solver/settling_cycle.hpp"
 
 #include <chrono>
+#include <utility>
 #include <vector>
 
 #include "solver/cycle_statistics.hpp"
@@ -28,7 +29,7 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   solver.check_solution();
   solver.release_step_arrays();
   std::vector<double> mean_pressure = mean_pressures(stats.close(solver).vessels);  // the rest freed here
-  solver.balance_compliances(period, &mean_pressure);
+  solver.balance_compliances(period, std::move(mean_pressure));
   solver.set_time_step(run_step);
   solver.set_coupling_passes(run_passes);
   solver.restart_clock();

@@ -1,6 +1,7 @@
 #include "steady/loaded_tree.hpp"
 
 #include <algorithm>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -98,11 +99,12 @@ TreePotentials LoadedTree::solve(const TreeLoads& loads) {
       (!no_capacitor_loads && (loads.capacitor_shunt.size() != outlets || loads.capacitor_current.size() != outlets)))
     throw std::invalid_argument("LoadedTree: loads not sized to the network");
   // Each node's shunt and current in the order the single solve had always added them: the
-  // loads, the vessels to held nodes, the held and the untouched nodes, the outlets.
-  std::vector<double> shunt, current;
-  shunt.reserve(system_.node_count());
+  // loads, the vessels to held nodes, the held and the untouched nodes, the outlets. The
+  // shunts go straight into the system's workspace (a capacitor node's at its place there).
+  const std::span<double> shunt = system_.shunt_workspace();
+  std::copy(loads.node_shunt.begin(), loads.node_shunt.end(), shunt.begin());
+  std::vector<double> current;
   current.reserve(system_.node_count());
-  shunt = loads.node_shunt;
   current = loads.node_current;
   for (const auto& [node, g] : held_end_shunt_) shunt[static_cast<std::size_t>(node)] += g;
   for (const auto* fixed : {&grounded_, &untouched_})
@@ -121,27 +123,28 @@ TreePotentials LoadedTree::solve(const TreeLoads& loads) {
     } else if (o.r2 == 0) {
       shunt[d] += 1 / o.r1;
     } else {
-      shunt.push_back(1 / o.r2 + loads.capacitor_shunt[k]);
+      shunt[static_cast<std::size_t>(capacitor_node_[k])] = 1 / o.r2 + loads.capacitor_shunt[k];
       current.push_back(loads.capacitor_current[k]);
     }
   }
   // The inlet is open: no conductance to ground there but the node's own load. A component
   // is named by its lowest node, never a capacitor node (numbered after the network's, each
   // joined to one of them).
-  const std::int64_t singular = system_.factorize(conductance_, shunt);
+  const std::int64_t singular = system_.factorize_in_place(conductance_);
   if (singular >= 0)
     throw InputError("node " + std::to_string(net_.node_id[static_cast<std::size_t>(singular)]) +
                      ": no path to ground (no outlet or load conductance in its part of the network)");
   system_.solve(current, current);
 
   TreePotentials p;
-  p.node.assign(current.begin(), current.begin() + static_cast<std::ptrdiff_t>(nodes));
   p.capacitor.assign(outlets, 0.0);
   for (std::size_t k = 0; k < outlets; ++k) {
     const Outlet& o = outlet(k);
     if (capacitor_node_[k] >= 0) p.capacitor[k] = current[static_cast<std::size_t>(capacitor_node_[k])];
-    else if (o.type == BoundaryType::rcr && o.r1 == 0) p.capacitor[k] = p.node[static_cast<std::size_t>(outlet_node(k))];
+    else if (o.type == BoundaryType::rcr && o.r1 == 0) p.capacitor[k] = current[static_cast<std::size_t>(outlet_node(k))];
   }
+  current.resize(nodes);  // the network's nodes come first
+  p.node = std::move(current);
   return p;
 }
 
