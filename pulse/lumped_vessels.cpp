@@ -132,18 +132,22 @@ void LumpedVessels::allocate_system() {
 
   if (2 * edges >= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw InputError("too many 0D vessels for 32-bit indices");
+  own_edge_ = true;
+  for (std::size_t e = 0; e < edges && own_edge_; ++e)
+    own_edge_ = static_cast<std::size_t>(std::max(a_[e], b_[e])) == e + 1;
+  // Edge e at node k, unless it is k's own (not listed).
+  auto listed = [&](std::size_t e, std::int32_t k) { return !own_edge_ || static_cast<std::size_t>(k) != e + 1; };
   incident_offset_.assign(nodes_ + 1, 0);
-  for (std::size_t e = 0; e < edges; ++e) {
-    ++incident_offset_[static_cast<std::size_t>(a_[e]) + 1];
-    ++incident_offset_[static_cast<std::size_t>(b_[e]) + 1];
-  }
+  for (std::size_t e = 0; e < edges; ++e)
+    for (const std::int32_t k : {a_[e], b_[e]})
+      if (listed(e, k)) ++incident_offset_[static_cast<std::size_t>(k) + 1];
   for (std::size_t k = 0; k < nodes_; ++k) incident_offset_[k + 1] += incident_offset_[k];
-  incident_edge_.resize(2 * edges);
+  incident_edge_.resize(static_cast<std::size_t>(incident_offset_.back()));
   std::vector<std::int32_t> fill(incident_offset_.begin(), incident_offset_.end() - 1);
   for (std::size_t e = 0; e < edges; ++e) {
     const auto edge = static_cast<std::int32_t>(e);
-    incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(a_[e])]++)] = edge;
-    incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(b_[e])]++)] = ~edge;
+    if (listed(e, a_[e])) incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(a_[e])]++)] = edge;
+    if (listed(e, b_[e])) incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(b_[e])]++)] = ~edge;
   }
   block_outflow_.assign((nodes_ + block - 1) / block, 0.0);
 }
@@ -532,10 +536,9 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
       if (!(system_shunt[k] > 0)) collapsed = std::min<std::int64_t>(collapsed, i);  // a lumen closing there
       double rhs =
           (1.5 * (c * ps - node_excess(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt + shunt_current(k);
-      for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
-        const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
+      for_each_incident(k, [&](std::int32_t e) {
         rhs += e >= 0 ? -history_[static_cast<std::size_t>(e)] : history_[static_cast<std::size_t>(~e)];
-      }
+      });
       rhs_[k] = rhs;
     }
   }
@@ -636,10 +639,9 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
         // A capacitor's R2 is not the network's; a held pressure's flow is counted below.
         if (k < network_nodes_ && (held_.empty() || !held_[k])) outflow += shunted;
         double inflow = -shunted;
-        for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
-          const std::int32_t e = incident_edge_[static_cast<std::size_t>(j)];
+        for_each_incident(k, [&](std::int32_t e) {
           inflow += e >= 0 ? -previous_flow_[static_cast<std::size_t>(e)] : previous_flow_[static_cast<std::size_t>(~e)];
-        }
+        });
         if (!held_.empty() && held_[k]) {
           // Dirichlet: the node sits at the held pressure, and the boundary lets in what its
           // volume and its vessel take (the stiff shunt's own flow, G (p - p_held), is
@@ -730,9 +732,14 @@ void LumpedVessels::update_resistance(std::size_t e) {
 }
 
 std::int32_t LumpedVessels::vessel_at_node(std::size_t k) const {
-  for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
-    const std::int32_t incident = incident_edge_[static_cast<std::size_t>(j)];
-    const auto e = static_cast<std::size_t>(incident >= 0 ? incident : ~incident);
+  std::int32_t first = 0;
+  bool any = false;
+  for_each_incident(k, [&](std::int32_t incident) {
+    if (!any) first = incident;
+    any = true;
+  });
+  if (any) {
+    const auto e = static_cast<std::size_t>(first >= 0 ? first : ~first);
     const std::size_t vessel_edge = e < vessel_edges_ ? e : static_cast<std::size_t>(capacitor_vessel_edge_[e - vessel_edges_]);
     const std::size_t slot = first_edge_.empty() ? vessel_edge
                                                  : static_cast<std::size_t>(std::upper_bound(first_edge_.begin(), first_edge_.end(),
@@ -747,17 +754,16 @@ double LumpedVessels::node_constant(std::size_t k) const {
   // Half of each adjacent section's L c^2 (a tapered vessel's int c^2 dx), in the order of
   // its edges, as the constructor summed a and b.
   double constant = 0;
-  for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) {
-    const std::int32_t incident = incident_edge_[static_cast<std::size_t>(j)];
+  for_each_incident(k, [&](std::int32_t incident) {
     const auto e = static_cast<std::size_t>(incident >= 0 ? incident : ~incident);
-    if (e >= vessel_edges_) continue;  // an R1 edge
+    if (e >= vessel_edges_) return;  // an R1 edge
     if (tapered(e)) {
       constant += tapered_[static_cast<std::size_t>(taper_edge_[e])].volume_c / 2;
-      continue;
+      return;
     }
     const double w = edge_length_[e] / 2, c = edge_root_intercept_[e];
     constant += w * c * c;
-  }
+  });
   return constant;
 }
 

@@ -426,7 +426,19 @@ class LumpedVessels {
   std::vector<double> coupling_predicted_;  // per coupling node: its pressure at t1, predicted (then solved)
   // Each node's edges, in increasing order (e where the edge leaves it, ~e where it enters):
   // the sums into a node are gathers, in parallel and in one order whatever the threads.
+  // Where every edge e leads to node e + 1 from a lower node (a tree's vessels in the order
+  // of their distal nodes, as the subtree order numbers them: own_edge_), that edge, node
+  // e + 1's first, is not listed but read from b_.
   std::vector<std::int32_t> incident_offset_, incident_edge_;
+  bool own_edge_ = false;
+  template <class F>
+  void for_each_incident(std::size_t k, F&& f) const {
+    if (own_edge_ && k >= 1 && k <= a_.size()) {
+      const auto e = static_cast<std::int32_t>(k - 1);
+      f(b_[k - 1] == static_cast<std::int32_t>(k) ? ~e : e);
+    }
+    for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) f(incident_edge_[static_cast<std::size_t>(j)]);
+  }
   static constexpr std::size_t block = 4096;
   std::vector<double> block_outflow_;  // per block of nodes: the outlets' outflow (a fixed-order sum)
   double dt_ = 0;
