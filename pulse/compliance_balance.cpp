@@ -32,7 +32,7 @@ std::vector<double> PulseSolver::vessel_volumes() const {
                   : lumped_.sections(e) > 1 ? lumped_.sectioned_volume(e)
                                             : net_.length[v] * 0.5 * (tube.area(lumped_.pressure_at(e, 0)) + tube.area(lumped_.pressure_at(e, 1)));
     }
-    for (auto el = first_element_[v]; el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
+    for (auto el = first_element(v); el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
   }
   return volume;
 }
@@ -78,8 +78,8 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
           sum += at.compliance_per_length(at.area(lumped_.pressure_at(e, x))) / 2;  // the mean of the two ends'
         }
       } else {
-        for (auto el = first_element_[v]; el < end_element(v); ++el) {
-          const double x = (el - first_element_[v] + 0.5) / elements_per_vessel_;
+        for (auto el = first_element(v); el < end_element(v); ++el) {
+          const double x = (el - first_element(v) + 0.5) / elements_per_vessel_;
           const double c = law_at(v, x).compliance_per_length(state_.area(el, 0));
           element_area_per_pressure[static_cast<std::size_t>(el)] = c;
           sum += c / elements_per_vessel_;
@@ -156,7 +156,7 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
     if (zero_d_[v]) continue;
     const double y0 = move.node[static_cast<std::size_t>(net_.from[v])], y1 = move.node[static_cast<std::size_t>(net_.to[v])];
     for (int k = 0; k < e; ++k) {
-      const auto el = first_element_[v] + k;
+      const auto el = first_element(v) + k;
       const double c = is_tapered(v) ? element_area_per_pressure[static_cast<std::size_t>(el)] : area_per_pressure[v];
       state_.area(el, 0) += c * (y0 + (y1 - y0) * (k + 0.5) / e);
       if (state_.area.cols() > 1 && vessel_degree_[v] >= 1) state_.area(el, 1) += c * (y1 - y0) / (2 * e);

@@ -65,14 +65,13 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
     if (o.type == BoundaryType::reflection)
       throw SettingError("model", "vessel " + std::to_string(net.id[v]) + ": a reflection outlet needs a 1D vessel (" +
                                       placeholder("model") + " 1d, or auto, keeps it 1D)");
-    outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(at), -1});
     // The outlet's rows (boundaries/resistance_outlet.hpp, rcr_outlet.hpp).
     const RcrOutlet rcr{o.r1, o.c, o.r2, o.p_out};
     if (o.type == BoundaryType::rcr && o.c > 0) {
       const LumpedCapacitor rows = rcr.lumped_capacitor();
       capacitor_of_outlet_[static_cast<std::size_t>(k)] = static_cast<std::int32_t>(outlet_of_capacitor_.size());
       const auto c = static_cast<std::int32_t>(nodes_++);
-      outlet_boundary_.back().r1_edge = static_cast<std::int32_t>(vessel_edges_ + outlet_of_capacitor_.size());
+      rcr_outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(vessel_edges_ + outlet_of_capacitor_.size())});
       outlet_of_capacitor_.push_back(k);
       // The vessel's section at the outlet: its first at `from`, its last at `to`.
       const auto index = static_cast<std::size_t>(index_of_vessel_[v]);
@@ -89,6 +88,7 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
                                                           : ResistanceOutlet{o.r, o.p_out}.lumped_shunt();
       shunt_[at] = row.conductance;
       shunt_pressure_[at] = row.pressure;
+      outlet_boundary_.push_back({boundary, static_cast<std::int32_t>(at)});
     }
   }
   // By node: complete() reads each outlet's node, in the arrays' order.

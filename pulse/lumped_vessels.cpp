@@ -91,7 +91,7 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   // reach 1.6 times): held for the whole run, they are cut to their sizes here.
   auto fit = [](auto&... arrays) { (arrays.shrink_to_fit(), ...); };
   fit(vessels_, first_edge_, a_, b_, edge_length_, edge_root_slope_, edge_root_intercept_, tapered_,
-      shunt_, shunt_pressure_, volume_b_, outlet_boundary_, outlet_of_capacitor_, capacitor_vessel_edge_,
+      shunt_, shunt_pressure_, volume_b_, outlet_boundary_, rcr_outlet_boundary_, outlet_of_capacitor_, capacitor_vessel_edge_,
       capacitor_edge_sign_, edge_fixed_resistance_, inflow_node_, inflow_boundary_, inflow_entering_,
       held_node_, held_boundary_, held_entering_, held_reference_conductance_);
 
@@ -695,10 +695,11 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     for (auto j = static_cast<std::size_t>(first); j < static_cast<std::size_t>(last); ++j) {
       const OutletNode& o = outlet_boundary_[j];
       const auto k = static_cast<std::size_t>(o.node);
-      const double out = o.r1_edge >= 0 ? flow_[static_cast<std::size_t>(o.r1_edge)] : shunt_[k] * p1[k] - shunt_current(k);
-      boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * out;
+      boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * (shunt_[k] * p1[k] - shunt_current(k));
     }
   });
+  for (const OutletEdge& o : rcr_outlet_boundary_)
+    boundary_volume[static_cast<std::size_t>(o.boundary)] -= dt * flow_[static_cast<std::size_t>(o.r1_edge)];
 }
 
 // ---- what the rest of the solver reads -------------------------------------------------------

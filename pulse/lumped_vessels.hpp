@@ -366,10 +366,15 @@ class LumpedVessels {
   std::vector<unsigned char> inflow_entering_, held_entering_;
   std::vector<std::int32_t> held_;  // per node: 1 + its place in held_node_, or 0 (empty: none held)
   std::vector<double> inflow_, held_reference_conductance_, held_out_;
+  // The outlets by their place in the run's list: a shunt at a node, or an RCR's R1 edge.
   struct OutletNode {
-    std::int32_t boundary, node, r1_edge;  // r1_edge: an RCR's R1 edge, or -1 (a shunt at node)
+    std::int32_t boundary, node;
+  };
+  struct OutletEdge {
+    std::int32_t boundary, r1_edge;
   };
   std::vector<OutletNode> outlet_boundary_;
+  std::vector<OutletEdge> rcr_outlet_boundary_;
 
   // Edges: the 0D vessels' sections (first), then the R1 of every RCR outlet on them.
   std::vector<std::int32_t> a_, b_;

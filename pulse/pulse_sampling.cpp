@@ -13,7 +13,7 @@
 namespace hemotree {
 
 void PulseSolver::locate(std::size_t vessel, double x, std::size_t& element, double& xi) const {
-  const auto first = first_element_[vessel], count = elements_per_vessel_;
+  const auto first = first_element(vessel), count = elements_per_vessel_;
   const double s = std::clamp(x, 0.0, 1.0) * count;
   const auto k = std::min(static_cast<std::int32_t>(s), count - 1);
   element = static_cast<std::size_t>(first + k);
@@ -89,7 +89,7 @@ void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) con
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t j = 0; j < one_d; ++j) {
     const auto v = static_cast<std::size_t>(one_d_vessels_[static_cast<std::size_t>(j)]);
-    const Eigen::Index el = first_element_[v] + k;
+    const Eigen::Index el = first_element(v) + k;
     double a = 0, q = 0;
     for (int m = 0; m <= vessel_degree_[v]; ++m) {
       a += state_.area(el, m) * phi[static_cast<std::size_t>(m)];
@@ -103,7 +103,7 @@ void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) con
 double PulseSolver::mean_flow(std::size_t vessel) const {
   if (zero_d_[vessel]) return lumped_.flow(lumped_.vessel_index(vessel));
   double sum = 0;
-  for (auto el = first_element_[vessel]; el < end_element(vessel); ++el) sum += state_.flow(el, 0);
+  for (auto el = first_element(vessel); el < end_element(vessel); ++el) sum += state_.flow(el, 0);
   return sum / elements_per_vessel_;
 }
 
@@ -117,7 +117,7 @@ double PulseSolver::network_volume() const {
   // The 1D vessels' volumes and what the 0D scheme conserves (lumped_vessels.hpp).
   double volume = lumped_.stored_volume();
   for (std::size_t v = 0; v < net_.vessel_count(); ++v)
-    for (auto el = first_element_[v]; el < end_element(v); ++el) volume += 2 * half_length_(el) * state_.area(el, 0);
+    for (auto el = first_element(v); el < end_element(v); ++el) volume += 2 * half_length_(el) * state_.area(el, 0);
   return volume;
 }
 

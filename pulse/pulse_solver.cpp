@@ -110,7 +110,11 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
 
   const std::optional<SteadyFlow> steady = solve_steady_flow();
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
-  boundaries_ = build_boundaries(net, first_element_, elements_per_vessel_, zero_d_);
+  {
+    std::vector<std::int32_t> first(n, -1);
+    for (const auto& [v, el] : first_elements_) first[static_cast<std::size_t>(v)] = el;
+    boundaries_ = build_boundaries(net, first, elements_per_vessel_, zero_d_);
+  }
   // The steady solve's rule (docs/network-format.md), once the boundaries' own form is checked:
   // a part with flow boundaries only has no pressure level, and a run from rest over it was
   // called complete (hostile-inputs 05), or failed deep in the 0D solve.
@@ -338,7 +342,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
   }
   const int top = std::max(0, n == 0 ? 0 : *std::max_element(vessel_degree_.begin(), vessel_degree_.end()));
   bases_.assign(static_cast<std::size_t>(top) + 1, ModalBasis{});
-  first_element_.assign(n, -1);
+  first_elements_.clear();
   element_vessel_.resize(one_d * static_cast<std::size_t>(e));
   half_length_.resize(static_cast<Eigen::Index>(element_vessel_.size()));
   element_beta_.resize(half_length_.size());
@@ -350,7 +354,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
     const std::int32_t first = next;
     for (std::size_t v = 0; v < n; ++v) {
       if (vessel_degree_[v] != p) continue;
-      first_element_[v] = next;
+      first_elements_.emplace_back(static_cast<std::int32_t>(v), next);
       for (int k = 0; k < e; ++k, ++next) {
         element_vessel_[static_cast<std::size_t>(next)] = static_cast<std::int32_t>(v);
         half_length_(next) = net_.length[v] / (2.0 * e);
@@ -363,6 +367,7 @@ void PulseSolver::choose_degrees_and_elements(const SolverOptions& options, cons
     bases_[static_cast<std::size_t>(p)] = modal_basis(p, options.quadrature_points);
     blocks_.push_back({p, first, next - first});
   }
+  std::sort(first_elements_.begin(), first_elements_.end());  // by vessel (they came by degree)
   build_taper_tables();
 }
 
@@ -391,7 +396,7 @@ void PulseSolver::build_taper_tables() {
     const auto v = static_cast<std::size_t>(element_vessel_[static_cast<std::size_t>(el)]);
     const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
     const ModalBasis& basis = bases_[static_cast<std::size_t>(vessel_degree_[v])];
-    const int k = el - first_element_[v];
+    const int k = el - first_element(v);
     for (Eigen::Index q = 0; q < basis.points; ++q) {
       const double s = (k + 0.5 * (basis.rule.nodes(q) + 1)) / e;
       taper_beta_(row, q) = taper.at(s).beta;
@@ -418,7 +423,7 @@ void PulseSolver::start_at_rest() {
       project_along(v, [&](double x) { return taper.rest_area(x); }, state_.area);
       continue;
     }
-    for (auto el = first_element_[v]; el < end_element(v); ++el)
+    for (auto el = first_element(v); el < end_element(v); ++el)
       state_.area(el, 0) = laws_[v].reference_area;
   }
   lumped_.start_at_rest(laws_);
@@ -438,7 +443,7 @@ void PulseSolver::project_along(std::size_t v, const F& f, Eigen::MatrixXd& coef
   Eigen::VectorXd values(basis.points);
   for (auto k = 0; k < e; ++k) {
     for (Eigen::Index q = 0; q < basis.points; ++q) values(q) = f((k + 0.5 * (basis.rule.nodes(q) + 1)) / e);
-    coefficients.row(first_element_[v] + k).head(basis.degree + 1) = (basis.projection * values).transpose();
+    coefficients.row(first_element(v) + k).head(basis.degree + 1) = (basis.projection * values).transpose();
   }
 }
 
@@ -476,7 +481,7 @@ void PulseSolver::compute_rest_correction() {
       flux(q) = TubeLaw::pressure_flux(taper_beta_(r, q) / (3 * rho), a_q(q));  // as evaluate's
       source(q) = a_q(q) * (taper_g1_(r, q) * root + taper_g0_(r, q));
     }
-    const int k = el - first_element_[v];
+    const int k = el - first_element(v);
     const TubeLaw left = taper.at(static_cast<double>(k) / e), right = taper.at(static_cast<double>(k + 1) / e);
     const double flux_left = left.flux_flow((basis.left * a).value(), 0.0);
     const double flux_right = right.flux_flow((basis.right * a).value(), 0.0);
@@ -502,7 +507,7 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
       // Pressure linear along the vessel as below, each point's area from the law there.
       const VesselTaper& taper = tapers_[static_cast<std::size_t>(taper_of_[v])];
       project_along(v, [&](double x) { return taper.at(x).area(p0 + (p1 - p0) * x); }, state_.area);
-      for (auto k = 0; k < e; ++k) state_.flow(first_element_[v] + k, 0) = s.flow[v];
+      for (auto k = 0; k < e; ++k) state_.flow(first_element(v) + k, 0) = s.flow[v];
       continue;
     }
     for (auto k = 0; k < e; ++k) {
@@ -512,7 +517,7 @@ void PulseSolver::start_from_steady_flow(const SteadyFlow& s) {
         const double x = (k + 0.5 * (basis.rule.nodes(q) + 1)) / e;
         a(q) = laws_[v].area(p0 + (p1 - p0) * x);
       }
-      const auto el = first_element_[v] + k;
+      const auto el = first_element(v) + k;
       state_.area.row(el).head(basis.degree + 1) = (basis.projection * a).transpose();
       state_.flow(el, 0) = s.flow[v];
     }
@@ -573,7 +578,7 @@ void PulseSolver::set_viscosity_factor(std::size_t vessel, double factor) {
     lumped_.set_viscosity_factor(lumped_.vessel_index(vessel), factor);
     return;
   }
-  for (auto el = first_element_[vessel]; el < end_element(vessel); ++el) element_viscosity_factor_(el) = factor;
+  for (auto el = first_element(vessel); el < end_element(vessel); ++el) element_viscosity_factor_(el) = factor;
 }
 
 void PulseSolver::track_face_volumes() {

@@ -206,7 +206,11 @@ class PulseSolver {
     lumped_.clear_passed_volumes();
   }
   const NetworkBoundaries& network_boundaries() const { return boundaries_; }
-  std::int32_t first_element(std::size_t vessel) const { return first_element_[vessel]; }
+  std::int32_t first_element(std::size_t vessel) const {  // -1: a 0D vessel
+    if (zero_d_[vessel]) return -1;
+    const auto v = static_cast<std::int32_t>(vessel);
+    return std::lower_bound(first_elements_.begin(), first_elements_.end(), std::pair{v, std::int32_t{-1}})->second;
+  }
   int elements_per_vessel() const { return elements_per_vessel_; }
   double element_half_length(std::size_t element) const { return half_length_(static_cast<Eigen::Index>(element)); }
   // The 1D vessels (indices), in the order of their elements.
@@ -221,7 +225,7 @@ class PulseSolver {
   }
   const TubeLaw& end_law(std::size_t vessel, bool distal) const {  // a 1D vessel's
     return distal && !taper_of_.empty() && taper_of_[vessel] >= 0 ? distal_laws_[static_cast<std::size_t>(taper_of_[vessel])]
-                                                                  : element_law_[static_cast<std::size_t>(first_element_[vessel])];
+                                                                  : element_law_[static_cast<std::size_t>(first_element(vessel))];
   }
   TubeLaw law_at(std::size_t vessel, double x) const;
   bool is_tapered(std::size_t vessel) const { return !taper_of_.empty() && taper_of_[vessel] >= 0; }
@@ -319,10 +323,10 @@ class PulseSolver {
   // steady: the network's steady flow, or null where it has none.
   void choose_degrees_and_elements(const SolverOptions& options, const SteadyFlow* steady);
   std::int32_t end_element(std::size_t vessel) const {
-    return zero_d_[vessel] ? first_element_[vessel] : first_element_[vessel] + elements_per_vessel_;
+    return zero_d_[vessel] ? first_element(vessel) : first_element(vessel) + elements_per_vessel_;
   }
   VesselEnd vessel_end(std::size_t vessel, bool distal) const {  // a 1D vessel's
-    return {static_cast<std::int32_t>(vessel), distal ? end_element(vessel) - 1 : first_element_[vessel], distal};
+    return {static_cast<std::int32_t>(vessel), distal ? end_element(vessel) - 1 : first_element(vessel), distal};
   }
   std::vector<double> capacitor_pressures() const;  // per run outlet (NaN: none)
   // A point of a 1D vessel: its element and xi in [-1, 1] there, and the modes' value (pulse_sampling.cpp).
@@ -402,7 +406,9 @@ class PulseSolver {
   std::vector<DegreeBlock> blocks_;
   std::vector<std::int8_t> vessel_degree_;  // per vessel: -1 (0D) to 30 (run_configuration)
   int elements_per_vessel_ = 1;
-  std::vector<std::int32_t> first_element_;  // per vessel: its elements are consecutive
+  // Each 1D vessel's first element, by vessel (increasing): its elements are consecutive. Only
+  // the 1D vessels' (a tree's millions of 0D vessels have none): first_element(v) finds it.
+  std::vector<std::pair<std::int32_t, std::int32_t>> first_elements_;
   std::vector<std::int32_t> element_vessel_; // per element
   Eigen::VectorXd half_length_;            // per element: the Jacobian J = h / 2
   Eigen::VectorXd element_beta_;           // per element

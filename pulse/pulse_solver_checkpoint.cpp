@@ -32,7 +32,7 @@ void PulseSolver::save(CheckpointWriter& out) const {
   // The junctions' Newton iterations start from the last end states: per vessel, proximal
   // then distal (area, flow), a 0D vessel's as zeros (the format's layout, which held them),
   // written in pieces of `block` vessels.
-  const std::size_t n = first_element_.size();
+  const std::size_t n = net_.vessel_count();
   out.begin_vector(4 * static_cast<std::uint64_t>(n));
   constexpr std::size_t block = 1 << 16;
   std::vector<double> ends;
@@ -105,8 +105,8 @@ void PulseSolver::restore(CheckpointReader& in) {
   if (rcr_outlets_ && !cycle_volume_.empty() && cycle_capacitor_.size() != outlet_count_)
     in.fail("outlets of another network");
   const std::vector<double> ends = in.get_vector();
-  if (ends.size() != 4 * first_element_.size()) in.fail("vessel ends of another network");
-  for (std::size_t v = 0; v < first_element_.size(); ++v)
+  if (ends.size() != 4 * net_.vessel_count()) in.fail("vessel ends of another network");
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
     if (!zero_d_[v])
       for (const bool distal : {false, true}) {
         const std::size_t k = 2 * v + (distal ? 1 : 0);

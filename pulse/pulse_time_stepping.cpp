@@ -90,7 +90,7 @@ void PulseSolver::choose_stable_step(const SolverOptions& options) {
   std::size_t wave_vessel = 0, friction_vessel = 0;
   for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
     if (zero_d_[v]) continue;
-    const auto el = first_element_[v];
+    const auto el = first_element(v);
     const TubeLaw& law = element_law_[static_cast<std::size_t>(el)];
     const double a = state_.area(el, 0), q = state_.flow(el, 0);
     const double h = 2 * half_length_(el);
@@ -98,8 +98,8 @@ void PulseSolver::choose_stable_step(const SolverOptions& options) {
     if (is_tapered(v)) {
       // The speeds change along the vessel: the largest at the ends of its elements.
       const int degree = vessel_degree_[v];
-      for (auto k = first_element_[v]; k < end_element(v); ++k) {
-        const int j = k - first_element_[v];
+      for (auto k = first_element(v); k < end_element(v); ++k) {
+        const int j = k - first_element(v);
         for (const int side : {0, 1}) {
           const TubeLaw at = law_at(v, static_cast<double>(j + side) / elements_per_vessel_);
           double ak = 0, qk = 0;

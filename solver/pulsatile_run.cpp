@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/errors.hpp"
+#include "core/free_memory.hpp"
 #include "core/setting_error.hpp"
 #include "formats/vtk_series.hpp"
 #include "solver/run_report.hpp"
@@ -334,6 +335,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       std::optional<VtkTimeSeries> series;  // each cycle could be the last: its frames replace the previous
       if (plan_.frames > 0) series.emplace(net_, folder_ / "frames", "frames", plan_.vtk_keep);
       std::size_t frames_written = 0;
+      return_free_memory();  // what the set-up or the last cycle end freed, before the loop's arrays
       stats_.begin(solver_);
       if (transport_) transport_->begin_cycle();
       double sampled_until = solver_.time();
