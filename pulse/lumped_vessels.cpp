@@ -94,6 +94,7 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
       shunt_, shunt_pressure_, volume_b_, outlet_boundary_, rcr_outlet_boundary_, outlet_of_capacitor_, capacitor_vessel_edge_,
       capacitor_edge_sign_, edge_fixed_resistance_, inflow_node_, inflow_boundary_, inflow_entering_,
       held_node_, held_boundary_, held_entering_, held_reference_conductance_);
+  share_shunt_pressure();
 
   // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes
   // (of each section's, L / n):
@@ -118,6 +119,29 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   volume_b_.assign(linear.begin(), linear.end());
 
   allocate_system();
+}
+
+void LumpedVessels::share_shunt_pressure() {
+  if (!held_node_.empty()) return;  // a held node's changes every step
+  // The same bits: no negative zero either, which would flip a zero current's sign.
+  bool shared = true, found = false;
+  double p = 0;
+  for (std::size_t k = 0; k < shunt_.size() && shared; ++k) {
+    const double q = shunt_pressure_[k];
+    if (std::signbit(q)) {
+      shared = false;
+    } else if (shunt_[k] == 0) {
+      shared = q == 0;
+    } else if (!found) {
+      p = q;
+      found = true;
+    } else {
+      shared = q == p;
+    }
+  }
+  if (!shared) return;
+  uniform_shunt_pressure_ = p;
+  std::vector<double>().swap(shunt_pressure_);
 }
 
 void LumpedVessels::allocate_system() {
@@ -474,7 +498,7 @@ void LumpedVessels::start_at_rest(std::span<const TubeLaw> laws) {
                                                        : law.reference_pressure;
         count[static_cast<std::size_t>(k)] += 1;
       }
-  for (std::size_t k = 0; k < nodes_; ++k) pressure_[k] = is_capacitor(k) ? shunt_pressure_[k] : sum[k] / count[k];
+  for (std::size_t k = 0; k < nodes_; ++k) pressure_[k] = is_capacitor(k) ? shunt_pressure(k) : sum[k] / count[k];
   std::fill(flow_.begin(), flow_.end(), 0.0);
   for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
   hold_coupling_pressures();
@@ -646,11 +670,11 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
           // Dirichlet: the node sits at the held pressure, and the boundary lets in what its
           // volume and its vessel take (the stiff shunt's own flow, G (p - p_held), is
           // round-off times G: not taken).
-          const double next_volume = node_excess(k, shunt_pressure_[k]);
+          const double next_volume = node_excess(k, shunt_pressure(k));
           const auto j = static_cast<std::size_t>(held_[k] - 1);
           held_out_[j] = inflow + shunted - (3 * next_volume - 4 * volume_[k] + previous_volume_[k]) / (2 * dt);
           previous_volume_[k] = next_volume;
-          previous_pressure_[k] = shunt_pressure_[k];
+          previous_pressure_[k] = shunt_pressure(k);
           continue;
         }
         const double next = (4 * volume_[k] - previous_volume_[k] + 2 * dt * inflow) / 3;

@@ -391,9 +391,19 @@ class LumpedVessels {
   std::vector<float> volume_a_, volume_b_;
   double node_constant(std::size_t k) const;  // c, from the node's edges: only to report V
   std::int32_t vessel_at_node(std::size_t k) const;  // a network vessel ending there (its R1's, at a capacitor)
-  // Shunts to ground: conductance and the pressure behind it (outlets, R2).
+  // Shunts to ground: conductance and the pressure behind it (outlets, R2). Where every
+  // shunt has one pressure behind it (a tree's outlets drain to one venous pressure) and no
+  // node is held, shunt_pressure_ is empty and that pressure is uniform_shunt_pressure_ (not
+  // negative, so that a node without a shunt has the same +0 current as with a 0 there).
   std::vector<double> shunt_, shunt_pressure_;
-  double shunt_current(std::size_t k) const { return shunt_[k] * shunt_pressure_[k]; }
+  double uniform_shunt_pressure_ = 0;
+  double shunt_pressure(std::size_t k) const {
+    return shunt_pressure_.empty() ? (shunt_[k] != 0 ? uniform_shunt_pressure_ : 0.0) : shunt_pressure_[k];
+  }
+  double shunt_current(std::size_t k) const {
+    return shunt_pressure_.empty() ? shunt_[k] * uniform_shunt_pressure_ : shunt_[k] * shunt_pressure_[k];
+  }
+  void share_shunt_pressure();  // empties shunt_pressure_ where it can
   std::vector<std::int32_t> outlet_of_capacitor_;  // per capacitor node
   std::vector<std::int32_t> capacitor_of_outlet_;  // per run outlet, -1 if none here
 
