@@ -196,15 +196,18 @@ std::int64_t NodalSystem::factorize_forward(std::span<const double> conductance,
   return factorize(conductance, shunt, y.data());
 }
 
+void NodalSystem::allocate_pivots() {
+  if (inverse_pivot_.size() == nodes_) return;  // else released (or never made)
+  inverse_pivot_.assign(nodes_, 0.0);
+  divider_.assign(nodes_, 0.0);
+}
+
 std::span<double> NodalSystem::shunt_workspace() {
   if (method_ != Method::tree_elimination) {
     shunt_workspace_.resize(nodes_);
     return shunt_workspace_;
   }
-  if (inverse_pivot_.size() != nodes_) {  // released
-    inverse_pivot_.assign(nodes_, 0.0);
-    divider_.assign(nodes_, 0.0);
-  }
+  allocate_pivots();
   return inverse_pivot_;
 }
 
@@ -240,10 +243,7 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
                                 " conductances and " + std::to_string(shunt.size()) + " shunts for " +
                                 std::to_string(edges_) + " edges and " + std::to_string(nodes_) + " nodes");
   factorized_ = false;
-  if (method_ == Method::tree_elimination && inverse_pivot_.size() != nodes_) {  // released
-    inverse_pivot_.assign(nodes_, 0.0);
-    divider_.assign(nodes_, 0.0);
-  }
+  if (method_ == Method::tree_elimination) allocate_pivots();
   auto bad_value = [](const char* what, std::size_t k, double v) {
     return std::invalid_argument("NodalSystem::factorize: " + std::string(what) + " " + std::to_string(k) +
                                  " is " + std::to_string(v));

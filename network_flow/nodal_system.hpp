@@ -129,6 +129,7 @@ class NodalSystem {
   // edge to the parent: the voltage divider of that edge and the subtree).
   std::vector<double> inverse_pivot_, divider_;
   std::vector<double> shunt_workspace_;  // shunt_workspace() where the pivots are not (sparse Cholesky)
+  void allocate_pivots();  // the tree's pivot arrays, where released
   // The sweeps' parallel plan: subtrees of at most a few ten thousand nodes whose parent (if
   // any) roots a larger one are tasks, each with its nodes in elimination order (task_nodes_
   // from task_offset_[t], the task's root first); top_ lists, in elimination order, the nodes

@@ -32,7 +32,7 @@ std::vector<double> PulseSolver::vessel_volumes() const {
                   : lumped_.sections(e) > 1 ? lumped_.sectioned_volume(e)
                                             : net_.length[v] * 0.5 * (tube.area(lumped_.pressure_at(e, 0)) + tube.area(lumped_.pressure_at(e, 1)));
     }
-    for (auto el = first_element(v); el < end_element(v); ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
+    for (auto el = first_element(v), end = end_element(v); el < end; ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
   }
   return volume;
 }
@@ -78,8 +78,9 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
           sum += at.compliance_per_length(at.area(lumped_.pressure_at(e, x))) / 2;  // the mean of the two ends'
         }
       } else {
-        for (auto el = first_element(v); el < end_element(v); ++el) {
-          const double x = (el - first_element(v) + 0.5) / elements_per_vessel_;
+        const auto first = first_element(v);
+        for (auto el = first, end = end_element(v); el < end; ++el) {
+          const double x = (el - first + 0.5) / elements_per_vessel_;
           const double c = law_at(v, x).compliance_per_length(state_.area(el, 0));
           element_area_per_pressure[static_cast<std::size_t>(el)] = c;
           sum += c / elements_per_vessel_;

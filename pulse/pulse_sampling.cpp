@@ -103,7 +103,7 @@ void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) con
 double PulseSolver::mean_flow(std::size_t vessel) const {
   if (zero_d_[vessel]) return lumped_.flow(lumped_.vessel_index(vessel));
   double sum = 0;
-  for (auto el = first_element(vessel); el < end_element(vessel); ++el) sum += state_.flow(el, 0);
+  for (auto el = first_element(vessel), end = end_element(vessel); el < end; ++el) sum += state_.flow(el, 0);
   return sum / elements_per_vessel_;
 }
 
@@ -117,7 +117,7 @@ double PulseSolver::network_volume() const {
   // The 1D vessels' volumes and what the 0D scheme conserves (lumped_vessels.hpp).
   double volume = lumped_.stored_volume();
   for (std::size_t v = 0; v < net_.vessel_count(); ++v)
-    for (auto el = first_element(v); el < end_element(v); ++el) volume += 2 * half_length_(el) * state_.area(el, 0);
+    for (auto el = first_element(v), end = end_element(v); el < end; ++el) volume += 2 * half_length_(el) * state_.area(el, 0);
   return volume;
 }
 

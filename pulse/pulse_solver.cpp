@@ -423,7 +423,7 @@ void PulseSolver::start_at_rest() {
       project_along(v, [&](double x) { return taper.rest_area(x); }, state_.area);
       continue;
     }
-    for (auto el = first_element(v); el < end_element(v); ++el)
+    for (auto el = first_element(v), end = end_element(v); el < end; ++el)
       state_.area(el, 0) = laws_[v].reference_area;
   }
   lumped_.start_at_rest(laws_);
@@ -578,7 +578,7 @@ void PulseSolver::set_viscosity_factor(std::size_t vessel, double factor) {
     lumped_.set_viscosity_factor(lumped_.vessel_index(vessel), factor);
     return;
   }
-  for (auto el = first_element(vessel); el < end_element(vessel); ++el) element_viscosity_factor_(el) = factor;
+  for (auto el = first_element(vessel), end = end_element(vessel); el < end; ++el) element_viscosity_factor_(el) = factor;
 }
 
 void PulseSolver::track_face_volumes() {

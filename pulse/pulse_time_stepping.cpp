@@ -98,8 +98,9 @@ void PulseSolver::choose_stable_step(const SolverOptions& options) {
     if (is_tapered(v)) {
       // The speeds change along the vessel: the largest at the ends of its elements.
       const int degree = vessel_degree_[v];
-      for (auto k = first_element(v); k < end_element(v); ++k) {
-        const int j = k - first_element(v);
+      const auto first = first_element(v);
+      for (auto k = first, end = end_element(v); k < end; ++k) {
+        const int j = k - first;
         for (const int side : {0, 1}) {
           const TubeLaw at = law_at(v, static_cast<double>(j + side) / elements_per_vessel_);
           double ak = 0, qk = 0;
