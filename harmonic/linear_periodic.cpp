@@ -168,7 +168,8 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
                                      const ViscosityTable& viscosity, int harmonics, int threads,
                                      const std::function<bool(const VesselLine&)>& shift_source) {
   const SteadyFlow steady =
-      solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
+      solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0, nullptr,
+                                  threads);
   return solve_linear_periodic(net, blood, laws, viscosity, steady, RunBoundaries(net), harmonics, threads, shift_source);
 }
 

@@ -37,6 +37,9 @@ class FlowNetwork {
   // pressures are undetermined), its lowest.
   std::int64_t factorize(std::span<const double> conductance, std::span<const double> shunt);
 
+  // Threads for a tree's sweeps (NodalSystem::set_threads: the same bits for any count).
+  void set_threads(int threads) { system_.set_threads(threads); }
+
   // Node pressures from the last factorisation: inflow[i] is the flow injected into free node
   // i (flow boundaries, plus s_i p_s,i for its shunt), pressure[i] is read at the prescribed
   // nodes and written at the others.

@@ -188,7 +188,7 @@ std::optional<SteadyFlow> PulseSolver::solve_steady_flow() {
   try {
     std::vector<double> resistance;
     steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet ? net.inlet->waveform.mean_value() : 0.0,
-                                         &resistance);
+                                         &resistance, threads_);
     steady_resistance_.assign(resistance.begin(), resistance.end());
   } catch (const InputError& e) {
     steady_refusal_ = e.what();

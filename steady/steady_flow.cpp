@@ -144,6 +144,7 @@ class SteadySystem {
  public:
   explicit SteadySystem(const Network& net);
   SteadyFlow solve(const std::vector<double>& resistance, double inlet_flow);
+  void set_threads(int threads) { system_->set_threads(threads); }
 
  private:
   void check_tree_form();
@@ -353,9 +354,10 @@ SteadyFlow solve_steady_flow(const Network& net) {
 
 SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, double inlet_flow,
-                                       std::vector<double>* resistance) {
+                                       std::vector<double>* resistance, int threads) {
   std::vector<double> r = vessel_resistances(net, blood);
   SteadySystem system(net);
+  system.set_threads(threads);
   SteadyFlow s = system.solve(r, inlet_flow);
   // Each sweep's resistances are blended with the last ones, r <- (1 - w) r + w R(p(r)): the
   // iteration alternates (a higher pressure widens the lumens, which lowers it), and w = 1/2

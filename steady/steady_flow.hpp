@@ -73,9 +73,10 @@ SteadyFlow solve_steady_flow(const Network& net);
 // sweeps; the nodal system is analysed once and refactorised each sweep). resistance, when
 // given, receives the final ones. Throws InputError where solve_steady_flow does, or where a
 // lumen collapses.
-// blood: the run's (its rheology may differ from the file's).
+// blood: the run's (its rheology may differ from the file's). threads: for a tree's sweeps
+// (the same numbers for any count).
 SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, double inlet_flow,
-                                       std::vector<double>* resistance = nullptr);
+                                       std::vector<double>* resistance = nullptr, int threads = 1);
 
 }  // namespace hemotree
