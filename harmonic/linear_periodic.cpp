@@ -234,6 +234,21 @@ void solve_harmonics(const Network& net, const LinearPeriodic& lines, const RunB
 
 namespace {
 
+// value(v) for every vessel v < n, a block at a time in parallel, each handed to consume(v,
+// value) in the order of v: a loop that adds into shared sums keeps its one-thread order
+// (and bits) without an array of n values.
+template <class Value, class Consume>
+void in_blocks(std::size_t n, int threads, const Value& value, const Consume& consume) {
+  std::vector<double> block(std::min<std::size_t>(n, std::size_t{1} << 16));
+  for (std::size_t first = 0; first < n; first += block.size()) {
+    const std::size_t count = std::min(block.size(), n - first);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+    for (std::int64_t j = 0; j < static_cast<std::int64_t>(count); ++j)
+      block[static_cast<std::size_t>(j)] = value(first + static_cast<std::size_t>(j));
+    for (std::size_t j = 0; j < count; ++j) consume(first + j, block[j]);
+  }
+}
+
 // The tube law's curvature and the friction's lumen of vessel v at its line's lumen
 // (harmonic/mean_shift.hpp): R'(A) = k mu(A) / A^2 differentiated over 1e-3 of the lumen.
 LumenSlopes lumen_slopes(const TubeLaw& law, const ViscosityTable& viscosity, double k_friction, double area) {
@@ -341,27 +356,41 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
     const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);
     return (capacity_slope(a) * node_variance[a] - capacity_slope(b) * node_variance[b]) / (2 * net.length[v]);
   };
-  for (std::size_t v = 0; v < n; ++v) {
-    if (sourced[v]) continue;
-    const double j = through(v);
-    current[static_cast<std::size_t>(net.from[v])] -= j;
-    current[static_cast<std::size_t>(net.to[v])] += j;
-  }
+  in_blocks(n, threads, [&](std::size_t v) { return sourced[v] ? 0.0 : through(v); },
+            [&](std::size_t v, double j) {
+              if (sourced[v]) return;
+              current[static_cast<std::size_t>(net.from[v])] -= j;
+              current[static_cast<std::size_t>(net.to[v])] += j;
+            });
   std::vector<FourierSeries> none = series;
   for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
   solve_harmonic(net, network, boundaries, none, line_of, 0, 0.0, work, threads, current);
   std::vector<double>().swap(current);
   const std::vector<Complex>& x = work.current;
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);
-    const auto found = sourced[v] ? source.find(v) : source.end();
-    const Source* s = found != source.end() ? &found->second : nullptr;
-    const double pa = x[a].real() - (s ? s->offset_from : 0.0), pb = x[b].real() - (s ? s->offset_to : 0.0);
-    const TwoPort y = (along.holds(v) ? along.line(v) : line_of(v)).two_port(0.0);
-    const double dq = s ? (y.aa * pa + y.ab * (pb + s->drops.back())).real() : (y.aa * pa + y.ab * pb).real() + through(v);
-    // The static mean's shift along it: the forced line's where sourced, else its nodes'.
-    apply(v, dq, s ? mean_shift_profile(along.line(v), pa, dq, s->drops) : std::vector<double>{}, x[a].real(), x[b].real());
-  }
+  auto line_at = [&](std::size_t v) { return (along.holds(v) ? along.line(v) : line_of(v)).two_port(0.0); };
+  in_blocks(
+      n, threads,
+      [&](std::size_t v) {  // an unforced vessel's: its line between its nodes' shifts, and its own current
+        if (sourced[v]) return 0.0;
+        const TwoPort y = line_at(v);
+        const double pa = x[static_cast<std::size_t>(net.from[v])].real(), pb = x[static_cast<std::size_t>(net.to[v])].real();
+        return (y.aa * pa + y.ab * pb).real() + through(v);
+      },
+      [&](std::size_t v, double dq) {
+        const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);
+        const auto found = sourced[v] ? source.find(v) : source.end();
+        if (found == source.end()) {
+          apply(v, dq, std::vector<double>{}, x[a].real(), x[b].real());
+          return;
+        }
+        // A forced vessel: its line with its ends' offsets and its forcing's drop.
+        const Source& f = found->second;
+        const double pa = x[a].real() - f.offset_from, pb = x[b].real() - f.offset_to;
+        const TwoPort y = line_at(v);
+        dq = (y.aa * pa + y.ab * (pb + f.drops.back())).real();
+        // The static mean's shift along it: the forced line's.
+        apply(v, dq, mean_shift_profile(along.line(v), pa, dq, f.drops), x[a].real(), x[b].real());
+      });
   for (std::size_t node = 0; node < nodes; ++node) node_pressure[node] += x[node].real();
 }
 
@@ -382,8 +411,12 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
     const LineAbout line_of{net, laws, viscosity, steady, friction_coefficient(blood.alpha), blood.density};
     std::vector<double> node_shift(net.node_count(), 0.0);
     std::vector<double> variance(net.node_count(), 0.0);  // <p1^2> at each node
-    for (const std::vector<Complex>& p : out.node_pressure_)
-      for (std::size_t node = 0; node < variance.size(); ++node) variance[node] += 0.5 * std::norm(p[node]);
+    const auto node_count = static_cast<std::int64_t>(variance.size());
+    for (const std::vector<Complex>& p : out.node_pressure_) {
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+      for (std::int64_t i = 0; i < node_count; ++i)
+        variance[static_cast<std::size_t>(i)] += 0.5 * std::norm(p[static_cast<std::size_t>(i)]);
+    }
     HarmonicWorkspace work;
     solve_mean_shift(net, blood, laws, viscosity, boundaries, harmonic_network(net, boundaries),
                      boundary_series(boundaries, harmonics), line_of, out, shift_sources, variance, node_shift, work, threads,
