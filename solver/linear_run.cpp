@@ -67,7 +67,8 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
   const double k_friction = friction_coefficient(blood.alpha);
   const std::size_t n = net.vessel_count();
   LinearCycle out;
-  out.cycle = steady_cycle(net, blood, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}, nullptr);
+  out.cycle.vessels.resize(n);  // every number of each is set below
+  add_boundary_flows(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}, out.cycle);
   out.wave_travels.assign(n, 0);
   out.womersley.assign(n, 0.0);
   out.pwv_elastic.assign(n, 0.0);

@@ -70,6 +70,11 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
     c.mean_wss = wall_shear_stress(mu, u, radius, blood.alpha);
     c.reynolds = blood.density * u * 2 * radius / mu;
   }
+  add_boundary_flows(net, steady, cycle);
+  return cycle;
+}
+
+void add_boundary_flows(const Network& net, const SteadyFlow& steady, CycleSummary& cycle) {
   const std::vector<double> inflow = boundary_inflow(net, steady);
   const RunBoundaries boundaries(net);
   for (const std::uint32_t i : in_node_order(boundaries)) {
@@ -80,7 +85,6 @@ CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFl
   // Where nothing flows (zero boundary flows, equal pressures) nothing is lost either.
   const double scale = std::max(cycle.inlet_mean_flow, cycle.outlets_mean_flow);
   cycle.conservation_error = scale > 0 ? (cycle.inlet_mean_flow - cycle.outlets_mean_flow) / scale : 0.0;
-  return cycle;
 }
 
 SummaryArray boundary_results(const Network& net, const SteadyFlow& steady) {

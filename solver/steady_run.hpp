@@ -27,6 +27,9 @@ namespace hemotree {
 // hematocrit: each vessel's discharge hematocrit for its viscosity, or null: the blood's.
 CycleSummary steady_cycle(const Network& net, const Blood& blood, const SteadyFlow& steady,
                           const std::vector<double>* hematocrit = nullptr);
+// The run's part of it alone: the flows in and out through the boundaries and their balance
+// (for a caller that fills the vessels' own: --linear).
+void add_boundary_flows(const Network& net, const SteadyFlow& steady, CycleSummary& cycle);
 
 // Every boundary node's condition and what the solve gives there: {"node", "type", "flow"
 // (into the network, m^3/s), "pressure" (Pa)}, by node.
