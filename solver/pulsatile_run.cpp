@@ -58,6 +58,19 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
   }
   return c;
 }
+
+// What a breakdown's usual advice (a shorter step) misses where the vessel is 1D with an end
+// at a node of 0D vessels: there each coupled end takes its node's own response alone, and a
+// shorter 0D step can make the coupling's fixed point diverge (docs/solver.md §10, "A known
+// limit": ADAN56 breaks down at a quarter of its default step and runs at the default).
+std::string coupling_advice(const Network& net, const NetworkBoundaries& boundaries, std::int64_t vessel_id) {
+  const std::int64_t vessel = net.index_of(vessel_id);
+  for (const NetworkBoundaries::CoupledEnd& c : boundaries.coupled)
+    if (c.end.vessel == vessel)
+      return "; its end meets 0D vessels, whose coupling to it a shorter step can itself break (docs/solver.md, "
+             "section 10): where " + placeholder("dt") + " was shortened, a longer one (the default) may run";
+  return "";
+}
 }  // namespace
 
 PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<Probe> probes, RunPlan plan,
@@ -429,7 +442,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
     }
   } catch (const SolutionBreakdown& e) {
     if (live) observer.clear_live_progress();
-    breakdown_ = e.message();
+    breakdown_ = e.message() + coupling_advice(net_, solver_.network_boundaries(), e.vessel);
     return RunStatus::broken_down;
   }
   if (plan_.until_periodic && !periodic()) return RunStatus::not_periodic;

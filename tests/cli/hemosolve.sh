@@ -191,6 +191,10 @@ refuse "--dt above the stability limit" 2 "times the stability limit" -- \
 # Forced, it breaks down in its first cycle: one line naming the vessel, no summary.
 refuse "breakdown (time step far too long, forced)" 2 "broke down in vessel 1" -- \
   "$HEMOSOLVE" "$CCA" --out "$(out)" --dt 20ms --force --quiet
+# A lone 1D vessel meets no 0D vessel: the advice about their coupling is not given.
+"$HEMOSOLVE" "$CCA" --out "$WORK/cca-broken" --dt 20ms --force --quiet 2>"$WORK/err"
+grep -q "broke down in vessel 1" "$WORK/err" && ! grep -q "meets 0D vessels" "$WORK/err" \
+  && pass "breakdown of a lone 1D vessel: no coupling advice" || fail "breakdown of the CCA: $(cat "$WORK/err")"
 # A failed upstream stage: hemosolve refuses the empty pipe on its own line.
 "$VPRUNE" --budget 0 "$WORK/net.json" 2>/dev/null | "$HEMOSOLVE" - --out "$WORK/after-vprune" 2>"$WORK/err"
 status=("${PIPESTATUS[@]}")
