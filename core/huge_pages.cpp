@@ -10,11 +10,12 @@
 // same through its tunable glibc.malloc.hugetlb=1, which a program cannot set for itself: it
 // is read from the environment before main.
 //
-// Only the advice is added: the block comes from malloc as before (operator delete, not
-// replaced, frees it), so the allocator's reuse, malloc_trim (core/free_memory.hpp) and every
-// tool that watches malloc (valgrind's massif) see what they saw. The advice covers the
+// Only the advice is added: the block comes from malloc as before and operator delete, replaced
+// with it, hands it to free, so the allocator's reuse, malloc_trim (core/free_memory.hpp) and
+// every tool that watches malloc and free (valgrind) see one pair. The advice covers the
 // 2 MiB-aligned interior of the block; the kernel may decline it (no huge page free, THP off),
-// which leaves ordinary pages.
+// which leaves ordinary pages. Under AddressSanitizer (scripts/test --sanitize, scripts/fuzz)
+// nothing is replaced: its own new and delete check that they are paired.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -23,6 +24,16 @@
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
+
+#if defined(__SANITIZE_ADDRESS__)
+#define HEMOTREE_SANITIZED_ALLOCATION 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define HEMOTREE_SANITIZED_ALLOCATION 1
+#endif
+#endif
+
+#if !defined(HEMOTREE_SANITIZED_ALLOCATION)
 
 namespace {
 
@@ -54,3 +65,10 @@ void* operator new(std::size_t size) {
 }
 
 void* operator new[](std::size_t size) { return ::operator new(size); }
+
+void operator delete(void* block) noexcept { std::free(block); }
+void operator delete[](void* block) noexcept { std::free(block); }
+void operator delete(void* block, std::size_t) noexcept { std::free(block); }
+void operator delete[](void* block, std::size_t) noexcept { std::free(block); }
+
+#endif
