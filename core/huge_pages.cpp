@@ -16,6 +16,8 @@
 // 2 MiB-aligned interior of the block; the kernel may decline it (no huge page free, THP off),
 // which leaves ordinary pages. Under AddressSanitizer (scripts/test --sanitize, scripts/fuzz)
 // nothing is replaced: its own new and delete check that they are paired.
+#include "core/huge_pages.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -33,7 +35,13 @@
 #endif
 #endif
 
-#if !defined(HEMOTREE_SANITIZED_ALLOCATION)
+#if defined(HEMOTREE_SANITIZED_ALLOCATION)
+
+bool hemotree::advises_huge_pages() { return false; }
+
+#else
+
+bool hemotree::advises_huge_pages() { return true; }
 
 namespace {
 

@@ -11,20 +11,9 @@
 #include <string>
 #include <vector>
 
-namespace {
+#include "core/huge_pages.hpp"
 
-// Under AddressSanitizer core/huge_pages.cpp leaves new and delete to it: no advice to see.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool sanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool sanitized = true;
-#else
-constexpr bool sanitized = false;
-#endif
-#else
-constexpr bool sanitized = false;
-#endif
+namespace {
 
 // The system's policy, "always", "madvise" or "never" (the bracketed word), or "" where the
 // kernel has no transparent huge pages.
@@ -58,7 +47,7 @@ int huge_page_eligible(const void* address) {
 }  // namespace
 
 TEST(HugePages, ALargeBlockIsAdvisedWhereThePolicyAsksForAdvice) {
-  if (sanitized) GTEST_SKIP() << "built with AddressSanitizer, whose new and delete are kept";
+  if (!hemotree::advises_huge_pages()) GTEST_SKIP() << "built with AddressSanitizer, whose new and delete are kept";
   if (huge_page_policy() != "madvise")
     GTEST_SKIP() << "transparent huge pages are '" << huge_page_policy() << "' here, not 'madvise'";
   // 64 MiB: several whole 2 MiB pages inside it wherever malloc places it.
@@ -69,7 +58,8 @@ TEST(HugePages, ALargeBlockIsAdvisedWhereThePolicyAsksForAdvice) {
 }
 
 TEST(HugePages, ASmallBlockIsLeftAsMallocGivesIt) {
-  if (sanitized) GTEST_SKIP() << "built with AddressSanitizer, whose allocator places blocks its own way";
+  if (!hemotree::advises_huge_pages())
+    GTEST_SKIP() << "built with AddressSanitizer, whose allocator places blocks its own way";
   if (huge_page_policy() != "madvise")
     GTEST_SKIP() << "transparent huge pages are '" << huge_page_policy() << "' here, not 'madvise'";
   // 1 MiB: below the 4 MiB from which blocks are advised. A fixed mmap threshold below it
