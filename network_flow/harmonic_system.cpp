@@ -1,5 +1,6 @@
 #include "network_flow/harmonic_system.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -57,6 +58,23 @@ bool peel_leaves(std::size_t nodes, std::span<const std::int32_t> a, std::span<c
   return order.size() == nodes;
 }
 
+// Where every node has at most one edge to a node of a lower label, the graph is a forest
+// whose every parent lies below its children (its roots: the nodes with no such edge; the
+// largest label on a cycle would have two), and the labels from the highest down are an
+// elimination order that walks the arrays once: a tree labelled from its root depth-first,
+// as the generator and the pruner write it. False (parent_edge left unspecified) where a
+// node has two.
+bool parents_below(std::size_t nodes, std::span<const std::int32_t> a, std::span<const std::int32_t> b,
+                   std::vector<std::int32_t>& parent_edge) {
+  parent_edge.assign(nodes, -1);
+  for (std::size_t e = 0; e < a.size(); ++e) {
+    const auto child = static_cast<std::size_t>(std::max(a[e], b[e]));
+    if (parent_edge[child] >= 0) return false;
+    parent_edge[child] = static_cast<std::int32_t>(e);
+  }
+  return true;
+}
+
 }  // namespace
 
 HarmonicSystem::HarmonicSystem(std::size_t nodes, std::vector<std::int32_t> a, std::vector<std::int32_t> b)
@@ -66,6 +84,10 @@ HarmonicSystem::HarmonicSystem(std::size_t nodes, std::vector<std::int32_t> a, s
     if (a_[e] < 0 || b_[e] < 0 || static_cast<std::size_t>(a_[e]) >= nodes || static_cast<std::size_t>(b_[e]) >= nodes ||
         a_[e] == b_[e])
       throw std::invalid_argument("harmonic system: edge " + std::to_string(e) + " joins no two distinct nodes");
+  if (parents_below(nodes, a_, b_, parent_edge_)) {
+    forest_ = true;  // order_ empty: the labels from the highest down
+    return;
+  }
   std::vector<std::int64_t> offset;
   std::vector<std::int32_t> incident;
   forest_ = peel_leaves(nodes, a_, b_, order_, parent_edge_, offset, incident);
@@ -102,21 +124,22 @@ void HarmonicSystem::eliminate_forest(std::span<const Edge> y, std::span<Complex
     m_ip = i_is_a ? y[e].ab : y[e].ba;
     m_pi = i_is_a ? y[e].ba : y[e].ab;
   };
-  for (const std::int32_t node : order_) {
-    const auto i = static_cast<std::size_t>(node);
+  for (std::size_t k = 0; k < nodes_; ++k) {
+    const std::size_t i = eliminated(k);
     if (pivot[i] == Complex(0)) singular_at(i);
     const std::int32_t e = parent_edge_[i];
     if (e < 0) continue;
     std::size_t p;
     Complex m_ip, m_pi;
     couplings(i, e, p, m_ip, m_pi);
-    const Complex m_pi_over_d = m_pi / pivot[i];
+    pivot[i] = reciprocal(pivot[i]);  // kept as 1 / d_i for the way down
+    const Complex m_pi_over_d = m_pi * pivot[i];
     pivot[p] -= m_pi_over_d * m_ip;
     x[p] -= m_pi_over_d * x[i];
   }
   // Roots down: X_i = (B_i - m_ip X_p) / d_i.
-  for (auto k = order_.size(); k-- > 0;) {
-    const auto i = static_cast<std::size_t>(order_[k]);
+  for (auto k = nodes_; k-- > 0;) {
+    const std::size_t i = eliminated(k);
     const std::int32_t e = parent_edge_[i];
     if (e < 0) {
       x[i] /= pivot[i];
@@ -125,7 +148,7 @@ void HarmonicSystem::eliminate_forest(std::span<const Edge> y, std::span<Complex
     std::size_t p;
     Complex m_ip, m_pi;
     couplings(i, e, p, m_ip, m_pi);
-    x[i] = (x[i] - m_ip * x[p]) / pivot[i];
+    x[i] = (x[i] - m_ip * x[p]) * pivot[i];
   }
 }
 

@@ -24,6 +24,17 @@ namespace hemotree {
 
 using Complex = std::complex<double>;
 
+// 1 / z as conj(z) / |z|^2: libgcc's complex division (__divdc3) rescales against overflow
+// and took about a tenth of the harmonic solve's time; the admittances, impedances and
+// pivots of vessels lie far inside 1e-100 < |z| < 1e100, where |z|^2 neither overflows nor
+// underflows. Outside it (and at 0, inf, NaN), the library's division.
+inline Complex reciprocal(Complex z) {
+  const double size = std::norm(z);
+  if (!(size >= 1e-200 && size <= 1e200)) return 1.0 / z;
+  const double inverse = 1.0 / size;
+  return {z.real() * inverse, -z.imag() * inverse};
+}
+
 struct TwoPort {
   Complex aa, ab, ba, bb;
   // The reciprocal edge of admittance y: what a resistor or a line's series branch draws.
@@ -42,8 +53,8 @@ class HarmonicSystem {
   // part of the network with no admittance to ground), naming the node.
   std::vector<Complex> solve(std::span<const TwoPort> edge, std::span<const Complex> shunt,
                              std::span<const Complex> current) const;
-  // The same in the caller's storage: shunt is overwritten (with the pivots), current with
-  // the potentials.
+  // The same in the caller's storage: shunt is overwritten (on a forest with the pivots'
+  // reciprocals, a root's its pivot), current with the potentials.
   void solve_in_place(std::span<const TwoPort> edge, std::span<Complex> shunt, std::span<Complex> current) const;
 
   // A forest's solve from what its elimination reads of each edge once the diagonal is summed:
@@ -70,8 +81,13 @@ class HarmonicSystem {
   std::size_t nodes_;
   std::vector<std::int32_t> a_, b_;
   bool forest_ = false;
-  // A forest's elimination order (leaves first) and each node's edge to its parent (-1 at a root).
+  // A forest's elimination order (leaves first; empty where every parent's label lies below
+  // its children's: the labels from the highest down) and each node's edge to its parent (-1
+  // at a root).
   std::vector<std::int32_t> order_, parent_edge_;
+  std::size_t eliminated(std::size_t k) const {
+    return order_.empty() ? nodes_ - 1 - k : static_cast<std::size_t>(order_[k]);
+  }
 };
 
 // One solve: HarmonicSystem(nodes, a, b).solve(edge, shunt, current).

@@ -91,6 +91,34 @@ TEST(HarmonicSystem, AForestSolvedFromItsCouplingsIsTheWholeSolveBitForBit) {
   EXPECT_THROW(looped.solve_forest_in_place(coupling, diagonal, x), std::logic_error);
 }
 
+// A tree labelled from its root (every parent below its children: the labels from the
+// highest down are the elimination order) and the same tree labelled the other way round
+// (a node with two lower neighbours: the order by peeling leaves) both solve as the dense
+// system does.
+TEST(HarmonicSystem, ATreeSolvesAlikeWhicheverWayItsNodesAreLabelled) {
+  const std::vector<std::int32_t> a{0, 0, 1, 1, 2, 2}, b{1, 2, 3, 4, 5, 6};
+  const std::vector<TwoPort> y{TwoPort::series({2, -1}), {{1.6, -0.2}, {-1.5, 0.3}, {-1.4, 0.1}, {1.5, -0.3}},
+                               TwoPort::series({0.7, -0.2}), {{3.1, -2}, {-3, 2.1}, {-2.9, 1.8}, {3, -1.9}},
+                               TwoPort::series({1, -0.1}), TwoPort::series({0.4, -0.4})};
+  const std::vector<C> s{{0, 0.1}, {0, 0.05}, {0, 0.2}, {0.5, 0.1}, {0.8, 0.02}, {0.3, 0.3}, {1.2, 0}};
+  const std::vector<C> rhs{{1, 0}, {0, 0}, {0, 0.5}, {0, 0}, {-0.2, 0}, {0, 0}, {0.1, -0.1}};
+  for (const bool reversed : {false, true}) {
+    auto label = [&](std::int32_t i) { return reversed ? 6 - i : i; };
+    std::vector<std::int32_t> la, lb;
+    std::vector<C> ls(7), lrhs(7);
+    for (std::size_t e = 0; e < a.size(); ++e) la.push_back(label(a[e])), lb.push_back(label(b[e]));
+    for (std::int32_t i = 0; i < 7; ++i) {
+      ls[static_cast<std::size_t>(label(i))] = s[static_cast<std::size_t>(i)];
+      lrhs[static_cast<std::size_t>(label(i))] = rhs[static_cast<std::size_t>(i)];
+    }
+    ASSERT_TRUE(HarmonicSystem(7, la, lb).forest());
+    const std::vector<C> x = solve_harmonic_system(7, la, lb, y, ls, lrhs), expected = dense_solve(7, la, lb, y, ls, lrhs);
+    for (std::size_t i = 0; i < 7; ++i)
+      EXPECT_LT(std::abs(x[i] - expected[i]), 1e-13 * std::abs(expected[static_cast<std::size_t>(label(0))]))
+          << "node " << i << (reversed ? ", labels reversed" : "");
+  }
+}
+
 TEST(HarmonicSystem, APartWithNoPathToGroundIsRefused) {
   const std::vector<std::int32_t> a{0}, b{1};
   const std::vector<TwoPort> y{TwoPort::series({1, -1})};
