@@ -102,20 +102,29 @@ struct VesselLine {
   // cosh(s x) and sinh(s x) / (s x), both even in s x, from s^2: by their Taylor series
   // through (s x)^18 where |s x| <= 1 (the first term left out, (s x)^20 / 20!, is below
   // 1e-18, and no term exceeds cosh 1 = 1.54 for a sum of at least cos 1 = 0.54: rounding
-  // stays within a few 1e-16), so that a vessel the pulse crosses nearly in phase (almost
-  // every vessel of a tree at every harmonic) needs no square root and no transcendental
-  // function; else from one real exponential and one sincos.
+  // stays within a few 1e-16); up to |s x| = 8 the same at x / 2^h, |s x| / 2^h <= 1,
+  // doubled back h times (cosh 2y = 2 cosh^2 y - 1, sinh(2y) / 2y = sinhc(y) cosh(y)); else
+  // from one real exponential and one sincos. So no vessel of a tree needs a square root or
+  // a transcendental function here: the pulse diffuses across a capillary (|s l| = 0.1 to 3
+  // over ten harmonics on the full tree) but is far from decaying within it.
   struct Hyperbolic {
     Complex cosh, sinhc;
   };
   static Hyperbolic hyperbolic(const Matrix& m, double x) {
-    const Complex x2 = m.s2 * (x * x);
-    if (std::norm(x2) <= 1) {
+    Complex x2 = m.s2 * (x * x);
+    double size = std::norm(x2);  // |s x|^4
+    if (size <= 4096) {
+      int halvings = 0;
+      for (; size > 1; size *= 1.0 / 16, ++halvings) x2 *= 0.25;
       // Horner from the highest term: 1/(2n)! and 1/(2n+1)! as ratios of their neighbours.
       Complex ch = 1.0, shc = 1.0;
       for (int n = 9; n >= 1; --n) {
         ch = 1.0 + x2 * ch * (1.0 / ((2 * n - 1) * (2 * n)));
         shc = 1.0 + x2 * shc * (1.0 / ((2 * n) * (2 * n + 1)));
+      }
+      for (; halvings > 0; --halvings) {
+        shc *= ch;
+        ch = 2.0 * ch * ch - 1.0;
       }
       return {ch, shc};
     }
@@ -135,12 +144,12 @@ struct VesselLine {
   }
   // With S = sinh(s l) / (s l) and C = cosh(s l): s coth(s l) = C / (l S), s csch(s l) = 1 / (l S).
   TwoPort two_port(const Matrix& m, const Hyperbolic& whole, Complex e) const {
-    const Complex s_csch = 1.0 / (length * whole.sinhc);  // the only division a short vessel needs
+    const Complex s_csch = reciprocal(length * whole.sinhc);
     return two_port(m, whole.cosh * s_csch, s_csch, e);
   }
   TwoPort two_port(const Matrix& m, Complex s_coth, Complex s_csch, Complex e) const {
-    const Complex over_m12 = 1.0 / m.m12;
-    return {-(s_coth + 0.5 * m.tau) * over_m12, s_csch / e * over_m12, e * s_csch * over_m12,
+    const Complex over_m12 = reciprocal(m.m12);
+    return {-(s_coth + 0.5 * m.tau) * over_m12, s_csch * reciprocal(e) * over_m12, e * s_csch * over_m12,
             -(s_coth - 0.5 * m.tau) * over_m12};
   }
 

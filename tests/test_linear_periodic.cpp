@@ -549,16 +549,17 @@ TEST(LinearPeriodic, TheMeanShiftTakesTheSteppedMeanToTheNextOrder) {
   EXPECT_LT(ms.mean, 0.1 * m.mean);  // measured 0.044
 }
 
-// The two-port from its series (|s l| <= 1) and from one exponential and one sincos (beyond),
-// against the textbook formula with the library's complex cosh and sinh, on both sides of
-// the switch and far beyond it, at rest and with a mean flow.
+// The two-port from its series (|s l| <= 1), from the series halved and doubled back (up to
+// |s l| = 8) and from one exponential and one sincos (beyond), against the textbook formula
+// with the library's complex cosh and sinh, on both sides of each switch and far beyond,
+// at rest and with a mean flow.
 TEST(VesselLine, TheTwoPortIsTheTextbookOneOnBothSidesOfTheSeries) {
   const double w = 2 * std::numbers::pi * 10;
   for (const double velocity : {0.0, 0.6}) {
     VesselLine line{2.2e8, 8.3e7, 3.3e-10, 1.0, velocity, 4.0 / 3.0};
     const VesselLine::Matrix m = line.matrix(w);
     const C s = m.s();
-    for (const double sl : {0.01, 0.5, 0.99, 1.01, 1.9, 2.1, 5.0, 30.0}) {
+    for (const double sl : {0.01, 0.5, 0.99, 1.01, 1.9, 2.1, 5.0, 7.99, 8.01, 30.0}) {
       line.length = sl / std::abs(s);
       const C x = s * line.length, e = std::exp(0.5 * m.tau * line.length);
       const C coth = std::cosh(x) / std::sinh(x), csch = 1.0 / std::sinh(x);
