@@ -540,6 +540,11 @@ std::array<VesselLine::Point, 3> LinearPeriodic::ends_and_middle(int k, std::siz
                                        node_pressure(k, static_cast<std::size_t>(net_->to[vessel])));
 }
 
+VesselLine::Point LinearPeriodic::middle(int k, std::size_t vessel) const {
+  return line_[vessel_place(vessel)].middle(omega(k), node_pressure(k, static_cast<std::size_t>(net_->from[vessel])),
+                                            node_pressure(k, static_cast<std::size_t>(net_->to[vessel])));
+}
+
 double LinearPeriodic::mean_pressure_at(std::size_t vessel, double s) const {
   double p = (1 - s) * mean_node_pressure_[node_place(static_cast<std::size_t>(net_->from[vessel]))] +
              s * mean_node_pressure_[node_place(static_cast<std::size_t>(net_->to[vessel]))];

@@ -65,8 +65,9 @@ class LinearPeriodic {
   }
   Complex pressure(int k, std::size_t vessel, double s) const;
   Complex flow(int k, std::size_t vessel, double s) const;
-  // Harmonic k >= 1 at the vessel's start, middle and end.
+  // Harmonic k >= 1 at the vessel's start, middle and end; at its middle alone.
   std::array<VesselLine::Point, 3> ends_and_middle(int k, std::size_t vessel) const;
+  VesselLine::Point middle(int k, std::size_t vessel) const;
   // The periodic state at time t: the mean plus every harmonic. The mean pressure along a
   // vessel is taken linear between its nodes, plus its second-order shift where one was kept.
   double pressure_at(std::size_t vessel, double s, double t) const;

@@ -83,6 +83,18 @@ struct VesselLine {
   // At its start, middle and end at once. Where the series serve (|s l| <= 2), the whole
   // line's functions are the half line's doubled: cosh 2x = 2 cosh^2 x - 1,
   // sinh(2x) / 2x = sinhc(x) cosh x, e^{2a} = (e^a)^2.
+  // At its middle alone: with f = e^{-tau x / 2} P, f'' = s^2 f, so f(l/2) = (f(0) + f(l)) /
+  // (2 cosh(s l / 2)) and f'(l/2) = (f(l) - f(0)) / (l sinhc(s l / 2)); with E = e^{tau l / 4},
+  //   P(l/2) = (E p0 + p1 / E) / (2 cosh(s l / 2)),
+  //   Q(l/2) = (P' - tau P) / m12 = ((p1 / E - E p0) / (l sinhc(s l / 2)) - tau P(l/2) / 2) / m12.
+  Point middle(double w, Complex p0, Complex p1) const {
+    const Matrix m = matrix(w);
+    const Hyperbolic half = hyperbolic(m, 0.5 * length);
+    const Complex e = exponential(0.25 * m.tau * length), over_e = reciprocal(e);
+    const Complex p = (e * p0 + p1 * over_e) * reciprocal(2.0 * half.cosh);
+    const Complex slope = (p1 * over_e - e * p0) * reciprocal(length * half.sinhc);
+    return {p, (slope - 0.5 * m.tau * p) * reciprocal(m.m12)};
+  }
   std::array<Point, 3> ends_and_middle(double w, Complex p0, Complex p1) const {
     const Matrix m = matrix(w);
     if (std::norm(m.s2 * (length * length)) > 16) {

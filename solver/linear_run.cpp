@@ -90,9 +90,9 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
       const double area = blood.density / line.inertance, radius = std::sqrt(area / std::numbers::pi);
       const double mu = viscosity(area);
       for (int k = 1; k <= harmonics; ++k) {
-        const auto points = periodic.ends_and_middle(k, v);
-        p[static_cast<std::size_t>(k - 1)] = points[1].pressure;
-        q[static_cast<std::size_t>(k - 1)] = points[1].flow;
+        const VesselLine::Point middle = periodic.middle(k, v);
+        p[static_cast<std::size_t>(k - 1)] = middle.pressure;
+        q[static_cast<std::size_t>(k - 1)] = middle.flow;
       }
       const Extremes dp = extremes(p, scratch), dq = extremes(q, scratch);
       c.mean_flow = periodic.mean_flow()[v];

@@ -598,5 +598,27 @@ TEST(VesselLine, TheMiddleByDoublingIsTheLinesOwnPoint) {
   }
 }
 
+// middle(w, p0, p1) solves f'' = s^2 f (f = e^{-tau x / 2} P) between the two ends instead of
+// carrying (P, Q) from one: the same point, for a line at rest, with a mean flow either way,
+// in phase (|s l| small) and over several wavelengths of decay (|s l| up to 6, where the
+// series are halved and doubled back).
+TEST(VesselLine, TheMiddleFromBothEndsIsTheLinesOwnPoint) {
+  const double w = 2 * std::numbers::pi * 7;
+  const C p0(1000, 200), p1(-300, 650);
+  for (const double velocity : {0.0, 0.6, -0.4}) {
+    VesselLine line{2.2e8, 8.3e7, 3.3e-10, 1.0, velocity, 4.0 / 3.0, 0.3};
+    const double modulus = std::abs(line.matrix(w).s());
+    for (const double sl : {1e-3, 0.05, 0.9, 1.5, 3.0, 6.0}) {
+      line.length = sl / modulus;
+      const VesselLine::Point mid = line.middle(w, p0, p1);
+      const TwoPort y = line.two_port(w);
+      const double q_scale = std::abs(y.aa * p0 + y.ab * p1) + std::abs(y.ba * p0 + y.bb * p1);
+      const double x = 0.5 * line.length;
+      EXPECT_LT(std::abs(mid.pressure - line.pressure(w, p0, p1, x)), 1e-13 * std::abs(p0)) << "|s l| " << sl << ", U " << velocity;
+      EXPECT_LT(std::abs(mid.flow - line.flow(w, p0, p1, x)), 1e-13 * q_scale) << "|s l| " << sl << ", U " << velocity;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hemotree
