@@ -29,7 +29,7 @@ ComplexL series_j(int n, ComplexL z) {
   for (int k = 1; k < 500; ++k) {
     term *= -half2 / static_cast<long double>(k * (k + n));
     sum += term;
-    if (std::abs(term) <= 1e-17L * std::abs(sum)) break;
+    if (std::norm(term) <= 1e-34L * std::norm(sum)) break;  // |term| <= 1e-17 |sum|, without hypotl
   }
   return sum;
 }
@@ -96,7 +96,7 @@ Complex one_minus_f10(Complex zd) {
     power *= -half2 / static_cast<long double>(k * k);
     const ComplexL term = power * static_cast<long double>(k) / static_cast<long double>(k + 1);
     numerator += term;
-    if (std::abs(term) <= 1e-17L * std::abs(numerator)) break;
+    if (std::norm(term) <= 1e-34L * std::norm(numerator)) break;
   }
   const ComplexL result = numerator / series_j(0, z);
   return {static_cast<double>(result.real()), static_cast<double>(result.imag())};
