@@ -15,6 +15,7 @@
 #include "boundaries/resistance_outlet.hpp"
 #include "boundaries/system_rows.hpp"
 #include "core/errors.hpp"
+#include "core/parallel_errors.hpp"
 #include "core/setting_error.hpp"
 #include "formats/run_boundaries.hpp"
 #include "formats/connected_parts.hpp"
@@ -29,15 +30,23 @@ std::vector<double> vessel_resistances(const Network& net, const Blood& blood) {
   return vessel_resistances(net, blood, {});
 }
 
+namespace {
+
+double vessel_resistance(const Network& net, const Blood& blood, std::size_t v) {
+  return net.is_tapered(v)
+             ? tapered_poiseuille_resistance([&](double d) { return apparent_viscosity(blood, d); }, net.length[v],
+                                             net.diameter[v], net.distal_diameter[v], blood.alpha)
+             : poiseuille_resistance(apparent_viscosity(blood, net.diameter[v]), net.length[v], net.diameter[v],
+                                     blood.alpha);
+}
+
+}  // namespace
+
 std::vector<double> vessel_resistances(const Network& net, Blood blood, std::span<const double> hematocrit) {
   std::vector<double> r(net.vessel_count());
   for (std::size_t v = 0; v < r.size(); ++v) {
     if (!hematocrit.empty()) blood.hematocrit = hematocrit[v];
-    r[v] = net.is_tapered(v)
-               ? tapered_poiseuille_resistance([&](double d) { return apparent_viscosity(blood, d); },
-                                               net.length[v], net.diameter[v], net.distal_diameter[v], blood.alpha)
-               : poiseuille_resistance(apparent_viscosity(blood, net.diameter[v]), net.length[v],
-                                       net.diameter[v], blood.alpha);
+    r[v] = vessel_resistance(net, blood, v);
   }
   return r;
 }
@@ -355,7 +364,14 @@ SteadyFlow solve_steady_flow(const Network& net) {
 SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, double inlet_flow,
                                        std::vector<double>* resistance, int threads) {
-  std::vector<double> r = vessel_resistances(net, blood);
+  // Every vessel's own numbers, in parallel blocks: the same for any count of threads (a
+  // collapsing lumen's message, the lowest vessel's).
+  std::vector<double> r(net.vessel_count());
+  const auto vessels = static_cast<std::int64_t>(r.size());
+  parallel_blocks(vessels, threads, [&](std::int64_t first, std::int64_t last) {
+    for (auto v = static_cast<std::size_t>(first); v < static_cast<std::size_t>(last); ++v)
+      r[v] = vessel_resistance(net, blood, v);
+  });
   SteadySystem system(net);
   system.set_threads(threads);
   SteadyFlow s = system.solve(r, inlet_flow);
@@ -367,14 +383,16 @@ SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, s
   // sweeps there; a growing change halves w).
   double blend = 0.5, last_blend = 0, last_change = 0;
   for (int sweep = 0; sweep < 200; ++sweep) {
-    for (std::size_t v = 0; v < r.size(); ++v) {
-      const double p = 0.5 * (s.node_pressure[net.from[v]] + s.node_pressure[net.to[v]]);
-      const double area = laws[v].area(p);
-      if (!(area > 0))
-        throw InputError("vessel " + std::to_string(net.id[v]) + ": the lumen collapses in steady flow");
-      const double diameter = std::sqrt(4 / std::numbers::pi * area);
-      r[v] = (1 - blend) * r[v] + blend * poiseuille_resistance(viscosity(area), net.length[v], diameter, blood.alpha);
-    }
+    parallel_blocks(vessels, threads, [&](std::int64_t first, std::int64_t last) {
+      for (auto v = static_cast<std::size_t>(first); v < static_cast<std::size_t>(last); ++v) {
+        const double p = 0.5 * (s.node_pressure[net.from[v]] + s.node_pressure[net.to[v]]);
+        const double area = laws[v].area(p);
+        if (!(area > 0))
+          throw InputError("vessel " + std::to_string(net.id[v]) + ": the lumen collapses in steady flow");
+        const double diameter = std::sqrt(4 / std::numbers::pi * area);
+        r[v] = (1 - blend) * r[v] + blend * poiseuille_resistance(viscosity(area), net.length[v], diameter, blood.alpha);
+      }
+    });
     SteadyFlow next = system.solve(r, inlet_flow);
     double change = 0;  // over the nodes that have a pressure (a node no vessel reaches has none)
     for (std::size_t k = 0; k < next.node_pressure.size(); ++k)
