@@ -1,6 +1,5 @@
 #include "network_flow/flow_network.hpp"
 
-#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -13,25 +12,12 @@ FlowNetwork::FlowNetwork(std::size_t nodes, std::span<const std::int32_t> a, std
     throw std::invalid_argument("FlowNetwork: " + std::to_string(a.size()) + " edge starts, " +
                                 std::to_string(b.size()) + " ends, " + std::to_string(prescribed.size()) +
                                 " prescribed flags for " + std::to_string(nodes) + " nodes");
-  // Each list reserved at its size, counted first: growing them by push_back copied the
-  // full tree's 15 MB arrays several times over and left up to twice their size reserved.
-  free_node_.reserve(static_cast<std::size_t>(std::count(prescribed.begin(), prescribed.end(), 0)));
   for (std::size_t i = 0; i < nodes; ++i)
     if (!prescribed[i]) {
       free_index_[i] = static_cast<std::int32_t>(free_node_.size());
       free_node_.push_back(static_cast<std::int32_t>(i));
     }
-  std::size_t inner = 0, boundary = 0;
-  for (std::size_t e = 0; e < a_.size(); ++e) {
-    const auto i = static_cast<std::size_t>(a_[e]), j = static_cast<std::size_t>(b_[e]);
-    if (i >= nodes || j >= nodes) continue;  // refused below
-    const bool free_i = free_index_[i] >= 0, free_j = free_index_[j] >= 0;
-    inner += free_i && free_j;
-    boundary += free_i != free_j;
-  }
   std::vector<std::int32_t> inner_a, inner_b;
-  inner_edge_.reserve(inner), inner_a.reserve(inner), inner_b.reserve(inner);
-  boundary_edge_.reserve(boundary);
   for (std::size_t e = 0; e < a_.size(); ++e) {
     const auto i = static_cast<std::size_t>(a_[e]), j = static_cast<std::size_t>(b_[e]);
     if (i >= nodes || j >= nodes || i == j)
