@@ -1,6 +1,5 @@
 #include "network_flow/harmonic_system.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -8,6 +7,8 @@
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseLU>
+
+#include "network_flow/parents_below.hpp"
 
 namespace hemotree {
 
@@ -56,23 +57,6 @@ bool peel_leaves(std::size_t nodes, std::span<const std::int32_t> a, std::span<c
     }
   }
   return order.size() == nodes;
-}
-
-// Where every node has at most one edge to a node of a lower label, the graph is a forest
-// whose every parent lies below its children (its roots: the nodes with no such edge; the
-// largest label on a cycle would have two), and the labels from the highest down are an
-// elimination order that walks the arrays once: a tree labelled from its root depth-first,
-// as the generator and the pruner write it. False (parent_edge left unspecified) where a
-// node has two.
-bool parents_below(std::size_t nodes, std::span<const std::int32_t> a, std::span<const std::int32_t> b,
-                   std::vector<std::int32_t>& parent_edge) {
-  parent_edge.assign(nodes, -1);
-  for (std::size_t e = 0; e < a.size(); ++e) {
-    const auto child = static_cast<std::size_t>(std::max(a[e], b[e]));
-    if (parent_edge[child] >= 0) return false;
-    parent_edge[child] = static_cast<std::int32_t>(e);
-  }
-  return true;
 }
 
 }  // namespace

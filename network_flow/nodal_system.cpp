@@ -8,6 +8,8 @@
 
 #include <Eigen/SparseCholesky>
 
+#include "network_flow/parents_below.hpp"
+
 namespace hemotree {
 
 // A Cholesky pivot this small against its row's unreduced diagonal is a nearly singular
@@ -67,22 +69,17 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
     throw std::invalid_argument("NodalSystem: " + std::to_string(m) + " edges exceed 32-bit indices");
 
   // Is the graph a forest, and in what order can it be eliminated (every parent before its
-  // children)? First the common case at the cost of one pass: a network numbered from its
-  // root (vgen's, and what is extracted from it) joins every node to at most one lower node.
-  // Then each node hangs from that one, the lowest node of each component is its root, and
-  // the nodes' own order serves, which makes the sweeps stream through memory.
+  // children)? First the common case at the cost of one pass (parents_below.hpp): the nodes'
+  // own order serves.
   bool forest = false;
   if (method != Method::sparse_cholesky) {
+    forest = parents_below(nodes_, a_, b_, parent_edge_);
     parent_.assign(nodes_, -1);
-    parent_edge_.assign(nodes_, -1);
-    forest = true;
-    for (std::size_t e = 0; e < m && forest; ++e) {
-      const auto high = static_cast<std::size_t>(std::max(a_[e], b_[e]));
-      forest = parent_[high] < 0;
-      parent_[high] = std::min(a_[e], b_[e]);
-      parent_edge_[high] = static_cast<std::int32_t>(e);
-    }
-    if (!forest) {
+    if (forest) {
+      for (std::size_t c = 0; c < nodes_; ++c)
+        if (const std::int32_t e = parent_edge_[c]; e >= 0)
+          parent_[c] = std::min(a_[static_cast<std::size_t>(e)], b_[static_cast<std::size_t>(e)]);
+    } else {
       // Else peeling leaves: a node with one edge left hangs from that edge's other node, and
       // removing it may make that one a leaf in turn; the last node of each component is its
       // root, and the reverse of the peeling an order for the elimination. parent_ and
@@ -91,7 +88,7 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
       // three flat arrays). Nodes on a loop or a doubled edge are never peeled.
       std::vector<std::int32_t> degree(nodes_, 0);
       std::fill(parent_.begin(), parent_.end(), 0);
-      std::fill(parent_edge_.begin(), parent_edge_.end(), 0);
+      parent_edge_.assign(nodes_, 0);
       for (std::size_t e = 0; e < m; ++e) {
         const auto ea = static_cast<std::size_t>(a_[e]), eb = static_cast<std::size_t>(b_[e]);
         ++degree[ea];
