@@ -104,7 +104,7 @@ struct VesselLine {
     const double dx = 0.5 * length;
     const Hyperbolic half = hyperbolic(m, dx);
     const Complex e_half = exponential(0.5 * m.tau * dx);
-    const TwoPort y = two_port(m, {2.0 * half.cosh * half.cosh - 1.0, half.sinhc * half.cosh}, e_half * e_half);
+    const TwoPort y = two_port(m, doubled(half), e_half * e_half);
     const Complex q0 = y.aa * p0 + y.ab * p1, q1 = -(y.ba * p0 + y.bb * p1);
     return {Point{p0, q0}, along(m, half, e_half, dx, p0, q0), Point{p1, q1}};
   }
@@ -115,13 +115,15 @@ struct VesselLine {
   // through (s x)^18 where |s x| <= 1 (the first term left out, (s x)^20 / 20!, is below
   // 1e-18, and no term exceeds cosh 1 = 1.54 for a sum of at least cos 1 = 0.54: rounding
   // stays within a few 1e-16); up to |s x| = 8 the same at x / 2^h, |s x| / 2^h <= 1,
-  // doubled back h times (cosh 2y = 2 cosh^2 y - 1, sinh(2y) / 2y = sinhc(y) cosh(y)); else
+  // doubled back h times; else
   // from one real exponential and one sincos. So no vessel of a tree needs a square root or
   // a transcendental function here: the pulse diffuses across a capillary (|s l| = 0.1 to 3
   // over ten harmonics on the full tree) but is far from decaying within it.
   struct Hyperbolic {
     Complex cosh, sinhc;
   };
+  // At 2y from y: cosh 2y = 2 cosh^2 y - 1, sinh(2y) / 2y = sinhc(y) cosh(y).
+  static Hyperbolic doubled(const Hyperbolic& h) { return {2.0 * h.cosh * h.cosh - 1.0, h.sinhc * h.cosh}; }
   static Hyperbolic hyperbolic(const Matrix& m, double x) {
     Complex x2 = m.s2 * (x * x);
     double size = std::norm(x2);  // |s x|^4
@@ -134,11 +136,9 @@ struct VesselLine {
         ch = 1.0 + x2 * ch * (1.0 / ((2 * n - 1) * (2 * n)));
         shc = 1.0 + x2 * shc * (1.0 / ((2 * n) * (2 * n + 1)));
       }
-      for (; halvings > 0; --halvings) {
-        shc *= ch;
-        ch = 2.0 * ch * ch - 1.0;
-      }
-      return {ch, shc};
+      Hyperbolic h{ch, shc};
+      for (; halvings > 0; --halvings) h = doubled(h);
+      return h;
     }
     const Complex z = m.s() * std::abs(x);
     const double grow = std::exp(z.real()), ch = 0.5 * (grow + 1 / grow), sh = 0.5 * (grow - 1 / grow);
