@@ -199,15 +199,14 @@ std::vector<FourierSeries> boundary_series(const RunBoundaries& boundaries, int 
   return series;
 }
 
-// Solves harmonics 1 .. K of the network about `lines`, all at once (one to a thread), and
-// hands each one's node amplitudes to consume(k, amplitudes) in the order of k, so that what
-// the caller keeps is in one order whatever the threads. The lowest harmonic that fails is
-// the one thrown.
+// Solves harmonics 1 .. K (those of `series`) of the network about `lines`, all at once (one
+// to a thread), and hands each one's node amplitudes to consume(k, amplitudes) in the order of
+// k, so that what the caller keeps is in one order whatever the threads. The lowest harmonic
+// that fails is the one thrown.
 template <class Consume>
-void solve_harmonics(const Network& net, const LinearPeriodic& lines, const RunBoundaries& boundaries,
-                     int harmonics, int threads, Consume&& consume) {
-  const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
-  const HarmonicNetwork network = harmonic_network(net, boundaries);
+void solve_harmonics(const Network& net, const HarmonicNetwork& network, const LinearPeriodic& lines,
+                     const RunBoundaries& boundaries, const std::vector<FourierSeries>& series, int harmonics,
+                     int threads, Consume&& consume) {
   std::vector<HarmonicWorkspace> work(static_cast<std::size_t>(std::max(threads, 1)));
   std::vector<std::vector<Complex>> solved(static_cast<std::size_t>(harmonics));
   std::vector<std::exception_ptr> failure(solved.size());
@@ -402,8 +401,11 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
                                      const std::function<bool(const VesselLine&)>& shift_source) {
   if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
   LinearPeriodic out = LinearPeriodic::about(net, blood, laws, viscosity, steady, threads);
-  // Every harmonic kept: all of them at once, one to a thread.
-  solve_harmonics(net, out, boundaries, harmonics, threads,
+  // Every harmonic kept: all of them at once, one to a thread. The system's structure and
+  // the boundaries' series serve the mean shift too.
+  const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
+  const HarmonicNetwork network = harmonic_network(net, boundaries);
+  solve_harmonics(net, network, out, boundaries, series, harmonics, threads,
                   [&](int, std::vector<Complex>&& p) { out.node_pressure_.push_back(std::move(p)); });
   if (shift_source) {
     std::vector<bool> shift_sources(net.vessel_count());
@@ -418,8 +420,8 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
         variance[static_cast<std::size_t>(i)] += 0.5 * std::norm(p[static_cast<std::size_t>(i)]);
     }
     HarmonicWorkspace work;
-    solve_mean_shift(net, blood, laws, viscosity, boundaries, harmonic_network(net, boundaries),
-                     boundary_series(boundaries, harmonics), line_of, out, shift_sources, variance, node_shift, work, threads,
+    solve_mean_shift(net, blood, laws, viscosity, boundaries, network, series, line_of, out, shift_sources, variance,
+                     node_shift, work, threads,
                      [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
                        out.mean_flow_[v] += dq;
                        if (!shift_sources[v]) return;  // its nodes' means move below, and it with them
