@@ -183,8 +183,8 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   folder.open();
   const std::filesystem::path dir = folder.staging();
   write_summary(dir / "summary.json", run_info, results, linear.cycle,
-                boundary_results(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}));
-  write_vessel_table(dir / "vessels.csv", results);
+                boundary_results(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}), options.threads);
+  write_vessel_table(dir / "vessels.csv", results, options.threads);
   if (!config.probes.empty()) write_probes(dir / "probes.csv", laws, periodic, config.probes);
   if (config.vtk) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
   folder.publish();

@@ -421,8 +421,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
       report_transport(net, *transport, pulsatile.last_red_cells(), pulsatile.red_cell_change(),
                        static_cast<double>(plan.transport_every) * dt, results, info);
     if (!last.vessels.empty()) info["statistics"] = group_statistics(net, results);
-    write_summary(dir / "summary.json", info, results, last, boundary_flows(net, run, last));
-    write_vessel_table(dir / "vessels.csv", results);
+    write_summary(dir / "summary.json", info, results, last, boundary_flows(net, run, last), config.solver.threads);
+    write_vessel_table(dir / "vessels.csv", results, config.solver.threads);
     if (config.vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
   }
   folder.publish();
@@ -460,6 +460,7 @@ void run_steady(const Network& net, const RunConfiguration& config, RunObserver&
   request.vtk = config.vtk;
   request.vtk_keep = config.vtk_keep;
   request.phase_separation = config.red_cells == RedCells::transport;
+  request.threads = config.solver.threads;
   run_steady(net, request, observer);
 }
 

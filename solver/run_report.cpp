@@ -10,6 +10,7 @@
 #include <string>
 
 #include "formats/output_stream.hpp"
+#include "formats/parallel_rows.hpp"
 #include "formats/quoting.hpp"
 #include "physics/womersley.hpp"
 
@@ -113,20 +114,21 @@ std::size_t member_place(const std::string& head, const std::string& name) {
 }
 
 // The member as nlohmann::json dumps it with an indent of one at depth one.
-void write_array(OutputStream& out, const SummaryArray& array) {
+void write_array(OutputStream& out, const SummaryArray& array, int threads) {
   constexpr auto replace = nlohmann::json::error_handler_t::replace;
   out << "\n \"" << array.name << "\": [";
-  for (std::size_t i = 0; i < array.size; ++i) {
+  if (array.size > 0) out << "\n  ";
+  write_rows(out, array.size, threads, ",\n  ", [&](std::string& text, std::size_t i) {
     std::string entry = array.entry(i).dump(1, ' ', false, replace);
     for (std::size_t at = entry.find('\n'); at != std::string::npos; at = entry.find('\n', at + 3)) entry.insert(at + 1, "  ");
-    out << (i ? ",\n  " : "\n  ") << entry;
-  }
+    text += entry;
+  });
   out << (array.size == 0 ? "]" : "\n ]");
 }
 }  // namespace
 
 void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const VesselTable& vessels,
-                   const CycleSummary& cycle, const SummaryArray& array) {
+                   const CycleSummary& cycle, const SummaryArray& array, int threads) {
   nlohmann::json summary = run;
   summary["inlet_mean_flow"] = cycle.inlet_mean_flow;
   summary["outlets_mean_flow"] = cycle.outlets_mean_flow;
@@ -153,18 +155,17 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
     const std::size_t place = member_place(head, array.name);
     if (place == std::string::npos) {
       out << head << ",";
-      write_array(out, array);
+      write_array(out, array, threads);
     } else {
       out << std::string_view(head).substr(0, place);
-      write_array(out, array);
+      write_array(out, array, threads);
       out << "," << std::string_view(head).substr(place);
     }
   }
   out << ",\n \"vessels\": [";
-  for (std::size_t v = 0; v < vessels.rows(); ++v) {
-    out << (v ? ",\n  " : "\n  ");
-    vessels.write_json_row(out, v);
-  }
+  if (vessels.rows() > 0) out << "\n  ";
+  write_rows(out, vessels.rows(), threads, ",\n  ",
+             [&](std::string& text, std::size_t v) { vessels.append_json_row(text, v); });
   out << (vessels.rows() == 0 ? "]\n}\n" : "\n ]\n}\n");
   out.commit();
 }
@@ -225,31 +226,14 @@ nlohmann::json group_statistics(const Network& net, const VesselTable& vessels) 
   return out;
 }
 
-void write_vessel_table(const std::filesystem::path& file, const VesselTable& vessels) {
+void write_vessel_table(const std::filesystem::path& file, const VesselTable& vessels, int threads) {
   OutputStream out(file.string());
   const auto& columns = vessels.columns();
-  std::vector<std::vector<std::string>> labels(columns.size());  // as CSV fields, quoted where they must be
-  for (std::size_t f = 0; f < columns.size(); ++f)
-    for (const std::string& label : columns[f].labels) labels[f].push_back(csv_field(label));
   if (vessels.rows() > 0) {
     for (std::size_t f = 0; f < columns.size(); ++f) out << (f ? "," : "") << csv_field(columns[f].name);
     out << '\n';
   }
-  for (std::size_t v = 0; v < vessels.rows(); ++v) {
-    for (std::size_t f = 0; f < columns.size(); ++f) {
-      if (f) out << ',';
-      const VesselTable::Column& c = columns[f];
-      // null: an empty field, which pandas and numpy read as NaN
-      if (c.kind == VesselTable::Kind::integer) {
-        if (c.integer[v] != VesselTable::null_integer) out << std::to_string(c.integer[v]);
-      } else if (c.kind == VesselTable::Kind::number) {
-        write_csv_number(out, c.number[v]);  // summary.json's text of the same double
-      } else {
-        out << labels[f][c.code[v]];
-      }
-    }
-    out << '\n';
-  }
+  write_rows(out, vessels.rows(), threads, "", [&](std::string& text, std::size_t v) { vessels.append_csv_row(text, v); });
   out.commit();
 }
 

@@ -64,9 +64,10 @@ struct SummaryArray {
 };
 
 // summary.json: the run's facts (`run`, and `array` among them), the mass balance and the
-// vessels' results, one vessel a line.
+// vessels' results, one vessel a line. threads: the rows formatted in parallel
+// (formats/parallel_rows.hpp: the same bytes for any count).
 void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const VesselTable& vessels,
-                   const CycleSummary& cycle, const SummaryArray& array = {});
+                   const CycleSummary& cycle, const SummaryArray& array = {}, int threads = 1);
 
 // The results summarised per class, model, generation and diameter bin (a factor sqrt(2)
 // wide): each group's vessel count and the median, 5th and 95th percentile of its mean
@@ -75,7 +76,7 @@ nlohmann::json group_statistics(const Network& net, const VesselTable& vessels);
 
 // vessels.csv: the same rows as a table, one line per vessel, a header of the fields (SI
 // units; an empty field where summary.json has null), for pandas, numpy or a spreadsheet.
-void write_vessel_table(const std::filesystem::path& file, const VesselTable& vessels);
+void write_vessel_table(const std::filesystem::path& file, const VesselTable& vessels, int threads = 1);
 
 // The network as VTK PolyData with every numeric per-vessel result as cell data (null -> NaN).
 // keep: the vessels written (one entry per vessel; empty: all).

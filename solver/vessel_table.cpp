@@ -21,12 +21,19 @@ void check_size(std::size_t size, std::size_t rows, const std::string& name) {
     throw std::invalid_argument("VesselTable: column " + name + " has " + std::to_string(size) + " rows, not " +
                                 std::to_string(rows));
 }
+void append_integer(std::string& text, std::int64_t x) {
+  char digits[24];
+  text.append(digits, std::to_chars(digits, digits + sizeof digits, x).ptr);
+}
 }  // namespace
 
 void VesselTable::push(Column c) {
   // Quoted once here, not per row: a name or label may hold anything a user typed.
   c.json_name = json_quoted(c.name);
-  for (const std::string& label : c.labels) c.json_labels.push_back(json_quoted(label));
+  for (const std::string& label : c.labels) {
+    c.json_labels.push_back(json_quoted(label));
+    c.csv_labels.push_back(csv_field(label));
+  }
   columns_.push_back(std::move(c));
 }
 
@@ -60,42 +67,63 @@ void VesselTable::add_text(std::string name, std::vector<std::uint8_t> codes, st
   push(std::move(c));
 }
 
-void write_csv_number(OutputStream& out, double x) {
+void append_csv_number(std::string& text, double x) {
   if (!std::isfinite(x)) return;
-  char text[32];
-  out << std::string_view(text, static_cast<std::size_t>(std::to_chars(text, text + sizeof text, x).ptr - text));
+  char digits[32];
+  text.append(digits, std::to_chars(digits, digits + sizeof digits, x).ptr);
 }
 
-void write_json_number(OutputStream& out, double x) {
+void append_json_number(std::string& text, double x) {
   if (!std::isfinite(x)) {
-    out << "null";
+    text += "null";
     return;
   }
-  char text[32];
-  const std::string_view s(text, static_cast<std::size_t>(std::to_chars(text, text + sizeof text, x).ptr - text));
-  out << s;
-  if (s.find_first_of(".e") == std::string_view::npos) out << ".0";
+  char digits[32];
+  const std::string_view s(digits, static_cast<std::size_t>(std::to_chars(digits, digits + sizeof digits, x).ptr - digits));
+  text += s;
+  if (s.find_first_of(".e") == std::string_view::npos) text += ".0";
 }
 
-void VesselTable::write_json_row(OutputStream& out, std::size_t row) const {
-  out << '{';
+void VesselTable::append_json_row(std::string& text, std::size_t row) const {
+  text += '{';
   for (std::size_t f = 0; f < columns_.size(); ++f) {
     const Column& c = columns_[f];
-    out << (f ? "," : "") << c.json_name << ':';
+    if (f) text += ',';
+    text += c.json_name;
+    text += ':';
     switch (c.kind) {
       case Kind::integer:
-        if (c.integer[row] == null_integer) out << "null";
-        else out << std::to_string(c.integer[row]);
+        if (c.integer[row] == null_integer) text += "null";
+        else append_integer(text, c.integer[row]);
         break;
       case Kind::number:
-        write_json_number(out, c.number[row]);
+        append_json_number(text, c.number[row]);
         break;
       case Kind::text:
-        out << c.json_labels[c.code[row]];
+        text += c.json_labels[c.code[row]];
         break;
     }
   }
-  out << '}';
+  text += '}';
+}
+
+void VesselTable::append_csv_row(std::string& text, std::size_t row) const {
+  for (std::size_t f = 0; f < columns_.size(); ++f) {
+    if (f) text += ',';
+    const Column& c = columns_[f];
+    switch (c.kind) {
+      case Kind::integer:
+        if (c.integer[row] != null_integer) append_integer(text, c.integer[row]);
+        break;
+      case Kind::number:
+        append_csv_number(text, c.number[row]);  // summary.json's text of the same double
+        break;
+      case Kind::text:
+        text += c.csv_labels[c.code[row]];
+        break;
+    }
+  }
+  text += '\n';
 }
 
 }  // namespace hemotree

@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "formats/output_stream.hpp"
 
 namespace hemotree {
 
@@ -27,6 +26,7 @@ class VesselTable {
     std::vector<std::string> labels;
     std::string json_name;                // name and labels as JSON strings, quotes included
     std::vector<std::string> json_labels;
+    std::vector<std::string> csv_labels;  // labels as CSV fields, quoted where they must be
   };
 
   explicit VesselTable(std::size_t rows = 0) : rows_(rows) {}
@@ -40,9 +40,11 @@ class VesselTable {
   void add_number(std::string name, std::vector<double> values);
   void add_text(std::string name, std::vector<std::uint8_t> codes, std::vector<std::string> labels);
 
-  // One row as a JSON object on one line ({"id":3,...}), numbers in their shortest text that
-  // reads back to the same double.
-  void write_json_row(OutputStream& out, std::size_t row) const;
+  // One row appended to text as a JSON object on one line ({"id":3,...}), numbers in their
+  // shortest text that reads back to the same double; as a CSV line (its newline included),
+  // the same numbers, null an empty field (which pandas and numpy read as NaN).
+  void append_json_row(std::string& text, std::size_t row) const;
+  void append_csv_row(std::string& text, std::size_t row) const;
 
  private:
   void push(Column c);
@@ -53,8 +55,8 @@ class VesselTable {
 
 // The shortest text that reads back to the same double (as summary.json writes it): with a
 // ".0" where it would read as an integer, "null" where not finite (JSON has no NaN).
-void write_json_number(OutputStream& out, double x);
+void append_json_number(std::string& text, double x);
 // The same without the ".0" and with nothing for a non-finite value: a CSV field.
-void write_csv_number(OutputStream& out, double x);
+void append_csv_number(std::string& text, double x);
 
 }  // namespace hemotree

@@ -14,6 +14,7 @@
 
 #include "core/errors.hpp"
 #include "formats/output_stream.hpp"
+#include "formats/parallel_rows.hpp"
 
 using namespace hemotree;
 namespace fs = std::filesystem;
@@ -254,4 +255,26 @@ TEST(OutputStream, AFullDiskIsReported) {
         out.commit();
       },
       IoError);
+}
+
+// Rows formatted in parallel blocks are written in their order: the bytes of a serial loop,
+// for any count of threads and rows across the blocks' edges (4096 rows a block).
+TEST(WriteRows, TheSameBytesForAnyThreads) {
+  const fs::path dir = fresh_folder("rows");
+  auto row = [](std::string& text, std::size_t i) { text += "row " + std::to_string(i * i) + (i % 7 ? "" : " seventh"); };
+  for (const std::size_t rows : {std::size_t{0}, std::size_t{1}, std::size_t{4096}, std::size_t{3 * 4096 + 17}}) {
+    std::string expected;
+    for (std::size_t i = 0; i < rows; ++i) {
+      if (i > 0) expected += ",\n";
+      row(expected, i);
+    }
+    for (const int threads : {1, 2, 3}) {
+      const fs::path file = dir / ("rows-" + std::to_string(rows) + "-" + std::to_string(threads));
+      OutputStream out(file.string());
+      write_rows(out, rows, threads, ",\n", row);
+      out.commit();
+      EXPECT_EQ(content(file), expected) << rows << " rows, " << threads << " threads";
+    }
+  }
+  fs::remove_all(dir);
 }

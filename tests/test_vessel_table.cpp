@@ -15,18 +15,13 @@
 using namespace hemotree;
 
 namespace {
-std::string written(const std::function<void(OutputStream&)>& write) {
-  const auto path = std::filesystem::temp_directory_path() / ("vessel_table_" + std::to_string(::getpid()));
-  {
-    OutputStream out(path.string());
-    write(out);
-    out.commit();
-  }
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::filesystem::remove(path);
-  return text.str();
+std::string appended(const std::function<void(std::string&)>& append) {
+  std::string text;
+  append(text);
+  return text;
+}
+std::string json_row(const VesselTable& t, std::size_t row) {
+  return appended([&](std::string& text) { t.append_json_row(text, row); });
 }
 
 VesselTable table() {
@@ -43,7 +38,7 @@ VesselTable table() {
 TEST(VesselTable, JsonRowsReadBackBitForBit) {
   const VesselTable t = table();
   for (std::size_t row = 0; row < t.rows(); ++row) {
-    const auto j = nlohmann::json::parse(written([&](OutputStream& out) { t.write_json_row(out, row); }));
+    const auto j = nlohmann::json::parse(json_row(t, row));
     EXPECT_EQ(j["id"].get<std::int64_t>(), t.find("id")->integer[row]);
     EXPECT_EQ(j["model"].get<std::string>(), row == 1 ? "1d" : "0d");
     EXPECT_EQ(j["degree"].is_null(), row != 1);
@@ -54,11 +49,21 @@ TEST(VesselTable, JsonRowsReadBackBitForBit) {
 }
 
 TEST(VesselTable, CsvFieldsAreTheShortestTextOfTheDouble) {
-  EXPECT_EQ(written([](OutputStream& out) { write_csv_number(out, 0.1 + 0.2); }), "0.30000000000000004");
-  EXPECT_EQ(written([](OutputStream& out) { write_csv_number(out, -3.0); }), "-3");
-  EXPECT_EQ(written([](OutputStream& out) { write_csv_number(out, std::nan("")); }), "");
-  EXPECT_EQ(written([](OutputStream& out) { write_json_number(out, -3.0); }), "-3.0");
-  EXPECT_EQ(written([](OutputStream& out) { write_json_number(out, 1e-300); }), "1e-300");
+  EXPECT_EQ(appended([](std::string& text) { append_csv_number(text, 0.1 + 0.2); }), "0.30000000000000004");
+  EXPECT_EQ(appended([](std::string& text) { append_csv_number(text, -3.0); }), "-3");
+  EXPECT_EQ(appended([](std::string& text) { append_csv_number(text, std::nan("")); }), "");
+  EXPECT_EQ(appended([](std::string& text) { append_json_number(text, -3.0); }), "-3.0");
+  EXPECT_EQ(appended([](std::string& text) { append_json_number(text, 1e-300); }), "1e-300");
+}
+
+TEST(VesselTable, CsvRowsHoldTheSameNumbersAndEmptyNulls) {
+  const VesselTable t = table();
+  EXPECT_EQ(appended([&](std::string& text) { t.append_csv_row(text, 0); }), "7,0d,,0.30000000000000004,\n");
+  EXPECT_EQ(appended([&](std::string& text) { t.append_csv_row(text, 1); }), "-2,1d,7,1e-300,\n");
+  EXPECT_EQ(appended([&](std::string& text) { t.append_csv_row(text, 2); }), "40000000000,0d,,-3,5e-07\n");
+  VesselTable quoted(1);
+  quoted.add_text("class", {0}, {"a,b"});
+  EXPECT_EQ(appended([&](std::string& text) { quoted.append_csv_row(text, 0); }), "\"a,b\"\n");
 }
 
 TEST(VesselTable, RefusesAColumnOfAnotherLength) {
@@ -72,12 +77,12 @@ TEST(VesselTable, RefusesAColumnOfAnotherLength) {
 // parses and gives it back (control characters escaped, bytes that are not UTF-8 replaced),
 // and a CSV field is quoted where it must be (hostile-inputs 07).
 TEST(VesselTable, AnyNameOrLabelKeepsTheRowJson) {
-  for (const std::string name : {std::string("a\nb"), std::string("q\"uote\\"), std::string("t\tab\x01"),
+  for (const std::string& name : {std::string("a\nb"), std::string("q\"uote\\"), std::string("t\tab\x01"),
                                   std::string("caf\xc3\xa9"), std::string("bad\xff")}) {
     VesselTable t(1);
     t.add_number(name + "_arrival_time", {1.5});
     t.add_text("class", {0}, {name});
-    const std::string text = written([&](OutputStream& out) { t.write_json_row(out, 0); });
+    const std::string text = json_row(t, 0);
     nlohmann::json j;
     ASSERT_NO_THROW(j = nlohmann::json::parse(text)) << text;
     if (name != "bad\xff") {
