@@ -278,3 +278,19 @@ TEST(WriteRows, TheSameBytesForAnyThreads) {
   }
   fs::remove_all(dir);
 }
+
+// A row that cannot be formatted stops the writing with its own exception, on any thread
+// (an exception leaving an OpenMP region would end the process instead).
+TEST(WriteRows, AFailingRowThrowsItsException) {
+  const fs::path dir = fresh_folder("rows-failing");
+  for (const int threads : {1, 2, 3}) {
+    OutputStream out((dir / "rows").string());
+    auto row = [](std::string& text, std::size_t i) {
+      if (i == 3 * 4096 + 5) throw std::runtime_error("row " + std::to_string(i));
+      text += "x";
+    };
+    EXPECT_THROW(write_rows(out, 5 * 4096, threads, "\n", row), std::runtime_error) << threads << " threads";
+  }
+  EXPECT_TRUE(entries(dir).empty());  // nothing committed
+  fs::remove_all(dir);
+}
