@@ -179,7 +179,7 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
                              {"status", "complete"},
                              {"cycles", 0},
                              {"wall_time", wall}};
-  run_info["statistics"] = group_statistics(net, results);
+  run_info["statistics"] = group_statistics(net, results, options.threads);
   folder.open();
   const std::filesystem::path dir = folder.staging();
   write_summary(dir / "summary.json", run_info, results, linear.cycle,

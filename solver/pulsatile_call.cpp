@@ -420,7 +420,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
     if (transport && !last.vessels.empty())
       report_transport(net, *transport, pulsatile.last_red_cells(), pulsatile.red_cell_change(),
                        static_cast<double>(plan.transport_every) * dt, results, info);
-    if (!last.vessels.empty()) info["statistics"] = group_statistics(net, results);
+    if (!last.vessels.empty()) info["statistics"] = group_statistics(net, results, config.solver.threads);
     write_summary(dir / "summary.json", info, results, last, boundary_flows(net, run, last), config.solver.threads);
     write_vessel_table(dir / "vessels.csv", results, config.solver.threads);
     if (config.vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/parallel_errors.hpp"
 #include "formats/output_stream.hpp"
 #include "formats/parallel_rows.hpp"
 #include "formats/quoting.hpp"
@@ -170,13 +171,14 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
   out.commit();
 }
 
-nlohmann::json group_statistics(const Network& net, const VesselTable& vessels) {
+nlohmann::json group_statistics(const Network& net, const VesselTable& vessels, int threads) {
   // Per group: how many vessels, and of each quantity the median, the 5th and 95th
   // percentiles (nearest rank) over the group's vessels where it is defined.
   static const char* quantities[] = {"mean_pressure", "pulsatility_index", "mean_flow", "mean_wss"};
-  auto describe = [&](const std::vector<std::uint32_t>& members) {
+  // values: scratch, kept from group to group (a fresh array a group and quantity was most of
+  // the time: first touches of its pages).
+  auto describe = [&](const std::vector<std::uint32_t>& members, std::vector<double>& values) {
     nlohmann::json g = {{"vessels", members.size()}};
-    std::vector<double> values;
     for (const char* q : quantities) {
       const VesselTable::Column* column = vessels.find(q);
       if (!column) continue;
@@ -194,31 +196,54 @@ nlohmann::json group_statistics(const Network& net, const VesselTable& vessels) 
     }
     return g;
   };
-  const VesselTable::Column& vessel_class = *vessels.find("class");
-  const VesselTable::Column& model = *vessels.find("model");
-  std::map<std::string, std::vector<std::uint32_t>> by_class, by_model;
+  // The members of each group, in the vessels' order. A text column's groups by label (its
+  // codes' labels looked up once, not a string-keyed map a vessel).
+  auto by_label = [&](const VesselTable::Column& column) {
+    std::map<std::string, std::vector<std::uint32_t>> groups;
+    std::vector<std::vector<std::uint32_t>*> of_code;
+    for (const std::string& label : column.labels) of_code.push_back(&groups[label]);
+    for (std::size_t v = 0; v < vessels.rows(); ++v) of_code[column.code[v]]->push_back(static_cast<std::uint32_t>(v));
+    std::erase_if(groups, [](const auto& group) { return group.second.empty(); });  // a label no vessel has
+    return groups;
+  };
+  const auto by_class = by_label(*vessels.find("class")), by_model = by_label(*vessels.find("model"));
   std::map<std::int32_t, std::vector<std::uint32_t>> by_generation, by_diameter;
   for (std::size_t v = 0; v < vessels.rows(); ++v) {
     const auto row = static_cast<std::uint32_t>(v);
-    by_class[vessel_class.labels[vessel_class.code[v]]].push_back(row);
-    by_model[model.labels[model.code[v]]].push_back(row);
     if (!net.generation.empty()) by_generation[net.generation[v]].push_back(row);
     // Diameter bins a factor sqrt(2) wide: bin k holds [2^(k/2), 2^((k+1)/2)) um.
     by_diameter[static_cast<std::int32_t>(std::floor(2 * std::log2(net.diameter[v] * 1e6)))].push_back(row);
   }
+  // Every group described in parallel (each its own: the same numbers for any count).
+  std::vector<const std::vector<std::uint32_t>*> groups;
+  for (const auto* grouping : {&by_class, &by_model})
+    for (const auto& [name, members] : *grouping) groups.push_back(&members);
+  for (const auto* grouping : {&by_generation, &by_diameter})
+    for (const auto& [key, members] : *grouping) groups.push_back(&members);
+  std::vector<nlohmann::json> described(groups.size());
+  ParallelErrors errors;
+#pragma omp parallel num_threads(threads) if (threads > 1)
+  {
+    std::vector<double> values;
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t i = 0; i < static_cast<std::int64_t>(groups.size()); ++i)
+      errors.guard(i, [&] { described[static_cast<std::size_t>(i)] = describe(*groups[static_cast<std::size_t>(i)], values); });
+  }
+  errors.rethrow();
+  std::size_t next = 0;
   nlohmann::json out;
-  for (const auto& [name, members] : by_class) out["by_class"][name] = describe(members);
-  for (const auto& [name, members] : by_model) out["by_model"][name] = describe(members);
+  for (const auto& [name, members] : by_class) out["by_class"][name] = std::move(described[next++]);
+  for (const auto& [name, members] : by_model) out["by_model"][name] = std::move(described[next++]);
   // Generations and diameter bins as arrays in their order (an object's keys would sort as text).
   out["by_generation"] = nlohmann::json::array();
   for (const auto& [g, members] : by_generation) {
-    nlohmann::json row = describe(members);
+    nlohmann::json row = std::move(described[next++]);
     row["generation"] = g;
     out["by_generation"].push_back(row);
   }
   out["by_diameter"] = nlohmann::json::array();
   for (const auto& [k, members] : by_diameter) {
-    nlohmann::json row = describe(members);
+    nlohmann::json row = std::move(described[next++]);
     row["diameter_from"] = 1e-6 * std::exp2(k / 2.0);  // [m]
     row["diameter_to"] = 1e-6 * std::exp2((k + 1) / 2.0);
     out["by_diameter"].push_back(row);

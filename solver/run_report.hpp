@@ -72,7 +72,8 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
 // The results summarised per class, model, generation and diameter bin (a factor sqrt(2)
 // wide): each group's vessel count and the median, 5th and 95th percentile of its mean
 // pressure, pulsatility index, mean flow and wall shear stress (summary.json "statistics").
-nlohmann::json group_statistics(const Network& net, const VesselTable& vessels);
+// threads: the groups described in parallel (the same numbers for any count).
+nlohmann::json group_statistics(const Network& net, const VesselTable& vessels, int threads = 1);
 
 // vessels.csv: the same rows as a table, one line per vessel, a header of the fields (SI
 // units; an empty field where summary.json has null), for pandas, numpy or a spreadsheet.

@@ -158,7 +158,7 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
                                        {"change", separated.change},
                                        {"tolerance", red_cell_tolerance},
                                        {"relaxation", 0.5}};
-  run_info["statistics"] = group_statistics(net, results);
+  run_info["statistics"] = group_statistics(net, results, request.threads);
   folder.open();
   const std::filesystem::path dir = folder.staging();
   write_summary(dir / "summary.json", run_info, results, cycle, boundary_results(net, steady), request.threads);
