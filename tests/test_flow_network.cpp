@@ -122,6 +122,35 @@ TEST(FlowNetwork, LoopedGraphMatchesTheDenseSolve) {
   }
 }
 
+// No pressure prescribed (a tree's inflow and outlets' shunts): the free system is the
+// network itself, taken without index lists or copies; the same numbers, to the bit, as the
+// nodal system given the graph directly.
+TEST(FlowNetwork, NothingPrescribedIsTheNodalSystemItself) {
+  for (const std::size_t extra : {std::size_t{0}, std::size_t{60}}) {
+    const Case c = random_case(300, extra, 0, 7);
+    expect_agreement(c);
+    FlowNetwork network(c.nodes, c.a, c.b, c.prescribed);
+    EXPECT_EQ(network.free_node_count(), c.nodes);
+    ASSERT_EQ(network.factorize(c.conductance, c.shunt), -1);
+    std::vector<double> p(c.nodes);
+    network.solve(c.inflow, p);
+    NodalSystem direct(c.nodes, c.a, c.b);
+    ASSERT_EQ(direct.factorize(c.conductance, c.shunt), -1);
+    std::vector<double> x(c.nodes);
+    direct.solve(c.inflow, x);
+    EXPECT_EQ(p, x) << extra << " chords";
+  }
+  // A part with no shunt is named by its lowest node here too.
+  const std::vector<std::int32_t> a{0, 2, 3}, b{1, 3, 4};
+  FlowNetwork network(5, a, b, std::vector<unsigned char>(5, 0));
+  std::vector<double> shunt(5, 0.0);
+  shunt[0] = 0.5;
+  EXPECT_EQ(network.factorize(std::vector<double>{1, 1, 1}, shunt), 2);
+  EXPECT_THROW(FlowNetwork(3, std::vector<std::int32_t>{0, 1}, std::vector<std::int32_t>{1, 1},
+                           std::vector<unsigned char>(3, 0)),
+               std::invalid_argument);  // an edge from a node to itself
+}
+
 // Two prescribed nodes joined by one edge: its flow follows from them alone.
 TEST(FlowNetwork, EdgeBetweenPrescribedNodes) {
   const std::vector<std::int32_t> a{0, 1}, b{1, 2};
