@@ -416,7 +416,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
   pulsatile.probes().write(dir / "probes.csv");
   run.release_lumped_state();  // the time loop is over: on the full tree 1.2 GB less while the report is written
   {  // the table (0.9 GB on the full tree) is freed before the last cycle is copied below
-    VesselTable results = last.vessels.empty() ? VesselTable() : vessel_results(net, run, last, analysis_frequency(driving));
+    VesselTable results = last.vessels.empty() ? VesselTable()
+                                               : vessel_results(net, run, last, analysis_frequency(driving), config.solver.threads);
     if (transport && !last.vessels.empty())
       report_transport(net, *transport, pulsatile.last_red_cells(), pulsatile.red_cell_change(),
                        static_cast<double>(plan.transport_every) * dt, results, info);

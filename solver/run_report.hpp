@@ -51,8 +51,9 @@ VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vect
 // speak of (--model auto's criteria); its flow is one along it and its ends' pressures differ
 // by its resistive drop, so a phase "lag" between them is no wave's (it read as 100 to
 // 10,000 m/s).
+// threads: the vessels' wave theory in parallel (the same numbers for any count).
 VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
-                           double analysis_frequency);
+                           double analysis_frequency, int threads = 1);
 
 // A member of summary.json with an entry per boundary: two million on a full tree, too many
 // to hold as a JSON tree (a few hundred bytes each), so written entry by entry, in the place
