@@ -128,7 +128,8 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
     separated = solve_steady_with_phase_separation(net, blood, red_cell_iterations, red_cell_tolerance, 0.5);
     steady = separated.flow;
   } else {
-    steady = solve_steady_flow(net, vessel_resistances(net, blood), net.inlet ? net.inlet->waveform.mean_value() : 0.0);
+    steady = solve_steady_flow(net, vessel_resistances(net, blood, {}, request.threads),
+                               net.inlet ? net.inlet->waveform.mean_value() : 0.0);
   }
   const CycleSummary cycle = steady_cycle(net, blood, steady, request.phase_separation ? &separated.hematocrit : nullptr);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -47,7 +47,7 @@ struct SteadyRunRequest {
   // Red cells: fixed (the blood's hematocrit everywhere) or phase separation at diverging
   // bifurcations, the flows and hematocrits solved together (steady/steady_hematocrit.hpp).
   bool phase_separation = false;
-  int threads = 1;  // the results' rows formatted in parallel (the same bytes for any count)
+  int threads = 1;  // the first resistances and the report in parallel (the same bytes for any count)
 };
 
 // Solves and writes OUT/summary.json, OUT/vessels.csv (and OUT/results.vtp with vtk) through

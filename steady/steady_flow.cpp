@@ -42,12 +42,16 @@ double vessel_resistance(const Network& net, const Blood& blood, std::size_t v) 
 
 }  // namespace
 
-std::vector<double> vessel_resistances(const Network& net, Blood blood, std::span<const double> hematocrit) {
+std::vector<double> vessel_resistances(const Network& net, const Blood& blood, std::span<const double> hematocrit,
+                                       int threads) {
   std::vector<double> r(net.vessel_count());
-  for (std::size_t v = 0; v < r.size(); ++v) {
-    if (!hematocrit.empty()) blood.hematocrit = hematocrit[v];
-    r[v] = vessel_resistance(net, blood, v);
-  }
+  parallel_blocks(static_cast<std::int64_t>(r.size()), threads, [&](std::int64_t first, std::int64_t last) {
+    Blood own = blood;
+    for (auto v = static_cast<std::size_t>(first); v < static_cast<std::size_t>(last); ++v) {
+      if (!hematocrit.empty()) own.hematocrit = hematocrit[v];
+      r[v] = vessel_resistance(net, own, v);
+    }
+  });
   return r;
 }
 
@@ -366,12 +370,8 @@ SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, s
                                        std::vector<double>* resistance, int threads) {
   // Every vessel's own numbers, in parallel blocks: the same for any count of threads (a
   // collapsing lumen's message, the lowest vessel's).
-  std::vector<double> r(net.vessel_count());
+  std::vector<double> r = vessel_resistances(net, blood, {}, threads);
   const auto vessels = static_cast<std::int64_t>(r.size());
-  parallel_blocks(vessels, threads, [&](std::int64_t first, std::int64_t last) {
-    for (auto v = static_cast<std::size_t>(first); v < static_cast<std::size_t>(last); ++v)
-      r[v] = vessel_resistance(net, blood, v);
-  });
   SteadySystem system(net);
   system.set_threads(threads);
   SteadyFlow s = system.solve(r, inlet_flow);

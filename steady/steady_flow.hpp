@@ -24,8 +24,10 @@ struct SteadyFlow {
 // its reference diameter and its velocity profile (alpha); a tapered vessel's integrated
 // along it (physics/poiseuille.hpp).
 std::vector<double> vessel_resistances(const Network& net, const Blood& blood);
-// The same with each vessel's own discharge hematocrit (empty: the blood's in every vessel).
-std::vector<double> vessel_resistances(const Network& net, Blood blood, std::span<const double> hematocrit);
+// The same with each vessel's own discharge hematocrit (empty: the blood's in every vessel),
+// in parallel blocks of `threads` (the same numbers, and an error's message, for any count).
+std::vector<double> vessel_resistances(const Network& net, const Blood& blood, std::span<const double> hematocrit,
+                                       int threads = 1);
 
 // Thevenin equivalent of what lies beyond a vessel's distal node: the flow into it is
 // (p - pressure) / resistance.

@@ -1,10 +1,9 @@
 // The columnar table every per-vessel output is written from: each row read back from its
 // JSON text gives the stored values bit for bit, nulls where a value is not finite or absent.
 #include <cmath>
-#include <filesystem>
-#include <fstream>
+#include <functional>
 #include <limits>
-#include <sstream>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
