@@ -468,6 +468,19 @@ void LumpedVessels::start(const std::vector<double>& network_node_pressure, cons
   update_dynamic_pressures();
 }
 
+void LumpedVessels::start_from(const LumpedVessels& other) {
+  if (empty() && other.empty()) return;
+  if (other.nodes_ != nodes_ || other.a_ != a_ || other.b_ != b_ || other.vessels_ != vessels_)
+    throw std::invalid_argument("LumpedVessels::start_from: the other 0D vessels are not built alike");
+  pressure_ = other.pressure_;
+  flow_ = other.flow_;
+  for (std::size_t k = 0; k < nodes_; ++k) volume_[k] = node_excess(k, pressure_[k]);
+  hold_coupling_pressures();
+  update_resistances();
+  restart_history();
+  update_dynamic_pressures();
+}
+
 void LumpedVessels::start_inner_nodes() {
   // A vessel in sections: its inner nodes on the steady profile of the whole vessel between
   // its end pressures (the flow capacity G linear in p between its ends': pressure_at's).

@@ -105,6 +105,10 @@ class LumpedVessels {
   // p - R1 Q of their vessel's end (R1 edges and outlets follow from the pressures).
   void start(const std::vector<double>& network_node_pressure, const std::vector<double>& vessel_flow);
   void start_at_rest(std::span<const TubeLaw> laws);
+  // The state of another of the same network, models and sections (built alike: the same
+  // nodes and edges in the same order), its pressures and flows as they are, the history
+  // restarting from them (std::invalid_argument for one built otherwise).
+  void start_from(const LumpedVessels& other);
 
   // The nodes where 1D vessel ends meet 0D vessels (each once).
   void set_coupling_nodes(std::vector<std::int32_t> nodes);

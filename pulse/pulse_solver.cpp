@@ -559,6 +559,24 @@ void PulseSolver::start_from_periodic(const PeriodicInstant& instant) {
   }
 }
 
+void PulseSolver::start_from(const PulseSolver& other) {
+  if (&other.net_ != &net_ || other.zero_d_ != zero_d_ || other.elements_per_vessel_ != elements_per_vessel_ ||
+      other.boundaries_.outlets.size() != boundaries_.outlets.size())
+    throw std::invalid_argument("PulseSolver::start_from: a solver of another network or other models");
+  lumped_.start_from(other.lumped_);
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    if (zero_d_[v]) continue;
+    project_along(v, [&](double x) { return other.area_at(v, x); }, state_.area);
+    project_along(v, [&](double x) { return other.flow_at(v, x); }, state_.flow);
+  }
+  for (const auto& o : boundaries_.outlets)
+    if (o.capacitor >= 0) state_.capacitor(o.capacitor) = other.state_.capacitor(o.capacitor);
+  restart_clock();
+  have_previous_rate_ = false;  // the multistep history starts again
+  // The coupled ends' first linearisation needs their end states (as after any start).
+  if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);
+}
+
 void PulseSolver::set_viscosity_factors(std::span<const double> per_vessel) {
   viscosity_factor_.assign(per_vessel.begin(), per_vessel.end());
   lumped_.set_viscosity_factors(viscosity_factor_);

@@ -154,6 +154,12 @@ class PulseSolver {
     time_ = 0;
     steps_ = 0;
   }
+  // Starts again, at t = 0, from the state of another solver of this network with the same
+  // models that differs in its discretisation (degrees, step): every 1D vessel's area and flow
+  // projected onto this one's modes, the 0D vessels' and the outlets' capacitors' state as
+  // they are (a settling cycle at a low degree, solver/settling_cycle.hpp). std::invalid_argument
+  // for a solver of another network or other models.
+  void start_from(const PulseSolver& other);
 
   // The solution at fraction x in [0, 1] along a vessel (index).
   double area_at(std::size_t vessel, double x) const;

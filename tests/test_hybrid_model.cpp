@@ -291,3 +291,36 @@ TEST(HybridModel, ModelsAreChosenByTransitTime) {
   options.model = ModelChoice::zero_d;
   EXPECT_THROW(PulseSolver(net, options), InputError);
 }
+
+// A start from another solver of the same network and models at another degree (the
+// settling cycle at a low degree, solver/settling_cycle.hpp): the 1D vessels' areas and
+// flows, polynomials of degree 2 there, are projected onto degree 5 exactly (to round-off),
+// the 0D vessels' state is taken as it is, and the clock starts again; a solver of another
+// network, or of other models, is refused.
+TEST(HybridModel, AStartFromAnotherDegreeTakesItsState) {
+  const Network net = three_couplings();
+  SolverOptions coarse_options = short_vessels_0d(), fine_options = short_vessels_0d();
+  coarse_options.degree = 2;
+  fine_options.degree = 5;
+  PulseSolver coarse(net, coarse_options), fine(net, fine_options);
+  ASSERT_EQ(coarse.lumped_count(), 2u);
+  for (int k = 0; k < 150; ++k) coarse.step();  // away from any start the fine one knows
+  fine.start_from(coarse);
+  EXPECT_EQ(fine.time(), 0.0);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    for (const double x : {0.0, 0.3, 0.5, 0.8, 1.0}) {
+      const double p = coarse.pressure_at(v, x), q = coarse.flow_at(v, x);
+      EXPECT_NEAR(fine.pressure_at(v, x), p, 1e-10 * std::abs(p)) << v << " " << x;
+      EXPECT_NEAR(fine.flow_at(v, x), q, 1e-10 * std::abs(q) + 1e-18) << v << " " << x;
+    }
+  fine.step();  // and it goes on from there
+  EXPECT_GT(fine.time(), 0.0);
+
+  const Network other = split_vessel(0.1);
+  PulseSolver elsewhere(other, short_vessels_0d());
+  EXPECT_THROW(fine.start_from(elsewhere), std::invalid_argument);
+  SolverOptions all_1d = fine_options;
+  all_1d.model = ModelChoice::one_d;
+  PulseSolver other_models(net, all_1d);
+  EXPECT_THROW(fine.start_from(other_models), std::invalid_argument);
+}
