@@ -22,6 +22,7 @@ const SettingWords& hemosolve_words() {
       {"lumped_step", "--lumped-step"},
       {"lumped_transit", "--lumped-transit"},
       {"max_cycles", "--max-cycles"},
+      {"settling_degree", "--settling-degree"},
       {"settling_step", "--settling-step"},
       {"mean_flow", "--mean-flow"},  // vprune's
       {"model", "--model"},

@@ -100,7 +100,8 @@ int finish(const RunResult& result, const RunConfiguration& config) {
 struct CommandLine {
   RunConfiguration config;
   std::string out_dir, resume_dir, rheology, scheme = "etd2", start = "periodic", dt_text, sample_text = "1ms",
-      external_text = "10mmHg", degree_text = "auto", lumped_step_text = "auto", coupling_passes_text = "auto", model = "auto", vtk_min_text, red_cells = "fixed";
+      external_text = "10mmHg", degree_text = "auto", lumped_step_text = "auto", coupling_passes_text = "auto", settling_degree_text = "auto",
+      model = "auto", vtk_min_text, red_cells = "fixed";
   std::vector<std::string> probe_texts, tracer_texts, pressure_at_texts;
   bool quiet = false, steady = false, linear = false;
   CLI::Option* until_periodic = nullptr;
@@ -113,6 +114,7 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
               &rheology = line.rheology, &scheme = line.scheme, &start = line.start, &dt_text = line.dt_text,
               &sample_text = line.sample_text, &external_text = line.external_text, &degree_text = line.degree_text,
               &lumped_step_text = line.lumped_step_text, &coupling_passes_text = line.coupling_passes_text,
+              &settling_degree_text = line.settling_degree_text,
               &model = line.model, &vtk_min_text = line.vtk_min_text, &red_cells = line.red_cells;
   int &cycles = config.cycles, &max_cycles = config.max_cycles, &frames = config.frames,
       &checkpoint_every = config.checkpoint_every;
@@ -141,6 +143,12 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
                  "with --until-periodic and 0D vessels: first one settling cycle, not reported, with the 0D step N "
                  "times --lumped-step, and the compliance balance after it (docs/solver.md §6a); 0 or 1: none (the "
                  "default: the periodic start leaves it nothing to settle), in [0, 20]")
+      ->capture_default_str();
+  app.add_option("--settling-degree", settling_degree_text,
+                 "with --until-periodic and 1D vessels: first one settling cycle, not reported, with the 1D vessels at "
+                 "this degree at most (many times cheaper than a cycle of the run's), the compliance balance after it, "
+                 "and the run from the state it leaves (docs/solver.md §6a); 0: none; auto: degree 2 where most "
+                 "vessels are 1D (the large arteries) and it costs at most a third of a cycle; else in [0, 30]")
       ->capture_default_str();
   app.add_option("--probe", probe_texts, "record p, Q, A, u at vessel ID, fraction x in [0, 1] along it (ID[:x], x 0.5 by default)");
   app.add_option("--sample-interval", sample_text, "time between probe samples, in (0, the period]")
@@ -258,10 +266,12 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
   app.set_version_flag("--version", std::string("hemosolve ") + HEMOTREE_VERSION);
 
   for (const char* pulsatile_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
-                                     "--settling-step", "--probe", "--frames", "--dt", "--start", "--transport-step", "--tracer"})
+                                     "--settling-step", "--settling-degree", "--probe", "--frames", "--dt", "--start", "--transport-step",
+                                     "--tracer"})
     steady_flag->excludes(app.get_option(pulsatile_only));
   for (const char* time_stepped_only : {"--resume", "--checkpoint-every", "--cycles", "--until-periodic", "--max-cycles",
-                                        "--settling-step", "--frames", "--dt", "--start", "--transport-step", "--tracer", "--steady",
+                                        "--settling-step", "--settling-degree", "--frames", "--dt", "--start", "--transport-step",
+                                        "--tracer", "--steady",
                                         "--red-cells"})
     linear_flag->excludes(app.get_option(time_stepped_only));
 }
@@ -290,6 +300,7 @@ int run_command_line(CommandLine& line, int cores) {
   options.degree = degree_named(line.degree_text);
   options.lumped_step = lumped_step_named(line.lumped_step_text);
   options.coupling_passes = coupling_passes_named(line.coupling_passes_text);
+  config.settling_degree = settling_degree_named(line.settling_degree_text);
   if (!line.dt_text.empty()) options.dt = parse_quantity(line.dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");
   if (options.threads < 1 || options.threads > cores)
     throw InputError("--threads must lie in [1, " + std::to_string(cores) + "] (got " +

@@ -319,16 +319,27 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
     if (plan_.settling_steps > 0) {
       // Not a cycle of the run's: nothing of it is reported or kept, and an interrupt
       // within it leaves nothing to resume from.
-      observer.note("settling cycle: " + std::to_string(plan_.settling_steps) + " steps, then the compliance balance");
+      const bool coarse = settling_solver_ != nullptr;
+      observer.note("settling cycle: " + std::to_string(plan_.settling_steps) + " steps" +
+                    (coarse ? " with the 1D vessels at degree " + std::to_string(settling_solver_->max_degree()) + " at most" : "") +
+                    ", then the compliance balance");
       try {
-        settling_ = settle(net_, solver_, plan_.settling_steps, observer);
+        settling_ = settle(net_, coarse ? *settling_solver_ : solver_, plan_.settling_steps, observer);
       } catch (const SolutionBreakdown& e) {
         // The option is named through its placeholder (core/setting_error.hpp), which the tool words.
-        breakdown_ = e.message() + "; it broke down in the settling cycle, whose 0D step is longer than the run's (without " +
-                     placeholder("settling_step") + ", the default, the run takes none)";
+        breakdown_ = e.message() + "; it broke down in the settling cycle, " +
+                     (coarse ? "whose 1D vessels take a lower degree than the run's (without " + placeholder("settling_degree")
+                             : "whose 0D step is longer than the run's (without " + placeholder("settling_step")) +
+                     ", the default, the run takes none)";
         return RunStatus::broken_down;
       }
       if ((signal_ = settling_.signal) != 0) return RunStatus::interrupted;
+      if (coarse) {
+        settling_.degree = settling_solver_->max_degree();
+        solver_.start_from(*settling_solver_);
+        settling_solver_.reset();
+        if (plan_.balance_compliances) solver_.balance_compliances(period);  // the first cycle's start
+      }
       if (transport_) transport_->restart();  // the cells did not move with it
       observer.note("settling cycle done in " + std::to_string(std::lround(settling_.seconds)) + " s");
     } else if (plan_.balance_compliances) {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -78,6 +79,10 @@ class PulsatileRun {
   const RedCellCycle& last_red_cells() const { return red_cells_last_; }
   double red_cell_change() const { return red_cell_change_; }
   bool has_change() const { return has_previous_; }
+  // The settling cycle is taken by `settling` (another discretisation of the run's network
+  // and models: its 1D vessels at a lower degree), and the run starts from the state it
+  // leaves (PulseSolver::start_from); without one, by the run's own solver. Before run().
+  void settle_with(std::unique_ptr<PulseSolver> settling) { settling_solver_ = std::move(settling); }
   // The settling cycle taken before the first (steps 0: none), and whether an interrupt
   // stopped the run within it (nothing to keep then).
   const Settling& settling() const { return settling_; }
@@ -142,6 +147,7 @@ class PulsatileRun {
   bool has_previous_ = false;
   PeriodicityChange change_;
   Settling settling_;
+  std::unique_ptr<PulseSolver> settling_solver_;  // until its cycle is taken
   int done_ = 0, balances_ = 0, signal_ = 0;
   bool resumed_ = false;
   double measured_step_ = 0;

@@ -112,6 +112,8 @@ int automatic_or_count(const std::string& name, int low, int high, const char* s
 
 int degree_named(const std::string& name) { return automatic_or_count(name, 0, 30, "degree"); }
 
+int settling_degree_named(const std::string& name) { return automatic_or_count(name, 0, 30, "settling_degree"); }
+
 int coupling_passes_named(const std::string& name) { return automatic_or_count(name, 1, 10, "coupling_passes"); }
 
 double lumped_step_named(const std::string& name) {
@@ -141,6 +143,7 @@ void check_configuration(const RunConfiguration& c) {
   check_count(c.cycles, 1, 100000, "cycles");
   check_count(c.max_cycles, 1, 100000, "max_cycles");
   check_count(c.settling_step, 0, 20, "settling_step");
+  if (c.settling_degree != SolverOptions::automatic) check_count(c.settling_degree, 0, 30, "settling_degree");
   check_count(c.checkpoint_every, 0, 100000, "checkpoint_every");
   check_count(c.frames, 0, 10000, "frames");
   check_count(c.solver.periodic_harmonics, 1, 1000, "periodic_harmonics");

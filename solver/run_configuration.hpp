@@ -31,6 +31,7 @@ ModelChoice model_named(const std::string& name);
 StartChoice start_named(const std::string& name);
 Rheology rheology_named(const std::string& name);  // "pries" or "newtonian"
 int degree_named(const std::string& name);         // "auto" (SolverOptions::automatic) or 0 to 30
+int settling_degree_named(const std::string& name);  // "auto" (SolverOptions::automatic) or 0 to 30
 int coupling_passes_named(const std::string& name);  // "auto" (SolverOptions::automatic) or 1 to 10
 double lumped_step_named(const std::string& name);   // "auto" (0) or a fraction in (0, 0.1]
 RedCells red_cells_named(const std::string& name);
@@ -49,6 +50,12 @@ struct RunConfiguration {
   // the run's (solver/settling_cycle.hpp); 0 or 1: none (the default since the periodic start
   // took its mean's second-order shift, docs/solver.md §6a). In [0, 20].
   int settling_step = 0;
+  // With until_periodic and 1D vessels: a settling cycle first with the 1D vessels at this
+  // degree at most (a coarser discretisation of the same models, many times cheaper), the
+  // compliance balance after it, and the run's first cycle from its state
+  // (solver/settling_cycle.hpp); 0: none; SolverOptions::automatic: degree 2 where most
+  // vessels are 1D and it costs at most a third of a cycle (pulsatile_call.cpp). In [0, 30].
+  int settling_degree = SolverOptions::automatic;
   bool balance_compliances = true;
   int checkpoint_every = 0;       // cycles; 0: a checkpoint only when interrupted
   bool resume = false;            // continue from the latest checkpoint of out_dir

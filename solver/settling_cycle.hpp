@@ -9,6 +9,12 @@
 // transient where the 0D vessels cost a third as much: its own mean differs from the run's
 // step's by about 2e-4 (the 1D-0D coupling's error grows with the step), and the run's
 // first two cycles then differ by less than 1e-3 (docs/solver.md §6a).
+//
+// Where the 1D vessels are the network (the large arteries), the first cycle's transient is
+// their nonlinear pulse's, and the settling cycle is taken by a second solver of the same
+// network and models with the 1D vessels at a low degree (a sixth of a cycle's cost), from
+// whose state the run's solver then starts (PulseSolver::start_from; pulsatile_call.cpp
+// chooses, solver/pulsatile_run.cpp takes it).
 #pragma once
 
 #include <cstddef>
@@ -23,6 +29,7 @@ struct Settling {
   std::size_t steps = 0;  // of the settling cycle (0: none taken)
   double seconds = 0;     // its wall time, the balance included
   int signal = 0;         // an interrupt request that stopped it (the state is then mid-cycle)
+  int degree = 0;         // the 1D vessels' highest degree in it, where it took a lower one than the run's (else 0)
 };
 
 // One cycle of `steps` equal steps and the compliance balance after it; the solver's step and

@@ -70,6 +70,8 @@ expect_error "--linear refuses a time-stepping option" 2 "--cycles excludes --li
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/x" --linear --cycles 3
 expect_error "--settling-step out of range" 2 "--settling-step must lie in [0, 20] (got 21)" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/x" --until-periodic 1e-3 --settling-step 21
+expect_error "--settling-degree out of range" 2 "--settling-degree must be auto or a whole number in [0, 30] (got '31')" -- \
+  "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/x" --until-periodic 1e-3 --settling-degree 31
 expect_error "--harmonics out of range" 2 "--harmonics must lie in [1, 1000] (got 0)" -- \
   "$HEMOSOLVE" "$WORK/net.json" --out "$WORK/x" --start periodic --harmonics 0
 finish
