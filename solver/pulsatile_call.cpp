@@ -137,43 +137,6 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
   return d;
 }
 
-// A cycle's cost by the estimate's model (solver/run_estimate.hpp), on one thread.
-double estimated_cycle(const Network& net, const PulseSolver& solver, double period) {
-  std::vector<double> elements_of_degree(static_cast<std::size_t>(solver.max_degree()) + 1, 0.0);
-  for (std::size_t v = 0; v < net.vessel_count(); ++v)
-    if (!solver.is_lumped(v)) elements_of_degree[static_cast<std::size_t>(solver.degree(v))] += solver.elements_per_vessel();
-  return estimate_run(elements_of_degree, std::ceil(period / solver.dt()), 1, solver.substeps() * solver.coupling_passes(),
-                      static_cast<double>(solver.lumped_count()))
-      .seconds;
-}
-
-// The solver of the settling cycle at a lower 1D degree (RunConfiguration::settling_degree),
-// or null where the run takes none: only where it seeks the periodic state from the steady
-// network with the compliance balance, and has 1D vessels above that degree. Automatic:
-// degree 2 where most of the vessels are 1D (the large arteries, whose pulse is nonlinear
-// enough that the linear start leaves its first cycle 2e-3 off; the complement of the 0D
-// settling cycle's rule) and the settling cycle costs at most a third of one. Measured
-// (docs/solver.md §6a): ADAN56 and the circle of Willis periodic to 1e-3 in two cycles after
-// it, three without; the trees, mostly 0D, in two without it.
-std::unique_ptr<PulseSolver> settling_solver(const Network& net, const PulseSolver& run, const RunConfiguration& config,
-                                             double period) {
-  const bool automatic = config.settling_degree == SolverOptions::automatic;
-  const int degree = automatic ? 2 : config.settling_degree;
-  if (!(config.until_periodic && degree > 0 && config.balance_compliances && run.started_from_steady() &&
-        run.lumped_count() < net.vessel_count() && degree < run.max_degree()))
-    return nullptr;
-  if (automatic && 2 * run.lumped_count() >= net.vessel_count()) return nullptr;
-  SolverOptions options = solver_options(config);
-  options.dt = 0;  // its own stable step
-  if (options.degree != SolverOptions::automatic) options.degree = std::min(options.degree, degree);
-  options.degree_rule.low = std::min(options.degree_rule.low, degree);
-  options.degree_rule.high = std::min(options.degree_rule.high, degree);
-  options.degree_rule.raise_to = std::min(options.degree_rule.raise_to, degree);
-  auto settling = std::make_unique<PulseSolver>(net, options);
-  if (automatic && estimated_cycle(net, *settling, period) > estimated_cycle(net, run, period) / 3) return nullptr;
-  return settling;
-}
-
 // A run is complete only when its numbers say so: the reason it is not, or empty.
 std::string check_results(const Network& net, const PulseSolver& run, const PulsatileRun& pulsatile,
                           RunStatus status, const std::string& beyond_limit) {
@@ -347,7 +310,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
   PulseSolver run(net, solver_options(config));  // the steady solve: minutes on the full tree
   // The settling cycle at a lower 1D degree (solver/settling_cycle.hpp) takes a solver of its
   // own, built here while the network still has its walls.
-  std::unique_ptr<PulseSolver> settling = checkpoint.bytes.empty() ? settling_solver(net, run, config, period) : nullptr;
+  std::unique_ptr<PulseSolver> settling = checkpoint.bytes.empty() ? low_degree_settling_solver(net, run, config, period) : nullptr;
   // The walls are in the vessels' tube laws now; only a VTK file would write them again.
   if (given_up && !config.vtk && config.frames == 0)
     for (std::vector<double>* wall : {&given_up->wall_thickness, &given_up->youngs_modulus}) std::vector<double>().swap(*wall);

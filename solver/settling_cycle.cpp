@@ -1,10 +1,14 @@
 #include "solver/settling_cycle.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "solver/cycle_statistics.hpp"
+#include "solver/run_estimate.hpp"
 
 namespace hemotree {
 
@@ -35,6 +39,44 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   solver.restart_clock();
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return s;
+}
+
+namespace {
+
+// A cycle's cost by the estimate's model (solver/run_estimate.hpp), on one thread.
+double estimated_cycle(const Network& net, const PulseSolver& solver, double period) {
+  std::vector<double> elements_of_degree(static_cast<std::size_t>(solver.max_degree()) + 1, 0.0);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (!solver.is_lumped(v)) elements_of_degree[static_cast<std::size_t>(solver.degree(v))] += solver.elements_per_vessel();
+  return estimate_run(elements_of_degree, std::ceil(period / solver.dt()), 1, solver.substeps() * solver.coupling_passes(),
+                      static_cast<double>(solver.lumped_count()))
+      .seconds;
+}
+
+}  // namespace
+
+// Automatic: degree 2 where most of the vessels are 1D (the large arteries, whose pulse is
+// nonlinear enough that the linear start leaves its first cycle 2e-3 off; the complement of
+// the 0D settling cycle's rule) and the settling cycle costs at most a third of one. Measured
+// (docs/solver.md §6a): ADAN56 and the circle of Willis periodic to 1e-3 in two cycles after
+// it, three without; the trees, mostly 0D, in two without it.
+std::unique_ptr<PulseSolver> low_degree_settling_solver(const Network& net, const PulseSolver& run,
+                                                       const RunConfiguration& config, double period) {
+  const bool automatic = config.settling_degree == SolverOptions::automatic;
+  const int degree = automatic ? 2 : config.settling_degree;
+  if (!(config.until_periodic && degree > 0 && config.balance_compliances && run.started_from_steady() &&
+        run.lumped_count() < net.vessel_count() && degree < run.max_degree()))
+    return nullptr;
+  if (automatic && 2 * run.lumped_count() >= net.vessel_count()) return nullptr;
+  SolverOptions options = solver_options(config);
+  options.dt = 0;  // its own stable step
+  if (options.degree != SolverOptions::automatic) options.degree = std::min(options.degree, degree);
+  options.degree_rule.low = std::min(options.degree_rule.low, degree);
+  options.degree_rule.high = std::min(options.degree_rule.high, degree);
+  options.degree_rule.raise_to = std::min(options.degree_rule.raise_to, degree);
+  auto settling = std::make_unique<PulseSolver>(net, options);
+  if (automatic && estimated_cycle(net, *settling, period) > estimated_cycle(net, run, period) / 3) return nullptr;
+  return settling;
 }
 
 }  // namespace hemotree

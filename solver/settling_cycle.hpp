@@ -18,9 +18,11 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 
 #include "formats/network.hpp"
 #include "pulse/pulse_solver.hpp"
+#include "solver/run_configuration.hpp"
 #include "solver/run_observer.hpp"
 
 namespace hemotree {
@@ -37,5 +39,12 @@ struct Settling {
 // here at the cycle's start (it records the volumes the rates are taken from). Interrupt
 // requests are polled every 256 steps; a breakdown throws SolutionBreakdown.
 Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunObserver& observer);
+
+// The solver of the settling cycle at a lower 1D degree (RunConfiguration::settling_degree:
+// the run's options with the 1D vessels' degrees capped and the step its own), or null where
+// the run takes none: only where it seeks the periodic state from the steady network with the
+// compliance balance and has 1D vessels above that degree. period: the pulse's [s].
+std::unique_ptr<PulseSolver> low_degree_settling_solver(const Network& net, const PulseSolver& run,
+                                                       const RunConfiguration& config, double period);
 
 }  // namespace hemotree
