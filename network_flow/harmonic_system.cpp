@@ -8,7 +8,7 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseLU>
 
-#include "network_flow/parents_below.hpp"
+#include "network_flow/forest_order.hpp"
 
 namespace hemotree {
 
@@ -17,46 +17,6 @@ namespace {
 [[noreturn]] void singular_at(std::size_t node) {
   throw std::invalid_argument("harmonic system: node " + std::to_string(node) +
                               " lies in a part with no admittance to ground");
-}
-
-// The forest's elimination order by peeling leaves; false if the graph has a cycle.
-bool peel_leaves(std::size_t nodes, std::span<const std::int32_t> a, std::span<const std::int32_t> b,
-                 std::vector<std::int32_t>& order, std::vector<std::int32_t>& parent_edge,
-                 std::vector<std::int64_t>& offset, std::vector<std::int32_t>& incident) {
-  const std::size_t edges = a.size();
-  offset.assign(nodes + 1, 0);
-  for (std::size_t e = 0; e < edges; ++e) {
-    ++offset[static_cast<std::size_t>(a[e]) + 1];
-    ++offset[static_cast<std::size_t>(b[e]) + 1];
-  }
-  for (std::size_t i = 0; i < nodes; ++i) offset[i + 1] += offset[i];
-  incident.assign(2 * edges, 0);
-  std::vector<std::int64_t> fill(offset.begin(), offset.end() - 1);
-  for (std::size_t e = 0; e < edges; ++e) {
-    incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(a[e])]++)] = static_cast<std::int32_t>(e);
-    incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(b[e])]++)] = static_cast<std::int32_t>(e);
-  }
-  std::vector<std::int64_t> degree(nodes);
-  for (std::size_t i = 0; i < nodes; ++i) degree[i] = offset[i + 1] - offset[i];
-  std::vector<unsigned char> edge_used(edges, 0), done(nodes, 0);
-  order.clear();
-  order.reserve(nodes);
-  parent_edge.assign(nodes, -1);
-  for (std::size_t i = 0; i < nodes; ++i)
-    if (degree[i] <= 1) order.push_back(static_cast<std::int32_t>(i));
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const auto i = static_cast<std::size_t>(order[k]);
-    done[i] = 1;
-    for (std::int64_t s = offset[i]; s < offset[i + 1]; ++s) {
-      const auto e = static_cast<std::size_t>(incident[static_cast<std::size_t>(s)]);
-      if (edge_used[e]) continue;
-      edge_used[e] = 1;
-      parent_edge[i] = static_cast<std::int32_t>(e);
-      const auto p = static_cast<std::size_t>(a[e] == static_cast<std::int32_t>(i) ? b[e] : a[e]);
-      if (--degree[p] == 1 && !done[p]) order.push_back(static_cast<std::int32_t>(p));
-    }
-  }
-  return order.size() == nodes;
 }
 
 }  // namespace
@@ -72,9 +32,8 @@ HarmonicSystem::HarmonicSystem(std::size_t nodes, std::vector<std::int32_t> a, s
     forest_ = true;  // order_ empty: the labels from the highest down
     return;
   }
-  std::vector<std::int64_t> offset;
-  std::vector<std::int32_t> incident;
-  forest_ = peel_leaves(nodes, a_, b_, order_, parent_edge_, offset, incident);
+  std::vector<std::int32_t> parent;
+  forest_ = peel_leaves(nodes, a_, b_, order_, parent, parent_edge_);
   if (!forest_) order_ = {}, parent_edge_ = {};
 }
 

@@ -8,7 +8,7 @@
 
 #include <Eigen/SparseCholesky>
 
-#include "network_flow/parents_below.hpp"
+#include "network_flow/forest_order.hpp"
 
 namespace hemotree {
 
@@ -69,7 +69,7 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
     throw std::invalid_argument("NodalSystem: " + std::to_string(m) + " edges exceed 32-bit indices");
 
   // Is the graph a forest, and in what order can it be eliminated (every parent before its
-  // children)? First the common case at the cost of one pass (parents_below.hpp): the nodes'
+  // children)? First the common case at the cost of one pass (forest_order.hpp): the nodes'
   // own order serves.
   bool forest = false;
   if (method != Method::sparse_cholesky) {
@@ -80,39 +80,7 @@ NodalSystem::NodalSystem(std::size_t nodes, std::vector<std::int32_t> a, std::ve
         if (const std::int32_t e = parent_edge_[c]; e >= 0)
           parent_[c] = std::min(a_[static_cast<std::size_t>(e)], b_[static_cast<std::size_t>(e)]);
     } else {
-      // Else peeling leaves: a node with one edge left hangs from that edge's other node, and
-      // removing it may make that one a leaf in turn; the last node of each component is its
-      // root, and the reverse of the peeling an order for the elimination. parent_ and
-      // parent_edge_ first hold the XOR of each node's remaining neighbours and edges, so that
-      // a leaf's one neighbour and edge are there to read without an adjacency list (O(nodes),
-      // three flat arrays). Nodes on a loop or a doubled edge are never peeled.
-      std::vector<std::int32_t> degree(nodes_, 0);
-      std::fill(parent_.begin(), parent_.end(), 0);
-      parent_edge_.assign(nodes_, 0);
-      for (std::size_t e = 0; e < m; ++e) {
-        const auto ea = static_cast<std::size_t>(a_[e]), eb = static_cast<std::size_t>(b_[e]);
-        ++degree[ea];
-        ++degree[eb];
-        parent_[ea] ^= b_[e];
-        parent_[eb] ^= a_[e];
-        parent_edge_[ea] ^= static_cast<std::int32_t>(e);
-        parent_edge_[eb] ^= static_cast<std::int32_t>(e);
-      }
-      for (std::int32_t i = 0; i < n; ++i)
-        if (degree[static_cast<std::size_t>(i)] <= 1) order_.push_back(i);
-      for (std::size_t head = 0; head < order_.size(); ++head) {
-        const auto c = static_cast<std::size_t>(order_[head]);
-        if (degree[c] == 0) {  // the last of its component
-          parent_[c] = parent_edge_[c] = -1;
-          continue;
-        }
-        degree[c] = 0;
-        const auto p = static_cast<std::size_t>(parent_[c]);
-        parent_[p] ^= static_cast<std::int32_t>(c);
-        parent_edge_[p] ^= parent_edge_[c];
-        if (--degree[p] == 1) order_.push_back(static_cast<std::int32_t>(p));
-      }
-      forest = order_.size() == nodes_;
+      forest = peel_leaves(nodes_, a_, b_, order_, parent_, parent_edge_);
       std::reverse(order_.begin(), order_.end());  // roots first
     }
   }
