@@ -13,8 +13,8 @@
 // Where the 1D vessels are the network (the large arteries), the first cycle's transient is
 // their nonlinear pulse's, and the settling cycle is taken by a second solver of the same
 // network and models with the 1D vessels at a low degree (a sixth of a cycle's cost), from
-// whose state the run's solver then starts (PulseSolver::start_from; pulsatile_call.cpp
-// chooses, solver/pulsatile_run.cpp takes it).
+// whose state the run's solver then starts (PulseSolver::start_from; chosen by
+// low_degree_settling_solver below, taken by solver/pulsatile_run.cpp).
 #pragma once
 
 #include <cstddef>
