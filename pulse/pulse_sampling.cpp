@@ -78,8 +78,9 @@ void PulseSolver::sample_one_d(double x, std::span<double> area, std::span<doubl
 
 template <class F>
 void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) const {
-  // The same element k and point xi in every vessel (locate's arithmetic); the first of each
-  // vessel's elements names it.
+  // The same element k and point xi in every vessel (locate's arithmetic). The 1D vessels are
+  // listed in the order of their elements, elements_per_vessel_ each: the j-th one's first
+  // element is j elements_per_vessel_ (first_element(v)'s, without its search).
   const double s = std::clamp(x, 0.0, 1.0) * elements_per_vessel_;
   const auto k = std::min(static_cast<std::int32_t>(s), elements_per_vessel_ - 1);
   const double xi = 2 * (s - k) - 1;
@@ -89,7 +90,7 @@ void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) con
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t j = 0; j < one_d; ++j) {
     const auto v = static_cast<std::size_t>(one_d_vessels_[static_cast<std::size_t>(j)]);
-    const Eigen::Index el = first_element(v) + k;
+    const Eigen::Index el = j * elements_per_vessel_ + k;
     double a = 0, q = 0;
     for (int m = 0; m <= vessel_degree_[v]; ++m) {
       a += state_.area(el, m) * phi[static_cast<std::size_t>(m)];
