@@ -326,11 +326,15 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       try {
         settling_ = settle(net_, coarse ? *settling_solver_ : solver_, plan_.settling_steps, observer);
       } catch (const SolutionBreakdown& e) {
-        // The option is named through its placeholder (core/setting_error.hpp), which the tool words.
+        // The options are named through their placeholders (core/setting_error.hpp), which the
+        // tool words. The 0D step's settling cycle is taken only when asked for; the low
+        // degree's by default where most vessels are 1D, so its advice is the value that
+        // turns it off.
         breakdown_ = e.message() + "; it broke down in the settling cycle, " +
-                     (coarse ? "whose 1D vessels take a lower degree than the run's (without " + placeholder("settling_degree")
-                             : "whose 0D step is longer than the run's (without " + placeholder("settling_step")) +
-                     ", the default, the run takes none)";
+                     (coarse ? "whose 1D vessels take a lower degree than the run's (with " + placeholder("settling_degree") +
+                                   " 0 the run takes none)"
+                             : "whose 0D step is longer than the run's (without " + placeholder("settling_step") +
+                                   ", the default, the run takes none)");
         return RunStatus::broken_down;
       }
       if ((signal_ = settling_.signal) != 0) return RunStatus::interrupted;

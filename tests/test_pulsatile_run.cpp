@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -170,6 +171,43 @@ TEST(PulsatileRun, TakesItsSettlingCycleBeforeItsOwn) {
   EXPECT_EQ(b.signal(), SIGINT);
   EXPECT_EQ(b.cycles_done(), 0);
   EXPECT_FALSE(std::filesystem::exists(f.folder / "snapshot.pending"));
+}
+
+// A settling cycle taken by another solver (the 1D vessels at a lower degree): the run starts
+// from the state it leaves; where it breaks down (here a step 20 times its stable one), the
+// run stops with nothing computed and says how to go without it: --settling-degree 0 (its
+// default takes one).
+TEST(PulsatileRun, SettlesWithAnotherSolverAndNamesItsOptionWhereItBreaksDown) {
+  Fixture f;
+  Interrupts quiet;
+  SolverOptions coarse_options = f.options;
+  coarse_options.degree = 1;
+  PulseSolver settled(f.net, f.options);
+  RunPlan plan = f.plan(settled, 1);
+  auto coarse = std::make_unique<PulseSolver>(f.net, coarse_options);
+  plan.settling_steps = static_cast<std::size_t>(std::ceil(f.net.inlet->waveform.period / coarse->dt()));
+  PulsatileRun a(f.net, settled, {}, plan, f.folder);
+  a.settle_with(std::move(coarse));
+  ASSERT_EQ(a.run(quiet), RunStatus::complete);
+  EXPECT_EQ(a.settling().degree, 1);
+  EXPECT_EQ(a.cycles_done(), 1);
+  EXPECT_EQ(settled.steps(), plan.steps_per_cycle);  // its own steps alone, from t = 0
+  a.discard_snapshot();
+
+  // Twenty elements: short ones, whose stable step the settling cycle's exceeds twentyfold.
+  SolverOptions fine = f.options;
+  fine.elements = coarse_options.elements = 20;
+  PulseSolver broken(f.net, fine);
+  RunPlan broken_plan = f.plan(broken, 1);
+  auto unstable = std::make_unique<PulseSolver>(f.net, coarse_options);
+  broken_plan.settling_steps = std::max<std::size_t>(1, static_cast<std::size_t>(f.net.inlet->waveform.period / (20 * unstable->dt())));
+  PulsatileRun b(f.net, broken, {}, broken_plan, f.folder);
+  b.settle_with(std::move(unstable));
+  ASSERT_EQ(b.run(quiet), RunStatus::broken_down);
+  EXPECT_EQ(b.cycles_done(), 0);
+  EXPECT_NE(in_words(b.breakdown(), hemosolve_words()).find("(with --settling-degree 0 the run takes none)"),
+            std::string::npos)
+      << b.breakdown();
 }
 
 TEST(PulsatileRun, ResumesFromItsCheckpointAsIfNeverStopped) {
