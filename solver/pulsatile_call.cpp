@@ -354,12 +354,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
       config.balance_compliances && run.started_from_steady())
     plan.settling_steps = std::max<std::size_t>(
         1, steps_per_cycle * static_cast<std::size_t>(run.coupling_passes()) / static_cast<std::size_t>(config.settling_step));
-  // At a lower 1D degree: the steps of that solver's own stable step (its 0D step as long as
-  // the run's), the longer 0D step too where asked.
-  if (settling)
-    plan.settling_steps = std::max<std::size_t>(
-        1, static_cast<std::size_t>(std::ceil(period / settling->dt() - 1e-9)) *
-               static_cast<std::size_t>(settling->coupling_passes()) / static_cast<std::size_t>(std::max(1, config.settling_step)));
+  if (settling) plan.settling_steps = low_degree_settling_steps(*settling, period, config.settling_step);
   std::optional<FlowTransport> transport;
   if (config.carries_transport()) {
     const bool red = config.red_cells == RedCells::transport;

@@ -79,4 +79,10 @@ std::unique_ptr<PulseSolver> low_degree_settling_solver(const Network& net, cons
   return settling;
 }
 
+std::size_t low_degree_settling_steps(const PulseSolver& settling, double period, int settling_step) {
+  return std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(period / settling.dt() - 1e-9)) *
+                                      static_cast<std::size_t>(settling.coupling_passes()) /
+                                      static_cast<std::size_t>(std::max(1, settling_step)));
+}
+
 }  // namespace hemotree

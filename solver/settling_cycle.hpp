@@ -46,5 +46,9 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
 // compliance balance and has 1D vessels above that degree. period: the pulse's [s].
 std::unique_ptr<PulseSolver> low_degree_settling_solver(const Network& net, const PulseSolver& run,
                                                        const RunConfiguration& config, double period);
+// The steps of its cycle: its own stable step, taken in one coupling pass (a 0D step as long as
+// the run's takes the run's passes' 1D substeps in one), and settling_step times longer where
+// that is asked too (RunConfiguration::settling_step).
+std::size_t low_degree_settling_steps(const PulseSolver& settling, double period, int settling_step);
 
 }  // namespace hemotree
