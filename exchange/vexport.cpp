@@ -1,5 +1,7 @@
 // vexport: writes a vnet network in another program's format: Secomb's network.dat (NetFlow)
-// or openBF's YAML model with its inlet table (docs/import.md).
+// or openBF's YAML model with its inlet table (docs/import.md); or in the other form of vnet
+// (json, h5: the same network, provenance included) or one of the tools' exports (vtk,
+// graphml, dot, csv).
 #include <filesystem>
 #include <string>
 
@@ -10,6 +12,7 @@
 #include "core/units.hpp"
 #include "exchange/openbf.hpp"
 #include "exchange/secomb.hpp"
+#include "formats/exports.hpp"
 #include "formats/network_io.hpp"
 
 using namespace hemotree;
@@ -38,9 +41,11 @@ void note_what_secomb_drops(const Network& net) {
 int main(int argc, char** argv) {
   CLI::App app{"Writes a vnet network in another program's format.", "vexport"};
   std::string format, input = "-", output = "-";
-  app.add_option("FORMAT", format, "secomb (NetFlow's network.dat) or openbf (YAML, with an inlet table beside it)")
+  app.add_option("FORMAT", format,
+                 "secomb (NetFlow's network.dat), openbf (YAML, with an inlet table beside it), json or h5 "
+                 "(vnet's two forms: the network as it is), vtk, graphml, dot or csv")
       ->required();
-  app.add_option("NET", input, "network file (vnet JSON); - reads standard input")->capture_default_str();
+  app.add_option("NET", input, "network file (vnet, JSON or HDF5); - reads standard input")->capture_default_str();
   app.add_option("-o,--output", output,
                  "output file; - for standard output (secomb only: openbf writes its inlet table beside the YAML, "
                  "as OUT's name + _inlet.dat)")
@@ -48,8 +53,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("vexport ") + HEMOTREE_VERSION);
 
   return run_tool(app, argc, argv, [&] {
-    if (format != "secomb" && format != "openbf")
-      throw InputError("FORMAT must be secomb or openbf (got '" + format + "')");
+    const auto export_format = parse_export_format(format);
+    if (format != "secomb" && format != "openbf" && !export_format)
+      throw InputError("FORMAT must be secomb, openbf, json, h5, vtk, graphml, dot or csv (got '" + format + "')");
     if (format == "openbf" && (output.empty() || output == "-"))
       throw InputError("vexport openbf needs -o FILE.yaml: its inlet table is written beside it");
 
@@ -57,7 +63,9 @@ int main(int argc, char** argv) {
     OutputStream out(output);
     // The writers name the vessel or node the format cannot hold; the network's file goes first.
     try {
-      if (format == "secomb") {
+      if (export_format) {
+        write_network_as(net, *export_format, out);
+      } else if (format == "secomb") {
         write_secomb(net, out);
         note_what_secomb_drops(net);
       } else {

@@ -16,6 +16,7 @@
 #include "exchange/vtk_centerline.hpp"
 #include "formats/field_ranges.hpp"
 #include "formats/largest_part.hpp"
+#include "formats/exports.hpp"
 #include "formats/network_io.hpp"
 
 using namespace hemotree;
@@ -47,7 +48,7 @@ int main(int argc, char** argv) {
                  "networkx (node-link JSON)")
       ->required();
   app.add_option("FILE", input, "the file to read")->required();
-  app.add_option("-o,--output", output, "output file (vnet JSON), - for standard output")->capture_default_str();
+  app.add_option("-o,--output", output, "output file (vnet: HDF5 if named *.h5, else JSON), - for standard output")->capture_default_str();
   app.add_option("--youngs-modulus", youngs_text,
                  "Young's modulus of every vessel whose file gives none, " + in(ranges::youngs_modulus, "Pa") +
                      " (default: hemotree's E(D) table)")
@@ -174,7 +175,7 @@ int main(int argc, char** argv) {
     stamp_import_provenance(net, format, input, parameters);
 
     OutputStream out(output);
-    write_network(net, out);
+    write_network_as(net, output_format("", output), out);
     out.commit();
     return 0;
   });

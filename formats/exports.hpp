@@ -13,9 +13,12 @@
 
 namespace hemotree {
 
-enum class ExportFormat { json, vtk, graphml, dot, csv };
+enum class ExportFormat { json, h5, vtk, graphml, dot, csv };
 std::optional<ExportFormat> parse_export_format(std::string_view name);
 std::string_view to_string(ExportFormat format);
+// The format a tool writes: the one named (--format), else h5 for an output file named
+// *.h5, else json. Throws InputError for an unknown name.
+ExportFormat output_format(const std::string& named, const std::string& output_path);
 
 // A per-vessel quantity to attach as VTK cell data (e.g. simulation results).
 struct CellField {
@@ -37,7 +40,8 @@ void write_graphml(const Network& net, OutputStream& out);
 void write_dot(const Network& net, OutputStream& out);
 void write_csv(const Network& net, OutputStream& out);
 
-// Dispatches on format; json is the native format (write_network).
+// Dispatches on format; json and h5 are the native format's two forms (write_network,
+// write_network_hdf5).
 void write_network_as(const Network& net, ExportFormat format, OutputStream& out);
 
 }  // namespace hemotree

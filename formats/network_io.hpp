@@ -1,5 +1,6 @@
-// Reading and writing the vnet JSON format (docs/network-format.md), streaming both ways:
-// a tree of millions of vessels goes through a pipe without a document tree in memory.
+// Reading and writing the vnet format (docs/network-format.md): JSON, streamed both ways (a
+// tree of millions of vessels goes through a pipe without a document tree in memory), and
+// the same content as HDF5 columns. Readers tell the two apart by their first byte.
 #pragma once
 
 #include <cstddef>
@@ -17,7 +18,11 @@ namespace hemotree {
 inline constexpr int vnet_version = 2;
 int format_version_needed(const Network& net);
 
-// path "-" reads standard input. Throws InputError naming the position or the vessel at
+namespace hdf5 {
+class File;
+}
+
+// path "-" reads standard input; either form (an HDF5 file by its signature). Throws InputError naming the position or the vessel at
 // fault, IoError when the file cannot be read.
 Network read_network(const std::string& path);
 Network read_network(std::FILE* in, const std::string& source);
@@ -29,5 +34,11 @@ Network read_network(std::FILE* in, const std::string& source, std::size_t buffe
 Network parse_network(std::string_view text, const std::string& source = "<text>");
 
 void write_network(const Network& net, OutputStream& out);
+
+// The HDF5 form (formats/network_hdf5.cpp), built in memory and written through out, so that
+// it is as atomic as the JSON one and may go to a pipe.
+void write_network_hdf5(const Network& net, OutputStream& out);
+// Throws InputError naming the file, the dataset and the row at fault.
+Network read_network_hdf5(const hdf5::File& file);
 
 }  // namespace hemotree

@@ -12,8 +12,11 @@
 #include <utility>
 #include <vector>
 
+#include <sys/stat.h>
+
 #include "core/errors.hpp"
 #include "formats/field_ranges.hpp"
+#include "formats/hdf5_file.hpp"
 #include "formats/json_pull.hpp"
 #include "formats/network_io.hpp"
 #include "formats/topology.hpp"
@@ -434,7 +437,29 @@ Network read_with(JsonPull& in, const std::string& source) { return Reader(in, s
 
 }  // namespace
 
+namespace {
+
+// HDF5 files begin with 0x89, which no JSON text does (a UTF-8 byte order mark begins with
+// 0xEF): one byte tells the forms apart, and ungetc puts it back for the JSON reader.
+bool begins_hdf5(std::FILE* in) {
+  const int first = std::getc(in);
+  if (first == EOF) return false;
+  std::ungetc(first, in);
+  return first == hdf5::signature[0];
+}
+
+Network read_hdf5_stream(std::FILE* in, const std::string& source) {
+  std::vector<char> bytes;
+  char block[1 << 16];
+  for (std::size_t got; (got = std::fread(block, 1, sizeof block, in)) > 0;) bytes.insert(bytes.end(), block, block + got);
+  if (std::ferror(in)) throw IoError("cannot read " + source + ": " + std::strerror(errno));
+  return read_network_hdf5(hdf5::File::open_image(std::move(bytes), source));
+}
+
+}  // namespace
+
 Network read_network(std::FILE* in, const std::string& source) {
+  if (begins_hdf5(in)) return read_hdf5_stream(in, source);
   return read_network(in, source, JsonPull::buffer_size);
 }
 
@@ -453,6 +478,12 @@ Network read_network(const std::string& path) {
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
                                                         &std::fclose);
   if (!file) throw IoError("cannot open " + path + ": " + std::strerror(errno));
+  // A regular HDF5 file is read in place; one from a pipe through memory.
+  struct stat status{};
+  if (begins_hdf5(file.get()) && ::fstat(::fileno(file.get()), &status) == 0 && S_ISREG(status.st_mode)) {
+    file.reset();
+    return read_network_hdf5(hdf5::File::open(path));
+  }
   return read_network(file.get(), path);
 }
 

@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Grow a full vascular tree by stochastic branching (Murray's law, fractal "
                "length law) and write it in the vnet network format.",
                "vgen"};
-  std::string root_text = "1mm", min_text = "7um", rules_path, output = "-", format_name = "json";
+  std::string root_text = "1mm", min_text = "7um", rules_path, output = "-", format_name;
   std::string seed_text = "1", mean_flow_text = "1.74ml/min", venous_pressure_text = "10mmHg",
               venous_ratio_text = "1";
   bool print_rules = false, force = false, venous = false;
@@ -73,8 +73,8 @@ int main(int argc, char** argv) {
   app.add_option("--rules", rules_path, "growth rules (JSON, the form --print-rules prints)");
   app.add_flag("--print-rules", print_rules, "print the growth rules in use (to -o) and exit");
   app.add_option("-o,--output", output, "output file, - for standard output")->capture_default_str();
-  app.add_option("--format", format_name, "json (vnet), vtk, graphml, dot or csv")
-      ->capture_default_str();
+  app.add_option("--format", format_name,
+                 "json or h5 (vnet), vtk, graphml, dot or csv (default: h5 for a -o file named *.h5, else json)");
   app.add_flag("--force", force,
                "grow even when the estimated size exceeds available memory (never beyond the "
                "2147483646 vessels a network holds)");
@@ -103,8 +103,7 @@ int main(int argc, char** argv) {
       out.commit();
       return 0;
     }
-    const auto format = parse_export_format(format_name);
-    if (!format) throw InputError("--format: unknown format '" + format_name + "'");
+    const ExportFormat format = output_format(format_name, output);
     GrowthParameters p;
     p.seed = parse_count(seed_text, "--seed", 0, std::numeric_limits<std::uint64_t>::max());
     // The rules' ranges are sorted and contiguous: together they cover [front.min, back.max).
@@ -167,7 +166,7 @@ int main(int argc, char** argv) {
     if (venous) net.provenance["parameters"]["venous"] = venous_parameters;
 
     OutputStream out(output);
-    write_network_as(net, *format, out);
+    write_network_as(net, format, out);
     out.commit();
     return 0;
   });

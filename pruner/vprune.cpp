@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Cut a full vascular tree to a computational budget and replace each removed "
                "subtree by a calibrated RCR or R outlet.",
                "vprune"};
-  std::string input = "-", output = "-", format_name = "json", strategy = "profile";
+  std::string input = "-", output = "-", format_name, strategy = "profile";
   std::string profile_report;
   std::string budget_text, seed_text = "1", max_generation_text, keep_subtree_text;
   std::string cutoff_text, mean_flow_text = "1.74ml/min", period_text = "1s",
@@ -119,7 +119,8 @@ int main(int argc, char** argv) {
                      " (the result has it within 1 %), or all: the whole tree, its leaves' outlets "
                      "calibrated (as any budget of at least the tree's size)");
   app.add_option("-o,--output", output, "output file, - for standard output")->capture_default_str();
-  app.add_option("--format", format_name, "json (vnet), vtk, graphml, dot or csv")->capture_default_str();
+  app.add_option("--format", format_name,
+                 "json or h5 (vnet), vtk, graphml, dot or csv (default: h5 for a -o file named *.h5, else json)");
   app.add_option("--strategy", strategy, "profile (the paper's), diameter or generation")
       ->capture_default_str();
   app.add_option("--cutoff", cutoff_text,
@@ -194,8 +195,7 @@ int main(int argc, char** argv) {
 
   const int status = run_tool(app, argc, argv, vprune_words(), [&] {
     // ---- every flag, before any work ---------------------------------------------------
-    const auto format = parse_export_format(format_name);
-    if (!format) throw InputError("--format: unknown format '" + format_name + "'");
+    const ExportFormat format = output_format(format_name, output);
     if (strategy != "profile" && strategy != "diameter" && strategy != "generation")
       throw InputError("--strategy must be profile, diameter or generation");
     // A flag of another strategy would be ignored: say so rather than run without it.
@@ -374,7 +374,7 @@ int main(int argc, char** argv) {
       report_out.commit();
     }
     OutputStream out(output);
-    write_network_as(pruned, *format, out);
+    write_network_as(pruned, format, out);
     out.commit();
     return 0;
   });

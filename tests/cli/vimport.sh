@@ -91,7 +91,7 @@ expect_error "bad mean cell volume" 2 "--mean-cell-volume" -- "$VIMPORT" secomb 
 expect_error "bad wall ratio" 2 "--wall-ratio" -- "$VIMPORT" secomb "$WORK/small.dat" --wall-ratio 0
 expect_error "missing file" 1 "cannot open" -- "$VIMPORT" secomb "$WORK/absent.dat"
 expect_error "vexport openbf to standard output" 2 "needs -o FILE.yaml" -- "$VEXPORT" openbf "$WORK/small.json"
-expect_error "vexport unknown format" 2 "FORMAT must be secomb or openbf" -- "$VEXPORT" netflow "$WORK/small.json"
+expect_error "vexport unknown format" 2 "FORMAT must be secomb, openbf, json, h5" -- "$VEXPORT" netflow "$WORK/small.json"
 /usr/bin/python3 - "$WORK/small.json" "$WORK/rcr.json" <<'PY'
 import json, sys
 net = json.load(open(sys.argv[1]))

@@ -1,0 +1,507 @@
+#include "formats/hdf5_file.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <fcntl.h>
+#include <hdf5_hl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "core/errors.hpp"
+
+namespace hemotree::hdf5 {
+
+namespace {
+
+// Rows a chunk: 64 Ki doubles are half a megabyte, a unit the deflate filter works through
+// quickly and a reader of a slice (a rank of a parallel run) wastes little of.
+constexpr hsize_t chunk_rows = 1 << 16;
+constexpr unsigned deflate_level = 1;
+// The core driver grows its image by this much at a time.
+constexpr std::size_t image_increment = 64 << 20;
+
+// The library prints its error stack on stderr unless told not to; the messages here are
+// built from it instead.
+void silence_library() {
+  static const bool silenced = [] {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    return true;
+  }();
+  (void)silenced;
+}
+
+// The innermost description on the library's error stack ("truncated file: eof = 96, ..."),
+// the most specific thing it knows about what failed.
+std::string library_reason() {
+  std::string reason;
+  H5Ewalk2(
+      H5E_DEFAULT, H5E_WALK_UPWARD,
+      [](unsigned n, const H5E_error2_t* error, void* data) -> herr_t {
+        if (n == 0 && error->desc) *static_cast<std::string*>(data) = error->desc;
+        return 0;
+      },
+      &reason);
+  H5Eclear2(H5E_DEFAULT);
+  return reason;
+}
+
+std::string with_reason(const std::string& what) {
+  const std::string reason = library_reason();
+  return reason.empty() ? what : what + " (" + reason + ")";
+}
+
+Handle property_list(hid_t kind) { return Handle(H5Pcreate(kind), H5Pclose); }
+
+// Objects without their times of creation and change, which the library records by default:
+// the same content gives the same bytes (reproducible runs compare files byte for byte).
+Handle untimed(hid_t kind) {
+  Handle list = property_list(kind);
+  H5Pset_obj_track_times(list.id(), 0);
+  return list;
+}
+
+// Links named in UTF-8.
+Handle utf8_links() {
+  Handle lcpl = property_list(H5P_LINK_CREATE);
+  H5Pset_char_encoding(lcpl.id(), H5T_CSET_UTF8);
+  return lcpl;
+}
+
+// Fixed-length UTF-8 text (at least one byte). Not variable-length: such strings live in
+// the file's global heap, which carries no checksum, and a damaged heap sent HDF5 1.10.8 into
+// an endless loop where a damaged fixed-length string is refused or read as damaged text.
+Handle text_type(std::size_t size) {
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.id(), std::max<std::size_t>(size, 1));
+  H5Tset_strpad(type.id(), H5T_STR_NULLPAD);
+  H5Tset_cset(type.id(), H5T_CSET_UTF8);
+  return type;
+}
+
+Handle enum_type(const EnumNames& names) {
+  Handle type(H5Tenum_create(H5T_NATIVE_UINT8), H5Tclose);
+  for (std::size_t k = 0; k < names.names.size(); ++k) {
+    const auto value = static_cast<std::uint8_t>(k);
+    H5Tenum_insert(type.id(), names.names[k].c_str(), &value);
+  }
+  return type;
+}
+
+const char* class_name(H5T_class_t c) {
+  switch (c) {
+    case H5T_INTEGER: return "integers";
+    case H5T_FLOAT: return "floating-point numbers";
+    case H5T_STRING: return "text";
+    case H5T_ENUM: return "an enumeration";
+    case H5T_COMPOUND: return "a compound type";
+    default: return "another type";
+  }
+}
+
+std::atomic<unsigned> images_made{0};
+
+// The crash guard's state: the line to print, the handlers it replaced, how many guards.
+char crash_line[1024];
+std::size_t crash_line_length = 0;
+constexpr int guarded_signals[] = {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL};
+struct sigaction replaced[std::size(guarded_signals)];
+int guards = 0;
+
+extern "C" void report_library_crash(int signal_number) {
+  // Only async-signal-safe calls: write and _exit.
+  ssize_t written = ::write(STDERR_FILENO, crash_line, crash_line_length);
+  char number[4] = {static_cast<char>('0' + signal_number / 10 % 10), static_cast<char>('0' + signal_number % 10), ')',
+                    '\n'};
+  written = ::write(STDERR_FILENO, number, sizeof number);
+  (void)written;
+  ::_exit(2);
+}
+
+}  // namespace
+
+CrashGuard::CrashGuard(const std::string& file_name) {
+  active_ = true;
+  if (guards++ > 0) return;
+  const std::string line = std::string(program_invocation_short_name) + ": error: " + file_name +
+                           ": damaged HDF5 file (the HDF5 library failed reading it: signal ";
+  crash_line_length = std::min(line.size(), sizeof crash_line);
+  std::memcpy(crash_line, line.data(), crash_line_length);
+  struct sigaction action{};
+  action.sa_handler = report_library_crash;
+  sigemptyset(&action.sa_mask);
+  for (std::size_t k = 0; k < std::size(guarded_signals); ++k) sigaction(guarded_signals[k], &action, &replaced[k]);
+}
+
+void CrashGuard::release() {
+  if (!active_) return;
+  active_ = false;
+  if (--guards > 0) return;
+  for (std::size_t k = 0; k < std::size(guarded_signals); ++k) sigaction(guarded_signals[k], &replaced[k], nullptr);
+}
+
+bool has_signature(std::span<const char> first_bytes) {
+  return first_bytes.size() >= sizeof signature &&
+         std::memcmp(first_bytes.data(), signature, sizeof signature) == 0;
+}
+
+File File::create(std::string name) {
+  silence_library();
+  // Built in memory (the core driver) and written once, at close, to a file that is unlinked
+  // at once: bytes() reads it back through a descriptor of its own, and a writer killed at
+  // any moment leaves nothing behind. Not H5Fget_file_image: its images of files with
+  // checksummed metadata came back with a superblock checksum no reader accepts (1.10.8).
+  Handle fapl = property_list(H5P_FILE_ACCESS);
+  H5Pset_fapl_core(fapl.id(), image_increment, 1);
+  // The newest object versions of HDF5 1.10 (h5py, and every HDF5 since 1.10, read them): their
+  // headers, chunk indexes and heaps carry checksums, so that a damaged header is refused
+  // rather than trusted; the data carry their own (fletcher32, below).
+  H5Pset_libver_bounds(fapl.id(), H5F_LIBVER_V110, H5F_LIBVER_V110);
+  const char* folder = std::getenv("TMPDIR");
+  const std::string path = std::string(folder && *folder ? folder : "/tmp") + "/hemotree-" +
+                           std::to_string(::getpid()) + "-" + std::to_string(images_made++) + ".h5";
+  Handle fcpl = untimed(H5P_FILE_CREATE);  // the root group's times
+  Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.id(), fapl.id()), H5Fclose);
+  if (!file) throw IoError(with_reason(name + ": cannot create an HDF5 file (in " + path + ")"));
+  const int backing = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int open_errno = errno;
+  ::unlink(path.c_str());
+  if (backing < 0) throw IoError(name + ": cannot open " + path + ": " + std::strerror(open_errno));
+  File created(std::move(file), std::move(name));
+  created.backing_ = backing;
+  return created;
+}
+
+File File::open(const std::string& path) {
+  silence_library();
+  std::ifstream probe(path, std::ios::binary);
+  if (!probe) throw IoError("cannot open " + path + ": " + std::strerror(errno));
+  char first[sizeof signature] = {};
+  probe.read(first, sizeof first);
+  if (!has_signature(std::span<const char>(first, static_cast<std::size_t>(probe.gcount()))))
+    throw InputError(path + ": not an HDF5 file (it does not begin with HDF5's signature)");
+  CrashGuard guard(path);
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file) throw InputError(with_reason(path + ": not a complete HDF5 file (truncated or damaged)"));
+  return File(std::move(file), path, std::move(guard));
+}
+
+File File::open_image(std::vector<char> bytes, std::string name) {
+  silence_library();
+  if (!has_signature(bytes))
+    throw InputError(name + ": not an HDF5 file (it does not begin with HDF5's signature)");
+  // Read in place: the image lives as long as the File.
+  CrashGuard guard(name);
+  Handle file(H5LTopen_file_image(bytes.data(), bytes.size(),
+                                  H5LT_FILE_IMAGE_DONT_COPY | H5LT_FILE_IMAGE_DONT_RELEASE),
+              H5Fclose);
+  if (!file) throw InputError(with_reason(name + ": not a complete HDF5 file (truncated or damaged)"));
+  return File(std::move(file), std::move(name), std::move(guard), std::move(bytes));
+}
+
+std::vector<char> File::bytes() {
+  if (backing_ < 0) throw IoError(name_ + ": bytes() of a file not created here");
+  if (H5Fclose(file_.release()) < 0) throw IoError(with_reason(name_ + ": cannot finish the HDF5 file"));
+  struct stat status{};
+  if (::fstat(backing_, &status) != 0) throw IoError(name_ + ": cannot read back the HDF5 file: " + std::strerror(errno));
+  std::vector<char> bytes(static_cast<std::size_t>(status.st_size));
+  for (std::size_t done = 0; done < bytes.size();) {
+    const ssize_t got = ::pread(backing_, bytes.data() + done, bytes.size() - done, static_cast<off_t>(done));
+    if (got <= 0) throw IoError(name_ + ": cannot read back the HDF5 file: " + std::strerror(errno));
+    done += static_cast<std::size_t>(got);
+  }
+  return bytes;
+}
+
+File::~File() {
+  if (backing_ >= 0) ::close(backing_);
+}
+
+File::File(File&& other) noexcept
+    : guard_(std::move(other.guard_)),
+      file_(std::move(other.file_)),
+      name_(std::move(other.name_)),
+      image_(std::move(other.image_)),
+      backing_(std::exchange(other.backing_, -1)) {}
+
+void File::fail(const std::string& path, const std::string& what) const {
+  throw InputError(name_ + ": " + path + ": " + what);
+}
+
+void File::create_group(const std::string& path) {
+  Handle lcpl = utf8_links();
+  Handle gcpl = untimed(H5P_GROUP_CREATE);
+  Handle group(H5Gcreate2(file_.id(), path.c_str(), lcpl.id(), gcpl.id(), H5P_DEFAULT), H5Gclose);
+  if (!group) throw IoError(with_reason(name_ + ": " + path + ": cannot create the group"));
+}
+
+Handle File::links_for(const std::string& path) {
+  for (std::size_t slash = path.find('/', 1); slash != std::string::npos; slash = path.find('/', slash + 1))
+    if (!exists(path.substr(0, slash))) create_group(path.substr(0, slash));
+  return utf8_links();
+}
+
+bool File::exists(const std::string& path) const {
+  // Each link of the path in turn: H5Lexists fails (rather than saying no) below a missing group.
+  std::size_t end = 0;
+  while (end != std::string::npos) {
+    end = path.find('/', end + 1);
+    const std::string prefix = path.substr(0, end);
+    if (prefix.empty() || prefix == "/") continue;
+    if (H5Lexists(file_.id(), prefix.c_str(), H5P_DEFAULT) <= 0) {
+      H5Eclear2(H5E_DEFAULT);
+      return false;
+    }
+  }
+  return true;
+}
+
+Handle File::open_dataset(const std::string& path) const {
+  if (!exists(path)) fail(path, "missing");
+  Handle dataset(H5Dopen2(file_.id(), path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!dataset) throw InputError(with_reason(name_ + ": " + path + ": not a dataset"));
+  return dataset;
+}
+
+std::size_t File::checked_rows(const Handle& dataset, const std::string& path, int type_class,
+                               const char* kind, std::optional<std::size_t> rows) const {
+  Handle type(H5Dget_type(dataset.id()), H5Tclose);
+  const H5T_class_t found = H5Tget_class(type.id());
+  if (found != static_cast<H5T_class_t>(type_class))
+    fail(path, std::string("must hold ") + kind + " (it holds " + class_name(found) + ")");
+  Handle space(H5Dget_space(dataset.id()), H5Sclose);
+  if (H5Sget_simple_extent_ndims(space.id()) != 1)
+    fail(path, "must be one-dimensional (it has " + std::to_string(H5Sget_simple_extent_ndims(space.id())) +
+                   " dimensions)");
+  hsize_t n = 0;
+  H5Sget_simple_extent_dims(space.id(), &n, nullptr);
+  if (rows && n != *rows)
+    fail(path, "must have " + std::to_string(*rows) + " rows, one per " +
+                   (path.rfind("/nodes/", 0) == 0 ? "node" : path.rfind("/vessels/", 0) == 0 ? "vessel" : "row") +
+                   " (it has " + std::to_string(n) + ")");
+  return static_cast<std::size_t>(n);
+}
+
+std::size_t File::rows(const std::string& path) const {
+  Handle dataset = open_dataset(path);
+  Handle space(H5Dget_space(dataset.id()), H5Sclose);
+  if (H5Sget_simple_extent_ndims(space.id()) != 1) fail(path, "must be one-dimensional");
+  hsize_t n = 0;
+  H5Sget_simple_extent_dims(space.id(), &n, nullptr);
+  return static_cast<std::size_t>(n);
+}
+
+void File::write_column(const std::string& path, hid_t memory_type, hid_t file_type, const void* data,
+                        std::size_t rows) {
+  const hsize_t n = rows;
+  Handle space(H5Screate_simple(1, &n, nullptr), H5Sclose);
+  Handle dcpl = untimed(H5P_DATASET_CREATE);
+  if (n > 0) {
+    const hsize_t chunk = std::min(n, chunk_rows);
+    H5Pset_chunk(dcpl.id(), 1, &chunk);
+    H5Pset_shuffle(dcpl.id());
+    H5Pset_deflate(dcpl.id(), deflate_level);
+    // A checksum a chunk: a flipped bit in the data is refused when read, not computed with.
+    H5Pset_fletcher32(dcpl.id());
+  }
+  Handle lcpl = links_for(path);
+  Handle dataset(H5Dcreate2(file_.id(), path.c_str(), file_type, space.id(), lcpl.id(), dcpl.id(), H5P_DEFAULT),
+                 H5Dclose);
+  if (!dataset) throw IoError(with_reason(name_ + ": " + path + ": cannot create the dataset"));
+  if (n > 0 && H5Dwrite(dataset.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+    throw IoError(with_reason(name_ + ": " + path + ": cannot write the dataset"));
+}
+
+void File::read_column(const Handle& dataset, const std::string& path, hid_t memory_type, void* data,
+                       std::size_t rows) const {
+  if (rows == 0) return;
+  if (H5Dread(dataset.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+    throw InputError(with_reason(name_ + ": " + path + ": cannot be read (damaged or of values out of range)"));
+}
+
+void File::write_matrix(const std::string& path, std::size_t rows, std::size_t columns,
+                        std::span<const double> values) {
+  if (values.size() != rows * columns) throw std::invalid_argument(path + ": a matrix of the wrong size");
+  const hsize_t dims[2] = {rows, columns};
+  Handle space(H5Screate_simple(2, dims, nullptr), H5Sclose);
+  Handle dcpl = untimed(H5P_DATASET_CREATE);
+  if (rows > 0 && columns > 0) {
+    const hsize_t chunk[2] = {std::min<hsize_t>(rows, std::max<hsize_t>(1, chunk_rows / columns)), columns};
+    H5Pset_chunk(dcpl.id(), 2, chunk);
+    H5Pset_shuffle(dcpl.id());
+    H5Pset_deflate(dcpl.id(), deflate_level);
+    H5Pset_fletcher32(dcpl.id());
+  }
+  Handle lcpl = links_for(path);
+  Handle dataset(H5Dcreate2(file_.id(), path.c_str(), H5T_IEEE_F64LE, space.id(), lcpl.id(), dcpl.id(), H5P_DEFAULT),
+                 H5Dclose);
+  if (!dataset) throw IoError(with_reason(name_ + ": " + path + ": cannot create the dataset"));
+  if (!values.empty() && H5Dwrite(dataset.id(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0)
+    throw IoError(with_reason(name_ + ": " + path + ": cannot write the dataset"));
+}
+
+void File::write(const std::string& path, std::span<const double> values) {
+  write_column(path, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, values.data(), values.size());
+}
+void File::write(const std::string& path, std::span<const std::int64_t> values) {
+  write_column(path, H5T_NATIVE_INT64, H5T_STD_I64LE, values.data(), values.size());
+}
+void File::write(const std::string& path, std::span<const std::int32_t> values) {
+  write_column(path, H5T_NATIVE_INT32, H5T_STD_I32LE, values.data(), values.size());
+}
+void File::write_enum(const std::string& path, std::span<const std::uint8_t> values, const EnumNames& names) {
+  Handle type = enum_type(names);
+  write_column(path, type.id(), type.id(), values.data(), values.size());
+}
+
+std::vector<double> File::read_reals(const std::string& path, std::optional<std::size_t> rows) const {
+  Handle dataset = open_dataset(path);
+  const std::size_t n = checked_rows(dataset, path, H5T_FLOAT, "floating-point numbers", rows);
+  std::vector<double> values(n);
+  read_column(dataset, path, H5T_NATIVE_DOUBLE, values.data(), n);
+  return values;
+}
+
+std::vector<std::int64_t> File::read_integers(const std::string& path, std::optional<std::size_t> rows) const {
+  Handle dataset = open_dataset(path);
+  const std::size_t n = checked_rows(dataset, path, H5T_INTEGER, "integers", rows);
+  std::vector<std::int64_t> values(n);
+  read_column(dataset, path, H5T_NATIVE_INT64, values.data(), n);
+  return values;
+}
+
+std::vector<std::uint8_t> File::read_enum(const std::string& path, const EnumNames& names,
+                                          std::optional<std::size_t> rows) const {
+  Handle dataset = open_dataset(path);
+  const std::size_t n = checked_rows(dataset, path, H5T_ENUM, "an enumeration", rows);
+  // The file's names, each one of ours (its values may differ: the library converts by name).
+  Handle file_type(H5Dget_type(dataset.id()), H5Tclose);
+  const int members = H5Tget_nmembers(file_type.id());
+  for (int m = 0; m < members; ++m) {
+    char* member = H5Tget_member_name(file_type.id(), static_cast<unsigned>(m));
+    const std::string found = member ? member : "";
+    H5free_memory(member);
+    if (std::find(names.names.begin(), names.names.end(), found) == names.names.end()) {
+      std::string known;
+      for (const std::string& name : names.names) known += (known.empty() ? "" : ", ") + name;
+      fail(path, "unknown value \"" + found + "\" (expected one of " + known + ")");
+    }
+  }
+  std::vector<std::uint8_t> values(n);
+  Handle memory_type = enum_type(names);
+  read_column(dataset, path, memory_type.id(), values.data(), n);
+  return values;
+}
+
+void File::write_text(const std::string& path, std::string_view text) {
+  // One row of one string, chunked, so that the text carries a checksum as the columns do
+  // (and is deflated: a list of boundaries may be long).
+  Handle type = text_type(text.size());
+  const hsize_t one = 1;
+  Handle space(H5Screate_simple(1, &one, nullptr), H5Sclose);
+  Handle dcpl = untimed(H5P_DATASET_CREATE);
+  H5Pset_chunk(dcpl.id(), 1, &one);
+  H5Pset_deflate(dcpl.id(), deflate_level);
+  H5Pset_fletcher32(dcpl.id());
+  Handle lcpl = links_for(path);
+  Handle dataset(H5Dcreate2(file_.id(), path.c_str(), type.id(), space.id(), lcpl.id(), dcpl.id(), H5P_DEFAULT),
+                 H5Dclose);
+  std::string padded(text);
+  padded.resize(std::max<std::size_t>(text.size(), 1), '\0');
+  if (!dataset || H5Dwrite(dataset.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, padded.data()) < 0)
+    throw IoError(with_reason(name_ + ": " + path + ": cannot write the text"));
+}
+
+namespace {
+
+// A fixed-length or variable-length string, of a dataset or an attribute.
+template <class Read>
+std::string read_string(hid_t stored_type, Read read) {
+  if (H5Tis_variable_str(stored_type) > 0) {
+    Handle memory(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(memory.id(), H5T_VARIABLE);
+    H5Tset_cset(memory.id(), H5Tget_cset(stored_type));
+    char* text = nullptr;
+    if (read(memory.id(), &text) < 0) return {};
+    std::string result = text ? text : "";
+    H5free_memory(text);
+    return result;
+  }
+  const std::size_t size = H5Tget_size(stored_type);
+  std::string text(size, '\0');
+  Handle memory(H5Tcopy(stored_type), H5Tclose);
+  if (read(memory.id(), text.data()) < 0) return {};
+  text.resize(std::strlen(text.c_str()));  // fixed-length strings are padded with nulls
+  return text;
+}
+
+}  // namespace
+
+std::string File::read_text(const std::string& path) const {
+  Handle dataset = open_dataset(path);
+  Handle type(H5Dget_type(dataset.id()), H5Tclose);
+  if (H5Tget_class(type.id()) != H5T_STRING) fail(path, "must be text");
+  Handle space(H5Dget_space(dataset.id()), H5Sclose);
+  // One text: a scalar, or one row (as written here).
+  if (H5Sget_simple_extent_npoints(space.id()) != 1) fail(path, "must hold one text");
+  bool failed = false;
+  std::string text = read_string(type.id(), [&](hid_t memory, void* into) {
+    const herr_t status = H5Dread(dataset.id(), memory, H5S_ALL, H5S_ALL, H5P_DEFAULT, into);
+    failed = status < 0;
+    return status;
+  });
+  if (failed) throw InputError(with_reason(name_ + ": " + path + ": cannot be read (damaged)"));
+  return text;
+}
+
+void File::write_attribute(const std::string& name, std::string_view text) {
+  Handle type = text_type(text.size());
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attribute(H5Acreate2(file_.id(), name.c_str(), type.id(), space.id(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  std::string padded(text);
+  padded.resize(std::max<std::size_t>(text.size(), 1), '\0');
+  if (!attribute || H5Awrite(attribute.id(), type.id(), padded.data()) < 0)
+    throw IoError(with_reason(name_ + ": /: cannot write the attribute " + name));
+}
+
+void File::write_attribute(const std::string& name, std::int64_t value) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attribute(H5Acreate2(file_.id(), name.c_str(), H5T_STD_I64LE, space.id(), H5P_DEFAULT, H5P_DEFAULT),
+                   H5Aclose);
+  if (!attribute || H5Awrite(attribute.id(), H5T_NATIVE_INT64, &value) < 0)
+    throw IoError(with_reason(name_ + ": /: cannot write the attribute " + name));
+}
+
+std::optional<std::string> File::text_attribute(const std::string& name) const {
+  if (H5Aexists(file_.id(), name.c_str()) <= 0) return std::nullopt;
+  Handle attribute(H5Aopen(file_.id(), name.c_str(), H5P_DEFAULT), H5Aclose);
+  Handle type(H5Aget_type(attribute.id()), H5Tclose);
+  if (H5Tget_class(type.id()) != H5T_STRING) fail("/", "the attribute \"" + name + "\" must be text");
+  bool failed = false;
+  std::string text = read_string(type.id(), [&](hid_t memory, void* into) {
+    const herr_t status = H5Aread(attribute.id(), memory, into);
+    failed = status < 0;
+    return status;
+  });
+  if (failed) throw InputError(with_reason(name_ + ": /: the attribute \"" + name + "\" cannot be read"));
+  return text;
+}
+
+std::optional<std::int64_t> File::integer_attribute(const std::string& name) const {
+  if (H5Aexists(file_.id(), name.c_str()) <= 0) return std::nullopt;
+  Handle attribute(H5Aopen(file_.id(), name.c_str(), H5P_DEFAULT), H5Aclose);
+  Handle type(H5Aget_type(attribute.id()), H5Tclose);
+  if (H5Tget_class(type.id()) != H5T_INTEGER) fail("/", "the attribute \"" + name + "\" must be an integer");
+  std::int64_t value = 0;
+  if (H5Aread(attribute.id(), H5T_NATIVE_INT64, &value) < 0)
+    throw InputError(with_reason(name_ + ": /: the attribute \"" + name + "\" cannot be read"));
+  return value;
+}
+
+}  // namespace hemotree::hdf5

@@ -1,0 +1,160 @@
+// HDF5 files of columns (docs/network-format.md, "HDF5"): a small owner of the C library's
+// handles and the few operations hemotree's layouts need: groups, one-dimensional columns
+// (chunked, byte-shuffled and deflated), enumerations, and JSON text. Every failure is one
+// InputError naming the file and the dataset ("net.h5: /vessels/length: ..."); the library's
+// own error stack is never printed.
+//
+// A file is built in memory (HDF5's core driver) and its bytes handed to an OutputStream,
+// so that it is atomic like every other output (complete or absent) and may go to a pipe;
+// it is read from a path in place, or from bytes held in memory (standard input).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <hdf5.h>
+
+namespace hemotree::hdf5 {
+
+// The eight bytes every HDF5 file begins with (at offset 0 here: no user block).
+inline constexpr unsigned char signature[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+bool has_signature(std::span<const char> first_bytes);
+
+// One handle of the C library, closed by its own close function.
+class Handle {
+ public:
+  Handle() = default;
+  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, -1)), close_(other.close_) {}
+  Handle& operator=(Handle&& other) noexcept {
+    if (this != &other) {
+      reset();
+      id_ = std::exchange(other.id_, -1);
+      close_ = other.close_;
+    }
+    return *this;
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() { reset(); }
+  hid_t id() const { return id_; }
+  hid_t release() { return std::exchange(id_, -1); }
+  explicit operator bool() const { return id_ >= 0; }
+
+ private:
+  void reset() {
+    if (id_ >= 0 && close_) close_(id_);
+    id_ = -1;
+  }
+  hid_t id_ = -1;
+  herr_t (*close_)(hid_t) = nullptr;
+};
+
+// HDF5 1.10 trusts a file's metadata: of the single-byte flips of a small network file, about
+// one in a thousand made the library itself crash (segmentation faults, heap corruption found
+// by glibc), where the others are refused (or land where nothing is read). While a file from
+// outside is open, such a crash becomes the one line every bad input gets,
+// "TOOL: error: FILE: damaged HDF5 file (the HDF5 library failed reading it: signal N)", and
+// exit status 2. Nested guards are one; the handlers before are restored when the last ends.
+class CrashGuard {
+ public:
+  CrashGuard() = default;
+  explicit CrashGuard(const std::string& file_name);
+  CrashGuard(CrashGuard&& other) noexcept : active_(std::exchange(other.active_, false)) {}
+  CrashGuard& operator=(CrashGuard&& other) noexcept {
+    if (this != &other) {
+      release();
+      active_ = std::exchange(other.active_, false);
+    }
+    return *this;
+  }
+  ~CrashGuard() { release(); }
+
+ private:
+  void release();
+  bool active_ = false;
+};
+
+// An enumeration stored as one byte a row, its names in the file's type (h5py:
+// h5py.check_enum_dtype).
+struct EnumNames {
+  std::vector<std::string> names;  // value k is names[k]
+};
+
+class File {
+ public:
+  // A new, empty file, built in memory; bytes() closes it and gives its bytes (once).
+  static File create(std::string name);
+  // An existing file, read-only: from a path, or from its bytes (name for messages).
+  static File open(const std::string& path);
+  static File open_image(std::vector<char> bytes, std::string name);
+
+  File(File&& other) noexcept;
+  File& operator=(File&&) = delete;
+  ~File();
+
+  const std::string& name() const { return name_; }
+  // The whole file, closed: nothing can be written after.
+  std::vector<char> bytes();
+
+  // Objects are named by absolute paths ("/vessels/length"); the groups above a dataset are
+  // made as needed.
+  void create_group(const std::string& path);
+  bool exists(const std::string& path) const;
+  // The number of rows of a one-dimensional dataset (InputError when it is not one).
+  std::size_t rows(const std::string& path) const;
+
+  // Columns. Writing: chunked, shuffled and deflated (level 1: the files are read far more
+  // often than written, and deflate's higher levels gain a few per cent for several times
+  // the time). Reading checks the dataset is one-dimensional, of the right kind (floating
+  // point, integer, enumeration) and, where rows is given, of that length.
+  void write(const std::string& path, std::span<const double> values);
+  void write(const std::string& path, std::span<const std::int64_t> values);
+  void write(const std::string& path, std::span<const std::int32_t> values);
+  void write_enum(const std::string& path, std::span<const std::uint8_t> values, const EnumNames& names);
+  // A table of reals, rows x columns, row by row (values.size() must be their product).
+  void write_matrix(const std::string& path, std::size_t rows, std::size_t columns, std::span<const double> values);
+  std::vector<double> read_reals(const std::string& path, std::optional<std::size_t> rows = {}) const;
+  std::vector<std::int64_t> read_integers(const std::string& path, std::optional<std::size_t> rows = {}) const;
+  // Values as written; names are checked against the file's type (a name it lacks, or a
+  // value it maps to another name, is refused).
+  std::vector<std::uint8_t> read_enum(const std::string& path, const EnumNames& names,
+                                      std::optional<std::size_t> rows = {}) const;
+
+  // Text (UTF-8, JSON for the small members) as a scalar dataset, and attributes of the root.
+  void write_text(const std::string& path, std::string_view text);
+  std::string read_text(const std::string& path) const;
+  void write_attribute(const std::string& name, std::string_view text);
+  void write_attribute(const std::string& name, std::int64_t value);
+  std::optional<std::string> text_attribute(const std::string& name) const;
+  std::optional<std::int64_t> integer_attribute(const std::string& name) const;
+
+  // "NAME: PATH: what" as an InputError.
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const;
+
+ private:
+  File(Handle file, std::string name, CrashGuard guard = {}, std::vector<char> image = {})
+      : guard_(std::move(guard)), file_(std::move(file)), name_(std::move(name)), image_(std::move(image)) {}
+  Handle open_dataset(const std::string& path) const;
+  // Creates the groups above path that do not exist yet; the link list to create it with.
+  Handle links_for(const std::string& path);
+  void write_column(const std::string& path, hid_t memory_type, hid_t file_type, const void* data,
+                    std::size_t rows);
+  void read_column(const Handle& dataset, const std::string& path, hid_t memory_type, void* data,
+                   std::size_t rows) const;
+  std::size_t checked_rows(const Handle& dataset, const std::string& path, int type_class,
+                           const char* kind, std::optional<std::size_t> rows) const;
+
+  CrashGuard guard_;  // first: it outlives the file's handle, closed before it
+  Handle file_;
+  std::string name_;
+  std::vector<char> image_;  // the bytes an opened image reads in place (kept with the file)
+  int backing_ = -1;         // a created file: where the library writes it when it closes
+};
+
+}  // namespace hemotree::hdf5

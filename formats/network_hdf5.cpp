@@ -1,0 +1,367 @@
+// The vnet network as HDF5 (docs/network-format.md, "HDF5"): the same content as the JSON
+// form, columns per node and per vessel instead of an object each, the small members
+// (provenance, blood, inlet, boundaries at nodes, members passed through) as their JSON text.
+// A reader checks everything the JSON reader checks, naming the dataset and the row.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "formats/field_ranges.hpp"
+#include "formats/hdf5_file.hpp"
+#include "formats/network_io.hpp"
+#include "formats/topology.hpp"
+
+namespace hemotree {
+
+namespace {
+
+const hdf5::EnumNames class_names{{"artery", "small_artery", "arteriole", "capillary"}};
+const hdf5::EnumNames outlet_type_names{{"RCR", "R", "reflection"}};
+constexpr double unset = std::numeric_limits<double>::quiet_NaN();
+
+std::uint8_t outlet_type_value(BoundaryType type) {
+  switch (type) {
+    case BoundaryType::rcr: return 0;
+    case BoundaryType::resistance: return 1;
+    default: return 2;
+  }
+}
+
+// One column of the outlets, gathered from their structs.
+template <class Field>
+std::vector<double> outlet_column(const std::vector<Outlet>& outlets, Field field) {
+  std::vector<double> column(outlets.size());
+  for (std::size_t k = 0; k < outlets.size(); ++k) column[k] = outlets[k].*field;
+  return column;
+}
+
+nlohmann::json parsed_json(const hdf5::File& file, const std::string& path) {
+  const std::string text = file.read_text(path);
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    file.fail(path, std::string("not JSON text (") + e.what() + ")");
+  }
+}
+
+class Hdf5Reader {
+ public:
+  explicit Hdf5Reader(const hdf5::File& file) : file_(file) {}
+
+  Network read() {
+    check_identity();
+    if (file_.exists("/provenance")) {
+      net_.provenance = parsed_json(file_, "/provenance");
+      if (!net_.provenance.is_object()) file_.fail("/provenance", "must be a JSON object");
+    }
+    if (file_.exists("/extra")) {
+      net_.extra = parsed_json(file_, "/extra");
+      if (!net_.extra.is_object()) file_.fail("/extra", "must be a JSON object");
+    }
+    read_nodes();
+    read_vessels();
+    read_outlets();
+    if (file_.exists("/blood")) net_.blood = converted("/blood", blood_from_json);
+    if (file_.exists("/inlet")) {
+      net_.inlet = converted("/inlet", inlet_from_json);
+      if (net_.index_of(net_.inlet->vessel) < 0)
+        file_.fail("/inlet", "unknown vessel " + std::to_string(net_.inlet->vessel));
+    }
+    read_boundaries();
+    return std::move(net_);
+  }
+
+ private:
+  template <class Convert>
+  auto converted(const std::string& path, Convert convert) -> decltype(convert(nlohmann::json())) {
+    const nlohmann::json value = parsed_json(file_, path);
+    try {
+      return convert(value);
+    } catch (const InputError& e) {
+      file_.fail(path, e.what());
+    }
+  }
+
+  void check_identity() {
+    const auto format = file_.text_attribute("format");
+    if (!format || *format != "vnet")
+      file_.fail("/", "the attribute \"format\" must be \"vnet\": this is not a hemotree network file");
+    const auto version = file_.integer_attribute("version");
+    if (!version)
+      file_.fail("/", "missing the attribute \"version\" (this build reads versions 1 to " +
+                          std::to_string(vnet_version) + ")");
+    if (*version < 1 || *version > vnet_version)
+      file_.fail("/", "network format version " + std::to_string(*version) +
+                          " is not supported (this build reads up to " + std::to_string(vnet_version) + ")");
+  }
+
+  std::string vessel_name(std::size_t v) const { return "vessel " + std::to_string(net_.id[v]); }
+
+  // A real column: every value in range, or (optional columns) NaN where not given.
+  std::vector<double> reals(const std::string& path, std::size_t rows, const FieldRange& range,
+                            bool may_be_unset, bool of_vessels) const {
+    std::vector<double> values = file_.read_reals(path, rows);
+    const std::string field = path.substr(path.rfind('/') + 1);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (range.contains(values[i]) || (may_be_unset && std::isnan(values[i]))) continue;
+      const std::string row = of_vessels ? vessel_name(i) : "node " + std::to_string(net_.node_id[i]);
+      file_.fail(path, "row " + std::to_string(i) + " (" + row + "): " + out_of_range(field, range, values[i]));
+    }
+    return values;
+  }
+
+  template <class Id>
+  void check_unique(const std::vector<Id>& ids, const std::string& path, const char* what) const {
+    bool identity = true;  // 0..n-1 in order: unique without sorting
+    for (std::size_t i = 0; i < ids.size() && identity; ++i) identity = ids[i] == static_cast<Id>(i);
+    if (identity) return;
+    std::vector<std::size_t> order(ids.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return ids[a] < ids[b] || (ids[a] == ids[b] && a < b);
+    });
+    for (std::size_t k = 1; k < order.size(); ++k)
+      if (ids[order[k]] == ids[order[k - 1]])
+        file_.fail(path, std::string(what) + " id " + std::to_string(ids[order[k]]) + " appears twice: rows " +
+                             std::to_string(order[k - 1]) + " and " + std::to_string(order[k]));
+  }
+
+  void read_nodes() {
+    net_.node_id = file_.read_integers("/nodes/id");
+    const std::size_t n = net_.node_count();
+    if (n > max_elements) file_.fail("/nodes/id", "more than " + std::to_string(max_elements) + " nodes");
+    check_unique(net_.node_id, "/nodes/id", "node");
+    const int coordinates = file_.exists("/nodes/x") + file_.exists("/nodes/y") + file_.exists("/nodes/z");
+    if (coordinates != 0 && coordinates != 3) file_.fail("/nodes", "has all of x, y, z or none");
+    if (coordinates == 3) {
+      net_.x = reals("/nodes/x", n, ranges::coordinate, false, false);
+      net_.y = reals("/nodes/y", n, ranges::coordinate, false, false);
+      net_.z = reals("/nodes/z", n, ranges::coordinate, false, false);
+    }
+  }
+
+  std::vector<std::int32_t> node_indices(const std::string& path, std::size_t rows) const {
+    const std::vector<std::int64_t> given = file_.read_integers(path, rows);
+    std::vector<std::int32_t> indices(given.size());
+    const auto nodes = static_cast<std::int64_t>(net_.node_count());
+    for (std::size_t v = 0; v < given.size(); ++v) {
+      if (given[v] < 0 || given[v] >= nodes)
+        file_.fail(path, "row " + std::to_string(v) + " (" + vessel_name(v) + "): a row of /nodes, in [0, " +
+                             std::to_string(nodes - 1) + "] (got " + std::to_string(given[v]) + ")");
+      indices[v] = static_cast<std::int32_t>(given[v]);
+    }
+    return indices;
+  }
+
+  void read_vessels() {
+    net_.id = file_.read_integers("/vessels/id");
+    const std::size_t n = net_.vessel_count();
+    if (n > max_elements) file_.fail("/vessels/id", "more than " + std::to_string(max_elements) + " vessels");
+    check_unique(net_.id, "/vessels/id", "vessel");
+    net_.from = node_indices("/vessels/from_node", n);
+    net_.to = node_indices("/vessels/to_node", n);
+    for (std::size_t v = 0; v < n; ++v)
+      if (net_.from[v] == net_.to[v])
+        file_.fail("/vessels/to_node", "row " + std::to_string(v) + " (" + vessel_name(v) +
+                                           "): begins and ends at the same node");
+    net_.length = reals("/vessels/length", n, ranges::length, false, true);
+    net_.diameter = reals("/vessels/diameter", n, ranges::diameter, false, true);
+    auto optional_reals = [&](const std::string& path, const FieldRange& range) {
+      return file_.exists(path) ? reals(path, n, range, true, true) : std::vector<double>(n, unset);
+    };
+    net_.wall_thickness = optional_reals("/vessels/wall_thickness", ranges::wall_thickness);
+    net_.youngs_modulus = optional_reals("/vessels/youngs_modulus", ranges::youngs_modulus);
+    if (file_.exists("/vessels/distal_diameter"))
+      net_.distal_diameter = reals("/vessels/distal_diameter", n, ranges::diameter, true, true);
+    const bool beta = file_.exists("/vessels/beta");
+    if (beta != file_.exists("/vessels/reference_pressure"))
+      file_.fail("/vessels", "give \"beta\" and \"reference_pressure\" together");
+    if (beta) {
+      net_.beta = reals("/vessels/beta", n, ranges::beta, true, true);
+      net_.reference_pressure = reals("/vessels/reference_pressure", n, ranges::pressure, true, true);
+      for (std::size_t v = 0; v < n; ++v)
+        if (std::isnan(net_.beta[v]) != std::isnan(net_.reference_pressure[v]))
+          file_.fail("/vessels/beta", "row " + std::to_string(v) + " (" + vessel_name(v) +
+                                          "): give \"beta\" and \"reference_pressure\" together");
+    }
+    net_.vessel_class.resize(n);
+    for (std::size_t v = 0; v < n; ++v) net_.vessel_class[v] = classify(net_.diameter[v]);
+    if (file_.exists("/vessels/class")) {
+      const std::vector<std::uint8_t> given = file_.read_enum("/vessels/class", class_names, n);
+      for (std::size_t v = 0; v < n; ++v)
+        if (given[v] != static_cast<std::uint8_t>(net_.vessel_class[v]))
+          file_.fail("/vessels/class",
+                     "row " + std::to_string(v) + " (" + vessel_name(v) + "): class \"" +
+                         class_names.names[given[v]] + "\" does not match its diameter (" +
+                         std::string(to_string(net_.vessel_class[v])) + ")");
+    }
+    if (file_.exists("/vessels/generation")) {
+      const std::vector<std::int64_t> given = file_.read_integers("/vessels/generation", n);
+      net_.generation.resize(n);
+      for (std::size_t v = 0; v < n; ++v) {
+        if (given[v] < 0 || given[v] >= static_cast<std::int64_t>(n))
+          file_.fail("/vessels/generation", "row " + std::to_string(v) + " (" + vessel_name(v) +
+                                                "): \"generation\" must lie in [0, " + std::to_string(n - 1) +
+                                                "] (the vessel count - 1) (got " + std::to_string(given[v]) + ")");
+        net_.generation[v] = static_cast<std::int32_t>(given[v]);
+      }
+    } else if (n > 0) {
+      net_.generation = generations_from_inlets(net_);
+    }
+  }
+
+  // The columns hold every model's parameters; a row's type says which of them it uses, and
+  // only those are checked and kept (the others are 0, as a JSON outlet read without them).
+  void read_outlets() {
+    if (!file_.exists("/outlets/vessel")) return;
+    const std::size_t n = file_.rows("/outlets/vessel");
+    const std::vector<std::int64_t> vessel = file_.read_integers("/outlets/vessel", n);
+    const std::vector<std::uint8_t> type = file_.read_enum("/outlets/type", outlet_type_names, n);
+    const std::vector<double> r1 = file_.read_reals("/outlets/R1", n), c = file_.read_reals("/outlets/C", n),
+                              r2 = file_.read_reals("/outlets/R2", n), r = file_.read_reals("/outlets/R", n),
+                              p_out = file_.read_reals("/outlets/p_out", n),
+                              coefficient = file_.read_reals("/outlets/coefficient", n);
+    const auto vessels = static_cast<std::int64_t>(net_.vessel_count());
+    net_.outlets.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::string row = "row " + std::to_string(k);
+      if (vessel[k] < 0 || vessel[k] >= vessels)
+        file_.fail("/outlets/vessel", row + ": a row of /vessels, in [0, " + std::to_string(vessels - 1) +
+                                          "] (got " + std::to_string(vessel[k]) + ")");
+      if (k > 0 && vessel[k] <= vessel[k - 1])
+        file_.fail("/outlets/vessel", row + ": outlets are sorted by vessel, one a vessel at most (got " +
+                                          std::to_string(vessel[k]) + " after " + std::to_string(vessel[k - 1]) + ")");
+      const std::string at = row + " (" + vessel_name(static_cast<std::size_t>(vessel[k])) + ")";
+      auto checked = [&](const char* name, const std::vector<double>& column, const FieldRange& range) {
+        if (!range.contains(column[k]))
+          file_.fail(std::string("/outlets/") + name, at + ": " + out_of_range(name, range, column[k]));
+        return column[k];
+      };
+      Outlet& o = net_.outlets[k];
+      o.vessel = static_cast<std::int32_t>(vessel[k]);
+      if (type[k] == outlet_type_value(BoundaryType::rcr)) {
+        o.type = BoundaryType::rcr;
+        o.r1 = checked("R1", r1, ranges::rcr_part);
+        o.c = checked("C", c, ranges::compliance);
+        o.r2 = checked("R2", r2, ranges::rcr_part);
+        o.p_out = checked("p_out", p_out, ranges::pressure);
+        if (!(o.r1 + o.r2 >= ranges::resistance.min))
+          file_.fail("/outlets/R1", at + ": RCR needs R1 + R2 >= " + format_number(ranges::resistance.min) +
+                                        " Pa s/m^3 (got " + format_number(o.r1 + o.r2) + ")");
+      } else if (type[k] == outlet_type_value(BoundaryType::resistance)) {
+        o.type = BoundaryType::resistance;
+        o.r = checked("R", r, ranges::resistance);
+        o.p_out = checked("p_out", p_out, ranges::pressure);
+      } else {
+        o.type = BoundaryType::reflection;
+        o.reflection = checked("coefficient", coefficient, ranges::reflection);
+      }
+    }
+  }
+
+  // As in JSON: the list of boundaries at nodes, nodes named by id.
+  void read_boundaries() {
+    if (!file_.exists("/boundaries")) return;
+    const nlohmann::json list = parsed_json(file_, "/boundaries");
+    if (!list.is_array()) file_.fail("/boundaries", "must be a JSON list");
+    std::vector<std::pair<std::int64_t, std::int32_t>> by_id(net_.node_count());
+    for (std::size_t n = 0; n < by_id.size(); ++n) by_id[n] = {net_.node_id[n], static_cast<std::int32_t>(n)};
+    std::sort(by_id.begin(), by_id.end());
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const std::string where = "boundaries[" + std::to_string(k) + "]";
+      std::int64_t node_id = 0;
+      NodeBoundary b;
+      try {
+        b = boundary_from_json(list[k], where, node_id);
+      } catch (const InputError& e) {
+        file_.fail("/boundaries", e.what());
+      }
+      const auto at = std::lower_bound(by_id.begin(), by_id.end(), std::pair{node_id, std::int32_t{0}});
+      if (at == by_id.end() || at->first != node_id)
+        file_.fail("/boundaries", where + ": unknown node " + std::to_string(node_id));
+      b.node = at->second;
+      net_.boundaries.push_back(std::move(b));
+    }
+    std::stable_sort(net_.boundaries.begin(), net_.boundaries.end(),
+                     [](const NodeBoundary& p, const NodeBoundary& q) { return p.node < q.node; });
+    try {
+      node_boundaries(net_);
+    } catch (const InputError& e) {
+      file_.fail("/boundaries", e.what());
+    }
+  }
+
+  static constexpr std::size_t max_elements = std::numeric_limits<std::int32_t>::max();
+  const hdf5::File& file_;
+  Network net_;
+};
+
+}  // namespace
+
+void write_network_hdf5(const Network& net, OutputStream& out) {
+  // Every member by name (as Network::shrink_to_fit): a member added to Network stops this
+  // from compiling until it is written here.
+  const auto& [node_id, x, y, z, id, from, to, length, diameter, wall_thickness, youngs_modulus, generation,
+               vessel_class, beta, reference_pressure, distal_diameter, blood, inlet, outlets, boundaries,
+               provenance, extra] = net;
+  hdf5::File file = hdf5::File::create(out.name());
+  file.write_attribute("format", "vnet");
+  file.write_attribute("version", std::int64_t{format_version_needed(net)});
+  file.write_text("/provenance", provenance.dump());
+  if (!extra.empty()) file.write_text("/extra", extra.dump());
+  if (blood) file.write_text("/blood", to_json(*blood).dump());
+  if (inlet) file.write_text("/inlet", to_json(*inlet).dump());
+  if (!boundaries.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const NodeBoundary& b : boundaries) list.push_back(to_json(b, node_id[static_cast<std::size_t>(b.node)]));
+    file.write_text("/boundaries", list.dump());
+  }
+  file.write("/nodes/id", std::span<const std::int64_t>(node_id));
+  if (net.has_coordinates()) {
+    file.write("/nodes/x", std::span<const double>(x));
+    file.write("/nodes/y", std::span<const double>(y));
+    file.write("/nodes/z", std::span<const double>(z));
+  }
+  file.write("/vessels/id", std::span<const std::int64_t>(id));
+  file.write("/vessels/from_node", std::span<const std::int32_t>(from));
+  file.write("/vessels/to_node", std::span<const std::int32_t>(to));
+  file.write("/vessels/length", std::span<const double>(length));
+  file.write("/vessels/diameter", std::span<const double>(diameter));
+  if (!distal_diameter.empty()) file.write("/vessels/distal_diameter", std::span<const double>(distal_diameter));
+  file.write("/vessels/wall_thickness", std::span<const double>(wall_thickness));
+  file.write("/vessels/youngs_modulus", std::span<const double>(youngs_modulus));
+  file.write("/vessels/generation", std::span<const std::int32_t>(generation));
+  static_assert(sizeof(VesselClass) == 1);
+  file.write_enum("/vessels/class",
+                  std::span(reinterpret_cast<const std::uint8_t*>(vessel_class.data()), vessel_class.size()),
+                  class_names);
+  if (!beta.empty()) {
+    file.write("/vessels/beta", std::span<const double>(beta));
+    file.write("/vessels/reference_pressure", std::span<const double>(reference_pressure));
+  }
+  if (!outlets.empty()) {
+    std::vector<std::int32_t> vessel(outlets.size());
+    std::vector<std::uint8_t> type(outlets.size());
+    for (std::size_t k = 0; k < outlets.size(); ++k) {
+      vessel[k] = outlets[k].vessel;
+      type[k] = outlet_type_value(outlets[k].type);
+    }
+    file.write("/outlets/vessel", std::span<const std::int32_t>(vessel));
+    file.write_enum("/outlets/type", type, outlet_type_names);
+    file.write("/outlets/R1", outlet_column(outlets, &Outlet::r1));
+    file.write("/outlets/C", outlet_column(outlets, &Outlet::c));
+    file.write("/outlets/R2", outlet_column(outlets, &Outlet::r2));
+    file.write("/outlets/R", outlet_column(outlets, &Outlet::r));
+    file.write("/outlets/p_out", outlet_column(outlets, &Outlet::p_out));
+    file.write("/outlets/coefficient", outlet_column(outlets, &Outlet::reflection));
+  }
+  const std::vector<char> bytes = file.bytes();
+  out.write(std::string_view(bytes.data(), bytes.size()));
+}
+
+Network read_network_hdf5(const hdf5::File& file) { return Hdf5Reader(file).read(); }
+
+}  // namespace hemotree
