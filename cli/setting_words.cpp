@@ -12,6 +12,7 @@ const SettingWords& hemosolve_words() {
       {"dt", "--dt"},
       {"elements", "--elements"},
       {"force", "--force"},
+      {"format", "--format"},
       {"frames", "--frames"},
       {"high_degree", "--high-degree"},
       {"linear_error", "--linear-error"},

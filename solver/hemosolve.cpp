@@ -101,7 +101,7 @@ struct CommandLine {
   RunConfiguration config;
   std::string out_dir, resume_dir, rheology, scheme = "etd2", start = "periodic", dt_text, sample_text = "1ms",
       external_text = "10mmHg", degree_text = "auto", lumped_step_text = "auto", coupling_passes_text = "auto", settling_degree_text = "auto",
-      model = "auto", vtk_min_text, red_cells = "fixed";
+      model = "auto", vtk_min_text, red_cells = "fixed", format = "text";
   std::vector<std::string> probe_texts, tracer_texts, pressure_at_texts;
   bool quiet = false, steady = false, linear = false;
   CLI::Option* until_periodic = nullptr;
@@ -115,7 +115,8 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
               &sample_text = line.sample_text, &external_text = line.external_text, &degree_text = line.degree_text,
               &lumped_step_text = line.lumped_step_text, &coupling_passes_text = line.coupling_passes_text,
               &settling_degree_text = line.settling_degree_text,
-              &model = line.model, &vtk_min_text = line.vtk_min_text, &red_cells = line.red_cells;
+              &model = line.model, &vtk_min_text = line.vtk_min_text, &red_cells = line.red_cells,
+              &format = line.format;
   int &cycles = config.cycles, &max_cycles = config.max_cycles, &frames = config.frames,
       &checkpoint_every = config.checkpoint_every;
   double &periodic_tol = config.periodic_tolerance, &transport_step = config.transport_step;
@@ -123,7 +124,7 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
                            &pressure_at_texts = line.pressure_at_texts;
   bool &vtk = config.vtk, &balance = config.balance_compliances, &force = config.force, &quiet = line.quiet,
        &steady = line.steady, &linear = line.linear;
-  app.add_option("network", input, "network file (vnet JSON), - for standard input")->required();
+  app.add_option("network", input, "network file (vnet, JSON or HDF5), - for standard input")->required();
   app.add_option("--out", out_dir,
                                     "folder for summary.json, probes.csv, results.vtp and frames/; written as "
                                     "OUT.partial and renamed to OUT when the run ends, so OUT never mixes two runs");
@@ -219,6 +220,10 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
                  "threads over elements, in [1, " + std::to_string(cores) +
                      "] (this machine's cores; use the idle ones: results agree to round-off)")
       ->capture_default_str();
+  app.add_option("--format", format,
+                 "text: summary.json, vessels.csv and probes.csv; h5: summary.json (the run's facts) and results.h5 "
+                 "(the vessels', boundaries' and probes' results as columns, for h5py and pandas)")
+      ->capture_default_str();
   app.add_flag("--vtk", vtk, "also write the network with every per-vessel result as VTK (results.vtp, for ParaView)");
   app.add_option("--vtk-min-diameter", vtk_min_text,
                  "--vtk and --frames write only the vessels of at least this diameter (e.g. 20um; a "
@@ -301,6 +306,7 @@ int run_command_line(CommandLine& line, int cores) {
   options.lumped_step = lumped_step_named(line.lumped_step_text);
   options.coupling_passes = coupling_passes_named(line.coupling_passes_text);
   config.settling_degree = settling_degree_named(line.settling_degree_text);
+  config.results_format = results_format_named(line.format);
   if (!line.dt_text.empty()) options.dt = parse_quantity(line.dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");
   if (options.threads < 1 || options.threads > cores)
     throw InputError("--threads must lie in [1, " + std::to_string(cores) + "] (got " +

@@ -1,5 +1,7 @@
 #include "solver/linear_run.hpp"
 
+#include "solver/results_files.hpp"
+
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -124,8 +126,8 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
   return out;
 }
 
-void write_probes(const std::filesystem::path& file, const std::vector<TubeLaw>& laws,
-                  const LinearPeriodic& periodic, const std::vector<Probe>& probes) {
+ProbeRecorder linear_probes(const std::vector<TubeLaw>& laws, const LinearPeriodic& periodic,
+                            const std::vector<Probe>& probes) {
   ProbeRecorder recorder(probes);
   for (int m = 0; m <= samples_per_period; ++m) {
     const double t = periodic.period() * m / samples_per_period;
@@ -135,7 +137,7 @@ void write_probes(const std::filesystem::path& file, const std::vector<TubeLaw>&
       return ProbeRecorder::Values{p, q, a};
     });
   }
-  recorder.write(file);
+  return recorder;
 }
 
 }  // namespace
@@ -182,10 +184,12 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   run_info["statistics"] = group_statistics(net, results, options.threads);
   folder.open();
   const std::filesystem::path dir = folder.staging();
-  write_summary(dir / "summary.json", run_info, results, linear.cycle,
-                boundary_results(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}), options.threads);
-  write_vessel_table(dir / "vessels.csv", results, options.threads);
-  if (!config.probes.empty()) write_probes(dir / "probes.csv", laws, periodic, config.probes);
+  const ProbeRecorder probes = linear_probes(laws, periodic, config.probes);
+  write_results(dir,
+                {run_info, results, linear.cycle,
+                 boundary_results(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}), &probes,
+                 options.threads},
+                config.results_format);
   if (config.vtk) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
   folder.publish();
   observer.note("linear periodic state of " + std::to_string(n) + " vessels (" + std::to_string(periodic.harmonics()) +

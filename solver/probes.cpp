@@ -1,5 +1,7 @@
 #include "solver/probes.hpp"
 
+#include <cstdlib>
+
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
 #include "formats/output_stream.hpp"
@@ -54,18 +56,38 @@ void ProbeRecorder::add_row(double t, const std::function<Values(const Probe&)>&
   rows_ << '\n';
 }
 
+std::vector<std::string> ProbeRecorder::column_names() const {
+  std::vector<std::string> names{"t [s]"};
+  for (const Probe& p : probes_) {
+    const std::string at = " vessel " + std::to_string(p.id) + " x " + number(p.x);
+    names.push_back("p" + at + " [Pa]");
+    names.push_back("Q" + at + " [m^3/s]");
+    names.push_back("A" + at + " [m^2]");
+    names.push_back("u" + at + " [m/s]");
+    for (const std::string& h : headers_) {
+      const auto unit = h.find(" [");  // "name [unit]": the place goes between
+      names.push_back(h.substr(0, unit) + at + (unit == std::string::npos ? "" : h.substr(unit)));
+    }
+  }
+  return names;
+}
+
+std::vector<double> ProbeRecorder::values() const {
+  std::vector<double> values;
+  const std::string text = rows_.str();
+  for (const char* at = text.c_str(); *at != '\0';) {
+    char* end = nullptr;
+    values.push_back(std::strtod(at, &end));
+    at = *end == '\0' ? end : end + 1;  // past the comma or the newline
+  }
+  return values;
+}
+
 void ProbeRecorder::write(const std::filesystem::path& file) const {
   if (probes_.empty()) return;
   OutputStream out(file.string());
-  out << "t [s]";
-  for (const Probe& p : probes_) {
-    const std::string at = " vessel " + std::to_string(p.id) + " x " + number(p.x);
-    out << ",p" << at << " [Pa],Q" << at << " [m^3/s],A" << at << " [m^2],u" << at << " [m/s]";
-    for (const std::string& h : headers_) {
-      const auto unit = h.find(" [");  // "name [unit]": the place goes between
-      out << ',' << csv_field(h.substr(0, unit) + at + (unit == std::string::npos ? "" : h.substr(unit)));
-    }
-  }
+  const std::vector<std::string> names = column_names();
+  for (std::size_t c = 0; c < names.size(); ++c) out << (c ? "," : "") << csv_field(names[c]);
   out << '\n' << rows_.str();
   out.commit();
 }

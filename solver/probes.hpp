@@ -40,6 +40,11 @@ class ProbeRecorder {
   }
   // probes.csv: a header with units, then one row per sample; nothing without probes.
   void write(const std::filesystem::path& file) const;
+  bool empty() const { return probes_.empty(); }
+  // probes.csv's columns, their names unquoted ("t [s]", "p vessel 3 x 0.5 [Pa]", ...), and
+  // its values row by row (the numbers probes.csv holds): results.h5's /probes.
+  std::vector<std::string> column_names() const;
+  std::vector<double> values() const;
   // The rows recorded so far, as text (a checkpoint keeps them).
   std::string rows() const { return rows_.str(); }
   void restore_rows(const std::string& rows) { rows_.str(rows); rows_.seekp(0, std::ios::end); }

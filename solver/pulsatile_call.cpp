@@ -1,5 +1,7 @@
 #include "solver/pulsatile_call.hpp"
 
+#include "solver/results_files.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -420,7 +422,6 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
   const std::filesystem::path dir = folder.staging();
   if (status == RunStatus::interrupted || config.checkpoint_every > 0) pulsatile.write_checkpoint();
   pulsatile.discard_snapshot();
-  pulsatile.probes().write(dir / "probes.csv");
   run.release_lumped_state();  // the time loop is over: on the full tree 1.2 GB less while the report is written
   {  // the table (0.9 GB on the full tree) is freed before the last cycle is copied below
     VesselTable results = last.vessels.empty() ? VesselTable()
@@ -429,8 +430,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
       report_transport(net, *transport, pulsatile.last_red_cells(), pulsatile.red_cell_change(),
                        static_cast<double>(plan.transport_every) * dt, results, info);
     if (!last.vessels.empty()) info["statistics"] = group_statistics(net, results, config.solver.threads);
-    write_summary(dir / "summary.json", info, results, last, boundary_flows(net, run, last), config.solver.threads);
-    write_vessel_table(dir / "vessels.csv", results, config.solver.threads);
+    write_results(dir, {info, results, last, boundary_flows(net, run, last), &pulsatile.probes(), config.solver.threads},
+                  config.results_format);
     if (config.vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
   }
   folder.publish();
@@ -469,6 +470,7 @@ void run_steady(const Network& net, const RunConfiguration& config, RunObserver&
   request.vtk_keep = config.vtk_keep;
   request.phase_separation = config.red_cells == RedCells::transport;
   request.threads = config.solver.threads;
+  request.results_format = config.results_format;
   run_steady(net, request, observer);
 }
 

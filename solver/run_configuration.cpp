@@ -59,6 +59,7 @@ constexpr ChoiceNames<RedCells> red_cell_names = {{RedCells::fixed, "fixed"}, {R
 constexpr ChoiceNames<StartChoice> start_names = {
     {StartChoice::steady, "steady"}, {StartChoice::rest, "rest"}, {StartChoice::periodic, "periodic"}};
 constexpr ChoiceNames<Rheology> rheology_names = {{Rheology::pries, "pries"}, {Rheology::newtonian, "newtonian"}};
+constexpr ChoiceNames<ResultsFormat> results_format_names = {{ResultsFormat::text, "text"}, {ResultsFormat::hdf5, "h5"}};
 
 template <class Choice>
 const char* name_of(Choice choice, ChoiceNames<Choice> names) {
@@ -83,12 +84,15 @@ const char* to_string(RedCells cells) { return name_of(cells, red_cell_names); }
 const char* to_string(ModelChoice model) { return name_of(model, model_names); }
 const char* to_string(TimeScheme scheme) { return name_of(scheme, scheme_names); }
 const char* to_string(StartChoice start) { return name_of(start, start_names); }
+const char* to_string(ResultsFormat format) { return name_of(format, results_format_names); }
 
 TimeScheme time_scheme_named(const std::string& name) { return named(name, scheme_names, "scheme"); }
 
 ModelChoice model_named(const std::string& name) { return named(name, model_names, "model"); }
 
 StartChoice start_named(const std::string& name) { return named(name, start_names, "start"); }
+
+ResultsFormat results_format_named(const std::string& name) { return named(name, results_format_names, "format"); }
 
 Rheology rheology_named(const std::string& name) { return named(name, rheology_names, "rheology"); }
 

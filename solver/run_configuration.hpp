@@ -11,6 +11,7 @@
 #include "core/setting_error.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "solver/probes.hpp"
+#include "solver/results_files.hpp"
 #include "solver/tracer_spec.hpp"
 
 namespace hemotree {
@@ -22,6 +23,7 @@ const char* to_string(RedCells cells);          // "fixed", "transport"
 const char* to_string(ModelChoice model);       // "auto", "1d", "0d"
 const char* to_string(TimeScheme scheme);       // "etd2", "ab2", "rk4"
 const char* to_string(StartChoice start);       // "steady", "rest", "periodic"
+const char* to_string(ResultsFormat format);    // "text", "h5"
 
 // The choices from their names, as a caller writes them (a command line, a script): a
 // SettingError naming the setting (scheme, model, start, rheology, degree, red_cells) for any
@@ -35,6 +37,7 @@ int settling_degree_named(const std::string& name);  // "auto" (SolverOptions::a
 int coupling_passes_named(const std::string& name);  // "auto" (SolverOptions::automatic) or 1 to 10
 double lumped_step_named(const std::string& name);   // "auto" (0) or a fraction in (0, 0.1]
 RedCells red_cells_named(const std::string& name);
+ResultsFormat results_format_named(const std::string& name);
 
 struct RunConfiguration {
   std::string network_name;  // as the caller named it (summary.json's "network")
@@ -66,6 +69,7 @@ struct RunConfiguration {
   double transport_step = 5e-3;   // the transport's step as a fraction of the period, in (0, 0.5]
   int frames = 0;                 // of the last cycle, as a ParaView time series
   bool vtk = false;               // results.vtp
+  ResultsFormat results_format = ResultsFormat::text;  // summary.json, vessels.csv, probes.csv, or results.h5
   std::vector<std::uint8_t> vtk_keep;  // the vessels the VTK output shows (empty: all)
   // Run even beyond the stability limit, a day per cycle, or over a killed run's checkpoint.
   bool force = false;

@@ -132,8 +132,7 @@ void write_array(OutputStream& out, const SummaryArray& array, int threads) {
 }
 }  // namespace
 
-void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const VesselTable& vessels,
-                   const CycleSummary& cycle, const SummaryArray& array, int threads) {
+nlohmann::json summary_facts(const nlohmann::json& run, const CycleSummary& cycle) {
   nlohmann::json summary = run;
   summary["inlet_mean_flow"] = cycle.inlet_mean_flow;
   summary["outlets_mean_flow"] = cycle.outlets_mean_flow;
@@ -145,6 +144,12 @@ void write_summary(const std::filesystem::path& file, const nlohmann::json& run,
   summary["conservation_error"] = cycle.conservation_error;
   summary["units"] = {{"flow", "m^3/s"}, {"pressure", "Pa"}, {"length", "m"}, {"wss", "Pa"},
                       {"speed", "m/s"}, {"frequency", "Hz"}};
+  return summary;
+}
+
+void write_summary(const std::filesystem::path& file, const nlohmann::json& run, const VesselTable& vessels,
+                   const CycleSummary& cycle, const SummaryArray& array, int threads) {
+  const nlohmann::json summary = summary_facts(run, cycle);
   // The run's facts, then the vessels one by one, a line each: no string of the whole report
   // in memory (a million vessels are a gigabyte of text). Strings from outside (a file name
   // that is not UTF-8) must not stop the report: such bytes are written as U+FFFD.

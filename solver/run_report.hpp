@@ -64,6 +64,10 @@ struct SummaryArray {
   std::function<nlohmann::json(std::size_t)> entry;
 };
 
+// The run's facts as summary.json gives them: run, with the cycle's mass balance, volume
+// change, conservation error and the units.
+nlohmann::json summary_facts(const nlohmann::json& run, const CycleSummary& cycle);
+
 // summary.json: the run's facts (`run`, and `array` among them), the mass balance and the
 // vessels' results, one vessel a line. threads: the rows formatted in parallel
 // (formats/parallel_rows.hpp: the same bytes for any count).

@@ -162,8 +162,8 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
   run_info["statistics"] = group_statistics(net, results, request.threads);
   folder.open();
   const std::filesystem::path dir = folder.staging();
-  write_summary(dir / "summary.json", run_info, results, cycle, boundary_results(net, steady), request.threads);
-  write_vessel_table(dir / "vessels.csv", results, request.threads);
+  write_results(dir, {run_info, results, cycle, boundary_results(net, steady), nullptr, request.threads},
+                request.results_format);
   if (request.vtk) write_results_vtk(dir / "results.vtp", net, results, request.vtk_keep);
   folder.publish();
   if (request.phase_separation && !separated.converged)

@@ -14,6 +14,7 @@
 #include "formats/network.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/run_observer.hpp"
+#include "solver/results_files.hpp"
 #include "solver/run_report.hpp"
 #include "steady/steady_flow.hpp"
 #include "solver/vessel_table.hpp"
@@ -48,9 +49,10 @@ struct SteadyRunRequest {
   // bifurcations, the flows and hematocrits solved together (steady/steady_hematocrit.hpp).
   bool phase_separation = false;
   int threads = 1;  // the first resistances and the report in parallel (the same bytes for any count)
+  ResultsFormat results_format = ResultsFormat::text;
 };
 
-// Solves and writes OUT/summary.json, OUT/vessels.csv (and OUT/results.vtp with vtk) through
+// Solves and writes OUT/summary.json, OUT/vessels.csv or OUT/results.h5 (and OUT/results.vtp with vtk) through
 // OutputFolder (never a half-written folder). InputError for a network it cannot solve. With
 // phase separation each vessel's discharge and tube hematocrit are reported too; an iteration
 // that does not converge writes its last state marked "not converged" and is InputError.
