@@ -67,6 +67,14 @@ Handle untimed(hid_t kind) {
   return list;
 }
 
+// A group (or the root) untimed, whose members are listed in the order they were made (h5py
+// iterates them so): a table's columns in the table's order.
+Handle ordered(hid_t kind) {
+  Handle list = untimed(kind);
+  H5Pset_link_creation_order(list.id(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED);
+  return list;
+}
+
 // Links named in UTF-8.
 Handle utf8_links() {
   Handle lcpl = property_list(H5P_LINK_CREATE);
@@ -166,7 +174,7 @@ File File::create(std::string name) {
   const char* folder = std::getenv("TMPDIR");
   const std::string path = std::string(folder && *folder ? folder : "/tmp") + "/hemotree-" +
                            std::to_string(::getpid()) + "-" + std::to_string(images_made++) + ".h5";
-  Handle fcpl = untimed(H5P_FILE_CREATE);  // the root group's times
+  Handle fcpl = ordered(H5P_FILE_CREATE);  // the root group's
   Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.id(), fapl.id()), H5Fclose);
   if (!file) throw IoError(with_reason(name + ": cannot create an HDF5 file (in " + path + ")"));
   const int backing = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -236,7 +244,7 @@ void File::fail(const std::string& path, const std::string& what) const {
 
 void File::create_group(const std::string& path) {
   Handle lcpl = utf8_links();
-  Handle gcpl = untimed(H5P_GROUP_CREATE);
+  Handle gcpl = ordered(H5P_GROUP_CREATE);
   Handle group(H5Gcreate2(file_.id(), path.c_str(), lcpl.id(), gcpl.id(), H5P_DEFAULT), H5Gclose);
   if (!group) throw IoError(with_reason(name_ + ": " + path + ": cannot create the group"));
 }

@@ -8,6 +8,10 @@
     facts = hio.read_summary("run")          # summary.json as a dict ("vessels": a list of dicts)
     vessels = hio.read_vessels("run")        # vessels.csv as a DataFrame, one row per vessel
     probes = hio.read_probes("run")          # probes.csv as a DataFrame, the time first
+
+Either form of either file: a network in JSON or HDF5 (net.h5), a run written as text or with
+`hemosolve --format h5` (results.h5 in the folder); the same DataFrames and dicts either way
+(HDF5 needs h5py: Debian python3-h5py).
     p = hio.probe_column(probes, "p", 1, 0.5)
 
 A run's folder is what `hemosolve NET --out DIR` writes (docs/solver.md); a reader given a
@@ -44,7 +48,49 @@ class FormatError(ValueError):
 
 
 class MissingDependency(ImportError):
-    """numpy or pandas is not installed; the message is one line saying what to install."""
+    """numpy, pandas or h5py is not installed; the message is one line saying what to install."""
+
+
+def _h5py():
+    try:
+        import h5py
+    except ImportError:
+        raise MissingDependency("reading hemotree's HDF5 files needs h5py "
+                                "(Debian: apt-get install python3-h5py)") from None
+    return h5py
+
+
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def _is_hdf5(path):
+    with open(path, "rb") as f:
+        return f.read(8) == _HDF5_SIGNATURE
+
+
+def _text(dataset):
+    """One text of a hemotree HDF5 file (a one-row string dataset, or a scalar)."""
+    value = dataset[()] if dataset.shape == () else dataset[0]
+    return value.decode("utf-8") if isinstance(value, bytes) else str(value)
+
+
+def _h5_columns(group, categories=True):
+    """A group of one-dimensional datasets as a dict of arrays, enumerations as categories
+    (CATEGORIES) or their labels."""
+    pd = _pandas()
+    h5py = _h5py()
+    columns = {}
+    for name, dataset in group.items():
+        values = dataset[:]
+        labels = h5py.check_enum_dtype(dataset.dtype)
+        if labels is not None:
+            by_code = {code: label for label, code in labels.items()}
+            codes = [by_code[c] for c in range(max(by_code) + 1)] if by_code else []
+            values = pd.Categorical.from_codes(values.astype(int), categories=codes)
+            if not categories:
+                values = values.astype(str)
+        columns[name] = values
+    return columns
 
 
 def _pandas():
@@ -94,6 +140,8 @@ def read_network(path):
     pruned networks, too much for a full tree of millions of vessels (about 10 GB)."""
     pd = _pandas()
     path = Path(path)
+    if _is_hdf5(path):
+        return _read_network_hdf5(path)
     with open(path) as f:
         doc = json.load(f)
     if not isinstance(doc, dict) or doc.get("format") != "vnet":
@@ -127,6 +175,49 @@ def read_network(path):
                    other={k: v for k, v in doc.items() if k not in known}, **members)
 
 
+def _read_network_hdf5(path):
+    """read_network's Network from the HDF5 form (docs/network-format.md): the same columns as
+    the JSON form gives (`from`, `to` as node ids, `class` as words, `outlet` as dicts)."""
+    pd = _pandas()
+    import numpy as np
+    h5py = _h5py()
+    with h5py.File(path, "r") as f:
+        fmt = f.attrs.get("format")
+        if (fmt.decode() if isinstance(fmt, bytes) else fmt) != "vnet":
+            raise FormatError(f"{path}: not a vnet network (no attribute format = \"vnet\")")
+        nodes = pd.DataFrame(_h5_columns(f["nodes"]))
+        columns = _h5_columns(f["vessels"], categories=False)
+        ids = nodes["id"].to_numpy()
+        columns["from"] = ids[columns.pop("from_node")]
+        columns["to"] = ids[columns.pop("to_node")]
+        order = ["id", "from", "to", "length", "diameter", "distal_diameter", "wall_thickness",
+                 "youngs_modulus", "generation", "class", "beta", "reference_pressure"]
+        vessels = pd.DataFrame({k: columns[k] for k in order if k in columns})
+        if "outlets" in f:
+            out = _h5_columns(f["outlets"], categories=False)
+            used = {"RCR": ("R1", "C", "R2", "p_out"), "R": ("R", "p_out"), "reflection": ("coefficient",)}
+            outlet = np.full(len(vessels), np.nan, dtype=object)
+            for k, v in enumerate(out["vessel"]):
+                kind = out["type"][k]
+                outlet[v] = {"type": kind, **{name: float(out[name][k]) for name in used[kind]}}
+            vessels["outlet"] = outlet
+        texts = {k: json.loads(_text(f[k])) for k in ("blood", "inlet", "provenance", "boundaries", "extra")
+                 if k in f}
+        version = int(f.attrs["version"])
+    return Network(vessels=vessels, nodes=nodes, version=version, blood=texts.get("blood", {}),
+                   inlet=texts.get("inlet", {}), boundaries=texts.get("boundaries", []),
+                   provenance=texts.get("provenance", {}), other=texts.get("extra", {}))
+
+
+def _results_h5(path):
+    """results.h5 of a run: PATH itself when it is that file, else PATH/results.h5 when the
+    folder holds one; None for a run written as text."""
+    path = Path(path)
+    if path.is_dir():
+        return path / "results.h5" if (path / "results.h5").exists() else None
+    return path if path.suffix == ".h5" else None
+
+
 # ---- summary.json -----------------------------------------------------------------------
 
 # hemosolve writes summary.json as the run's facts, one member a line, then this line and
@@ -142,6 +233,16 @@ def read_summary(path, vessels=True):
     the vessels) only the lines before the vessels are parsed, so a full tree's 3.8 million
     vessels cost nothing, and what follows them (e.g. "statistics") is not read either;
     a summary of another layout is read whole and its "vessels" left out."""
+    results = _results_h5(path)
+    if results is not None:
+        h5py = _h5py()
+        with h5py.File(results, "r") as f:
+            summary = json.loads(_text(f["summary"]))
+        if vessels:
+            table = read_vessels(results)
+            summary["vessels"] = [{k: (None if isinstance(x, float) and x != x else x) for k, x in row.items()}
+                                  for row in table.astype(object).to_dict("records")]
+        return summary
     path = _file(path, "summary.json")
     if not vessels:
         head = _summary_head(path)
@@ -324,6 +425,20 @@ def read_vessels(path, columns=None):
     float64 (int64 for a whole-number column without nulls), NaN for an empty field (null);
     class and model as categories. COLUMNS (a list of names) reads those alone (less memory
     for a full tree); a name not in the header raises FormatError."""
+    results = _results_h5(path)
+    if results is not None:
+        pd = _pandas()
+        h5py = _h5py()
+        with h5py.File(results, "r") as f:
+            group = f["vessels"]
+            names = list(group.keys()) if columns is None else columns
+            missing = [n for n in names if n not in group]
+            if missing:
+                raise FormatError(f"{results}: no column {', '.join(missing)}")
+            data = _h5_columns({n: group[n] for n in names})
+        frame = pd.DataFrame(data, copy=False)
+        frame.attrs["path"] = str(results)
+        return frame
     return _read_table(_file(path, "vessels.csv"), TEXT_COLUMNS, columns)
 
 
@@ -333,6 +448,16 @@ def read_probes(path):
     `A ... [m^2]`, `u ... [m/s]` and its tracers' `c_NAME vessel ID x X [unit]`, one row per
     sample (the header's names as they are: parse_probe_name takes them apart); an empty
     file as an empty DataFrame."""
+    results = _results_h5(path)
+    if results is not None:
+        pd = _pandas()
+        h5py = _h5py()
+        with h5py.File(results, "r") as f:
+            if "probes" not in f:
+                return pd.DataFrame()
+            frame = pd.DataFrame(f["probes/values"][:], columns=json.loads(_text(f["probes/columns"])))
+        frame.attrs["path"] = str(results)
+        return frame
     path = _file(path, "probes.csv")
     frame = _read_table(path)
     if len(frame.columns) and not frame.columns[0].strip().startswith("t"):
