@@ -4,9 +4,9 @@
 // InputError naming the file and the dataset ("net.h5: /vessels/length: ..."); the library's
 // own error stack is never printed.
 //
-// A file is built in memory (HDF5's core driver) and its bytes handed to an OutputStream,
-// so that it is atomic like every other output (complete or absent) and may go to a pipe;
-// it is read from a path in place, or from bytes held in memory (standard input).
+// A file is written through an OutputStream (write_through), so that it is atomic like every
+// other output (complete or absent) and may go to a pipe; it is read from a path in place, or
+// from bytes held in memory (standard input).
 #pragma once
 
 #include <cstdint>
@@ -18,6 +18,8 @@
 #include <vector>
 
 #include <hdf5.h>
+
+#include "formats/output_stream.hpp"
 
 namespace hemotree::hdf5 {
 
@@ -88,8 +90,12 @@ struct EnumNames {
 
 class File {
  public:
-  // A new, empty file, built in memory; bytes() closes it and gives its bytes (once).
+  // A new, empty file, in a temporary file of its own; bytes() closes it and gives its bytes
+  // (once).
   static File create(std::string name);
+  // A new, empty file written at path as it is built (name for messages); close() ends it.
+  static File create_at(const std::string& path, std::string name);
+  void close();
   // An existing file, read-only: from a path, or from its bytes (name for messages).
   static File open(const std::string& path);
   static File open_image(std::vector<char> bytes, std::string name);
@@ -156,5 +162,18 @@ class File {
   std::vector<char> image_;  // the bytes an opened image reads in place (kept with the file)
   int backing_ = -1;         // a created file: where the library writes it when it closes
 };
+
+// A file written through out, as atomic as every output: in place where out is a file (the
+// library writes its temporary, which out.commit() then puts at its name), built in memory
+// and copied where out is standard output. fill writes the content; the caller commits out.
+template <class Fill>
+void write_through(OutputStream& out, Fill fill) {
+  const std::string path = out.path_for_writer();
+  File file = path.empty() ? File::create(out.name()) : File::create_at(path, out.name());
+  fill(file);
+  if (!path.empty()) return file.close();
+  const std::vector<char> bytes = file.bytes();
+  out.write(std::string_view(bytes.data(), bytes.size()));
+}
 
 }  // namespace hemotree::hdf5

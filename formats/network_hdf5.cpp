@@ -307,59 +307,58 @@ void write_network_hdf5(const Network& net, OutputStream& out) {
   const auto& [node_id, x, y, z, id, from, to, length, diameter, wall_thickness, youngs_modulus, generation,
                vessel_class, beta, reference_pressure, distal_diameter, blood, inlet, outlets, boundaries,
                provenance, extra] = net;
-  hdf5::File file = hdf5::File::create(out.name());
-  file.write_attribute("format", "vnet");
-  file.write_attribute("version", std::int64_t{format_version_needed(net)});
-  file.write_text("/provenance", provenance.dump());
-  if (!extra.empty()) file.write_text("/extra", extra.dump());
-  if (blood) file.write_text("/blood", to_json(*blood).dump());
-  if (inlet) file.write_text("/inlet", to_json(*inlet).dump());
-  if (!boundaries.empty()) {
-    nlohmann::json list = nlohmann::json::array();
-    for (const NodeBoundary& b : boundaries) list.push_back(to_json(b, node_id[static_cast<std::size_t>(b.node)]));
-    file.write_text("/boundaries", list.dump());
-  }
-  file.write("/nodes/id", std::span<const std::int64_t>(node_id));
-  if (net.has_coordinates()) {
-    file.write("/nodes/x", std::span<const double>(x));
-    file.write("/nodes/y", std::span<const double>(y));
-    file.write("/nodes/z", std::span<const double>(z));
-  }
-  file.write("/vessels/id", std::span<const std::int64_t>(id));
-  file.write("/vessels/from_node", std::span<const std::int32_t>(from));
-  file.write("/vessels/to_node", std::span<const std::int32_t>(to));
-  file.write("/vessels/length", std::span<const double>(length));
-  file.write("/vessels/diameter", std::span<const double>(diameter));
-  if (!distal_diameter.empty()) file.write("/vessels/distal_diameter", std::span<const double>(distal_diameter));
-  file.write("/vessels/wall_thickness", std::span<const double>(wall_thickness));
-  file.write("/vessels/youngs_modulus", std::span<const double>(youngs_modulus));
-  file.write("/vessels/generation", std::span<const std::int32_t>(generation));
-  static_assert(sizeof(VesselClass) == 1);
-  file.write_enum("/vessels/class",
-                  std::span(reinterpret_cast<const std::uint8_t*>(vessel_class.data()), vessel_class.size()),
-                  class_names);
-  if (!beta.empty()) {
-    file.write("/vessels/beta", std::span<const double>(beta));
-    file.write("/vessels/reference_pressure", std::span<const double>(reference_pressure));
-  }
-  if (!outlets.empty()) {
-    std::vector<std::int32_t> vessel(outlets.size());
-    std::vector<std::uint8_t> type(outlets.size());
-    for (std::size_t k = 0; k < outlets.size(); ++k) {
-      vessel[k] = outlets[k].vessel;
-      type[k] = outlet_type_value(outlets[k].type);
+  hdf5::write_through(out, [&](hdf5::File& file) {
+    file.write_attribute("format", "vnet");
+    file.write_attribute("version", std::int64_t{format_version_needed(net)});
+    file.write_text("/provenance", provenance.dump());
+    if (!extra.empty()) file.write_text("/extra", extra.dump());
+    if (blood) file.write_text("/blood", to_json(*blood).dump());
+    if (inlet) file.write_text("/inlet", to_json(*inlet).dump());
+    if (!boundaries.empty()) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const NodeBoundary& b : boundaries) list.push_back(to_json(b, node_id[static_cast<std::size_t>(b.node)]));
+      file.write_text("/boundaries", list.dump());
     }
-    file.write("/outlets/vessel", std::span<const std::int32_t>(vessel));
-    file.write_enum("/outlets/type", type, outlet_type_names);
-    file.write("/outlets/R1", outlet_column(outlets, &Outlet::r1));
-    file.write("/outlets/C", outlet_column(outlets, &Outlet::c));
-    file.write("/outlets/R2", outlet_column(outlets, &Outlet::r2));
-    file.write("/outlets/R", outlet_column(outlets, &Outlet::r));
-    file.write("/outlets/p_out", outlet_column(outlets, &Outlet::p_out));
-    file.write("/outlets/coefficient", outlet_column(outlets, &Outlet::reflection));
-  }
-  const std::vector<char> bytes = file.bytes();
-  out.write(std::string_view(bytes.data(), bytes.size()));
+    file.write("/nodes/id", std::span<const std::int64_t>(node_id));
+    if (net.has_coordinates()) {
+      file.write("/nodes/x", std::span<const double>(x));
+      file.write("/nodes/y", std::span<const double>(y));
+      file.write("/nodes/z", std::span<const double>(z));
+    }
+    file.write("/vessels/id", std::span<const std::int64_t>(id));
+    file.write("/vessels/from_node", std::span<const std::int32_t>(from));
+    file.write("/vessels/to_node", std::span<const std::int32_t>(to));
+    file.write("/vessels/length", std::span<const double>(length));
+    file.write("/vessels/diameter", std::span<const double>(diameter));
+    if (!distal_diameter.empty()) file.write("/vessels/distal_diameter", std::span<const double>(distal_diameter));
+    file.write("/vessels/wall_thickness", std::span<const double>(wall_thickness));
+    file.write("/vessels/youngs_modulus", std::span<const double>(youngs_modulus));
+    file.write("/vessels/generation", std::span<const std::int32_t>(generation));
+    static_assert(sizeof(VesselClass) == 1);
+    file.write_enum("/vessels/class",
+                    std::span(reinterpret_cast<const std::uint8_t*>(vessel_class.data()), vessel_class.size()),
+                    class_names);
+    if (!beta.empty()) {
+      file.write("/vessels/beta", std::span<const double>(beta));
+      file.write("/vessels/reference_pressure", std::span<const double>(reference_pressure));
+    }
+    if (!outlets.empty()) {
+      std::vector<std::int32_t> vessel(outlets.size());
+      std::vector<std::uint8_t> type(outlets.size());
+      for (std::size_t k = 0; k < outlets.size(); ++k) {
+        vessel[k] = outlets[k].vessel;
+        type[k] = outlet_type_value(outlets[k].type);
+      }
+      file.write("/outlets/vessel", std::span<const std::int32_t>(vessel));
+      file.write_enum("/outlets/type", type, outlet_type_names);
+      file.write("/outlets/R1", outlet_column(outlets, &Outlet::r1));
+      file.write("/outlets/C", outlet_column(outlets, &Outlet::c));
+      file.write("/outlets/R2", outlet_column(outlets, &Outlet::r2));
+      file.write("/outlets/R", outlet_column(outlets, &Outlet::r));
+      file.write("/outlets/p_out", outlet_column(outlets, &Outlet::p_out));
+      file.write("/outlets/coefficient", outlet_column(outlets, &Outlet::reflection));
+    }
+  });
 }
 
 Network read_network_hdf5(const hdf5::File& file) { return Hdf5Reader(file).read(); }

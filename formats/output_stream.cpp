@@ -8,6 +8,7 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <limits>
+#include <stdexcept>
 #include <string_view>
 #include <unistd.h>
 
@@ -149,6 +150,21 @@ OutputStream::~OutputStream() {
   std::error_code ignored;
   std::filesystem::remove(temp_path_, ignored);
   unwatch_temp();
+}
+
+std::string OutputStream::path_for_writer() {
+  if (is_stdout_ || direct_) return "";
+  if (anonymous_) {
+    if (used_ != 0 || std::ftell(file_) != 0) throw std::logic_error(display_name_ + ": path_for_writer after a write");
+    std::fclose(file_);  // nothing in it: it vanishes
+    file_ = nullptr;
+    anonymous_ = false;
+    temp_path_ = partial_path(final_path_);
+    file_ = std::fopen(temp_path_.c_str(), "wb");
+    if (!file_) throw IoError("cannot create " + final_path_ + ": " + errno_text());
+    watch_temp(temp_path_);
+  }
+  return temp_path_;
 }
 
 void OutputStream::flush_buffer() {

@@ -45,6 +45,11 @@ class OutputStream {
   const std::string& name() const { return display_name_; }
   // Where the bytes go until commit(): "" for an anonymous file, else NAME.partial-HOST-PID.
   const std::string& temporary_path() const { return temp_path_; }
+  // A path through which a library that writes files by name (HDF5) writes this file's bytes
+  // itself, before any write() and before commit(): the named temporary (an anonymous file
+  // is traded for one: HDF5 resolves a /proc/self/fd link to a name that does not exist);
+  // "" for standard output and devices, which take bytes through write() only.
+  std::string path_for_writer();
 
  private:
   void flush_buffer();

@@ -105,16 +105,15 @@ void write_probes(hdf5::File& file, const ProbeRecorder& probes) {
 
 void write_results_hdf5(const std::filesystem::path& path, const RunResults& results) {
   OutputStream out(path.string());
-  hdf5::File file = hdf5::File::create(out.name());
-  file.write_attribute("format", "hemotree-results");
-  file.write_attribute("version", std::int64_t{1});
-  constexpr auto replace = nlohmann::json::error_handler_t::replace;
-  file.write_text("/summary", summary_facts(results.run, results.cycle).dump(1, ' ', false, replace));
-  write_vessels(file, results.vessels);
-  write_boundaries(file, results.boundaries);
-  if (results.probes && !results.probes->empty()) write_probes(file, *results.probes);
-  const std::vector<char> bytes = file.bytes();
-  out.write(std::string_view(bytes.data(), bytes.size()));
+  hdf5::write_through(out, [&](hdf5::File& file) {
+    file.write_attribute("format", "hemotree-results");
+    file.write_attribute("version", std::int64_t{1});
+    constexpr auto replace = nlohmann::json::error_handler_t::replace;
+    file.write_text("/summary", summary_facts(results.run, results.cycle).dump(1, ' ', false, replace));
+    write_vessels(file, results.vessels);
+    write_boundaries(file, results.boundaries);
+    if (results.probes && !results.probes->empty()) write_probes(file, *results.probes);
+  });
   out.commit();
 }
 
