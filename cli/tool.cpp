@@ -2,6 +2,8 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <initializer_list>
 #include <cstring>
 #include <iostream>
 #include <new>
@@ -26,6 +28,19 @@ void say(const std::string& kind, const std::string& message) {
   std::fprintf(stderr, "%s: %s%s\n", tool_name.c_str(), kind.c_str(), message.c_str());
 }
 }  // namespace
+
+namespace {
+// An MPI launcher's environment (Open MPI's mpirun, a PMI launcher such as Slurm's srun, MPICH's
+// Hydra): the number of ranks and this one's, without initialising MPI. 1 and 0 without one.
+int environment_number(std::initializer_list<const char*> names, int otherwise) {
+  for (const char* name : names)
+    if (const char* value = std::getenv(name); value && *value) return std::atoi(value);
+  return otherwise;
+}
+}  // namespace
+
+int launched_ranks() { return environment_number({"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"}, 1); }
+int launched_rank() { return environment_number({"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"}, 0); }
 
 void warn(const std::string& message) { say("warning: ", message); }
 void note(const std::string& message) { say("", message); }
@@ -87,6 +102,16 @@ int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, co
     }
     say("error: ", culprit.empty() ? std::string("an argument's value is out of range (see --help)")
                                    : "'" + culprit + "': the value is out of range for that option (see --help)");
+    return 2;
+  }
+  // Started by an MPI launcher on several ranks, every rank would run the whole command and
+  // write the same outputs: refused on every rank, said once (rank 0), until a tool runs
+  // distributed (issue 24).
+  if (const int ranks = launched_ranks(); ranks > 1) {
+    if (launched_rank() == 0)
+      say("error: ", "started on " + std::to_string(ranks) + " MPI ranks: " + tool_name +
+                         " runs as one process for now (each rank would run the whole command and write the same "
+                         "outputs); run it without mpirun, or with -np 1");
     return 2;
   }
   try {

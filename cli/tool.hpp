@@ -19,6 +19,11 @@ int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, co
 // The same for a tool whose libraries name no setting of its own.
 int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
 
+// The ranks an MPI launcher started (1 without one) and this process's (0 without one), from
+// the launcher's environment: run_tool refuses more than one rank, said by rank 0.
+int launched_ranks();
+int launched_rank();
+
 // "vgen: warning: ..." / "vgen: ..." on stderr.
 void warn(const std::string& message);
 void note(const std::string& message);

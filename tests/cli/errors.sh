@@ -34,4 +34,20 @@ status=${PIPESTATUS[0]}
 sleep 0.5; kill -TERM $pid; wait $pid 2>/dev/null
 [ -e "$WORK/big.json" ] && fail "killed vgen left big.json" || pass "killed vgen left no final file"
 ls "$WORK" | grep -q partial && fail "killed vgen left its partial file" || pass "killed vgen cleaned up"
+# Under mpirun with several ranks every rank would run the whole command: refused, said once.
+if command -v mpirun >/dev/null; then
+  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 mpirun --oversubscribe -np 2 \
+    "$VGEN" --root-diameter 150um -o "$WORK/mpi.json" >"$WORK/mpi.out" 2>&1
+  status=$?
+  count=$(grep -c "started on 2 MPI ranks: vgen runs as one process for now" "$WORK/mpi.out")
+  [ "$status" -ne 0 ] && [ "$count" -eq 1 ] && [ ! -e "$WORK/mpi.json" ] \
+    && pass "mpirun -np 2 vgen: refused, said once, nothing written" \
+    || fail "mpirun -np 2 vgen: status $status, said $count times: $(cat "$WORK/mpi.out")"
+  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 mpirun --oversubscribe -np 1 \
+    "$VGEN" --root-diameter 150um -o "$WORK/mpi1.json" >"$WORK/mpi1.out" 2>&1 \
+    && cmp -s "$WORK/mpi1.json" <("$VGEN" --root-diameter 150um 2>/dev/null) \
+    && pass "mpirun -np 1 vgen: the plain command's network" || fail "mpirun -np 1 vgen: $(cat "$WORK/mpi1.out")"
+else
+  echo "skip: mpirun (no Open MPI)"
+fi
 finish
