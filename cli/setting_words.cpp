@@ -63,7 +63,7 @@ const SettingWords& vprune_words() {
 }
 
 const SettingWords& vstats_words() {
-  static const SettingWords words = {{"json", "--json"}};
+  static const SettingWords words = {{"json", "--json"}, {"ranks", "--partition"}};
   return words;
 }
 

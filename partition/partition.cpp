@@ -1,0 +1,89 @@
+#include "partition/partition.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "core/setting_error.hpp"
+#include "partition/partition_methods.hpp"
+
+namespace hemotree {
+
+double Partition::imbalance() const {
+  if (cost.empty()) return 1;
+  const double total = std::accumulate(cost.begin(), cost.end(), 0.0);
+  return total > 0 ? *std::max_element(cost.begin(), cost.end()) / (total / static_cast<double>(cost.size())) : 1;
+}
+
+const char* to_string(Partition::Method method) {
+  switch (method) {
+    case Partition::Method::single: return "one rank";
+    case Partition::Method::subtrees: return "subtrees";
+    case Partition::Method::metis: return "METIS";
+  }
+  return "?";
+}
+
+std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> rank_of_vessel) {
+  std::vector<std::int32_t> seen(net.node_count(), -1);
+  std::vector<std::uint8_t> cut(net.node_count(), 0);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    for (const std::int32_t node : {net.from[v], net.to[v]}) {
+      auto& s = seen[static_cast<std::size_t>(node)];
+      if (s < 0) s = rank_of_vessel[v];
+      else if (s != rank_of_vessel[v]) cut[static_cast<std::size_t>(node)] = 1;
+    }
+  return static_cast<std::size_t>(std::count(cut.begin(), cut.end(), std::uint8_t{1}));
+}
+
+Partition partition_network(const Network& net, std::span<const double> cost, int ranks) {
+  const std::size_t n = net.vessel_count();
+  if (cost.size() != n) throw std::invalid_argument("partition_network: one cost per vessel");
+  if (ranks < 1)
+    throw SettingError("ranks", placeholder("ranks") + " must be at least 1 (got " + std::to_string(ranks) + ")");
+  if (static_cast<std::size_t>(ranks) > n)
+    throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(ranks) + ": more ranks than the " +
+                                    std::to_string(n) + " vessels (at most one rank a vessel)");
+  for (std::size_t v = 0; v < n; ++v)
+    if (!(cost[v] > 0) || !std::isfinite(cost[v]))
+      throw std::invalid_argument("partition_network: a vessel's cost must be positive");
+  Partition p;
+  if (ranks == 1) {
+    p.rank_of_vessel.assign(n, 0);
+  } else {
+    p = is_forest(net) ? partition_subtrees(net, cost, ranks) : partition_with_metis(net, cost, ranks);
+  }
+  p.ranks = ranks;
+  p.cost.assign(static_cast<std::size_t>(ranks), 0.0);
+  p.vessels.assign(static_cast<std::size_t>(ranks), 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    p.cost[static_cast<std::size_t>(p.rank_of_vessel[v])] += cost[v];
+    ++p.vessels[static_cast<std::size_t>(p.rank_of_vessel[v])];
+  }
+  for (int r = 0; r < ranks; ++r)
+    if (p.vessels[static_cast<std::size_t>(r)] == 0)
+      throw SettingError("ranks", placeholder("ranks") + ": a partition of " + std::to_string(n) + " vessels into " + std::to_string(ranks) +
+                       " ranks leaves rank " + std::to_string(r) + " without a vessel (" + to_string(p.method) +
+                       "): use fewer ranks");
+  p.cut_nodes = count_cut_nodes(net, p.rank_of_vessel);
+  return p;
+}
+
+std::string describe(const Partition& p) {
+  std::ostringstream s;
+  const auto [fewest, most] = std::minmax_element(p.vessels.begin(), p.vessels.end());
+  s << p.ranks << (p.ranks == 1 ? " rank" : " ranks");
+  if (p.ranks > 1) s << " by " << to_string(p.method);
+  s << ": " << *fewest;
+  if (*most != *fewest) s << " to " << *most;
+  s << " vessels a rank, cost imbalance " << std::fixed;
+  s.precision(3);
+  s << p.imbalance() << " (the largest over the mean), " << p.cut_nodes << " cut nodes";
+  if (p.method == Partition::Method::subtrees)
+    s << ", the top's " << p.top_vessels << " vessels on rank " << p.top_rank;
+  return s.str();
+}
+
+}  // namespace hemotree

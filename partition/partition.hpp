@@ -1,0 +1,50 @@
+// The vessels of a network split over P ranks for a distributed run (issue 24), each vessel
+// weighted by its cost. A forest of trees (every node entered by at most one vessel, no loop)
+// is split into whole subtrees: subtrees are split from the top, largest first, until the
+// largest is an eighth of a rank's share, then dealt to the ranks largest first (each to the
+// least loaded: Graham's LPT rule, at most the largest piece above the best), and the vessels
+// split off above them, the top, go together to the rank left least loaded, so that the top's
+// small system is one rank's. Any other graph is split by METIS (multilevel k-way on the
+// nodes, each weighted by half its vessels' cost), a vessel going with its `from` node.
+// Deterministic: the same partition for the same network, costs and P.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "formats/network.hpp"
+
+namespace hemotree {
+
+struct Partition {
+  enum class Method { single, subtrees, metis };
+  Method method = Method::single;
+  int ranks = 1;
+  std::vector<std::int32_t> rank_of_vessel;  // one per vessel, in [0, ranks)
+  std::vector<double> cost;                  // per rank: the sum of its vessels' costs
+  std::vector<std::size_t> vessels;          // per rank
+  std::size_t cut_nodes = 0;                 // nodes whose vessels lie on more than one rank
+  std::size_t top_vessels = 0;               // subtrees: the vessels above the cut
+  int top_rank = 0;                          // subtrees: the rank that holds them
+
+  // The largest rank's cost over the mean (1: perfect balance).
+  double imbalance() const;
+};
+
+const char* to_string(Partition::Method method);  // "one rank", "subtrees", "METIS"
+
+// P in [1, vessel count]: SettingError "ranks" for P < 1, for more ranks than vessels, and
+// for a partition that would leave a rank without a vessel. cost: one positive number per
+// vessel.
+Partition partition_network(const Network& net, std::span<const double> cost, int ranks);
+
+// Nodes whose vessels lie on more than one rank.
+std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> rank_of_vessel);
+
+// One line: "4 ranks by subtrees: 1325 to 1326 vessels, cost imbalance 1.001, 9 cut nodes,
+// the top's 5 vessels on rank 3".
+std::string describe(const Partition& partition);
+
+}  // namespace hemotree
