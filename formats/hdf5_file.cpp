@@ -14,11 +14,11 @@
 
 #include <fcntl.h>
 #include <hdf5_hl.h>
-#include <zlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "core/errors.hpp"
+#include "formats/hdf5_chunk_filters.hpp"
 
 namespace hemotree::hdf5 {
 
@@ -117,44 +117,7 @@ const char* class_name(H5T_class_t c) {
 
 std::atomic<unsigned> images_made{0};
 
-// The crash guard's state: the line to print, the handlers it replaced, how many guards.
-char crash_line[1024];
-std::size_t crash_line_length = 0;
-constexpr int guarded_signals[] = {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL};
-struct sigaction replaced[std::size(guarded_signals)];
-int guards = 0;
-
-extern "C" void report_library_crash(int signal_number) {
-  // Only async-signal-safe calls: write and _exit.
-  ssize_t written = ::write(STDERR_FILENO, crash_line, crash_line_length);
-  char number[4] = {static_cast<char>('0' + signal_number / 10 % 10), static_cast<char>('0' + signal_number % 10), ')',
-                    '\n'};
-  written = ::write(STDERR_FILENO, number, sizeof number);
-  (void)written;
-  ::_exit(2);
-}
-
 }  // namespace
-
-CrashGuard::CrashGuard(const std::string& file_name) {
-  active_ = true;
-  if (guards++ > 0) return;
-  const std::string line = std::string(program_invocation_short_name) + ": error: " + file_name +
-                           ": damaged HDF5 file (the HDF5 library failed reading it: signal ";
-  crash_line_length = std::min(line.size(), sizeof crash_line);
-  std::memcpy(crash_line, line.data(), crash_line_length);
-  struct sigaction action{};
-  action.sa_handler = report_library_crash;
-  sigemptyset(&action.sa_mask);
-  for (std::size_t k = 0; k < std::size(guarded_signals); ++k) sigaction(guarded_signals[k], &action, &replaced[k]);
-}
-
-void CrashGuard::release() {
-  if (!active_) return;
-  active_ = false;
-  if (--guards > 0) return;
-  for (std::size_t k = 0; k < std::size(guarded_signals); ++k) sigaction(guarded_signals[k], &replaced[k], nullptr);
-}
 
 bool has_signature(std::span<const char> first_bytes) {
   return first_bytes.size() >= sizeof signature &&
@@ -327,60 +290,6 @@ std::size_t File::rows(const std::string& path) const {
   return static_cast<std::size_t>(n);
 }
 
-namespace {
-
-// HDF5's Fletcher-32 (H5_checksum_fletcher32): 16-bit words, most significant byte first, the
-// sums folded every 360 words; an odd last byte as a word's high byte.
-std::uint32_t fletcher32(const unsigned char* data, std::size_t length) {
-  std::uint32_t sum1 = 0, sum2 = 0;
-  for (std::size_t words = length / 2; words > 0;) {
-    std::size_t block = std::min<std::size_t>(words, 360);
-    words -= block;
-    for (; block > 0; --block, data += 2) {
-      sum1 += static_cast<std::uint32_t>(data[0]) << 8 | data[1];
-      sum2 += sum1;
-    }
-    sum1 = (sum1 & 0xffff) + (sum1 >> 16);
-    sum2 = (sum2 & 0xffff) + (sum2 >> 16);
-  }
-  if (length % 2 != 0) {
-    sum1 += static_cast<std::uint32_t>(*data) << 8;
-    sum2 += sum1;
-    sum1 = (sum1 & 0xffff) + (sum1 >> 16);
-    sum2 = (sum2 & 0xffff) + (sum2 >> 16);
-  }
-  sum1 = (sum1 & 0xffff) + (sum1 >> 16);
-  sum2 = (sum2 & 0xffff) + (sum2 >> 16);
-  return sum2 << 16 | sum1;
-}
-
-// One chunk through the filters set on every column, in their order: the byte shuffle (byte
-// k of every element together), deflate (zlib's compress2 at the level set) and Fletcher-32
-// appended in the machine's order, as HDF5's own filters produce it (tested byte for byte:
-// tests/test_network_hdf5.cpp). rows: the chunk's values; a last chunk is padded with
-// zeros (the fill value) to the chunk's size, as the library stores it.
-std::vector<unsigned char> filtered_chunk(const unsigned char* values, std::size_t rows, std::size_t chunk,
-                                          std::size_t element) {
-  const std::size_t bytes = chunk * element;
-  std::vector<unsigned char> shuffled(bytes, 0);
-  if (element == 1) {
-    std::memcpy(shuffled.data(), values, rows);
-  } else {
-    for (std::size_t i = 0; i < rows; ++i)
-      for (std::size_t k = 0; k < element; ++k) shuffled[k * chunk + i] = values[i * element + k];
-  }
-  uLongf packed = compressBound(bytes);
-  std::vector<unsigned char> out(packed + 4);
-  if (compress2(out.data(), &packed, shuffled.data(), bytes, static_cast<int>(deflate_level)) != Z_OK)
-    throw std::bad_alloc();  // compress2 fails only for want of memory with a bound-sized buffer
-  const std::uint32_t sum = fletcher32(out.data(), packed);
-  std::memcpy(out.data() + packed, &sum, 4);
-  out.resize(packed + 4);
-  return out;
-}
-
-}  // namespace
-
 void File::write_column(const std::string& path, hid_t memory_type, hid_t file_type, const void* data,
                         std::size_t rows) {
   const hsize_t n = rows;
@@ -412,7 +321,7 @@ void File::write_column(const std::string& path, hid_t memory_type, hid_t file_t
   for (std::size_t c = 0; c < chunks; ++c) {
     try {
       const std::size_t first = c * chunk, count = std::min<std::size_t>(chunk, rows - first);
-      filtered[c] = filtered_chunk(bytes + first * element, count, chunk, element);
+      filtered[c] = filtered_chunk(bytes + first * element, count, chunk, element, static_cast<int>(deflate_level));
     } catch (...) {
 #pragma omp critical(hdf5_chunk_error)
       if (!error) error = std::current_exception();

@@ -19,6 +19,7 @@
 
 #include <hdf5.h>
 
+#include "formats/hdf5_crash_guard.hpp"
 #include "formats/output_stream.hpp"
 
 namespace hemotree::hdf5 {
@@ -55,31 +56,6 @@ class Handle {
   }
   hid_t id_ = -1;
   herr_t (*close_)(hid_t) = nullptr;
-};
-
-// HDF5 1.10 trusts a file's metadata: of the single-byte flips of a small network file, about
-// one in a thousand made the library itself crash (segmentation faults, heap corruption found
-// by glibc), where the others are refused (or land where nothing is read). While a file from
-// outside is open, such a crash becomes the one line every bad input gets,
-// "TOOL: error: FILE: damaged HDF5 file (the HDF5 library failed reading it: signal N)", and
-// exit status 2. Nested guards are one; the handlers before are restored when the last ends.
-class CrashGuard {
- public:
-  CrashGuard() = default;
-  explicit CrashGuard(const std::string& file_name);
-  CrashGuard(CrashGuard&& other) noexcept : active_(std::exchange(other.active_, false)) {}
-  CrashGuard& operator=(CrashGuard&& other) noexcept {
-    if (this != &other) {
-      release();
-      active_ = std::exchange(other.active_, false);
-    }
-    return *this;
-  }
-  ~CrashGuard() { release(); }
-
- private:
-  void release();
-  bool active_ = false;
 };
 
 // An enumeration stored as one byte a row, its names in the file's type (h5py:

@@ -3,6 +3,7 @@
 // truncated or foreign file is refused in one line naming the dataset (never a crash).
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -354,4 +355,43 @@ TEST(Hdf5File, ColumnsFilteredHereReadBackThroughTheLibrarysFilters) {
     EXPECT_TRUE(std::equal(narrow_back.begin(), narrow_back.end(), narrow.begin(), narrow.end())) << rows;
     EXPECT_EQ(back.read_enum("/codes", names), codes) << rows;
   }
+}
+
+// The guard over the library: a crash while a file is open is one line and exit status 2;
+// once the guard is gone, a crash is a crash again (the handlers before are restored).
+TEST(Hdf5CrashGuard, ACrashWhileGuardedIsOneLineAndStatusTwo) {
+  int error_pipe[2];
+  ASSERT_EQ(::pipe(error_pipe), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::dup2(error_pipe[1], STDERR_FILENO);
+    hdf5::CrashGuard guard("damaged.h5");
+    std::raise(SIGSEGV);
+    ::_exit(0);
+  }
+  ::close(error_pipe[1]);
+  char text[512] = {};
+  const ssize_t got = ::read(error_pipe[0], text, sizeof text - 1);
+  ::close(error_pipe[0]);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  const std::string line(text, got > 0 ? static_cast<std::size_t>(got) : 0);
+  EXPECT_NE(line.find(": error: damaged.h5: damaged HDF5 file (the HDF5 library failed reading it: signal 11)\n"),
+            std::string::npos)
+      << line;
+  EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1);
+
+  const pid_t after = ::fork();
+  ASSERT_GE(after, 0);
+  if (after == 0) {
+    std::freopen("/dev/null", "w", stderr);
+    { hdf5::CrashGuard guard("read.h5"); }
+    std::raise(SIGSEGV);
+    ::_exit(0);
+  }
+  ::waitpid(after, &status, 0);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGSEGV);
 }
