@@ -20,11 +20,16 @@ struct sigaction replaced[std::size(guarded_signals)];
 int guards = 0;
 
 extern "C" void report_library_crash(int signal_number) {
-  // Only async-signal-safe calls: write and _exit.
-  ssize_t written = ::write(STDERR_FILENO, crash_line, crash_line_length);
-  char number[4] = {static_cast<char>('0' + signal_number / 10 % 10), static_cast<char>('0' + signal_number % 10), ')',
-                    '\n'};
-  written = ::write(STDERR_FILENO, number, sizeof number);
+  // Only async-signal-safe calls (write, _exit), and the line in one write, so that it is not
+  // split by what another process writes to the same terminal.
+  char line[sizeof crash_line + 8];
+  std::size_t n = 0;
+  for (; n < crash_line_length; ++n) line[n] = crash_line[n];
+  if (signal_number >= 10) line[n++] = static_cast<char>('0' + signal_number / 10 % 10);
+  line[n++] = static_cast<char>('0' + signal_number % 10);
+  line[n++] = ')';
+  line[n++] = '\n';
+  const ssize_t written = ::write(STDERR_FILENO, line, n);
   (void)written;
   ::_exit(2);
 }
