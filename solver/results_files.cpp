@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -42,55 +43,107 @@ void write_vessels(hdf5::File& file, const VesselTable& vessels) {
   }
 }
 
-// summary.json's list of boundaries as columns, one per member the entries have (a number
-// column where every value is a number or null, NaN for null or absent; an enumeration where
-// every value is text; integers where every value is one).
-void write_boundaries(hdf5::File& file, const SummaryArray& array) {
-  if (array.name.empty() || array.size == 0) return;
-  struct Column {
-    std::vector<double> number;
-    std::vector<std::int64_t> integer;
-    std::vector<std::uint8_t> code;
-    std::vector<std::string> labels;
-    bool integers = true, texts = true, numbers = true;
-  };
-  std::vector<std::pair<std::string, Column>> columns;  // in the first entry's order
-  auto column = [&](const std::string& key) -> Column& {
-    for (auto& [name, c] : columns)
-      if (name == key) return c;
-    Column& c = columns.emplace_back(key, Column{}).second;
-    return c;
-  };
-  for (std::size_t i = 0; i < array.size; ++i) {
+// summary.json's list of boundaries as columns, one per member the entries have, in the
+// order they first appear (a number column where every value is a number or null, NaN for
+// null or absent; an enumeration where every value is text, its labels in the order they
+// first appear; integers where every value is one). The entries (two million on a full tree,
+// a JSON object each) are read in blocks on every thread and the blocks joined in order: the
+// same columns for any count of threads.
+struct BoundaryColumn {
+  std::string name;
+  std::vector<double> number;
+  std::vector<std::int64_t> integer;
+  std::vector<std::uint8_t> code;
+  std::vector<std::string> labels;
+  std::size_t present = 0;  // entries that have the member
+  bool integers = true, texts = true, numbers = true;
+};
+
+// Entries [first, end) as columns of end - first rows.
+std::vector<BoundaryColumn> boundary_block(const SummaryArray& array, std::size_t first, std::size_t end) {
+  std::vector<BoundaryColumn> columns;
+  const std::size_t rows = end - first;
+  for (std::size_t i = first; i < end; ++i) {
     const nlohmann::json entry = array.entry(i);
     for (const auto& [key, value] : entry.items()) {
-      Column& c = column(key);
-      c.number.resize(i, null_number);
-      c.integer.resize(i, 0);
-      c.code.resize(i, 0);
+      auto at = std::find_if(columns.begin(), columns.end(), [&](const BoundaryColumn& c) { return c.name == key; });
+      if (at == columns.end()) {
+        at = columns.insert(columns.end(), BoundaryColumn{key});
+        at->number.assign(rows, null_number);
+        at->integer.assign(rows, 0);
+        at->code.assign(rows, 0);
+      }
+      BoundaryColumn& c = *at;
+      const std::size_t row = i - first;
+      ++c.present;
       c.integers = c.integers && value.is_number_integer();
       c.numbers = c.numbers && (value.is_number() || value.is_null());
       c.texts = c.texts && value.is_string();
-      c.number.push_back(value.is_number() ? value.get<double>() : null_number);
-      c.integer.push_back(value.is_number_integer() ? value.get<std::int64_t>() : 0);
-      std::uint8_t code = 0;
+      if (value.is_number()) c.number[row] = value.get<double>();
+      if (value.is_number_integer()) c.integer[row] = value.get<std::int64_t>();
       if (value.is_string()) {
         const std::string text = value.get<std::string>();
-        const auto at = std::find(c.labels.begin(), c.labels.end(), text);
-        code = static_cast<std::uint8_t>(at - c.labels.begin());
-        if (at == c.labels.end()) c.labels.push_back(text);
-        c.texts = c.texts && c.labels.size() <= 255;
+        const auto label = std::find(c.labels.begin(), c.labels.end(), text);
+        c.code[row] = static_cast<std::uint8_t>(std::min<std::ptrdiff_t>(label - c.labels.begin(), 255));
+        if (label == c.labels.end()) c.labels.push_back(text);
       }
-      c.code.push_back(code);
     }
   }
-  for (auto& [name, c] : columns) {
-    const bool complete = c.number.size() == array.size;
-    c.number.resize(array.size, null_number);
-    const std::string path = "/" + array.name + "/" + name;
-    if (c.texts && complete) file.write_enum(path, c.code, enum_names(c.labels));
+  return columns;
+}
+
+void write_boundaries(hdf5::File& file, const SummaryArray& array, int threads) {
+  if (array.name.empty() || array.size == 0) return;
+  const std::size_t blocks = std::min<std::size_t>(static_cast<std::size_t>(std::max(threads, 1)) * 4, array.size);
+  std::vector<std::vector<BoundaryColumn>> parts(blocks);
+  std::exception_ptr error;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(std::max(threads, 1))
+  for (std::size_t b = 0; b < blocks; ++b) {
+    try {
+      parts[b] = boundary_block(array, b * array.size / blocks, (b + 1) * array.size / blocks);
+    } catch (...) {
+#pragma omp critical(boundary_block_error)
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  // The blocks joined in order: members and labels in the order of their first appearance.
+  std::vector<BoundaryColumn> columns;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t first = b * array.size / blocks, rows = (b + 1) * array.size / blocks - first;
+    for (BoundaryColumn& part : parts[b]) {
+      auto at = std::find_if(columns.begin(), columns.end(), [&](const BoundaryColumn& c) { return c.name == part.name; });
+      if (at == columns.end()) {
+        at = columns.insert(columns.end(), BoundaryColumn{part.name});
+        at->number.assign(array.size, null_number);
+        at->integer.assign(array.size, 0);
+        at->code.assign(array.size, 0);
+      }
+      BoundaryColumn& c = *at;
+      c.present += part.present;
+      c.integers = c.integers && part.integers;
+      c.numbers = c.numbers && part.numbers;
+      c.texts = c.texts && part.texts;
+      std::copy(part.number.begin(), part.number.end(), c.number.begin() + static_cast<std::ptrdiff_t>(first));
+      std::copy(part.integer.begin(), part.integer.end(), c.integer.begin() + static_cast<std::ptrdiff_t>(first));
+      std::vector<std::uint8_t> global(part.labels.size());
+      for (std::size_t k = 0; k < part.labels.size(); ++k) {
+        const auto label = std::find(c.labels.begin(), c.labels.end(), part.labels[k]);
+        global[k] = static_cast<std::uint8_t>(std::min<std::ptrdiff_t>(label - c.labels.begin(), 255));
+        if (label == c.labels.end()) c.labels.push_back(part.labels[k]);
+      }
+      for (std::size_t row = 0; row < rows; ++row)
+        if (!part.labels.empty()) c.code[first + row] = global[std::min<std::size_t>(part.code[row], global.size() - 1)];
+    }
+    std::vector<BoundaryColumn>().swap(parts[b]);  // joined: freed
+  }
+  for (const BoundaryColumn& c : columns) {
+    const bool complete = c.present == array.size;
+    const std::string path = "/" + array.name + "/" + c.name;
+    if (c.texts && complete && c.labels.size() <= 255) file.write_enum(path, c.code, enum_names(c.labels));
     else if (c.integers && complete) file.write(path, std::span<const std::int64_t>(c.integer));
     else if (c.numbers) file.write(path, std::span<const double>(c.number));
+    else throw std::logic_error("results.h5: the boundaries' member " + c.name + " is neither numbers nor texts");
   }
 }
 
@@ -111,7 +164,7 @@ void write_results_hdf5(const std::filesystem::path& path, const RunResults& res
     constexpr auto replace = nlohmann::json::error_handler_t::replace;
     file.write_text("/summary", summary_facts(results.run, results.cycle).dump(1, ' ', false, replace));
     write_vessels(file, results.vessels);
-    write_boundaries(file, results.boundaries);
+    write_boundaries(file, results.boundaries, results.threads);
     if (results.probes && !results.probes->empty()) write_probes(file, *results.probes);
   });
   out.commit();
