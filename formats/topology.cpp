@@ -177,7 +177,21 @@ Children children_of(const Network& net) {
 }
 
 std::vector<std::int32_t> breadth_first_order(const Children& children, std::size_t root) {
-  std::vector<std::int32_t> order{static_cast<std::int32_t>(root)};
+  const std::int32_t roots[] = {static_cast<std::int32_t>(root)};
+  return breadth_first_order(children, roots);
+}
+
+std::vector<std::int32_t> inlet_vessels(const Network& net) {
+  std::vector<std::uint8_t> entered(net.node_count(), 0);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) entered[static_cast<std::size_t>(net.to[v])] = 1;
+  std::vector<std::int32_t> roots;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (!entered[static_cast<std::size_t>(net.from[v])]) roots.push_back(static_cast<std::int32_t>(v));
+  return roots;
+}
+
+std::vector<std::int32_t> breadth_first_order(const Children& children, std::span<const std::int32_t> roots) {
+  std::vector<std::int32_t> order(roots.begin(), roots.end());
   order.reserve(children.offset.size() - 1);
   for (std::size_t head = 0; head < order.size(); ++head) {
     const auto v = static_cast<std::size_t>(order[head]);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <boost/graph/compressed_sparse_row_graph.hpp>
@@ -42,5 +43,10 @@ Children children_of(const Network& net);
 
 // Vessels breadth first from the root: every parent before its daughters.
 std::vector<std::int32_t> breadth_first_order(const Children& children, std::size_t root);
+// The same from several roots (a forest), the roots first in their order.
+std::vector<std::int32_t> breadth_first_order(const Children& children, std::span<const std::int32_t> roots);
+
+// Vessels leaving a node that no vessel enters, in index order: a forest's roots.
+std::vector<std::int32_t> inlet_vessels(const Network& net);
 
 }  // namespace hemotree

@@ -1,8 +1,9 @@
-// Any graph split by METIS (partition/partition.hpp): the nodes, each weighted by half the
-// cost of its vessels, cut into k parts of balanced weight along few vessels; a vessel goes
+// Any graph split by METIS (partition/partition.hpp): the nodes, each weighted by the cost of
+// the vessels leaving it, cut into k parts of balanced weight along few vessels; a vessel goes
 // with its `from` node.
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -30,15 +31,16 @@ Partition partition_with_metis(const Network& net, std::span<const double> cost,
     adjacent[e] = edges[e].second;
   }
   for (std::size_t k = 0; k < nodes; ++k) offset[k + 1] += offset[k];
-  // Integer weights: the costs in units of the least cost over 100, so that a vessel of the
-  // least cost weighs 100 and ratios keep two digits.
-  const double unit = *std::min_element(cost.begin(), cost.end()) / 100;
+  // Integer weights, each vessel's whole cost on its `from` node, the node it goes with (a
+  // node only entered weighs nothing): in units that give the least cost 100 (two digits of
+  // the ratios), or fewer where the total would pass 2^30 (METIS's 32-bit sums); each vessel
+  // at least 1.
+  const double total = std::accumulate(cost.begin(), cost.end(), 0.0);
+  const double least = *std::min_element(cost.begin(), cost.end());
+  const double scale = std::min(100 / least, std::ldexp(1.0, 30) / total);
   std::vector<idx_t> weight(nodes, 0);
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    const auto half = static_cast<idx_t>(std::llround(cost[v] / unit / 2));
-    weight[static_cast<std::size_t>(net.from[v])] += half;
-    weight[static_cast<std::size_t>(net.to[v])] += half;
-  }
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    weight[static_cast<std::size_t>(net.from[v])] += static_cast<idx_t>(std::max(1.0, std::round(cost[v] * scale)));
   idx_t vertices = static_cast<idx_t>(nodes), constraints = 1, parts = ranks, edge_cut = 0;
   std::vector<idx_t> part(nodes, 0);
   idx_t options[METIS_NOPTIONS];

@@ -43,6 +43,7 @@ Partition partition_network(const Network& net, std::span<const double> cost, in
   if (cost.size() != n) throw std::invalid_argument("partition_network: one cost per vessel");
   if (ranks < 1)
     throw SettingError("ranks", placeholder("ranks") + " must be at least 1 (got " + std::to_string(ranks) + ")");
+  if (n == 0) throw SettingError("ranks", placeholder("ranks") + ": the network has no vessels to split");
   if (static_cast<std::size_t>(ranks) > n)
     throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(ranks) + ": more ranks than the " +
                                     std::to_string(n) + " vessels (at most one rank a vessel)");
@@ -81,8 +82,10 @@ std::string describe(const Partition& p) {
   s << " vessels a rank, cost imbalance " << std::fixed;
   s.precision(3);
   s << p.imbalance() << " (the largest over the mean), " << p.cut_nodes << " cut nodes";
-  if (p.method == Partition::Method::subtrees)
-    s << ", the top's " << p.top_vessels << " vessels on rank " << p.top_rank;
+  if (p.method == Partition::Method::subtrees && p.top_spread)
+    s << ", the top's " << p.top.size() << " vessels each with its first daughter";
+  else if (p.method == Partition::Method::subtrees)
+    s << ", the top's " << p.top.size() << " vessels on rank " << p.top_rank;
   return s.str();
 }
 

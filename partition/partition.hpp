@@ -1,11 +1,14 @@
 // The vessels of a network split over P ranks for a distributed run (issue 24), each vessel
 // weighted by its cost. A forest of trees (every node entered by at most one vessel, no loop)
-// is split into whole subtrees: subtrees are split from the top, largest first, until the
-// largest is an eighth of a rank's share, then dealt to the ranks largest first (each to the
-// least loaded: Graham's LPT rule, at most the largest piece above the best), and the vessels
-// split off above them, the top, go together to the rank left least loaded, so that the top's
-// small system is one rank's. Any other graph is split by METIS (multilevel k-way on the
-// nodes, each weighted by half its vessels' cost), a vessel going with its `from` node.
+// is split into whole subtrees: subtrees with daughters are split from the top, largest first,
+// until the largest is an eighth of a rank's share, and the pieces dealt largest first, each
+// to the least loaded rank (Graham's LPT rule: the largest load at most the mean plus the
+// largest piece). The vessels split off above them, the top, are dealt as one more piece, so
+// that the top's small system is one rank's; where the top outgrows a rank's share (many
+// ranks for the vessels: P above about the square root of an eighth of them), each top
+// vessel goes with its first daughter instead. Of the cuts on the way the best dealt is kept.
+// Any other graph is split by METIS (multilevel k-way on the nodes, each weighted by the cost
+// of the vessels leaving it), a vessel going with its `from` node.
 // Deterministic: the same partition for the same network, costs and P.
 #pragma once
 
@@ -26,8 +29,9 @@ struct Partition {
   std::vector<double> cost;                  // per rank: the sum of its vessels' costs
   std::vector<std::size_t> vessels;          // per rank
   std::size_t cut_nodes = 0;                 // nodes whose vessels lie on more than one rank
-  std::size_t top_vessels = 0;               // subtrees: the vessels above the cut
-  int top_rank = 0;                          // subtrees: the rank that holds them
+  std::vector<std::int32_t> top;             // subtrees: the vessels above the cut
+  int top_rank = 0;                          // subtrees: the rank that holds them (-1: spread)
+  bool top_spread = false;                   // subtrees: each top vessel with its first daughter
 
   // The largest rank's cost over the mean (1: perfect balance).
   double imbalance() const;
@@ -43,8 +47,8 @@ Partition partition_network(const Network& net, std::span<const double> cost, in
 // Nodes whose vessels lie on more than one rank.
 std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> rank_of_vessel);
 
-// One line: "4 ranks by subtrees: 1325 to 1326 vessels, cost imbalance 1.001, 9 cut nodes,
-// the top's 5 vessels on rank 3".
+// One line: "4 ranks by subtrees: 1325 to 1326 vessels a rank, cost imbalance 1.001 (the
+// largest over the mean), 9 cut nodes, the top's 5 vessels on rank 3".
 std::string describe(const Partition& partition);
 
 }  // namespace hemotree

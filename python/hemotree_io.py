@@ -199,10 +199,14 @@ def _read_network_hdf5(path):
             outlet = np.full(len(vessels), np.nan, dtype=object)
             for k, v in enumerate(out["vessel"]):
                 kind = out["type"][k]
+                if kind not in used:
+                    raise FormatError(f"{path}: /outlets/type row {k}: unknown outlet type {kind!r}")
                 outlet[v] = {"type": kind, **{name: float(out[name][k]) for name in used[kind]}}
             vessels["outlet"] = outlet
         texts = {k: json.loads(_text(f[k])) for k in ("blood", "inlet", "provenance", "boundaries", "extra")
                  if k in f}
+        if "version" not in f.attrs:
+            raise FormatError(f"{path}: no attribute version")
         version = int(f.attrs["version"])
     return Network(vessels=vessels, nodes=nodes, version=version, blood=texts.get("blood", {}),
                    inlet=texts.get("inlet", {}), boundaries=texts.get("boundaries", []),
@@ -237,7 +241,25 @@ def read_summary(path, vessels=True):
     if results is not None:
         h5py = _h5py()
         with h5py.File(results, "r") as f:
+            if "summary" not in f:
+                raise FormatError(f"{results}: not a hemosolve results.h5 (no /summary)")
             summary = json.loads(_text(f["summary"]))
+            if "boundaries" in f:
+                # summary.json's list as the text form has it: a member absent where NaN
+                # (hematocrit at outlets), enumerations as their words, integers as ints.
+                columns = _h5_columns(f["boundaries"], categories=False)
+                names = list(columns)
+                rows = len(columns[names[0]]) if names else 0
+                entries = []
+                for i in range(rows):
+                    entry = {}
+                    for name in names:
+                        x = columns[name][i]
+                        if isinstance(x, float) and x != x:
+                            continue
+                        entry[name] = x.item() if hasattr(x, "item") else x
+                    entries.append(entry)
+                summary["boundaries"] = entries
         if vessels:
             table = read_vessels(results)
             summary["vessels"] = [{k: (None if isinstance(x, float) and x != x else x) for k, x in row.items()}

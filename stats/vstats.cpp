@@ -41,9 +41,11 @@ int main(int argc, char** argv) {
                             {"vessels", partition->vessels},
                             {"cost", partition->cost},
                             {"imbalance", partition->imbalance()},
-                            {"cut_nodes", partition->cut_nodes},
-                            {"top_vessels", partition->top_vessels},
-                            {"top_rank", partition->top_rank}};
+                            {"cut_nodes", partition->cut_nodes}};
+      if (partition->method == hemotree::Partition::Method::subtrees) {
+        out["partition"]["top_vessels"] = partition->top.size();
+        out["partition"]["top_rank"] = partition->top_spread ? nlohmann::json(nullptr) : nlohmann::json(partition->top_rank);
+      }
       std::cout << out.dump(2) << '\n';
     } else {
       hemotree::print_table(stats, std::cout, hemotree::vstats_words());

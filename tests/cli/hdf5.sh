@@ -130,6 +130,11 @@ pd.testing.assert_frame_equal(hio.read_vessels(work / "h5").astype({"class": str
 check("hemotree_io.read_vessels: the same frame from results.h5 and vessels.csv", True)
 pd.testing.assert_frame_equal(hio.read_probes(work / "h5"), hio.read_probes(work / "text"), check_dtype=False)
 check("hemotree_io.read_probes: the same frame from either", True)
+sa, sb = hio.read_summary(work / "h5"), hio.read_summary(work / "text")
+check("hemotree_io.read_summary: the same boundaries from results.h5 and summary.json",
+      sa["boundaries"] == sb["boundaries"] and len(sa["boundaries"]) > 0)
+check("hemotree_io.read_summary: the same vessels from results.h5 and summary.json",
+      sa["vessels"] == sb["vessels"] and len(sa["vessels"]) == len(text))
 a, b = hio.read_network(work / "net.h5"), hio.read_network(work / "net.json")
 pd.testing.assert_frame_equal(a.vessels, b.vessels, check_dtype=False)
 pd.testing.assert_frame_equal(a.nodes, b.nodes, check_dtype=False)
