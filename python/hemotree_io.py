@@ -215,11 +215,21 @@ def _read_network_hdf5(path):
 
 def _results_h5(path):
     """results.h5 of a run: PATH itself when it is that file, else PATH/results.h5 when the
-    folder holds one; None for a run written as text."""
+    folder holds one; None for a run written as text. FormatError for an HDF5 file that is not
+    a run's results (a network given by mistake)."""
     path = Path(path)
     if path.is_dir():
-        return path / "results.h5" if (path / "results.h5").exists() else None
-    return path if path.suffix == ".h5" else None
+        path = path / "results.h5"
+        if not path.exists():
+            return None
+    elif not (path.exists() and _is_hdf5(path)):
+        return None
+    h5py = _h5py()
+    with h5py.File(path, "r") as f:
+        fmt = f.attrs.get("format")
+    if (fmt.decode() if isinstance(fmt, bytes) else fmt) != "hemotree-results":
+        raise FormatError(f"{path}: not a hemosolve results.h5 (its format attribute is {fmt!r})")
+    return path
 
 
 # ---- summary.json -----------------------------------------------------------------------
