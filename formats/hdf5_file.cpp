@@ -5,7 +5,6 @@
 #include <bit>
 #include <exception>
 #include <new>
-#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -115,7 +114,7 @@ const char* class_name(H5T_class_t c) {
   }
 }
 
-std::atomic<unsigned> images_made{0};
+std::atomic<unsigned> temporaries_made{0};
 
 }  // namespace
 
@@ -145,7 +144,7 @@ File File::create(std::string name) {
   Handle fapl = newest_objects(property_list(H5P_FILE_ACCESS));
   const char* folder = std::getenv("TMPDIR");
   const std::string path = std::string(folder && *folder ? folder : "/tmp") + "/hemotree-" +
-                           std::to_string(::getpid()) + "-" + std::to_string(images_made++) + ".h5";
+                           std::to_string(::getpid()) + "-" + std::to_string(temporaries_made++) + ".h5";
   Handle fcpl = ordered(H5P_FILE_CREATE);  // the root group's
   Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.id(), fapl.id()), H5Fclose);
   if (!file) throw IoError(with_reason(name + ": cannot create an HDF5 file (in " + path + ")"));
