@@ -13,6 +13,7 @@
 
 #include <fcntl.h>
 #include <hdf5_hl.h>
+#include <omp.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -220,7 +221,8 @@ File::File(File&& other) noexcept
       file_(std::move(other.file_)),
       name_(std::move(other.name_)),
       image_(std::move(other.image_)),
-      backing_(std::exchange(other.backing_, -1)) {}
+      backing_(std::exchange(other.backing_, -1)),
+      threads_(other.threads_) {}
 
 void File::fail(const std::string& path, const std::string& what) const {
   throw InputError(name_ + ": " + path + ": " + what);
@@ -316,7 +318,8 @@ void File::write_column(const std::string& path, hid_t memory_type, hid_t file_t
   std::vector<std::vector<unsigned char>> filtered(chunks);
   std::exception_ptr error;
   const auto* bytes = static_cast<const unsigned char*>(data);
-#pragma omp parallel for schedule(dynamic, 1)
+  const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
   for (std::size_t c = 0; c < chunks; ++c) {
     try {
       const std::size_t first = c * chunk, count = std::min<std::size_t>(chunk, rows - first);

@@ -81,6 +81,8 @@ class File {
   ~File();
 
   const std::string& name() const { return name_; }
+  // Threads that filter a column's chunks (0, the default: OpenMP's count).
+  void set_threads(int threads) { threads_ = threads; }
   // The whole file, closed: nothing can be written after.
   std::vector<char> bytes();
 
@@ -137,6 +139,7 @@ class File {
   std::string name_;
   std::vector<char> image_;  // the bytes an opened image reads in place (kept with the file)
   int backing_ = -1;         // a created file: where the library writes it when it closes
+  int threads_ = 0;
 };
 
 // A file written through out, as atomic as every output: in place where out is a file (the

@@ -159,6 +159,7 @@ void write_probes(hdf5::File& file, const ProbeRecorder& probes) {
 void write_results_hdf5(const std::filesystem::path& path, const RunResults& results) {
   OutputStream out(path.string());
   hdf5::write_through(out, [&](hdf5::File& file) {
+    file.set_threads(results.threads);
     file.write_attribute("format", "hemotree-results");
     file.write_attribute("version", std::int64_t{1});
     constexpr auto replace = nlohmann::json::error_handler_t::replace;
