@@ -1,7 +1,6 @@
 #include "formats/hdf5_file.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <exception>
 #include <new>
@@ -9,10 +8,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <utility>
+#include <limits>
 #include <stdexcept>
 
 #include <fcntl.h>
-#include <hdf5_hl.h>
 #include <omp.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -28,6 +29,8 @@ namespace {
 // quickly and a reader of a slice (a rank of a parallel run) wastes little of.
 constexpr hsize_t chunk_rows = 1 << 16;
 constexpr unsigned deflate_level = 1;
+// The longest text read (a network's list of boundaries at nodes as JSON: about 100 bytes each).
+constexpr std::size_t max_text_bytes = std::size_t{1} << 30;
 
 // The library prints its error stack on stderr unless told not to; the messages here are
 // built from it instead.
@@ -115,8 +118,6 @@ const char* class_name(H5T_class_t c) {
   }
 }
 
-std::atomic<unsigned> temporaries_made{0};
-
 }  // namespace
 
 bool has_signature(std::span<const char> first_bytes) {
@@ -136,6 +137,28 @@ Handle newest_objects(Handle fapl) {
 
 }  // namespace
 
+namespace {
+
+// A file of its own in TMPDIR (mkstemp: no other user's link followed), open for writing.
+std::pair<std::string, int> temporary_file(const std::string& name) {
+  const char* folder = std::getenv("TMPDIR");
+  std::string path = std::string(folder && *folder ? folder : "/tmp") + "/hemotree-XXXXXX";
+  const int fd = ::mkstemp(path.data());
+  if (fd < 0) throw IoError(name + ": cannot create a temporary file in " + path + ": " + std::strerror(errno));
+  return {path, fd};
+}
+
+bool write_all(int fd, const char* data, std::size_t size) {
+  for (std::size_t done = 0; done < size;) {
+    const ssize_t wrote = ::write(fd, data + done, size - done);
+    if (wrote <= 0) return false;
+    done += static_cast<std::size_t>(wrote);
+  }
+  return true;
+}
+
+}  // namespace
+
 File File::create(std::string name) {
   silence_library();
   // Written as create_at writes (the same bytes) to a file in TMPDIR that is unlinked at once:
@@ -143,12 +166,14 @@ File File::create(std::string name) {
   // leaves nothing behind. Not the core driver's H5Fget_file_image: its images of files with
   // checksummed metadata came back with a superblock checksum no reader accepts (1.10.8).
   Handle fapl = newest_objects(property_list(H5P_FILE_ACCESS));
-  const char* folder = std::getenv("TMPDIR");
-  const std::string path = std::string(folder && *folder ? folder : "/tmp") + "/hemotree-" +
-                           std::to_string(::getpid()) + "-" + std::to_string(temporaries_made++) + ".h5";
+  const auto [path, made] = temporary_file(name);
+  ::close(made);
   Handle fcpl = ordered(H5P_FILE_CREATE);  // the root group's
   Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.id(), fapl.id()), H5Fclose);
-  if (!file) throw IoError(with_reason(name + ": cannot create an HDF5 file (in " + path + ")"));
+  if (!file) {
+    ::unlink(path.c_str());
+    throw IoError(with_reason(name + ": cannot create an HDF5 file (in " + path + ")"));
+  }
   const int backing = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   const int open_errno = errno;
   ::unlink(path.c_str());
@@ -171,31 +196,56 @@ void File::close() {
   if (H5Fclose(file_.release()) < 0) throw IoError(with_reason(name_ + ": cannot finish the HDF5 file"));
 }
 
-File File::open(const std::string& path) {
+File File::open(const std::string& path) { return open(path, path); }
+
+File File::open(const std::string& path, const std::string& name) {
   silence_library();
   std::ifstream probe(path, std::ios::binary);
-  if (!probe) throw IoError("cannot open " + path + ": " + std::strerror(errno));
+  if (!probe) throw IoError("cannot open " + name + ": " + std::strerror(errno));
   char first[sizeof signature] = {};
   probe.read(first, sizeof first);
   if (!has_signature(std::span<const char>(first, static_cast<std::size_t>(probe.gcount()))))
-    throw InputError(path + ": not an HDF5 file (it does not begin with HDF5's signature)");
-  CrashGuard guard(path);
+    throw InputError(name + ": not an HDF5 file (it does not begin with HDF5's signature)");
+  CrashGuard guard(name);
   Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-  if (!file) throw InputError(with_reason(path + ": not a complete HDF5 file (truncated or damaged)"));
-  return File(std::move(file), path, std::move(guard));
+  if (!file) throw InputError(with_reason(name + ": not a complete HDF5 file (truncated or damaged)"));
+  return File(std::move(file), name, std::move(guard));
 }
 
-File File::open_image(std::vector<char> bytes, std::string name) {
+// Bytes from elsewhere (a pipe, memory) go to a temporary file, opened by path and unlinked at
+// once: read as a file is, not held in memory (HDF5-HL's in-memory image also leaked its
+// bookkeeping at every open).
+File File::open_temporary(std::string name, const std::function<bool(int fd)>& fill) {
   silence_library();
-  if (!has_signature(bytes))
-    throw InputError(name + ": not an HDF5 file (it does not begin with HDF5's signature)");
-  // Read in place: the image lives as long as the File.
-  CrashGuard guard(name);
-  Handle file(H5LTopen_file_image(bytes.data(), bytes.size(),
-                                  H5LT_FILE_IMAGE_DONT_COPY | H5LT_FILE_IMAGE_DONT_RELEASE),
-              H5Fclose);
-  if (!file) throw InputError(with_reason(name + ": not a complete HDF5 file (truncated or damaged)"));
-  return File(std::move(file), std::move(name), std::move(guard), std::move(bytes));
+  auto [path, fd] = temporary_file(name);
+  const bool filled = fill(fd);
+  const int write_errno = errno;
+  ::close(fd);
+  if (!filled) {
+    ::unlink(path.c_str());
+    throw IoError("cannot read " + name + " into " + path + ": " + std::strerror(write_errno));
+  }
+  try {
+    File file = open(path, name);
+    ::unlink(path.c_str());
+    return file;
+  } catch (...) {
+    ::unlink(path.c_str());
+    throw;
+  }
+}
+
+File File::open_image(const std::vector<char>& bytes, std::string name) {
+  return open_temporary(std::move(name), [&](int fd) { return write_all(fd, bytes.data(), bytes.size()); });
+}
+
+File File::open_stream(std::FILE* in, std::string name) {
+  return open_temporary(std::move(name), [&](int fd) {
+    char block[1 << 16];
+    for (std::size_t got; (got = std::fread(block, 1, sizeof block, in)) > 0;)
+      if (!write_all(fd, block, got)) return false;
+    return !std::ferror(in);
+  });
 }
 
 std::vector<char> File::bytes() {
@@ -220,7 +270,6 @@ File::File(File&& other) noexcept
     : guard_(std::move(other.guard_)),
       file_(std::move(other.file_)),
       name_(std::move(other.name_)),
-      image_(std::move(other.image_)),
       backing_(std::exchange(other.backing_, -1)),
       threads_(other.threads_) {}
 
@@ -252,6 +301,11 @@ bool File::exists(const std::string& path) const {
       H5Eclear2(H5E_DEFAULT);
       return false;
     }
+    // Only the file's own objects: a link to another file (or to a pipe, which would hang the
+    // read) is not followed.
+    H5L_info_t link{};
+    if (H5Lget_info(file_.id(), prefix.c_str(), &link, H5P_DEFAULT) < 0 || link.type != H5L_TYPE_HARD)
+      fail(prefix, "a link to outside the file, not followed");
   }
   return true;
 }
@@ -275,6 +329,16 @@ std::size_t File::checked_rows(const Handle& dataset, const std::string& path, i
                    " dimensions)");
   hsize_t n = 0;
   H5Sget_simple_extent_dims(space.id(), &n, nullptr);
+  if (found == H5T_INTEGER && H5Tget_sign(type.id()) == H5T_SGN_NONE && H5Tget_size(type.id()) >= 8)
+    fail(path, "must hold signed integers (unsigned 64-bit values may not fit)");
+  // Before any room is taken for them: rows the file's index could hold (32-bit), and that
+  // its stored bytes can hold (deflate shrinks at most about 1032 to 1).
+  if (n > static_cast<hsize_t>(std::numeric_limits<std::int32_t>::max()))
+    fail(path, "declares " + std::to_string(n) + " rows, more than 2^31 - 1");
+  const double declared = static_cast<double>(n) * static_cast<double>(H5Tget_size(type.id()));
+  if (declared > 1100.0 * static_cast<double>(H5Dget_storage_size(dataset.id())) + 1e6)
+    fail(path, "declares " + std::to_string(n) + " rows, more than its stored " +
+                   std::to_string(H5Dget_storage_size(dataset.id())) + " bytes can hold");
   if (rows && n != *rows)
     fail(path, "must have " + std::to_string(*rows) + " rows, one per " +
                    (path.rfind("/nodes/", 0) == 0 ? "node" : path.rfind("/vessels/", 0) == 0 ? "vessel" : "row") +
@@ -416,6 +480,9 @@ std::vector<std::uint8_t> File::read_enum(const std::string& path, const EnumNam
   std::vector<std::uint8_t> values(n);
   Handle memory_type = enum_type(names);
   read_column(dataset, path, memory_type.id(), values.data(), n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (values[i] >= names.names.size())
+      fail(path, "row " + std::to_string(i) + ": a value that names none of the enumeration's");
   return values;
 }
 
@@ -470,6 +537,8 @@ std::string File::read_text(const std::string& path) const {
   Handle space(H5Dget_space(dataset.id()), H5Sclose);
   // One text: a scalar, or one row (as written here).
   if (H5Sget_simple_extent_npoints(space.id()) != 1) fail(path, "must hold one text");
+  if (H5Tis_variable_str(type.id()) <= 0 && H5Tget_size(type.id()) > max_text_bytes)
+    fail(path, "is longer than " + std::to_string(max_text_bytes) + " bytes");
   bool failed = false;
   std::string text = read_string(type.id(), [&](hid_t memory, void* into) {
     const herr_t status = H5Dread(dataset.id(), memory, H5S_ALL, H5S_ALL, H5P_DEFAULT, into);
@@ -498,11 +567,20 @@ void File::write_attribute(const std::string& name, std::int64_t value) {
     throw IoError(with_reason(name_ + ": /: cannot write the attribute " + name));
 }
 
+// An attribute of one value (a list of them would be read over the one value's room).
+bool one_value(hid_t attribute) {
+  Handle space(H5Aget_space(attribute), H5Sclose);
+  return H5Sget_simple_extent_npoints(space.id()) == 1;
+}
+
 std::optional<std::string> File::text_attribute(const std::string& name) const {
   if (H5Aexists(file_.id(), name.c_str()) <= 0) return std::nullopt;
   Handle attribute(H5Aopen(file_.id(), name.c_str(), H5P_DEFAULT), H5Aclose);
   Handle type(H5Aget_type(attribute.id()), H5Tclose);
-  if (H5Tget_class(type.id()) != H5T_STRING) fail("/", "the attribute \"" + name + "\" must be text");
+  if (H5Tget_class(type.id()) != H5T_STRING || !one_value(attribute.id()))
+    fail("/", "the attribute \"" + name + "\" must be one text");
+  if (H5Tis_variable_str(type.id()) <= 0 && H5Tget_size(type.id()) > max_text_bytes)
+    fail("/", "the attribute \"" + name + "\" is longer than " + std::to_string(max_text_bytes) + " bytes");
   bool failed = false;
   std::string text = read_string(type.id(), [&](hid_t memory, void* into) {
     const herr_t status = H5Aread(attribute.id(), memory, into);
@@ -517,7 +595,8 @@ std::optional<std::int64_t> File::integer_attribute(const std::string& name) con
   if (H5Aexists(file_.id(), name.c_str()) <= 0) return std::nullopt;
   Handle attribute(H5Aopen(file_.id(), name.c_str(), H5P_DEFAULT), H5Aclose);
   Handle type(H5Aget_type(attribute.id()), H5Tclose);
-  if (H5Tget_class(type.id()) != H5T_INTEGER) fail("/", "the attribute \"" + name + "\" must be an integer");
+  if (H5Tget_class(type.id()) != H5T_INTEGER || !one_value(attribute.id()))
+    fail("/", "the attribute \"" + name + "\" must be one integer");
   std::int64_t value = 0;
   if (H5Aread(attribute.id(), H5T_NATIVE_INT64, &value) < 0)
     throw InputError(with_reason(name_ + ": /: the attribute \"" + name + "\" cannot be read"));

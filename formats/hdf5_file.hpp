@@ -6,10 +6,12 @@
 //
 // A file is written through an OutputStream (write_through), so that it is atomic like every
 // other output (complete or absent) and may go to a pipe; it is read from a path in place, or
-// from bytes held in memory (standard input).
+// from a temporary file that a pipe's bytes are copied to.
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -72,9 +74,13 @@ class File {
   // A new, empty file written at path as it is built (name for messages); close() ends it.
   static File create_at(const std::string& path, std::string name);
   void close();
-  // An existing file, read-only: from a path, or from its bytes (name for messages).
+  // An existing file, read-only: from a path (named in messages by name), or from bytes
+  // elsewhere (held in memory, or a stream such as standard input), which go to a temporary
+  // file first, unlinked once open.
   static File open(const std::string& path);
-  static File open_image(std::vector<char> bytes, std::string name);
+  static File open(const std::string& path, const std::string& name);
+  static File open_image(const std::vector<char>& bytes, std::string name);
+  static File open_stream(std::FILE* in, std::string name);
 
   File(File&& other) noexcept;
   File& operator=(File&&) = delete;
@@ -122,8 +128,9 @@ class File {
   [[noreturn]] void fail(const std::string& path, const std::string& what) const;
 
  private:
-  File(Handle file, std::string name, CrashGuard guard = {}, std::vector<char> image = {})
-      : guard_(std::move(guard)), file_(std::move(file)), name_(std::move(name)), image_(std::move(image)) {}
+  File(Handle file, std::string name, CrashGuard guard = {})
+      : guard_(std::move(guard)), file_(std::move(file)), name_(std::move(name)) {}
+  static File open_temporary(std::string name, const std::function<bool(int fd)>& fill);
   Handle open_dataset(const std::string& path) const;
   // Creates the groups above path that do not exist yet; the link list to create it with.
   Handle links_for(const std::string& path);
@@ -137,14 +144,14 @@ class File {
   CrashGuard guard_;  // first: it outlives the file's handle, closed before it
   Handle file_;
   std::string name_;
-  std::vector<char> image_;  // the bytes an opened image reads in place (kept with the file)
   int backing_ = -1;         // a created file: where the library writes it when it closes
   int threads_ = 0;
 };
 
 // A file written through out, as atomic as every output: in place where out is a file (the
-// library writes its temporary, which out.commit() then puts at its name), built in memory
-// and copied where out is standard output. fill writes the content; the caller commits out.
+// library writes its temporary, which out.commit() then puts at its name), written to an
+// unlinked temporary in TMPDIR and copied where out is standard output or a device. fill
+// writes the content; the caller commits out.
 template <class Fill>
 void write_through(OutputStream& out, Fill fill) {
   const std::string path = out.path_for_writer();

@@ -60,6 +60,10 @@ class Hdf5Reader {
     if (file_.exists("/extra")) {
       net_.extra = parsed_json(file_, "/extra");
       if (!net_.extra.is_object()) file_.fail("/extra", "must be a JSON object");
+      // The format's own members have places of their own; here they would be written twice.
+      for (const char* own : {"format", "version", "provenance", "blood", "inlet", "boundaries", "nodes", "vessels"})
+        if (net_.extra.contains(own))
+          file_.fail("/extra", std::string("holds \"") + own + "\", a member of the format's own");
     }
     read_nodes();
     read_vessels();
@@ -255,9 +259,11 @@ class Hdf5Reader {
         o.type = BoundaryType::resistance;
         o.r = checked("R", r, ranges::resistance);
         o.p_out = checked("p_out", p_out, ranges::pressure);
-      } else {
+      } else if (type[k] == outlet_type_value(BoundaryType::reflection)) {
         o.type = BoundaryType::reflection;
         o.reflection = checked("coefficient", coefficient, ranges::reflection);
+      } else {
+        file_.fail("/outlets/type", at + ": an outlet type of none of the names RCR, R, reflection");
       }
     }
   }

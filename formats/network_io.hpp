@@ -35,8 +35,8 @@ Network parse_network(std::string_view text, const std::string& source = "<text>
 
 void write_network(const Network& net, OutputStream& out);
 
-// The HDF5 form (formats/network_hdf5.cpp), built in memory and written through out, so that
-// it is as atomic as the JSON one and may go to a pipe.
+// The HDF5 form (formats/network_hdf5.cpp), written through out (hdf5::write_through: at its
+// temporary, renamed by its commit), so that it is as atomic as the JSON one and may go to a pipe.
 void write_network_hdf5(const Network& net, OutputStream& out);
 // Throws InputError naming the file, the dataset and the row at fault.
 Network read_network_hdf5(const hdf5::File& file);

@@ -449,11 +449,7 @@ bool begins_hdf5(std::FILE* in) {
 }
 
 Network read_hdf5_stream(std::FILE* in, const std::string& source) {
-  std::vector<char> bytes;
-  char block[1 << 16];
-  for (std::size_t got; (got = std::fread(block, 1, sizeof block, in)) > 0;) bytes.insert(bytes.end(), block, block + got);
-  if (std::ferror(in)) throw IoError("cannot read " + source + ": " + std::strerror(errno));
-  return read_network_hdf5(hdf5::File::open_image(std::move(bytes), source));
+  return read_network_hdf5(hdf5::File::open_stream(in, source));
 }
 
 }  // namespace

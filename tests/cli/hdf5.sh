@@ -62,6 +62,62 @@ PY
 expect_error "a length out of range, written by h5py" 2 \
   "bad.h5: /vessels/length: row 4 (vessel 4): \"length\" must lie in [1e-7, 10] m (got 25)" \
   -- "$VEXPORT" json "$WORK/bad.h5"
+# Files a hostile or careless program could write (found in review): each refused in one line.
+"$PY" - "$WORK/net.h5" "$WORK" <<'PY' || fail "h5py could not write the hostile files"
+import shutil, sys, h5py, numpy as np
+src, work = sys.argv[1], sys.argv[2]
+def copy(name, change):
+    path = f"{work}/{name}.h5"
+    shutil.copy(src, path)
+    with h5py.File(path, "r+") as f:
+        change(f)
+def many_versions(f):
+    del f.attrs["version"]
+    f.attrs["version"] = np.arange(4096, dtype=np.int64)
+def class_out_of_names(f):
+    c = f["vessels/class"][:]
+    c[2] = 9
+    dt = f["vessels/class"].dtype
+    del f["vessels/class"]
+    f.create_dataset("vessels/class", data=c.astype(np.uint8), dtype=dt)
+def outlet_type_seven(f):
+    t = f["outlets/type"][:]
+    t[0] = 7
+    dt = f["outlets/type"].dtype
+    del f["outlets/type"]
+    f.create_dataset("outlets/type", data=t.astype(np.uint8), dtype=dt)
+def extra_vessels(f):
+    f.create_dataset("extra", data=np.array([b'{"vessels": [1, 2]}']))
+def external_length(f):
+    del f["vessels/length"]
+    f["vessels/length"] = h5py.ExternalLink(src, "/vessels/length")
+def huge_rows(f):
+    del f["nodes/id"]
+    f.create_dataset("nodes/id", shape=(2**40,), dtype=np.int64, chunks=(65536,))
+def unsigned_ids(f):
+    ids = f["vessels/id"][:]
+    del f["vessels/id"]
+    f.create_dataset("vessels/id", data=ids.astype(np.uint64))
+for name, change in [("many_versions", many_versions), ("class_out_of_names", class_out_of_names),
+                     ("outlet_type_seven", outlet_type_seven), ("extra_vessels", extra_vessels),
+                     ("external_length", external_length), ("huge_rows", huge_rows),
+                     ("unsigned_ids", unsigned_ids)]:
+    copy(name, change)
+PY
+expect_error "a version attribute of 4096 values" 2 "many_versions.h5: /: the attribute \"version\" must be one integer" \
+  -- "$VEXPORT" json "$WORK/many_versions.h5"
+expect_error "a class value outside the names" 2 "class_out_of_names.h5: /vessels/class: row 2: a value that names none" \
+  -- "$VEXPORT" json "$WORK/class_out_of_names.h5"
+expect_error "an outlet type outside the names" 2 "outlet_type_seven.h5: /outlets/type: row 0" \
+  -- "$VEXPORT" json "$WORK/outlet_type_seven.h5"
+expect_error "/extra holding the format's own vessels" 2 "extra_vessels.h5: /extra: holds \"vessels\"" \
+  -- "$VEXPORT" json "$WORK/extra_vessels.h5"
+expect_error "a column linked to another file" 2 "external_length.h5: /vessels/length: a link to outside the file" \
+  -- "$VEXPORT" json "$WORK/external_length.h5"
+expect_error "2^40 rows declared, nothing stored" 2 "huge_rows.h5: /nodes/id: declares 1099511627776 rows" \
+  -- "$VEXPORT" json "$WORK/huge_rows.h5"
+expect_error "unsigned 64-bit ids" 2 "unsigned_ids.h5: /vessels/id: must hold signed integers" \
+  -- "$VEXPORT" json "$WORK/unsigned_ids.h5"
 expect_error "hemosolve --format xml" 2 "--format must be text or h5 (got 'xml')" \
   -- "$HEMOSOLVE" "$WORK/net.h5" --out "$WORK/never" --format xml
 
