@@ -72,6 +72,17 @@ Handle untimed(hid_t kind) {
   return list;
 }
 
+// A dataset of chunks of these dimensions, each shuffled, deflated and checksummed
+// (Fletcher-32: a flipped bit in the data is refused when read, not computed with); untimed.
+Handle filtered_chunks(int rank, const hsize_t* chunk) {
+  Handle dcpl = untimed(H5P_DATASET_CREATE);
+  H5Pset_chunk(dcpl.id(), rank, chunk);
+  H5Pset_shuffle(dcpl.id());
+  H5Pset_deflate(dcpl.id(), deflate_level);
+  H5Pset_fletcher32(dcpl.id());
+  return dcpl;
+}
+
 // A group (or the root) untimed, whose members are listed in the order they were made (h5py
 // iterates them so): a table's columns in the table's order.
 Handle ordered(hid_t kind) {
@@ -359,15 +370,8 @@ void File::write_column(const std::string& path, hid_t memory_type, hid_t file_t
                         std::size_t rows) {
   const hsize_t n = rows;
   Handle space(H5Screate_simple(1, &n, nullptr), H5Sclose);
-  Handle dcpl = untimed(H5P_DATASET_CREATE);
   const hsize_t chunk = std::max<hsize_t>(1, std::min(n, chunk_rows));
-  if (n > 0) {
-    H5Pset_chunk(dcpl.id(), 1, &chunk);
-    H5Pset_shuffle(dcpl.id());
-    H5Pset_deflate(dcpl.id(), deflate_level);
-    // A checksum a chunk: a flipped bit in the data is refused when read, not computed with.
-    H5Pset_fletcher32(dcpl.id());
-  }
+  Handle dcpl = n > 0 ? filtered_chunks(1, &chunk) : untimed(H5P_DATASET_CREATE);
   Handle lcpl = links_for(path);
   Handle dataset(H5Dcreate2(file_.id(), path.c_str(), file_type, space.id(), lcpl.id(), dcpl.id(), H5P_DEFAULT),
                  H5Dclose);
@@ -414,14 +418,9 @@ void File::write_matrix(const std::string& path, std::size_t rows, std::size_t c
   if (values.size() != rows * columns) throw std::invalid_argument(path + ": a matrix of the wrong size");
   const hsize_t dims[2] = {rows, columns};
   Handle space(H5Screate_simple(2, dims, nullptr), H5Sclose);
-  Handle dcpl = untimed(H5P_DATASET_CREATE);
-  if (rows > 0 && columns > 0) {
-    const hsize_t chunk[2] = {std::min<hsize_t>(rows, std::max<hsize_t>(1, chunk_rows / columns)), columns};
-    H5Pset_chunk(dcpl.id(), 2, chunk);
-    H5Pset_shuffle(dcpl.id());
-    H5Pset_deflate(dcpl.id(), deflate_level);
-    H5Pset_fletcher32(dcpl.id());
-  }
+  const hsize_t chunk[2] = {std::min<hsize_t>(rows, std::max<hsize_t>(1, chunk_rows / std::max<std::size_t>(columns, 1))),
+                            columns};
+  Handle dcpl = rows > 0 && columns > 0 ? filtered_chunks(2, chunk) : untimed(H5P_DATASET_CREATE);
   Handle lcpl = links_for(path);
   Handle dataset(H5Dcreate2(file_.id(), path.c_str(), H5T_IEEE_F64LE, space.id(), lcpl.id(), dcpl.id(), H5P_DEFAULT),
                  H5Dclose);

@@ -202,4 +202,10 @@ Waveform driving_waveform(const Network& net) {
   return Waveform::constant_value(0.0);  // period 1 s
 }
 
+void sort_boundaries_by_node(Network& net) {
+  std::stable_sort(net.boundaries.begin(), net.boundaries.end(),
+                   [](const NodeBoundary& p, const NodeBoundary& q) { return p.node < q.node; });
+  node_boundaries(net);
+}
+
 }  // namespace hemotree

@@ -111,6 +111,10 @@ NodeBoundary as_node_boundary(const Network& net, const Inlet& inlet);
 // vessels' `to` nodes). Throws InputError when two land on one node.
 std::vector<NodeBoundary> node_boundaries(const Network& net);
 
+// A reader's last step with the boundaries at nodes: sorted by node (equal nodes in the
+// file's order), then checked as check_one_boundary_per_node checks them.
+void sort_boundaries_by_node(Network& net);
+
 // Throws InputError when two boundary conditions land on one node (naming the lowest such
 // node and its first two in node_boundaries' order), or for an inlet of no vessel. The run's
 // list of them, in its order: formats/run_boundaries.hpp.

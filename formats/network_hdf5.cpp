@@ -12,6 +12,7 @@
 #include "formats/field_ranges.hpp"
 #include "formats/hdf5_file.hpp"
 #include "formats/network_io.hpp"
+#include "formats/node_index.hpp"
 #include "formats/topology.hpp"
 
 namespace hemotree {
@@ -273,9 +274,7 @@ class Hdf5Reader {
     if (!file_.exists("/boundaries")) return;
     const nlohmann::json list = parsed_json(file_, "/boundaries");
     if (!list.is_array()) file_.fail("/boundaries", "must be a JSON list");
-    std::vector<std::pair<std::int64_t, std::int32_t>> by_id(net_.node_count());
-    for (std::size_t n = 0; n < by_id.size(); ++n) by_id[n] = {net_.node_id[n], static_cast<std::int32_t>(n)};
-    std::sort(by_id.begin(), by_id.end());
+    const NodeIndex index(net_.node_id);
     for (std::size_t k = 0; k < list.size(); ++k) {
       const std::string where = "boundaries[" + std::to_string(k) + "]";
       std::int64_t node_id = 0;
@@ -285,16 +284,12 @@ class Hdf5Reader {
       } catch (const InputError& e) {
         file_.fail("/boundaries", e.what());
       }
-      const auto at = std::lower_bound(by_id.begin(), by_id.end(), std::pair{node_id, std::int32_t{0}});
-      if (at == by_id.end() || at->first != node_id)
-        file_.fail("/boundaries", where + ": unknown node " + std::to_string(node_id));
-      b.node = at->second;
+      b.node = index.find(node_id, net_.node_count());
+      if (b.node < 0) file_.fail("/boundaries", where + ": unknown node " + std::to_string(node_id));
       net_.boundaries.push_back(std::move(b));
     }
-    std::stable_sort(net_.boundaries.begin(), net_.boundaries.end(),
-                     [](const NodeBoundary& p, const NodeBoundary& q) { return p.node < q.node; });
     try {
-      node_boundaries(net_);
+      sort_boundaries_by_node(net_);
     } catch (const InputError& e) {
       file_.fail("/boundaries", e.what());
     }

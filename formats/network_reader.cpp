@@ -18,6 +18,7 @@
 #include "formats/field_ranges.hpp"
 #include "formats/hdf5_file.hpp"
 #include "formats/json_pull.hpp"
+#include "formats/node_index.hpp"
 #include "formats/network_io.hpp"
 #include "formats/topology.hpp"
 
@@ -55,30 +56,6 @@ std::int64_t read_integer(JsonPull& in, const char* member, const Where& where) 
     in.fail(std::string(where()) + ": \"" + member + "\" must be an integer");
   return in.integer();
 }
-
-// Vessels refer to nodes by id; ids are resolved to indices once both lists are read.
-struct NodeIndex {
-  std::vector<std::pair<std::int64_t, std::int32_t>> sorted;  // (id, index) by id
-  bool identity = true;  // ids 0..n-1 in order, the usual case: no search needed
-
-  explicit NodeIndex(const std::vector<std::int64_t>& ids) {
-    for (std::size_t i = 0; i < ids.size(); ++i)
-      if (ids[i] != static_cast<std::int64_t>(i)) identity = false;
-    if (identity) return;
-    sorted.reserve(ids.size());
-    for (std::size_t i = 0; i < ids.size(); ++i)
-      sorted.emplace_back(ids[i], static_cast<std::int32_t>(i));
-    std::sort(sorted.begin(), sorted.end());
-  }
-  std::size_t size() const { return identity ? 0 : sorted.size(); }
-  // -1 when unknown
-  std::int32_t find(std::int64_t id, std::size_t count) const {
-    if (identity) return id >= 0 && id < static_cast<std::int64_t>(count)
-                             ? static_cast<std::int32_t>(id) : -1;
-    auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(id, std::int32_t{0}));
-    return it != sorted.end() && it->first == id ? it->second : -1;
-  }
-};
 
 // Where a token was, to report it after the parser has moved on.
 struct Position {
@@ -196,10 +173,8 @@ class Reader {
         throw InputError(source_ + ": boundaries[" + std::to_string(k) + "]: unknown node " + std::to_string(node_id));
       net_.boundaries.push_back(std::move(b));
     }
-    std::stable_sort(net_.boundaries.begin(), net_.boundaries.end(),
-                     [](const NodeBoundary& p, const NodeBoundary& q) { return p.node < q.node; });
     try {
-      node_boundaries(net_);
+      sort_boundaries_by_node(net_);
     } catch (const InputError& e) {
       throw InputError(source_ + ": " + e.what());
     }

@@ -21,15 +21,15 @@
 #include "generator/growth_rules.hpp"
 #include "generator/tree_growth.hpp"
 #include "generator/tree_layout.hpp"
+#include "scratch_path.hpp"
 
 using namespace hemotree;
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path temp_path(const std::string& name) {
-  return fs::temp_directory_path() / ("hemotree-test-" + std::to_string(::getpid()) + "-" + name);
-}
+// This process's scratch folder, removed when it ends (tests/scratch_path.hpp).
+fs::path temp_path(const std::string& name) { return scratch_path(name); }
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
