@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace hemotree::hdf5 {
@@ -17,11 +18,27 @@ namespace hemotree::hdf5 {
 std::uint32_t fletcher32(const unsigned char* data, std::size_t length);
 
 // The filters in their order: the byte shuffle (byte k of every element together), deflate
-// (zlib's compress2 at deflate_level) and the Fletcher-32 of the result appended in the
-// machine's order. values: the chunk's rows (element bytes each); a last chunk is padded with
-// zeros, the fill value, to the chunk's rows, as the library stores it. std::bad_alloc where
-// zlib has no memory.
-std::vector<unsigned char> filtered_chunk(const unsigned char* values, std::size_t rows, std::size_t chunk,
-                                          std::size_t element, int deflate_level);
+// (zlib at deflate_level) and the Fletcher-32 of the result appended in the machine's order.
+// `strategy` is zlib's (Z_DEFAULT_STRATEGY, as the library's own filter deflates, or Z_RLE):
+// any deflate stream is what the library's filter inflates. One a thread: zlib's state and the chunk's buffers are kept from one
+// chunk to the next (made afresh, they were about 1.3 MB of fresh pages a chunk, a third of
+// the time of writing a full tree's results). std::bad_alloc where zlib has no memory.
+class ChunkFilter {
+ public:
+  // chunk: the rows of a whole chunk; element: the bytes of a value.
+  ChunkFilter(std::size_t chunk, std::size_t element, int deflate_level, int strategy);
+  ~ChunkFilter();
+  ChunkFilter(const ChunkFilter&) = delete;
+  ChunkFilter& operator=(const ChunkFilter&) = delete;
+  // values: the chunk's rows (at most chunk); a last chunk is padded with zeros, the fill
+  // value, to the chunk's rows, as the library stores it.
+  std::vector<unsigned char> operator()(const unsigned char* values, std::size_t rows);
+
+ private:
+  struct Deflate;
+  std::size_t chunk_, element_;
+  std::unique_ptr<Deflate> deflate_;
+  std::vector<unsigned char> shuffled_, packed_;
+};
 
 }  // namespace hemotree::hdf5
