@@ -328,7 +328,7 @@ TEST(NetworkHdf5, FlippedBytesAreReadOrRefusedNeverCrashNorChangeAValue) {
 // would store them (H5Dwrite_chunk): the library reads them back through its own filters
 // (shuffle, deflate, Fletcher-32 checked) to the same values, for every size around a chunk's
 // 65,536 rows and every width. (Byte for byte the same file as the library's own filters gave,
-// checked on vgen's full tree when this was written.)
+// checked on vgen's full tree, while every column took zlib's default strategy.)
 TEST(Hdf5File, ColumnsFilteredHereReadBackThroughTheLibrarysFilters) {
   for (const std::size_t rows : {std::size_t{1}, std::size_t{65535}, std::size_t{65536}, std::size_t{65537},
                                  std::size_t{200001}}) {
