@@ -401,7 +401,10 @@ void NodalSystem::backward_at(std::span<const std::int32_t> nodes, std::span<con
       double above = 0;
       for (std::size_t q = path.size(); q-- > 0;) {
         const auto i = static_cast<std::size_t>(path[q]);
-        above = y[i] * inverse_pivot_[i] + (parent_[i] >= 0 ? divider_[i] * above : 0.0);
+        if (parent_[i] < 0 && open_roots_)
+          above = y[i];
+        else
+          above = y[i] * inverse_pivot_[i] + (parent_[i] >= 0 ? divider_[i] * above : 0.0);
       }
       out[k] = above;
     }
@@ -506,6 +509,20 @@ void NodalSystem::plan_subtrees() {
     std::vector<std::int64_t>().swap(task_shift_);
 }
 
+void NodalSystem::open_roots() {
+  if (method_ != Method::tree_elimination) throw std::logic_error("NodalSystem::open_roots: a tree's elimination only");
+  open_roots_ = true;
+  factorized_ = false;
+}
+
+double NodalSystem::open_root_conductance(std::size_t root) const {
+  if (!open_roots_ || root >= nodes_ || parent_[root] >= 0)
+    throw std::invalid_argument("NodalSystem::open_root_conductance: node " + std::to_string(root) +
+                                " is not an open root");
+  check_solvable(nodes_, "open_root_conductance");
+  return inverse_pivot_[root];
+}
+
 bool NodalSystem::parallel_sweeps() const { return threads_ > 1 && !task_offset_.empty(); }
 
 void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& valid, bool& singular) const {
@@ -520,6 +537,7 @@ void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& vali
   auto up = [&](std::size_t c, bool& ok, bool& lost) {
     const std::int32_t p = parent_[c];
     if (p < 0) {
+      if (open_roots_) return;  // S_r and y_r go on to the rest of the tree
       // A root's S is its whole component's conductance to ground: a sum of non-negative
       // terms, zero exactly when no node of the component has a shunt.
       if (el) {
@@ -580,6 +598,7 @@ void NodalSystem::sweep_up(const Elimination* elimination, double* y, bool& vali
 void NodalSystem::sweep_down(double* x) const {
   auto down = [&](std::size_t i) {
     const std::int32_t p = parent_[i];
+    if (p < 0 && open_roots_) return;  // the potential the rest of the tree found
     x[i] = x[i] * inverse_pivot_[i] + (p >= 0 ? divider_[i] * x[static_cast<std::size_t>(p)] : 0.0);
   };
   if (!parallel_sweeps()) {
@@ -603,6 +622,7 @@ void NodalSystem::sweep_down(double* x) const {
 void NodalSystem::inverse_diagonal(std::span<const std::int32_t> nodes, std::span<double> out) const {
   check_node_list(nodes, out.size(), "inverse_diagonal", "outputs");
   if (!factorized_) throw std::logic_error("NodalSystem::inverse_diagonal: no successful factorisation to use");
+  if (open_roots_) throw std::logic_error("NodalSystem::inverse_diagonal: a share of a tree holds no whole inverse");
   if (nodes.empty()) return;
 
   // The scratch is back to its resting state after every call; an exception (bad_alloc of the

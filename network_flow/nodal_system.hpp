@@ -79,6 +79,18 @@ class NodalSystem {
   // their paths to their roots (past 1/32 of all, the whole backward half).
   void backward_at(std::span<const std::int32_t> nodes, std::span<const double> y, std::span<double> out) const;
 
+  // A share of a larger tree (distributed/tree_share.hpp): every root of this forest hangs
+  // from a node held elsewhere. The elimination then leaves at each root r, in place of its
+  // pivot, S_r, its subtree's conductance to ground seen from r (its shunt and its children
+  // through their edges: open_root_conductance), the forward half leaves y_r summed over its
+  // subtree, and the backward half takes x_r as given (the potential the rest of the tree
+  // found for it). Every other node's arithmetic is the closed system's, so that a tree cut
+  // into shares and swept share by share gives the bits of the whole. Tree elimination only
+  // (std::logic_error otherwise); the singular check is the rest of the tree's.
+  void open_roots();
+  bool roots_open() const { return open_roots_; }
+  double open_root_conductance(std::size_t root) const;
+
   // Threads for the tree elimination's sweeps: subtrees in parallel, the top of the tree and
   // each subtree's root serially in the one-thread order, so the bits do not depend on it.
   void set_threads(int threads) { threads_ = threads; }
@@ -149,6 +161,7 @@ class NodalSystem {
     return task_nodes_.empty() ? TaskNodes{nullptr, task_shift_[t]} : TaskNodes{task_nodes_.data(), 0};
   }
   int threads_ = 1;
+  bool open_roots_ = false;
   bool parallel_sweeps() const;
   std::int64_t factorize(std::span<const double> conductance, std::span<const double> shunt, double* y);
   void check_solvable(std::size_t size, const char* what) const;  // a vector of every node, and a factorisation
