@@ -1,0 +1,18 @@
+// A tree network's nodal system cut by its partition (partition/): the network's nodes, each
+// vessel an edge (from, to), as the steady flow's and the 0D vessels' systems take them, and
+// each vessel on the rank the partition gave it, the top's on the top's rank
+// (distributed/tree_share.hpp).
+#pragma once
+
+#include "distributed/tree_share.hpp"
+#include "formats/network.hpp"
+#include "partition/partition.hpp"
+
+namespace hemotree {
+
+// SettingError "ranks" where the partition cannot be swept so yet: a network with loops
+// (METIS's pieces need the distributed sparse solver) or a top spread over the ranks (more
+// ranks than about the square root of an eighth of the vessels).
+TreeCut tree_cut(const Network& net, const Partition& partition);
+
+}  // namespace hemotree

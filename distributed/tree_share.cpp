@@ -1,0 +1,218 @@
+#include "distributed/tree_share.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "network_flow/forest_order.hpp"
+
+namespace hemotree {
+
+TreeCut::TreeCut(std::size_t nodes, std::span<const std::int32_t> a, std::span<const std::int32_t> b,
+                 std::span<const std::int32_t> edge_owner, int rank_count, int top_rank_)
+    : ranks(rank_count), top_rank(top_rank_) {
+  if (ranks < 1 || top_rank < 0 || top_rank >= ranks)
+    throw std::invalid_argument("TreeCut: the top's rank " + std::to_string(top_rank) + " of " + std::to_string(ranks));
+  if (edge_owner.size() != a.size() || a.size() != b.size())
+    throw std::invalid_argument("TreeCut: an owner and two nodes per edge");
+  // NodalSystem's order, from the same functions (network_flow/forest_order.hpp).
+  if (parents_below(nodes, a, b, parent_edge)) {
+    parent.assign(nodes, -1);
+    order.resize(nodes);
+    for (std::size_t c = 0; c < nodes; ++c) {
+      order[c] = static_cast<std::int32_t>(c);
+      if (const std::int32_t e = parent_edge[c]; e >= 0)
+        parent[c] = std::min(a[static_cast<std::size_t>(e)], b[static_cast<std::size_t>(e)]);
+    }
+  } else {
+    if (!peel_leaves(nodes, a, b, order, parent, parent_edge))
+      throw std::invalid_argument("TreeCut: the graph has a loop or a doubled edge: not a forest");
+    std::reverse(order.begin(), order.end());
+  }
+  owner.assign(nodes, top);
+  for (std::size_t c = 0; c < nodes; ++c)
+    if (const std::int32_t e = parent_edge[c]; e >= 0) owner[c] = edge_owner[static_cast<std::size_t>(e)];
+  place.assign(nodes, 0);
+  for (std::size_t k = 0; k < nodes; ++k) place[static_cast<std::size_t>(order[k])] = static_cast<std::int32_t>(k);
+  roots.assign(static_cast<std::size_t>(ranks), {});
+  for (const std::int32_t node : order) {
+    const auto c = static_cast<std::size_t>(node);
+    const std::int32_t mine = owner[c], p = parent[c];
+    if (mine != top && (mine < 0 || mine >= ranks))
+      throw std::invalid_argument("TreeCut: edge " + std::to_string(parent_edge[c]) + " on rank " +
+                                  std::to_string(mine) + " of " + std::to_string(ranks));
+    const std::int32_t above = p >= 0 ? owner[static_cast<std::size_t>(p)] : top;
+    if (above != top && above != mine)
+      throw std::invalid_argument("TreeCut: node " + std::to_string(c) + " (" +
+                                  (mine == top ? std::string("the top") : "rank " + std::to_string(mine)) +
+                                  ") hangs from node " + std::to_string(p) + " of rank " + std::to_string(above) +
+                                  ": a share must be whole subtrees below the top");
+    if (mine != top && above == top) roots[static_cast<std::size_t>(mine)].push_back(node);
+  }
+}
+
+std::vector<std::int32_t> TreeCut::share_nodes(int rank) const {
+  std::vector<std::int32_t> out;
+  for (const std::int32_t node : order)
+    if (owner[static_cast<std::size_t>(node)] == rank) out.push_back(node);
+  return out;
+}
+
+std::vector<std::int32_t> TreeCut::top_nodes() const { return share_nodes(top); }
+
+namespace {
+
+// A system of some of the forest's nodes (in elimination order) and, for each whose parent is
+// among them, the edge to it: (parent's place, its place); edge_place: the node below each.
+NodalSystem system_of(const TreeCut& cut, std::span<const std::int32_t> nodes, std::vector<std::int32_t>& edge_place) {
+  std::vector<std::int32_t> local(nodes.size()), a, b;
+  // Places by binary search in the forest's order: the nodes are a subsequence of it.
+  auto local_place = [&](std::int32_t node) -> std::int32_t {
+    const std::int32_t k = cut.place[static_cast<std::size_t>(node)];
+    const auto it = std::lower_bound(nodes.begin(), nodes.end(), k, [&](std::int32_t n, std::int32_t key) {
+      return cut.place[static_cast<std::size_t>(n)] < key;
+    });
+    return it != nodes.end() && *it == node ? static_cast<std::int32_t>(it - nodes.begin()) : -1;
+  };
+  edge_place.clear();
+  for (std::size_t j = 0; j < nodes.size(); ++j) {
+    const std::int32_t p = cut.parent[static_cast<std::size_t>(nodes[j])];
+    if (p < 0) continue;
+    const std::int32_t above = local_place(p);
+    if (above < 0) continue;
+    a.push_back(above);
+    b.push_back(static_cast<std::int32_t>(j));
+    edge_place.push_back(static_cast<std::int32_t>(j));
+  }
+  return NodalSystem(nodes.size(), std::move(a), std::move(b), NodalSystem::Method::tree_elimination);
+}
+
+}  // namespace
+
+TreeShare::TreeShare(const TreeCut& cut, int rank) : nodes_(cut.share_nodes(rank)) {
+  system_ = system_of(cut, nodes_, edge_place_);
+  system_.open_roots();
+  edge_conductance_.resize(edge_place_.size());
+  // The roots come in elimination order, as cut.roots lists them.
+  for (std::size_t j = 0; j < nodes_.size(); ++j) {
+    const std::int32_t p = cut.parent[static_cast<std::size_t>(nodes_[j])];
+    if (p < 0 || cut.owner[static_cast<std::size_t>(p)] == TreeCut::top) roots_.push_back(static_cast<std::int32_t>(j));
+  }
+}
+
+std::vector<double> TreeShare::factorize_forward(std::span<const double> conductance, std::span<const double> shunt,
+                                                 std::span<double> y) {
+  if (conductance.size() != nodes_.size() || shunt.size() != nodes_.size() || y.size() != nodes_.size())
+    throw std::invalid_argument("TreeShare::factorize_forward: " + std::to_string(nodes_.size()) +
+                                " numbers of each kind expected");
+  for (std::size_t e = 0; e < edge_place_.size(); ++e)
+    edge_conductance_[e] = conductance[static_cast<std::size_t>(edge_place_[e])];
+  system_.factorize_forward(edge_conductance_, shunt, y);  // open roots: never singular here
+  std::vector<double> message;
+  message.reserve(3 * roots_.size());
+  for (const std::int32_t r : roots_) {
+    const auto j = static_cast<std::size_t>(r);
+    message.insert(message.end(), {conductance[j], system_.open_root_conductance(j), y[j]});
+  }
+  return message;
+}
+
+std::vector<double> TreeShare::forward(std::span<double> y) const {
+  system_.forward(y);
+  std::vector<double> message(roots_.size());
+  for (std::size_t k = 0; k < roots_.size(); ++k) message[k] = y[static_cast<std::size_t>(roots_[k])];
+  return message;
+}
+
+void TreeShare::backward(std::span<const double> root_potential, std::span<double> y) const {
+  if (root_potential.size() != roots_.size())
+    throw std::invalid_argument("TreeShare::backward: one potential per root");
+  for (std::size_t k = 0; k < roots_.size(); ++k) y[static_cast<std::size_t>(roots_[k])] = root_potential[k];
+  system_.backward(y, y);
+}
+
+TreeTop::TreeTop(const TreeCut& cut) {
+  // The top's own nodes and every share's roots, merged in elimination order.
+  std::vector<std::pair<std::int32_t, std::int32_t>> members;  // (place in the forest, source)
+  const std::vector<std::int32_t> own = cut.top_nodes();
+  for (std::size_t i = 0; i < own.size(); ++i)
+    members.emplace_back(cut.place[static_cast<std::size_t>(own[i])], static_cast<std::int32_t>(i));
+  std::int32_t slot = 0;
+  for (const auto& rank_roots : cut.roots)
+    for (const std::int32_t r : rank_roots) members.emplace_back(cut.place[static_cast<std::size_t>(r)], ~slot++);
+  std::sort(members.begin(), members.end());
+  nodes_.resize(members.size());
+  own_.resize(own.size());
+  root_place_.resize(static_cast<std::size_t>(slot));
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const auto [where, source] = members[k];
+    nodes_[k] = cut.order[static_cast<std::size_t>(where)];
+    if (source >= 0)
+      own_[static_cast<std::size_t>(source)] = static_cast<std::int32_t>(k);
+    else
+      root_place_[static_cast<std::size_t>(~source)] = static_cast<std::int32_t>(k);
+  }
+  system_ = system_of(cut, nodes_, edge_place_);
+  edge_conductance_.resize(edge_place_.size());
+  shunt_.resize(nodes_.size());
+  y_.resize(nodes_.size());
+}
+
+void TreeTop::gather(std::span<const double> b, std::span<const double> messages, std::size_t stride,
+                     std::span<const double> conductance, std::span<const double> shunt) {
+  if (b.size() != own_.size() || messages.size() != stride * root_place_.size())
+    throw std::invalid_argument("TreeTop: " + std::to_string(own_.size()) + " own numbers and " +
+                                std::to_string(stride * root_place_.size()) + " from the shares expected");
+  const bool factorizing = stride == 3;
+  std::vector<double> below_conductance;  // per place: the conductance of its edge to its parent
+  if (factorizing) below_conductance.assign(nodes_.size(), 0.0);
+  for (std::size_t i = 0; i < own_.size(); ++i) {
+    const auto k = static_cast<std::size_t>(own_[i]);
+    y_[k] = b[i];
+    if (factorizing) {
+      shunt_[k] = shunt[i];
+      below_conductance[k] = conductance[i];
+    }
+  }
+  for (std::size_t s = 0; s < root_place_.size(); ++s) {
+    const auto k = static_cast<std::size_t>(root_place_[s]);
+    const double* m = messages.data() + stride * s;
+    y_[k] = m[stride - 1];
+    if (factorizing) {
+      below_conductance[k] = m[0];
+      shunt_[k] = m[1];
+    }
+  }
+  if (factorizing)
+    for (std::size_t e = 0; e < edge_place_.size(); ++e)
+      edge_conductance_[e] = below_conductance[static_cast<std::size_t>(edge_place_[e])];
+}
+
+void TreeTop::solve_and_scatter(std::span<double> x, std::span<double> answer) {
+  if (x.size() != own_.size() || answer.size() != root_place_.size())
+    throw std::invalid_argument("TreeTop: a potential per own node and per share root");
+  system_.backward(y_, y_);
+  for (std::size_t i = 0; i < own_.size(); ++i) x[i] = y_[static_cast<std::size_t>(own_[i])];
+  for (std::size_t s = 0; s < root_place_.size(); ++s) answer[s] = y_[static_cast<std::size_t>(root_place_[s])];
+}
+
+std::int64_t TreeTop::factorize_solve(std::span<const double> conductance, std::span<const double> shunt,
+                                      std::span<const double> b, std::span<const double> messages, std::span<double> x,
+                                      std::span<double> answer) {
+  if (conductance.size() != own_.size() || shunt.size() != own_.size())
+    throw std::invalid_argument("TreeTop::factorize_solve: a conductance and a shunt per own node");
+  gather(b, messages, 3, conductance, shunt);
+  const std::int64_t singular = system_.factorize_forward(edge_conductance_, shunt_, y_);
+  if (singular >= 0) return nodes_[static_cast<std::size_t>(singular)];
+  solve_and_scatter(x, answer);
+  return -1;
+}
+
+void TreeTop::solve(std::span<const double> b, std::span<const double> messages, std::span<double> x,
+                    std::span<double> answer) {
+  gather(b, messages, 1, {}, {});
+  system_.forward(y_);
+  solve_and_scatter(x, answer);
+}
+
+}  // namespace hemotree
