@@ -1,6 +1,7 @@
 #include "distributed/tree_share.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -96,7 +97,10 @@ TreeShare::TreeShare(const TreeCut& cut, int rank) : nodes_(cut.share_nodes(rank
   // The roots come in elimination order, as cut.roots lists them.
   for (std::size_t j = 0; j < nodes_.size(); ++j) {
     const std::int32_t p = cut.parent[static_cast<std::size_t>(nodes_[j])];
-    if (p < 0 || cut.owner[static_cast<std::size_t>(p)] == TreeCut::top) roots_.push_back(static_cast<std::int32_t>(j));
+    if (p < 0 || cut.owner[static_cast<std::size_t>(p)] == TreeCut::top) {
+      roots_.push_back(static_cast<std::int32_t>(j));
+      root_has_parent_.push_back(p >= 0);
+    }
   }
 }
 
@@ -107,6 +111,14 @@ std::vector<double> TreeShare::factorize_forward(std::span<const double> conduct
                                 " numbers of each kind expected");
   for (std::size_t e = 0; e < edge_place_.size(); ++e)
     edge_conductance_[e] = conductance[static_cast<std::size_t>(edge_place_[e])];
+  // A root's edge into the top is the top's to eliminate, but this share's to answer for.
+  for (std::size_t k = 0; k < roots_.size(); ++k) {
+    const double g = conductance[static_cast<std::size_t>(roots_[k])];
+    if (root_has_parent_[k] && !(g > 0 && g < std::numeric_limits<double>::infinity()))
+      throw std::invalid_argument("TreeShare::factorize_forward: the conductance of node " +
+                                  std::to_string(nodes_[static_cast<std::size_t>(roots_[k])]) +
+                                  "'s edge into the top is " + std::to_string(g));
+  }
   system_.factorize_forward(edge_conductance_, shunt, y);  // open roots: never singular here
   std::vector<double> message;
   message.reserve(3 * roots_.size());

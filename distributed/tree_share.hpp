@@ -73,6 +73,7 @@ class TreeShare {
  private:
   std::vector<std::int32_t> nodes_;       // global node per local place
   std::vector<std::int32_t> roots_;       // local places of the roots
+  std::vector<bool> root_has_parent_;     // per root: whether an edge joins it to the top
   std::vector<std::int32_t> edge_place_;  // per local edge, the local place of the node below it
   std::vector<double> edge_conductance_;  // scratch: per local edge
   NodalSystem system_;

@@ -1,0 +1,59 @@
+// A tree's nodal system solved over the ranks of an MPI communicator (the arithmetic:
+// distributed/tree_share.hpp): per factorisation and solve one gather of every share's roots
+// to the top's rank and one scatter of their potentials back, in rank order, so the
+// potentials are the whole system's bit for bit for any number of ranks.
+//
+// A rank holds the nodes of its share (TreeCut::share_nodes) and, on the top's rank, the
+// top's after them (TreeCut::top_nodes): its arrays run over nodes(), in that order.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <mpi.h>
+
+#include "distributed/tree_share.hpp"
+
+namespace hemotree {
+
+class MpiTreeSystem {
+ public:
+  // Collective over comm, whose size must be cut.ranks.
+  MpiTreeSystem(MPI_Comm comm, const TreeCut& cut);
+  int rank() const { return rank_; }
+  std::span<const std::int32_t> nodes() const { return nodes_; }
+  // The parent of each share root of this rank, in the order of TreeCut::roots[rank], and its
+  // potential after the last solve (0 where a root has none): what a vessel into the share
+  // needs of the node above it.
+  std::span<const std::int32_t> root_parents() const { return root_parents_; }
+  std::span<const double> root_parent_potentials() const { return root_parent_potential_; }
+
+  // Per node of this rank: the conductance of its edge to its parent (unread at a root of
+  // the whole forest), its shunt; x: the right-hand side in, the potentials out. Collective.
+  // Returns -1, or the node (of the whole forest) that names a component with no path to
+  // ground, the same on every rank. Numbers one rank's system refuses (NodalSystem's
+  // std::invalid_argument) are thrown on every rank: that rank's own message there, the rank
+  // named elsewhere.
+  std::int64_t factorize_solve(std::span<const double> conductance, std::span<const double> shunt, std::span<double> x);
+  // The same right-hand side in, potentials out, with the last factorisation. Collective.
+  void solve(std::span<double> x);
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0, top_rank_ = 0;
+  std::vector<std::int32_t> nodes_, root_parents_;
+  std::vector<double> root_parent_potential_;
+  std::size_t share_size_ = 0;
+  TreeShare share_;
+  std::vector<TreeTop> top_;  // one, on the top's rank
+  // Per rank: 1 + its roots (a solve's message: a status and y_r each; a factorisation's
+  // sends 1 + 3 roots: g_r, S_r, y_r), 1 + 2 roots (the answer: a status, x_r and x_parent
+  // each), and where its answer starts.
+  std::vector<int> message_count_, answer_count_, answer_offset_;
+  std::vector<std::int32_t> parent_of_slot_;  // top's rank: per share root, its parent among the top's own nodes
+  std::int64_t exchange(std::span<const double> conductance, std::span<const double> shunt, std::span<double> x,
+                        bool factorizing);
+};
+
+}  // namespace hemotree
