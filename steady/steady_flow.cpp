@@ -30,8 +30,6 @@ std::vector<double> vessel_resistances(const Network& net, const Blood& blood) {
   return vessel_resistances(net, blood, {});
 }
 
-namespace {
-
 double vessel_resistance(const Network& net, const Blood& blood, std::size_t v) {
   return net.is_tapered(v)
              ? tapered_poiseuille_resistance([&](double d) { return apparent_viscosity(blood, d); }, net.length[v],
@@ -39,8 +37,6 @@ double vessel_resistance(const Network& net, const Blood& blood, std::size_t v) 
              : poiseuille_resistance(apparent_viscosity(blood, net.diameter[v]), net.length[v], net.diameter[v],
                                      blood.alpha);
 }
-
-}  // namespace
 
 std::vector<double> vessel_resistances(const Network& net, const Blood& blood, std::span<const double> hematocrit,
                                        int threads) {
@@ -167,31 +163,23 @@ class SteadySystem {
   void set_threads(int threads) { system_->set_threads(threads); }
 
  private:
-  void check_tree_form();
-  void check_node_form(const std::vector<NodeBoundary>& boundaries);
-  template <class Conditions>
-  void add_rows(const Conditions& conditions);
-
   const Network& net_;
-  std::int64_t inlet_node_ = -1;  // where the tree's inflow (solve's inlet_flow) enters
-  std::vector<double> shunt_, inflow_;      // per node: outlets' 1/R; flows in and p_out / R
-  std::vector<double> pressure_;            // per node: the prescribed ones
-  std::vector<unsigned char> prescribed_;   // per node
+  SteadyRows rows_;
   std::vector<double> conductance_;         // per vessel
-  std::vector<double> inflow_with_inlet_;   // per node: inflow_ and the inlet's
+  std::vector<double> inflow_with_inlet_;   // per node: the rows' inflow and the inlet's
   std::unique_ptr<FlowNetwork> system_;
 };
 
 // Each condition's row (boundaries/), the tree's inflow left to solve()'s inlet_flow.
 template <class Conditions>
-void SteadySystem::add_rows(const Conditions& conditions) {
-  if (net_.inlet) inlet_node_ = net_.from[static_cast<std::size_t>(net_.index_of(net_.inlet->vessel))];
-  NodalRows rows{shunt_, inflow_, pressure_, prescribed_};
+void add_rows(const Network& net, const Conditions& conditions, SteadyRows& out) {
+  if (net.inlet) out.inlet_node = net.from[static_cast<std::size_t>(net.index_of(net.inlet->vessel))];
+  NodalRows rows{out.shunt, out.inflow, out.pressure, out.prescribed};
   for (const NodeBoundary& b : conditions) {
     const auto i = static_cast<std::size_t>(b.node);
     switch (b.type) {
       case BoundaryType::flow:
-        if (static_cast<std::int64_t>(i) != inlet_node_) FlowInlet{b.waveform.mean_value()}.add_steady_row(rows, i);
+        if (static_cast<std::int64_t>(i) != out.inlet_node) FlowInlet{b.waveform.mean_value()}.add_steady_row(rows, i);
         break;
       case BoundaryType::pressure:
         PressureEnd{b.waveform.mean_value()}.add_steady_row(rows, i);
@@ -208,38 +196,51 @@ void SteadySystem::add_rows(const Conditions& conditions) {
   }
 }
 
-SteadySystem::SteadySystem(const Network& net) : net_(net) {
+// The checks of a tree's boundaries (an inlet, outlets on its terminal vessels); without a
+// given inlet, the one vessel no vessel feeds names its node.
+void check_tree_form(const Network& net, SteadyRows& rows);
+// The checks of boundaries at nodes: every dead end, every part without a pressure reference.
+void check_node_form(const Network& net, const std::vector<NodeBoundary>& boundaries);
+
+}  // namespace
+
+SteadyRows steady_rows(const Network& net) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   if (n == 0) throw InputError("the network has no vessels");
-  shunt_.assign(nodes, 0.0);
-  inflow_.assign(nodes, 0.0);
-  pressure_.assign(nodes, 0.0);
-  prescribed_.assign(nodes, 0);
+  SteadyRows rows;
+  rows.shunt.assign(nodes, 0.0);
+  rows.inflow.assign(nodes, 0.0);
+  rows.pressure.assign(nodes, 0.0);
+  rows.prescribed.assign(nodes, 0);
   // A tree's boundaries (an inlet, outlets on its terminal vessels) keep the tree's checks
   // and messages; boundaries at nodes make any connected graph solvable.
   if (net.boundaries.empty()) {
-    check_tree_form();
+    check_tree_form(net, rows);
     // A view (formats/run_boundaries.hpp): a tree's two million outlets are not copied as
     // conditions (twice over where node_boundaries sorts them: the run's set-up peak). One
     // condition per node, each adding to its own node's row: the order does not matter.
-    add_rows(RunBoundaries(net));
+    add_rows(net, RunBoundaries(net), rows);
   } else {
     const std::vector<NodeBoundary> boundaries = node_boundaries(net);
-    check_node_form(boundaries);
-    add_rows(boundaries);
+    check_node_form(net, boundaries);
+    add_rows(net, boundaries, rows);
   }
-
   // A node that no vessel touches carries nothing: a unit shunt holds it at 0 Pa.
   std::vector<unsigned char> touched(nodes, 0);
   for (std::size_t v = 0; v < n; ++v) touched[static_cast<std::size_t>(net.from[v])] = touched[static_cast<std::size_t>(net.to[v])] = 1;
   for (std::size_t i = 0; i < nodes; ++i)
-    if (!touched[i] && !prescribed_[i]) shunt_[i] = 1;
-  system_ = std::make_unique<FlowNetwork>(nodes, net.from, net.to, prescribed_);
-  conductance_.resize(n);
+    if (!touched[i] && !rows.prescribed[i]) rows.shunt[i] = 1;
+  return rows;
 }
 
-void SteadySystem::check_tree_form() {
-  const Network& net = net_;
+namespace {
+
+SteadySystem::SteadySystem(const Network& net) : net_(net), rows_(steady_rows(net)) {
+  system_ = std::make_unique<FlowNetwork>(net.node_count(), net.from, net.to, rows_.prescribed);
+  conductance_.resize(net.vessel_count());
+}
+
+void check_tree_form(const Network& net, SteadyRows& rows) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   auto name = [&](std::size_t v) { return "vessel " + std::to_string(net.id[v]); };
   steady_outlets(net);  // the outlets sit on exactly the terminal vessels, none a reflection
@@ -274,7 +275,7 @@ void SteadySystem::check_tree_form() {
       throw InputError(name(v) + " is fed by no vessel and does not start at the inlet (vessel " +
                        std::to_string(net.id[static_cast<std::size_t>(inlet)]) + ")");
   }
-  if (!net.inlet) inlet_node_ = static_cast<std::int64_t>(inlet_node);
+  if (!net.inlet) rows.inlet_node = static_cast<std::int64_t>(inlet_node);
 
   // Every vessel must hang together with the inlet: a part apart from it would carry no flow
   // (or, with no outlet, have no solution at all).
@@ -284,8 +285,7 @@ void SteadySystem::check_tree_form() {
     if (parts.root(net.from[v]) != inlet_part) throw InputError(name(v) + " is not connected to the inlet");
 }
 
-void SteadySystem::check_node_form(const std::vector<NodeBoundary>& boundaries) {
-  const Network& net = net_;
+void check_node_form(const Network& net, const std::vector<NodeBoundary>& boundaries) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   auto node_name = [&](std::int64_t i) { return "node " + std::to_string(net.node_id[static_cast<std::size_t>(i)]); };
   std::vector<std::int32_t> degree(nodes, 0), some_vessel(nodes, -1);
@@ -337,19 +337,19 @@ void SteadySystem::solve(const std::vector<double>& resistance, double inlet_flo
     throw std::invalid_argument("solve_steady_flow: " + std::to_string(resistance.size()) + " resistances for " +
                                 std::to_string(n) + " vessels");
   for (std::size_t v = 0; v < n; ++v) conductance_[v] = 1 / resistance[v];
-  const std::int64_t floating = system_->factorize(conductance_, shunt_);
+  const std::int64_t floating = system_->factorize(conductance_, rows_.shunt);
   if (floating >= 0) {
     if (net_.boundaries.empty()) throw InputError("the network has no outlet for the inflow");
     // The checks found a reference in every part: this one's is lost in rounding.
     throw InputError("node " + std::to_string(net_.node_id[static_cast<std::size_t>(floating)]) +
                      ": the outlets' resistances of its part are too large against its vessels' to fix its pressure");
   }
-  s.node_pressure.assign(pressure_.begin(), pressure_.end());
+  s.node_pressure.assign(rows_.pressure.begin(), rows_.pressure.end());
   std::vector<double>& inflow = inflow_with_inlet_;
-  inflow.assign(inflow_.begin(), inflow_.end());
-  if (inlet_node_ >= 0) inflow[static_cast<std::size_t>(inlet_node_)] += inlet_flow;
+  inflow.assign(rows_.inflow.begin(), rows_.inflow.end());
+  if (rows_.inlet_node >= 0) inflow[static_cast<std::size_t>(rows_.inlet_node)] += inlet_flow;
   system_->solve(inflow, s.node_pressure);
-  s.inlet_pressure = inlet_node_ >= 0 ? s.node_pressure[static_cast<std::size_t>(inlet_node_)]
+  s.inlet_pressure = rows_.inlet_node >= 0 ? s.node_pressure[static_cast<std::size_t>(rows_.inlet_node)]
                                       : std::numeric_limits<double>::quiet_NaN();
   s.flow.resize(n);
   for (std::size_t v = 0; v < n; ++v)

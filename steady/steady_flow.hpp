@@ -29,6 +29,21 @@ std::vector<double> vessel_resistances(const Network& net, const Blood& blood);
 std::vector<double> vessel_resistances(const Network& net, const Blood& blood, std::span<const double> hematocrit,
                                        int threads = 1);
 
+// One vessel's (the function of every vessel of vessel_resistances, the blood's hematocrit).
+double vessel_resistance(const Network& net, const Blood& blood, std::size_t v);
+
+// The steady flow's boundary rows, after its checks (InputError, SettingError "pressure_at",
+// as solve_steady_flow's below): per node the outlets' 1/R to ground (shunt; a unit shunt at a
+// node no vessel touches), the flows in and the outlets' p_out / R (inflow), the prescribed
+// pressures; the node where the tree's inflow enters (-1: none). What solve_steady_flow
+// solves with, and a rank's share of it (distributed/).
+struct SteadyRows {
+  std::vector<double> shunt, inflow, pressure;
+  std::vector<unsigned char> prescribed;
+  std::int64_t inlet_node = -1;
+};
+SteadyRows steady_rows(const Network& net);
+
 // Thevenin equivalent of what lies beyond a vessel's distal node: the flow into it is
 // (p - pressure) / resistance.
 struct Equivalent {
