@@ -7,6 +7,7 @@
 #include <cstring>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <unistd.h>
@@ -18,6 +19,7 @@
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
 #include "cli/interrupt.hpp"
+#include "mpi/session.hpp"
 
 namespace hemotree {
 
@@ -73,6 +75,11 @@ int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& b
 }
 
 int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, const std::function<int()>& body) {
+  return run_tool(app, argc, argv, words, body, {});
+}
+
+int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, const std::function<int()>& body,
+             const std::function<std::string()>& over_ranks) {
   tool_name = app.get_name();
 #ifdef __GLIBC__
   // Blocks of a megabyte or more mapped on their own, and given back to the system when
@@ -104,37 +111,56 @@ int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, co
                                    : "'" + culprit + "': the value is out of range for that option (see --help)");
     return 2;
   }
-  // Started by an MPI launcher on several ranks, every rank would run the whole command and
-  // write the same outputs: refused on every rank, said once (rank 0), until a tool runs
-  // distributed (issue 24).
-  if (const int ranks = launched_ranks(); ranks > 1) {
-    if (launched_rank() == 0)
-      say("error: ", "started on " + std::to_string(ranks) + " MPI ranks: " + tool_name +
-                         " runs as one process for now (each rank would run the whole command and write the same "
-                         "outputs); run it without mpirun, or with -np 1");
-    return 2;
+  // Started by an MPI launcher on several ranks, a command that does not run over them would
+  // run whole on every rank and write the same outputs: refused on every rank, said once.
+  const int ranks = launched_ranks();
+  std::optional<MpiSession> session;
+  if (ranks > 1) {
+    const std::string refusal =
+        over_ranks ? over_ranks()
+                   : tool_name + " runs as one process (each rank would run the whole command and write the same "
+                                 "outputs)";
+    if (!refusal.empty()) {
+      if (launched_rank() == 0)
+        say("error: ", "started on " + std::to_string(ranks) + " MPI ranks: " + refusal +
+                           "; run it without mpirun, or with -np 1");
+      return 2;
+    }
+    try {
+      session.emplace(argc, argv);
+    } catch (const std::exception& e) {
+      say("error: ", e.what());
+      return 1;
+    }
   }
+  // Errors of the input, and of files (every rank reads the same input; rank 0 alone writes),
+  // are every rank's alike: said by rank 0 alone. Memory and internal errors may be one
+  // rank's own: said by it, naming it.
+  const bool lead = world_rank() == 0;
+  auto said = [&](const std::string& kind, const std::string& message, bool every_rank_alike) {
+    if (lead || !every_rank_alike) say(kind, world_size() > 1 && !lead ? "rank " + std::to_string(world_rank()) + ": " + message : message);
+  };
   try {
     return checked_success(body());
   } catch (const InterruptedExit& e) {
     return e.status;
   } catch (const SettingError& e) {
-    say("error: ", e.in_words(words));
+    said("error: ", e.in_words(words), true);
     return 2;
   } catch (const InputError& e) {
-    say("error: ", e.what());
+    said("error: ", e.what(), true);
     return 2;
   } catch (const JsonError& e) {
-    say("error: ", e.what());
+    said("error: ", e.what(), true);
     return 2;
   } catch (const IoError& e) {
-    say("error: ", e.what());
+    said("error: ", e.what(), true);
     return 1;
   } catch (const std::bad_alloc&) {
-    say("error: ", "out of memory");
+    said("error: ", "out of memory", false);
     return 1;
   } catch (const std::exception& e) {
-    say("internal error: ", e.what());
+    said("internal error: ", e.what(), false);
     return 70;
   }
 }

@@ -18,9 +18,17 @@ namespace hemotree {
 int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, const std::function<int()>& body);
 // The same for a tool whose libraries name no setting of its own.
 int run_tool(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+// The same for a tool that runs some of its commands over MPI ranks (issue 24): over_ranks,
+// asked once the command line is parsed, returns "" where this command runs over the
+// ranks a launcher started, else the refusal's words. Started on several ranks, the body
+// then runs inside an MPI session (mpi/session.hpp) on every rank, and an error
+// every rank meets alike (bad input: every rank reads the same) is said once, by rank 0.
+int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, const std::function<int()>& body,
+             const std::function<std::string()>& over_ranks);
 
 // The ranks an MPI launcher started (1 without one) and this process's (0 without one), from
-// the launcher's environment: run_tool refuses more than one rank, said by rank 0.
+// the launcher's environment: run_tool refuses more than one rank, said by rank 0, for a
+// command that does not run over them.
 int launched_ranks();
 int launched_rank();
 
