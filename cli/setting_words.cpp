@@ -5,6 +5,7 @@ namespace hemotree {
 const SettingWords& hemosolve_words() {
   static const SettingWords words = {
       {"cfl", "--cfl"},
+      {"ranks", "the ranks (mpirun -np)"},
       {"checkpoint_every", "--checkpoint-every"},
       {"cycles", "--cycles"},
       {"coupling_passes", "--coupling-passes"},

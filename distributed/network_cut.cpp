@@ -9,18 +9,19 @@ namespace hemotree {
 
 TreeCut tree_cut(const Network& net, const Partition& partition) {
   if (partition.method == Partition::Method::metis)
-    throw SettingError("ranks", "a network with loops is split by METIS, and its distributed solve is not built yet "
-                                "(run it on one rank)");
+    throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(partition.ranks) +
+                                    ": a network with loops is split by METIS, and its distributed solve is not built "
+                                    "yet: run it on one rank");
   if (partition.top_spread || partition.top_rank < 0)
-    throw SettingError("ranks", std::to_string(partition.ranks) + " ranks spread the tree's top over them, which the "
-                                "distributed solve does not take yet: fewer ranks (about the square root of an eighth "
-                                "of the vessels at most)");
+    throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(partition.ranks) +
+                                    ": so many ranks spread the tree's top over them, which the distributed solve does "
+                                    "not take yet: fewer (at most about the square root of an eighth of the vessels)");
   std::vector<std::int32_t> owner(partition.rank_of_vessel.begin(), partition.rank_of_vessel.end());
   for (const std::int32_t v : partition.top) owner[static_cast<std::size_t>(v)] = TreeCut::top;
   try {
     return TreeCut(net.node_count(), net.from, net.to, owner, partition.ranks, partition.top_rank);
   } catch (const std::invalid_argument& e) {
-    throw SettingError("ranks", std::string("the partition is not whole subtrees below a top: ") + e.what());
+    throw SettingError("ranks", placeholder("ranks") + ": the partition is not whole subtrees below a top: " + e.what());
   }
 }
 

@@ -351,5 +351,11 @@ int main(int argc, char** argv) {
   CommandLine line;
   const int cores = omp_get_num_procs();
   bind_options(app, line, cores);
-  return run_tool(app, argc, argv, hemosolve_words(), [&] { return run_command_line(line, cores); });
+  // Over MPI ranks: the steady flow with red cells fixed, so far (issue 24).
+  auto over_ranks = [&]() -> std::string {
+    if (!line.steady) return "hemosolve runs --steady over MPI ranks so far; its pulsatile and --linear runs are one process";
+    if (line.red_cells != "fixed") return "--steady with --red-cells " + line.red_cells + " runs as one process";
+    return "";
+  };
+  return run_tool(app, argc, argv, hemosolve_words(), [&] { return run_command_line(line, cores); }, over_ranks);
 }

@@ -7,13 +7,17 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <optional>
+#include <stdexcept>
 #include <utility>
 
 #include "core/errors.hpp"
 #include "core/units.hpp"
+#include "distributed/steady_over_ranks.hpp"
 #include "formats/run_boundaries.hpp"
 #include "physics/rheology.hpp"
 #include "solver/output_folder.hpp"
+#include "mpi/session.hpp"
 #include "physics/phase_separation.hpp"
 #include "solver/run_report.hpp"
 #include "steady/steady_hematocrit.hpp"
@@ -118,11 +122,21 @@ VesselTable steady_results(const Network& net, const CycleSummary& cycle) {
 void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver& observer) {
   Blood blood = net.blood.value_or(Blood{});
   if (request.rheology_override >= 0) blood.rheology = static_cast<Rheology>(request.rheology_override);
-  OutputFolder folder(request.out_dir);
+  // Over MPI ranks (distributed/steady_over_ranks.hpp) rank 0 alone takes the folder and
+  // writes; its refusal is every rank's before any of them enters the solve.
+  std::optional<OutputFolder> taken;
+  on_lead_rank([&] { taken.emplace(request.out_dir); });
   const auto started = std::chrono::steady_clock::now();
   SteadyFlow steady;
   SteadyHematocritResult separated;
-  if (request.phase_separation) {
+  if (world_size() > 1) {
+    if (request.phase_separation)
+      throw std::logic_error("run_steady: phase separation over MPI ranks (hemosolve refuses it before)");
+    SteadyOverRanks over = solve_steady_flow_over_ranks(net, blood, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
+    if (world_rank() != 0) return;
+    observer.note(over.partition);
+    steady = std::move(over.flow);
+  } else if (request.phase_separation) {
     // Under-relaxed by half: undamped, the rat mesentery's split oscillates (Gardner et al.
     // 2010 on such networks); 59 passes to 1e-10 there.
     separated = solve_steady_with_phase_separation(net, blood, red_cell_iterations, red_cell_tolerance, 0.5);
@@ -160,6 +174,7 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
                                        {"tolerance", red_cell_tolerance},
                                        {"relaxation", 0.5}};
   run_info["statistics"] = group_statistics(net, results, request.threads);
+  OutputFolder& folder = *taken;
   folder.open();
   const std::filesystem::path dir = folder.staging();
   write_results(dir, {run_info, results, cycle, boundary_results(net, steady), nullptr, request.threads},

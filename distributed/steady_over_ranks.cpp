@@ -1,0 +1,92 @@
+#include "distributed/steady_over_ranks.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+#include "core/setting_error.hpp"
+#include "mpi/session.hpp"
+#include "distributed/mpi_tree_system.hpp"
+#include "distributed/network_cut.hpp"
+#include "partition/partition.hpp"
+
+namespace hemotree {
+
+SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& blood, double inlet_flow) {
+  const int ranks = world_size(), rank = world_rank();
+  const SteadyRows rows = steady_rows(net);  // its checks on every rank alike
+  if (std::any_of(rows.prescribed.begin(), rows.prescribed.end(), [](unsigned char p) { return p != 0; }))
+    throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(ranks) +
+                                    ": pressures prescribed at nodes are not taken by the distributed solve yet: run "
+                                    "this network on one rank");
+  const Partition partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), ranks);
+  const TreeCut cut = tree_cut(net, partition);
+  MpiTreeSystem system(MPI_COMM_WORLD, cut);
+
+  // This rank's numbers: per node, its edge's conductance (the vessel to its parent: 1 / R as
+  // the one-process system takes it), its shunt and its inflow (the inlet's added as there).
+  const std::span<const std::int32_t> nodes = system.nodes();
+  std::vector<double> conductance(nodes.size(), 0.0), shunt(nodes.size()), x(nodes.size()), resistance(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const auto node = static_cast<std::size_t>(nodes[k]);
+    if (const std::int32_t v = cut.parent_edge[node]; v >= 0) {
+      resistance[k] = vessel_resistance(net, blood, static_cast<std::size_t>(v));
+      conductance[k] = 1 / resistance[k];
+    }
+    shunt[k] = rows.shunt[node];
+    x[k] = rows.inflow[node];
+    if (static_cast<std::int64_t>(node) == rows.inlet_node) x[k] += inlet_flow;
+  }
+  if (const std::int64_t floating = system.factorize_solve(conductance, shunt, x); floating >= 0)
+    refuse_floating_part(net, floating);
+
+  // Each vessel's flow on the rank of the node below it, from its nodes' pressures.
+  std::vector<double> pressure(net.node_count(), 0.0);
+  for (std::size_t k = 0; k < nodes.size(); ++k) pressure[static_cast<std::size_t>(nodes[k])] = x[k];
+  for (std::size_t k = 0; k < system.root_parents().size(); ++k)
+    if (const std::int32_t p = system.root_parents()[k]; p >= 0)
+      pressure[static_cast<std::size_t>(p)] = system.root_parent_potentials()[k];
+  std::vector<double> mine(2 * nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    mine[2 * k] = x[k];
+    const std::int32_t v = cut.parent_edge[static_cast<std::size_t>(nodes[k])];
+    mine[2 * k + 1] = v >= 0 ? (pressure[static_cast<std::size_t>(net.from[static_cast<std::size_t>(v)])] -
+                                pressure[static_cast<std::size_t>(net.to[static_cast<std::size_t>(v)])]) /
+                                   resistance[k]
+                             : 0.0;
+  }
+  // Gathered on rank 0 in rank order, each rank's nodes as MpiTreeSystem lists them.
+  std::vector<std::vector<std::int32_t>> held(static_cast<std::size_t>(ranks));
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(static_cast<std::size_t>(ranks), 0);
+  for (int r = 0; r < ranks; ++r) {
+    held[static_cast<std::size_t>(r)] = cut.share_nodes(r);
+    if (r == cut.top_rank) {
+      const std::vector<std::int32_t> top = cut.top_nodes();
+      held[static_cast<std::size_t>(r)].insert(held[static_cast<std::size_t>(r)].end(), top.begin(), top.end());
+    }
+    counts[static_cast<std::size_t>(r)] = 2 * static_cast<int>(held[static_cast<std::size_t>(r)].size());
+    if (r > 0) offsets[static_cast<std::size_t>(r)] = offsets[static_cast<std::size_t>(r) - 1] + counts[static_cast<std::size_t>(r) - 1];
+  }
+  std::vector<double> all(rank == 0 ? 2 * net.node_count() : 0);
+  MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+              MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  SteadyOverRanks out{{}, describe(partition)};
+  if (rank != 0) return out;
+  SteadyFlow& s = out.flow;
+  s.node_pressure.assign(net.node_count(), 0.0);
+  s.flow.assign(net.vessel_count(), 0.0);
+  for (int r = 0; r < ranks; ++r) {
+    const double* from = all.data() + offsets[static_cast<std::size_t>(r)];
+    const auto& list = held[static_cast<std::size_t>(r)];
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const auto node = static_cast<std::size_t>(list[k]);
+      s.node_pressure[node] = from[2 * k];
+      if (const std::int32_t v = cut.parent_edge[node]; v >= 0) s.flow[static_cast<std::size_t>(v)] = from[2 * k + 1];
+    }
+  }
+  s.inlet_pressure = rows.inlet_node >= 0 ? s.node_pressure[static_cast<std::size_t>(rows.inlet_node)]
+                                          : std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
+
+}  // namespace hemotree

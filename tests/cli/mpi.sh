@@ -1,0 +1,60 @@
+# hemosolve --steady under mpirun (issue 24): the tree's nodal system solved over 1 to 4
+# ranks gives the plain command's outputs byte for byte (but the wall time), text or HDF5;
+# the partition is said in one line; what does not run over ranks yet is refused in one line,
+# said once, nothing written.
+source "$(dirname "$0")/lib.sh"
+HEMOSOLVE=$BUILD/solver/hemosolve
+if ! command -v mpirun >/dev/null; then
+  echo "skip: mpirun (no Open MPI)"
+  finish
+fi
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+MPIRUN="timeout 120 mpirun --oversubscribe"
+"$VGEN" --seed 3 --root-diameter 200um --min-diameter 8um 2>/dev/null | "$BUILD/pruner/vprune" --budget all \
+  -o "$WORK/tree.json" 2>/dev/null || fail "vgen | vprune"
+"$HEMOSOLVE" "$WORK/tree.json" --steady --out "$WORK/one" 2>/dev/null || fail "hemosolve --steady"
+"$HEMOSOLVE" "$WORK/tree.json" --steady --format h5 --out "$WORK/one-h5" 2>/dev/null || fail "hemosolve --steady --format h5"
+same_run() {  # the plain run's files, summary.json but its wall time
+  cmp -s "$WORK/one/vessels.csv" "$1/vessels.csv" \
+    && diff <(grep -v '"wall_time"' "$WORK/one/summary.json") <(grep -v '"wall_time"' "$1/summary.json") >/dev/null
+}
+for ranks in 1 2 3 4; do
+  $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/tree.json" --steady --out "$WORK/ranks$ranks" >"$WORK/out$ranks" 2>&1
+  status=$?
+  said=$(grep -c "^hemosolve: $ranks ranks by subtrees: .* cut nodes, the top's" "$WORK/out$ranks")
+  if [ $ranks -eq 1 ]; then said=1; fi  # one rank: the plain command
+  [ $status -eq 0 ] && [ "$said" -eq 1 ] && same_run "$WORK/ranks$ranks" \
+    && pass "mpirun -np $ranks hemosolve --steady: the plain run's bytes, the partition said once" \
+    || fail "mpirun -np $ranks: status $status, partition said $said times: $(head -3 "$WORK/out$ranks")"
+done
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/tree.json" --steady --format h5 --out "$WORK/ranks-h5" >/dev/null 2>&1
+/usr/bin/python3 - "$WORK/one-h5/results.h5" "$WORK/ranks-h5/results.h5" <<'PY' && pass "mpirun -np 3 --format h5: the plain run's values" || fail "--format h5 over ranks"
+import sys, h5py, numpy as np
+a, b = h5py.File(sys.argv[1]), h5py.File(sys.argv[2])
+for group in ("vessels", "boundaries"):
+    assert list(a[group]) == list(b[group]), group
+    for name in a[group]:
+        x, y = a[group][name][()], b[group][name][()]
+        assert x.dtype == y.dtype and x.shape == y.shape, name
+        assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), name  # bit for bit, NaNs too
+PY
+expect_refused() {  # name, text, command...: status 2, said once, no folder
+  local name=$1 text=$2
+  shift 2
+  $MPIRUN "$@" >"$WORK/refused" 2>&1
+  local status=$? count
+  count=$(grep -c -- "$text" "$WORK/refused")
+  [ $status -ne 0 ] && [ "$count" -eq 1 ] && [ ! -e "$WORK/refused-out" ] \
+    && pass "$name: refused, said once, nothing written" \
+    || fail "$name: status $status, said $count times: $(head -3 "$WORK/refused")"
+}
+expect_refused "a pulsatile run over 2 ranks" "hemosolve: error: started on 2 MPI ranks: hemosolve runs --steady over MPI ranks so far" \
+  -np 2 "$HEMOSOLVE" "$WORK/tree.json" --out "$WORK/refused-out"
+expect_refused "phase separation over 2 ranks" "--steady with --red-cells transport runs as one process" \
+  -np 2 "$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport --out "$WORK/refused-out"
+mkdir -p "$WORK/not-ours" && touch "$WORK/not-ours/file"
+expect_refused "an output folder rank 0 refuses" "hemosolve: error: --out $WORK/not-ours: exists and is not a hemosolve results folder" \
+  -np 3 "$HEMOSOLVE" "$WORK/tree.json" --steady --out "$WORK/not-ours"
+expect_refused "a network every rank refuses" "hemosolve: error: " \
+  -np 2 "$HEMOSOLVE" "$WORK/missing.json" --steady --out "$WORK/refused-out"
+finish
