@@ -204,6 +204,13 @@ void check_node_form(const Network& net, const std::vector<NodeBoundary>& bounda
 
 }  // namespace
 
+void refuse_floating_part(const Network& net, std::int64_t node) {
+  if (net.boundaries.empty()) throw InputError("the network has no outlet for the inflow");
+  // The checks found a reference in every part: this one's is lost in rounding.
+  throw InputError("node " + std::to_string(net.node_id[static_cast<std::size_t>(node)]) +
+                   ": the outlets' resistances of its part are too large against its vessels' to fix its pressure");
+}
+
 SteadyRows steady_rows(const Network& net) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   if (n == 0) throw InputError("the network has no vessels");
@@ -338,12 +345,7 @@ void SteadySystem::solve(const std::vector<double>& resistance, double inlet_flo
                                 std::to_string(n) + " vessels");
   for (std::size_t v = 0; v < n; ++v) conductance_[v] = 1 / resistance[v];
   const std::int64_t floating = system_->factorize(conductance_, rows_.shunt);
-  if (floating >= 0) {
-    if (net_.boundaries.empty()) throw InputError("the network has no outlet for the inflow");
-    // The checks found a reference in every part: this one's is lost in rounding.
-    throw InputError("node " + std::to_string(net_.node_id[static_cast<std::size_t>(floating)]) +
-                     ": the outlets' resistances of its part are too large against its vessels' to fix its pressure");
-  }
+  if (floating >= 0) refuse_floating_part(net_, floating);
   s.node_pressure.assign(rows_.pressure.begin(), rows_.pressure.end());
   std::vector<double>& inflow = inflow_with_inlet_;
   inflow.assign(rows_.inflow.begin(), rows_.inflow.end());

@@ -43,6 +43,8 @@ struct SteadyRows {
   std::int64_t inlet_node = -1;
 };
 SteadyRows steady_rows(const Network& net);
+// The refusal of a system found singular at `node` (a part whose pressure nothing fixes).
+[[noreturn]] void refuse_floating_part(const Network& net, std::int64_t node);
 
 // Thevenin equivalent of what lies beyond a vessel's distal node: the flow into it is
 // (p - pressure) / resistance.
