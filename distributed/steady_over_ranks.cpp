@@ -8,18 +8,58 @@
 #include "mpi/session.hpp"
 #include "distributed/mpi_tree_system.hpp"
 #include "distributed/network_cut.hpp"
+#include "distributed/petsc_flow_network.hpp"
 #include "partition/partition.hpp"
 
 namespace hemotree {
 
+namespace {
+
+// Any other network (loops, pressures prescribed at nodes): PETSc's solve of the nodal system
+// over the ranks, each node on the rank of a vessel leaving it (METIS's pieces go with their
+// `from` nodes), else of one entering it; the pressures on every rank, the flows on rank 0
+// as the one-process solve forms them.
+SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, double inlet_flow, const SteadyRows& rows,
+                               const Partition& partition) {
+  const std::size_t n = net.vessel_count(), nodes = net.node_count();
+  std::vector<std::int32_t> owner(nodes, -1);
+  for (std::size_t v = 0; v < n; ++v) owner[static_cast<std::size_t>(net.from[v])] = partition.rank_of_vessel[v];
+  for (std::size_t v = 0; v < n; ++v)
+    if (std::int32_t& o = owner[static_cast<std::size_t>(net.to[v])]; o < 0) o = partition.rank_of_vessel[v];
+  for (std::int32_t& o : owner) o = std::max(o, 0);  // a node no vessel touches: a unit shunt, rank 0's
+  std::vector<double> resistance(n), conductance(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    resistance[v] = vessel_resistance(net, blood, v);
+    conductance[v] = 1 / resistance[v];
+  }
+  std::vector<double> inflow = rows.inflow;
+  if (rows.inlet_node >= 0) inflow[static_cast<std::size_t>(rows.inlet_node)] += inlet_flow;
+  SteadyOverRanks out{{}, describe(partition)};
+  std::vector<double> pressure = rows.pressure;
+  PetscFlowNetwork system(nodes, net.from, net.to, rows.prescribed, owner);
+  system.solve(conductance, rows.shunt, inflow, pressure);
+  out.partition += "; conjugate gradients with BoomerAMG in " + std::to_string(system.iterations()) + " iterations";
+  if (world_rank() != 0) return out;
+  SteadyFlow& s = out.flow;
+  s.node_pressure = std::move(pressure);
+  s.flow.resize(n);
+  for (std::size_t v = 0; v < n; ++v)
+    s.flow[v] = (s.node_pressure[static_cast<std::size_t>(net.from[v])] - s.node_pressure[static_cast<std::size_t>(net.to[v])]) /
+                resistance[v];
+  s.inlet_pressure = rows.inlet_node >= 0 ? s.node_pressure[static_cast<std::size_t>(rows.inlet_node)]
+                                          : std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
+
+}  // namespace
+
 SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& blood, double inlet_flow) {
   const int ranks = world_size(), rank = world_rank();
   const SteadyRows rows = steady_rows(net);  // its checks on every rank alike
-  if (std::any_of(rows.prescribed.begin(), rows.prescribed.end(), [](unsigned char p) { return p != 0; }))
-    throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(ranks) +
-                                    ": pressures prescribed at nodes are not taken by the distributed solve yet: run "
-                                    "this network on one rank");
   const Partition partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), ranks);
+  if (partition.method == Partition::Method::metis ||
+      std::any_of(rows.prescribed.begin(), rows.prescribed.end(), [](unsigned char p) { return p != 0; }))
+    return solve_by_petsc(net, blood, inlet_flow, rows, partition);
   const TreeCut cut = tree_cut(net, partition);
   MpiTreeSystem system(MPI_COMM_WORLD, cut);
 

@@ -3,6 +3,8 @@
 #include <exception>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
@@ -11,7 +13,10 @@ namespace hemotree {
 
 namespace {
 bool initialised_here = false;
+std::vector<std::function<void()>> session_end;
 }  // namespace
+
+void at_session_end(std::function<void()> step) { session_end.push_back(std::move(step)); }
 
 MpiSession::MpiSession(int& argc, char**& argv) {
   int provided = 0;
@@ -21,6 +26,8 @@ MpiSession::MpiSession(int& argc, char**& argv) {
 }
 
 MpiSession::~MpiSession() {
+  for (auto step = session_end.rbegin(); step != session_end.rend(); ++step) (*step)();
+  session_end.clear();
   if (initialised_here) MPI_Finalize();
   initialised_here = false;
 }

@@ -21,6 +21,10 @@ class MpiSession {
 int world_size();
 int world_rank();
 
+// Called when the session ends, before MPI is finalised, the last registered first: a library
+// started on MPI (PETSc) finalised before it.
+void at_session_end(std::function<void()> step);
+
 // Runs a step that only rank 0 takes (the output folder, the files) and makes its failure
 // every rank's: the same kind of error (InputError, SettingError, IoError; any other a
 // std::runtime_error) with the same message on each, so that no rank waits in a collective

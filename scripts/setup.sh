@@ -17,7 +17,7 @@ JOBS=${HEMOTREE_JOBS:-$(nproc)}
 packages=(build-essential cmake ninja-build libboost-graph-dev libeigen3-dev
           nlohmann-json3-dev libgtest-dev libcli11-dev libyaml-cpp-dev zlib1g-dev python3-matplotlib
           python3-numpy python3-pandas libhdf5-openmpi-dev libopenmpi-dev openmpi-bin python3-h5py
-          libmetis-dev)
+          libmetis-dev libpetsc-real-dev pkg-config)
 
 say() { echo "hemotree: $*" >&2; }
 

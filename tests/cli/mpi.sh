@@ -1,7 +1,7 @@
 # hemosolve --steady under mpirun (issue 24): the tree's nodal system solved over 1 to 4
-# ranks gives the plain command's outputs byte for byte (but the wall time), text or HDF5;
-# the partition is said in one line; what does not run over ranks yet is refused in one line,
-# said once, nothing written.
+# ranks gives the plain command's outputs byte for byte (but the wall time), text or HDF5; a
+# looped network (PETSc) the plain run's to 1e-10; the partition is said in one line; what
+# does not run over ranks yet is refused in one line, said once, nothing written.
 source "$(dirname "$0")/lib.sh"
 HEMOSOLVE=$BUILD/solver/hemosolve
 if ! command -v mpirun >/dev/null; then
@@ -38,6 +38,33 @@ for group in ("vessels", "boundaries"):
         assert x.dtype == y.dtype and x.shape == y.shape, name
         assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), name  # bit for bit, NaNs too
 PY
+# A network with loops and pressures prescribed at nodes (the rat mesentery): PETSc's
+# conjugate gradients over the ranks, within 1e-10 of the plain run (relative to each
+# column's largest value).
+NETWORKS=${HEMOTREE_NETWORKS_DIR:-$(dirname "$0")/../../../shared/networks}
+if [ -f "$NETWORKS/mesentery-rat/network.dat" ]; then
+  "$BUILD/exchange/vimport" secomb "$NETWORKS/mesentery-rat/network.dat" -o "$WORK/mesentery.json" 2>/dev/null
+  "$HEMOSOLVE" "$WORK/mesentery.json" --steady --out "$WORK/mesentery-one" 2>/dev/null || fail "the mesentery, plain"
+  for ranks in 2 3; do
+    $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/mesentery.json" --steady --out "$WORK/mesentery-$ranks" >"$WORK/m-out" 2>&1
+    status=$?
+    grep -q "^hemosolve: $ranks ranks by METIS: .*; conjugate gradients with BoomerAMG in [0-9]* iterations" "$WORK/m-out" \
+      && [ $status -eq 0 ] && /usr/bin/python3 - "$WORK/mesentery-one/vessels.csv" "$WORK/mesentery-$ranks/vessels.csv" <<'PY' \
+      && pass "the mesentery over $ranks ranks (METIS, PETSc): the plain run's within 1e-10" \
+      || fail "the mesentery over $ranks ranks: status $status: $(head -3 "$WORK/m-out")"
+import sys, pandas as pd, numpy as np
+a, b = pd.read_csv(sys.argv[1]), pd.read_csv(sys.argv[2])
+assert list(a.columns) == list(b.columns) and len(a) == len(b)
+for c in ("mean_flow", "mean_pressure", "mean_wss", "reynolds"):
+    x, y = a[c].to_numpy(), b[c].to_numpy()
+    assert np.abs(x - y).max() <= 1e-10 * np.abs(x).max(), c
+assert (a["id"] == b["id"]).all()
+PY
+  done
+else
+  echo "skip: the mesentery over ranks (no shared networks)"
+fi
+
 expect_refused() {  # name, text, command...: status 2, said once, no folder
   local name=$1 text=$2
   shift 2

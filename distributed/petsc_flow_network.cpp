@@ -1,0 +1,174 @@
+#include "distributed/petsc_flow_network.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <petscksp.h>
+
+#include "core/errors.hpp"
+#include "mpi/session.hpp"
+
+namespace hemotree {
+
+namespace {
+
+// PETSc's error codes as exceptions; its own printing of a traceback is turned off.
+void check(PetscErrorCode code, const char* what) {
+  if (code != 0) throw std::runtime_error(std::string("PETSc: ") + what + " failed (error " + std::to_string(code) + ")");
+}
+
+// PETSc on the session's MPI, once, finalised before MPI when the session ends.
+void start_petsc() {
+  PetscBool started = PETSC_FALSE;
+  check(PetscInitialized(&started), "PetscInitialized");
+  if (started) return;
+  check(PetscInitializeNoArguments(), "PetscInitialize");
+  check(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr), "PetscPushErrorHandler");
+  at_session_end([] { PetscFinalize(); });
+}
+
+// The PETSc objects of one solve, destroyed whatever happens.
+struct Objects {
+  Mat matrix = nullptr;
+  Vec x = nullptr, rhs = nullptr, everywhere = nullptr;
+  VecScatter to_all = nullptr;
+  KSP solver = nullptr;
+  ~Objects() {
+    if (solver) KSPDestroy(&solver);
+    if (to_all) VecScatterDestroy(&to_all);
+    if (everywhere) VecDestroy(&everywhere);
+    if (rhs) VecDestroy(&rhs);
+    if (x) VecDestroy(&x);
+    if (matrix) MatDestroy(&matrix);
+  }
+};
+
+}  // namespace
+
+PetscFlowNetwork::PetscFlowNetwork(std::size_t nodes, std::span<const std::int32_t> a, std::span<const std::int32_t> b,
+                                   std::span<const unsigned char> prescribed, std::span<const std::int32_t> owner)
+    : nodes_(nodes), a_(a.begin(), a.end()), b_(b.begin(), b.end()), owner_(owner.begin(), owner.end()),
+      prescribed_(prescribed.begin(), prescribed.end()) {
+  if (a.size() != b.size() || prescribed.size() != nodes || owner.size() != nodes)
+    throw std::invalid_argument("PetscFlowNetwork: two nodes per edge, a flag and an owner per node");
+  if (nodes > static_cast<std::size_t>(std::numeric_limits<PetscInt>::max()))
+    throw std::invalid_argument("PetscFlowNetwork: more nodes than PETSc's indices hold");
+  start_petsc();
+  const int ranks = world_size(), rank = world_rank();
+  // The free nodes numbered rank by rank, each rank's in the order of the nodes.
+  std::vector<std::int64_t> count(static_cast<std::size_t>(ranks) + 1, 0);
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (!prescribed_[i]) {
+      if (owner_[i] < 0 || owner_[i] >= ranks)
+        throw std::invalid_argument("PetscFlowNetwork: node " + std::to_string(i) + " on rank " + std::to_string(owner_[i]));
+      ++count[static_cast<std::size_t>(owner_[i]) + 1];
+    }
+  for (int r = 0; r < ranks; ++r) count[static_cast<std::size_t>(r) + 1] += count[static_cast<std::size_t>(r)];
+  first_row_ = count[static_cast<std::size_t>(rank)];
+  rows_ = count[static_cast<std::size_t>(rank) + 1] - first_row_;
+  all_rows_ = count.back();
+  row_.assign(nodes, -1);
+  std::vector<std::int64_t> next(count.begin(), count.end() - 1);
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (!prescribed_[i]) row_[i] = next[static_cast<std::size_t>(owner_[i])]++;
+}
+
+PetscFlowNetwork::~PetscFlowNetwork() = default;
+
+void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<const double> shunt,
+                             std::span<const double> inflow, std::span<double> pressure) {
+  if (conductance.size() != a_.size() || shunt.size() != nodes_ || inflow.size() != nodes_ || pressure.size() != nodes_)
+    throw std::invalid_argument("PetscFlowNetwork::solve: a conductance per edge, a shunt, an inflow and a pressure per node");
+  const int rank = world_rank();
+  auto mine = [&](std::size_t i) { return !prescribed_[i] && owner_[i] == rank; };
+  // This rank's rows: the diagonal (shunt and every edge's conductance), an entry -g per edge
+  // to a free node, g p for an edge to a prescribed one on the right-hand side.
+  const auto local = static_cast<std::size_t>(rows_);
+  std::vector<double> diagonal(local, 0.0), rhs(local, 0.0);
+  std::vector<PetscInt> in_block(local, 1), off_block(local, 0);  // preallocation
+  std::vector<std::pair<PetscInt, PetscInt>> entry_at;
+  std::vector<double> entry;
+  for (std::size_t i = 0; i < nodes_; ++i)
+    if (mine(i)) {
+      const auto k = static_cast<std::size_t>(row_[i] - first_row_);
+      diagonal[k] += shunt[i];
+      rhs[k] += inflow[i];
+    }
+  for (std::size_t e = 0; e < a_.size(); ++e) {
+    const double g = conductance[e];
+    for (const bool from_a : {true, false}) {
+      const auto i = static_cast<std::size_t>(from_a ? a_[e] : b_[e]), j = static_cast<std::size_t>(from_a ? b_[e] : a_[e]);
+      if (!mine(i)) continue;
+      const auto k = static_cast<std::size_t>(row_[i] - first_row_);
+      diagonal[k] += g;
+      if (prescribed_[j]) {
+        rhs[k] += g * pressure[j];
+      } else {
+        entry_at.emplace_back(static_cast<PetscInt>(row_[i]), static_cast<PetscInt>(row_[j]));
+        entry.push_back(-g);
+        (owner_[j] == rank ? in_block : off_block)[k] += 1;
+      }
+    }
+  }
+  Objects o;
+  const auto n = static_cast<PetscInt>(rows_), all = static_cast<PetscInt>(all_rows_);
+  check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
+  check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
+  check(MatSetType(o.matrix, MATAIJ), "MatSetType");
+  for (std::size_t k = 0; k < local; ++k) {  // parallel edges share an entry: counted once each
+    in_block[k] = std::min<PetscInt>(in_block[k], n);
+    off_block[k] = std::min<PetscInt>(off_block[k], all - n);
+  }
+  check(MatSeqAIJSetPreallocation(o.matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
+  check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
+  check(MatSetOption(o.matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
+  for (std::size_t k = 0; k < local; ++k) {
+    const auto r = static_cast<PetscInt>(first_row_ + static_cast<std::int64_t>(k));
+    check(MatSetValue(o.matrix, r, r, diagonal[k], ADD_VALUES), "MatSetValue");
+  }
+  for (std::size_t q = 0; q < entry.size(); ++q)
+    check(MatSetValue(o.matrix, entry_at[q].first, entry_at[q].second, entry[q], ADD_VALUES), "MatSetValue");
+  check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  check(MatSetOption(o.matrix, MAT_SPD, PETSC_TRUE), "MatSetOption");
+
+  check(MatCreateVecs(o.matrix, &o.x, &o.rhs), "MatCreateVecs");
+  PetscScalar* values = nullptr;
+  check(VecGetArray(o.rhs, &values), "VecGetArray");
+  std::copy(rhs.begin(), rhs.end(), values);
+  check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+
+  check(KSPCreate(PETSC_COMM_WORLD, &o.solver), "KSPCreate");
+  check(KSPSetOperators(o.solver, o.matrix, o.matrix), "KSPSetOperators");
+  check(KSPSetType(o.solver, KSPCG), "KSPSetType");
+  PC preconditioner = nullptr;
+  check(KSPGetPC(o.solver, &preconditioner), "KSPGetPC");
+  check(PCSetType(preconditioner, PCHYPRE), "PCSetType");
+  check(PCHYPRESetType(preconditioner, "boomeramg"), "PCHYPRESetType");
+  check(KSPSetTolerances(o.solver, 1e-13, 0.0, PETSC_DEFAULT, 2000), "KSPSetTolerances");
+  check(KSPSetFromOptions(o.solver), "KSPSetFromOptions");  // PETSC_OPTIONS may tune it
+  check(KSPSolve(o.solver, o.rhs, o.x), "KSPSolve");
+  KSPConvergedReason reason;
+  check(KSPGetConvergedReason(o.solver, &reason), "KSPGetConvergedReason");
+  PetscInt iterations = 0;
+  check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
+  iterations_ = static_cast<int>(iterations);
+  if (reason < 0)
+    throw InputError("the distributed solve (conjugate gradients, BoomerAMG) did not converge in " +
+                     std::to_string(iterations) + " iterations (PETSc's reason " + std::to_string(reason) +
+                     "): a part of the network whose pressure nothing fixes, or resistances too far apart");
+
+  // Every rank gets every free node's potential.
+  check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");
+  check(VecScatterBegin(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+  check(VecScatterEnd(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  const PetscScalar* solved = nullptr;
+  check(VecGetArrayRead(o.everywhere, &solved), "VecGetArrayRead");
+  for (std::size_t i = 0; i < nodes_; ++i)
+    if (!prescribed_[i]) pressure[i] = solved[row_[i]];
+  check(VecRestoreArrayRead(o.everywhere, &solved), "VecRestoreArrayRead");
+}
+
+}  // namespace hemotree
