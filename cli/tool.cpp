@@ -44,8 +44,14 @@ int environment_number(std::initializer_list<const char*> names, int otherwise) 
 int launched_ranks() { return environment_number({"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"}, 1); }
 int launched_rank() { return environment_number({"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"}, 0); }
 
-void warn(const std::string& message) { say("warning: ", message); }
-void note(const std::string& message) { say("", message); }
+// Over several MPI ranks every rank runs the same command: its notes and warnings are said
+// once, by rank 0.
+void warn(const std::string& message) {
+  if (world_rank() == 0) say("warning: ", message);
+}
+void note(const std::string& message) {
+  if (world_rank() == 0) say("", message);
+}
 
 std::string standard_output_error() {
   std::cout.flush();
@@ -133,35 +139,40 @@ int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, co
       return 1;
     }
   }
-  // Errors of the input, and of files (every rank reads the same input; rank 0 alone writes),
-  // are every rank's alike: said by rank 0 alone. Memory and internal errors may be one
-  // rank's own: said by it, naming it.
-  const bool lead = world_rank() == 0;
-  auto said = [&](const std::string& kind, const std::string& message, bool every_rank_alike) {
-    if (lead || !every_rank_alike) say(kind, world_size() > 1 && !lead ? "rank " + std::to_string(world_rank()) + ": " + message : message);
+  // Over several ranks a failure made every rank's (mpi/session.hpp: reading, checks, the
+  // distributed solve's status) is said by rank 0 alone, and every rank ends alike. Any other
+  // is one rank's own: said by it, naming it, and the run ends on every rank (no rank is left
+  // waiting in a collective call for it; the output folder stays DIR.partial).
+  auto said = [&](const std::string& kind, const std::string& message, int status) {
+    if (world_size() == 1) {
+      say(kind, message);
+      return status;
+    }
+    if (failure_is_collective()) {
+      if (world_rank() == 0) say(kind, message);
+      return status;
+    }
+    say(kind, "rank " + std::to_string(world_rank()) + ": " + message);
+    std::fflush(stderr);
+    end_every_rank(status);
+    return status;
   };
   try {
     return checked_success(body());
   } catch (const InterruptedExit& e) {
     return e.status;
   } catch (const SettingError& e) {
-    said("error: ", e.in_words(words), true);
-    return 2;
+    return said("error: ", e.in_words(words), 2);
   } catch (const InputError& e) {
-    said("error: ", e.what(), true);
-    return 2;
+    return said("error: ", e.what(), 2);
   } catch (const JsonError& e) {
-    said("error: ", e.what(), true);
-    return 2;
+    return said("error: ", e.what(), 2);
   } catch (const IoError& e) {
-    said("error: ", e.what(), true);
-    return 1;
+    return said("error: ", e.what(), 1);
   } catch (const std::bad_alloc&) {
-    said("error: ", "out of memory", false);
-    return 1;
+    return said("error: ", "out of memory", 1);
   } catch (const std::exception& e) {
-    said("internal error: ", e.what(), false);
-    return 70;
+    return said("internal error: ", e.what(), 70);
   }
 }
 

@@ -1,5 +1,8 @@
 #include "distributed/mpi_tree_system.hpp"
 
+#include "mpi/session.hpp"
+
+#include <algorithm>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -62,21 +65,25 @@ MpiTreeSystem::MpiTreeSystem(MPI_Comm comm, const TreeCut& cut)
 
 std::int64_t MpiTreeSystem::exchange(std::span<const double> conductance, std::span<const double> shunt,
                                      std::span<double> x, bool factorizing) {
-  if (x.size() != nodes_.size() || (factorizing && (conductance.size() != nodes_.size() || shunt.size() != nodes_.size())))
-    throw std::invalid_argument("MpiTreeSystem: " + std::to_string(nodes_.size()) + " numbers of each kind on rank " +
-                                std::to_string(rank_));
   const std::size_t stride = factorizing ? 3 : 1;
-  // Move 1: this rank's share, its roots' numbers behind a status.
+  // Move 1: this rank's share, its roots' numbers behind a status. Whatever fails here is
+  // said in the status, never thrown before the collective calls the other ranks are in.
   std::exception_ptr failure;
   std::vector<double> message{0.0};
-  const std::span<double> share_x = x.subspan(0, share_size_);
+  const std::span<double> share_x = x.subspan(0, std::min(share_size_, x.size()));
   try {
+    if (x.size() != nodes_.size() ||
+        (factorizing && (conductance.size() != nodes_.size() || shunt.size() != nodes_.size())))
+      throw std::invalid_argument("MpiTreeSystem: " + std::to_string(nodes_.size()) + " numbers of each kind on rank " +
+                                  std::to_string(rank_));
+    if (!factorizing && !factorized_)
+      throw std::logic_error("MpiTreeSystem::solve: no factorisation succeeded on every rank");
     const std::vector<double> roots = factorizing
                                           ? share_.factorize_forward(conductance.subspan(0, share_size_),
                                                                      shunt.subspan(0, share_size_), share_x)
                                           : share_.forward(share_x);
     message.insert(message.end(), roots.begin(), roots.end());
-  } catch (const std::invalid_argument&) {
+  } catch (...) {
     failure = std::current_exception();
     message.assign(1 + stride * root_parents_.size(), 0.0);
     message[0] = 1;
@@ -88,8 +95,12 @@ std::int64_t MpiTreeSystem::exchange(std::span<const double> conductance, std::s
     if (r > 0) offsets[r] = offsets[r - 1] + counts[r - 1];
   }
   std::vector<double> gathered(top ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
+  double entered = MPI_Wtime();
   MPI_Gatherv(message.data(), static_cast<int>(message.size()), MPI_DOUBLE, gathered.data(), counts.data(),
               offsets.data(), MPI_DOUBLE, top_rank_, comm_);
+  traffic_.seconds += MPI_Wtime() - entered;
+  traffic_.calls += 1;
+  traffic_.bytes += sizeof(double) * (message.size() + gathered.size());
 
   // Move 2, on the top's rank: the top solved, or the first refusal or the singular node said.
   std::vector<double> answers;
@@ -114,7 +125,7 @@ std::int64_t MpiTreeSystem::exchange(std::span<const double> conductance, std::s
         } else {
           top_[0].solve(b, messages, top_x, root_x);
         }
-      } catch (const std::invalid_argument&) {
+      } catch (...) {
         if (!failure) failure = std::current_exception();
         status = refused_by(rank_);
       }
@@ -136,12 +147,18 @@ std::int64_t MpiTreeSystem::exchange(std::span<const double> conductance, std::s
     }
   }
   std::vector<double> answer(static_cast<std::size_t>(answer_count_[static_cast<std::size_t>(rank_)]));
+  entered = MPI_Wtime();
   MPI_Scatterv(answers.data(), answer_count_.data(), answer_offset_.data(), MPI_DOUBLE, answer.data(),
                static_cast<int>(answer.size()), MPI_DOUBLE, top_rank_, comm_);
+  traffic_.seconds += MPI_Wtime() - entered;
+  traffic_.calls += 1;
+  traffic_.bytes += sizeof(double) * (answers.size() + answer.size());
 
-  // Move 3: this rank's share down from its roots' potentials.
+  // Move 3: this rank's share down from its roots' potentials. A failure is every rank's.
   const double status = answer[0];
+  if (factorizing) factorized_ = status == solved;
   if (status <= -2) {
+    mark_collective_failure();
     const int refusing = static_cast<int>(-2 - status);
     if (refusing == rank_ && failure) std::rethrow_exception(failure);
     throw std::invalid_argument("rank " + std::to_string(refusing) + " of the distributed solve refused its numbers");

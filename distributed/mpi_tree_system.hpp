@@ -33,11 +33,23 @@ class MpiTreeSystem {
   // the whole forest), its shunt; x: the right-hand side in, the potentials out. Collective.
   // Returns -1, or the node (of the whole forest) that names a component with no path to
   // ground, the same on every rank. Numbers one rank's system refuses (NodalSystem's
-  // std::invalid_argument) are thrown on every rank: that rank's own message there, the rank
-  // named elsewhere.
+  // std::invalid_argument), or any other failure of one rank's part, are thrown on every
+  // rank (marked collective: mpi/session.hpp): that rank's own error there, the rank named
+  // elsewhere.
   std::int64_t factorize_solve(std::span<const double> conductance, std::span<const double> shunt, std::span<double> x);
-  // The same right-hand side in, potentials out, with the last factorisation. Collective.
+  // The same right-hand side in, potentials out, with the last factorisation (refused on
+  // every rank where it did not succeed on every rank). Collective.
   void solve(std::span<double> x);
+
+  // What this rank's exchanges have cost so far: the collective calls it made (a gather and a
+  // scatter a solve), the bytes it sent and received in them, and the seconds inside them
+  // (waiting for the slowest rank included).
+  struct Traffic {
+    int calls = 0;
+    std::size_t bytes = 0;
+    double seconds = 0;
+  };
+  const Traffic& traffic() const { return traffic_; }
 
  private:
   MPI_Comm comm_;
@@ -52,6 +64,8 @@ class MpiTreeSystem {
   // each), and where its answer starts.
   std::vector<int> message_count_, answer_count_, answer_offset_;
   std::vector<std::int32_t> parent_of_slot_;  // top's rank: per share root, its parent among the top's own nodes
+  Traffic traffic_;
+  bool factorized_ = false;  // the last factorisation succeeded on every rank
   std::int64_t exchange(std::span<const double> conductance, std::span<const double> shunt, std::span<double> x,
                         bool factorizing);
 };

@@ -155,10 +155,12 @@ void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<cons
   PetscInt iterations = 0;
   check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
   iterations_ = static_cast<int>(iterations);
-  if (reason < 0)
+  if (reason < 0) {
+    mark_collective_failure();  // every rank's solver says the same
     throw InputError("the distributed solve (conjugate gradients, BoomerAMG) did not converge in " +
                      std::to_string(iterations) + " iterations (PETSc's reason " + std::to_string(reason) +
                      "): a part of the network whose pressure nothing fixes, or resistances too far apart");
+  }
 
   // Every rank gets every free node's potential.
   check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");

@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "core/setting_error.hpp"
+#include "core/units.hpp"
 #include "mpi/session.hpp"
 #include "distributed/mpi_tree_system.hpp"
 #include "distributed/network_cut.hpp"
 #include "distributed/petsc_flow_network.hpp"
+#include "mpi/session.hpp"
 #include "partition/partition.hpp"
 
 namespace hemotree {
@@ -23,17 +26,19 @@ SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, double in
                                const Partition& partition) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   std::vector<std::int32_t> owner(nodes, -1);
-  for (std::size_t v = 0; v < n; ++v) owner[static_cast<std::size_t>(net.from[v])] = partition.rank_of_vessel[v];
-  for (std::size_t v = 0; v < n; ++v)
-    if (std::int32_t& o = owner[static_cast<std::size_t>(net.to[v])]; o < 0) o = partition.rank_of_vessel[v];
-  for (std::int32_t& o : owner) o = std::max(o, 0);  // a node no vessel touches: a unit shunt, rank 0's
-  std::vector<double> resistance(n), conductance(n);
-  for (std::size_t v = 0; v < n; ++v) {
-    resistance[v] = vessel_resistance(net, blood, v);
-    conductance[v] = 1 / resistance[v];
-  }
-  std::vector<double> inflow = rows.inflow;
-  if (rows.inlet_node >= 0) inflow[static_cast<std::size_t>(rows.inlet_node)] += inlet_flow;
+  std::vector<double> resistance(n), conductance(n), inflow;
+  on_every_rank([&] {
+    for (std::size_t v = 0; v < n; ++v) owner[static_cast<std::size_t>(net.from[v])] = partition.rank_of_vessel[v];
+    for (std::size_t v = 0; v < n; ++v)
+      if (std::int32_t& o = owner[static_cast<std::size_t>(net.to[v])]; o < 0) o = partition.rank_of_vessel[v];
+    for (std::int32_t& o : owner) o = std::max(o, 0);  // a node no vessel touches: a unit shunt, rank 0's
+    for (std::size_t v = 0; v < n; ++v) {
+      resistance[v] = vessel_resistance(net, blood, v);
+      conductance[v] = 1 / resistance[v];
+    }
+    inflow = rows.inflow;
+    if (rows.inlet_node >= 0) inflow[static_cast<std::size_t>(rows.inlet_node)] += inlet_flow;
+  });
   SteadyOverRanks out{{}, describe(partition)};
   std::vector<double> pressure = rows.pressure;
   PetscFlowNetwork system(nodes, net.from, net.to, rows.prescribed, owner);
@@ -55,62 +60,94 @@ SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, double in
 
 SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& blood, double inlet_flow) {
   const int ranks = world_size(), rank = world_rank();
-  const SteadyRows rows = steady_rows(net);  // its checks on every rank alike
-  const Partition partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), ranks);
-  if (partition.method == Partition::Method::metis ||
-      std::any_of(rows.prescribed.begin(), rows.prescribed.end(), [](unsigned char p) { return p != 0; }))
-    return solve_by_petsc(net, blood, inlet_flow, rows, partition);
-  const TreeCut cut = tree_cut(net, partition);
-  MpiTreeSystem system(MPI_COMM_WORLD, cut);
+  // What each rank sets up alone, its failure every rank's before any of them solves.
+  SteadyRows rows;
+  Partition partition;
+  bool iterative = false;
+  std::optional<TreeCut> cut;
+  on_every_rank([&] {
+    rows = steady_rows(net);  // its checks on every rank alike
+    partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), ranks);
+    iterative = partition.method == Partition::Method::metis ||
+                std::any_of(rows.prescribed.begin(), rows.prescribed.end(), [](unsigned char p) { return p != 0; });
+    // Rank 0 gathers a pressure and a flow a node, counted in MPI's ints.
+    if (2 * net.node_count() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+      throw SettingError("ranks", placeholder("ranks") + ": " + std::to_string(net.node_count()) +
+                                      " nodes are more than the gathering of the results on one rank takes yet");
+    if (!iterative) cut.emplace(tree_cut(net, partition));
+  });
+  if (iterative) return solve_by_petsc(net, blood, inlet_flow, rows, partition);
 
   // This rank's numbers: per node, its edge's conductance (the vessel to its parent: 1 / R as
   // the one-process system takes it), its shunt and its inflow (the inlet's added as there).
-  const std::span<const std::int32_t> nodes = system.nodes();
-  std::vector<double> conductance(nodes.size(), 0.0), shunt(nodes.size()), x(nodes.size()), resistance(nodes.size());
-  for (std::size_t k = 0; k < nodes.size(); ++k) {
-    const auto node = static_cast<std::size_t>(nodes[k]);
-    if (const std::int32_t v = cut.parent_edge[node]; v >= 0) {
-      resistance[k] = vessel_resistance(net, blood, static_cast<std::size_t>(v));
-      conductance[k] = 1 / resistance[k];
+  std::optional<MpiTreeSystem> system;
+  std::vector<double> conductance, shunt, x, resistance;
+  on_every_rank([&] {
+    system.emplace(MPI_COMM_WORLD, *cut);
+    const std::span<const std::int32_t> nodes = system->nodes();
+    conductance.assign(nodes.size(), 0.0);
+    shunt.resize(nodes.size());
+    x.resize(nodes.size());
+    resistance.resize(nodes.size());
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const auto node = static_cast<std::size_t>(nodes[k]);
+      if (const std::int32_t v = cut->parent_edge[node]; v >= 0) {
+        resistance[k] = vessel_resistance(net, blood, static_cast<std::size_t>(v));
+        conductance[k] = 1 / resistance[k];
+      }
+      shunt[k] = rows.shunt[node];
+      x[k] = rows.inflow[node];
+      if (static_cast<std::int64_t>(node) == rows.inlet_node) x[k] += inlet_flow;
     }
-    shunt[k] = rows.shunt[node];
-    x[k] = rows.inflow[node];
-    if (static_cast<std::int64_t>(node) == rows.inlet_node) x[k] += inlet_flow;
-  }
-  if (const std::int64_t floating = system.factorize_solve(conductance, shunt, x); floating >= 0)
+  });
+  if (const std::int64_t floating = system->factorize_solve(conductance, shunt, x); floating >= 0) {
+    mark_collective_failure();  // said on every rank alike
     refuse_floating_part(net, floating);
+  }
+  const std::span<const std::int32_t> nodes = system->nodes();
 
   // Each vessel's flow on the rank of the node below it, from its nodes' pressures.
   std::vector<double> pressure(net.node_count(), 0.0);
   for (std::size_t k = 0; k < nodes.size(); ++k) pressure[static_cast<std::size_t>(nodes[k])] = x[k];
-  for (std::size_t k = 0; k < system.root_parents().size(); ++k)
-    if (const std::int32_t p = system.root_parents()[k]; p >= 0)
-      pressure[static_cast<std::size_t>(p)] = system.root_parent_potentials()[k];
+  for (std::size_t k = 0; k < system->root_parents().size(); ++k)
+    if (const std::int32_t p = system->root_parents()[k]; p >= 0)
+      pressure[static_cast<std::size_t>(p)] = system->root_parent_potentials()[k];
   std::vector<double> mine(2 * nodes.size());
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     mine[2 * k] = x[k];
-    const std::int32_t v = cut.parent_edge[static_cast<std::size_t>(nodes[k])];
+    const std::int32_t v = cut->parent_edge[static_cast<std::size_t>(nodes[k])];
     mine[2 * k + 1] = v >= 0 ? (pressure[static_cast<std::size_t>(net.from[static_cast<std::size_t>(v)])] -
                                 pressure[static_cast<std::size_t>(net.to[static_cast<std::size_t>(v)])]) /
                                    resistance[k]
                              : 0.0;
   }
-  // Gathered on rank 0 in rank order, each rank's nodes as MpiTreeSystem lists them.
-  std::vector<std::vector<std::int32_t>> held(static_cast<std::size_t>(ranks));
-  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(static_cast<std::size_t>(ranks), 0);
-  for (int r = 0; r < ranks; ++r) {
-    held[static_cast<std::size_t>(r)] = cut.share_nodes(r);
-    if (r == cut.top_rank) {
-      const std::vector<std::int32_t> top = cut.top_nodes();
-      held[static_cast<std::size_t>(r)].insert(held[static_cast<std::size_t>(r)].end(), top.begin(), top.end());
+  // Gathered on rank 0 in rank order, each rank's nodes as MpiTreeSystem lists them (its
+  // share's, then on the top's rank the top's): on rank 0 alone, bucketed in one pass.
+  std::vector<std::vector<std::int32_t>> held;
+  std::vector<int> counts, offsets;
+  if (rank == 0) {
+    held.resize(static_cast<std::size_t>(ranks));
+    std::vector<std::int32_t> top;
+    for (const std::int32_t node : cut->order) {
+      const std::int32_t owner = cut->owner[static_cast<std::size_t>(node)];
+      (owner == TreeCut::top ? top : held[static_cast<std::size_t>(owner)]).push_back(node);
     }
-    counts[static_cast<std::size_t>(r)] = 2 * static_cast<int>(held[static_cast<std::size_t>(r)].size());
-    if (r > 0) offsets[static_cast<std::size_t>(r)] = offsets[static_cast<std::size_t>(r) - 1] + counts[static_cast<std::size_t>(r) - 1];
+    auto& top_rank = held[static_cast<std::size_t>(cut->top_rank)];
+    top_rank.insert(top_rank.end(), top.begin(), top.end());
+    counts.resize(static_cast<std::size_t>(ranks));
+    offsets.assign(static_cast<std::size_t>(ranks), 0);
+    for (std::size_t r = 0; r < held.size(); ++r) {
+      counts[r] = 2 * static_cast<int>(held[r].size());
+      if (r > 0) offsets[r] = offsets[r - 1] + counts[r - 1];
+    }
   }
   std::vector<double> all(rank == 0 ? 2 * net.node_count() : 0);
   MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
               MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  SteadyOverRanks out{{}, describe(partition)};
+  const MpiTreeSystem::Traffic& traffic = system->traffic();
+  SteadyOverRanks out{{}, describe(partition) + "; the tree's exchange on rank 0: " + std::to_string(traffic.calls) +
+                              " collective calls, " + std::to_string(traffic.bytes) + " bytes, " +
+                              format_quantity(traffic.seconds, "s")};
   if (rank != 0) return out;
   SteadyFlow& s = out.flow;
   s.node_pressure.assign(net.node_count(), 0.0);
@@ -121,7 +158,7 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
     for (std::size_t k = 0; k < list.size(); ++k) {
       const auto node = static_cast<std::size_t>(list[k]);
       s.node_pressure[node] = from[2 * k];
-      if (const std::int32_t v = cut.parent_edge[node]; v >= 0) s.flow[static_cast<std::size_t>(v)] = from[2 * k + 1];
+      if (const std::int32_t v = cut->parent_edge[node]; v >= 0) s.flow[static_cast<std::size_t>(v)] = from[2 * k + 1];
     }
   }
   s.inlet_pressure = rows.inlet_node >= 0 ? s.node_pressure[static_cast<std::size_t>(rows.inlet_node)]

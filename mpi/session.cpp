@@ -1,6 +1,8 @@
 #include "mpi/session.hpp"
 
 #include <exception>
+#include <limits>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -46,41 +48,86 @@ int world_rank() {
   return rank;
 }
 
+namespace {
+
+// A failure as the ranks pass it on: its kind, and for a SettingError its setting.
+struct Failure {
+  enum Kind : int { none, input, refused_setting, io, memory, other };
+  int kind = none;
+  std::string setting, message;
+};
+
+Failure caught(const std::function<void()>& step) {
+  Failure f;
+  try {
+    step();
+  } catch (const SettingError& e) {
+    f = {Failure::refused_setting, e.setting(), e.message()};
+  } catch (const InputError& e) {
+    f = {Failure::input, "", e.what()};
+  } catch (const IoError& e) {
+    f = {Failure::io, "", e.what()};
+  } catch (const std::bad_alloc&) {
+    f = {Failure::memory, "", "out of memory"};
+  } catch (const std::exception& e) {
+    f = {Failure::other, "", e.what()};
+  }
+  return f;
+}
+
+// The failure of rank `from` on every rank: the same kind, the same words.
+[[noreturn]] void thrown_everywhere(Failure f, int from) {
+  MPI_Bcast(&f.kind, 1, MPI_INT, from, MPI_COMM_WORLD);
+  for (std::string* text : {&f.setting, &f.message}) {
+    int length = static_cast<int>(text->size());
+    MPI_Bcast(&length, 1, MPI_INT, from, MPI_COMM_WORLD);
+    text->resize(static_cast<std::size_t>(length));
+    MPI_Bcast(text->data(), length, MPI_CHAR, from, MPI_COMM_WORLD);
+  }
+  if (from != 0) f.message = "rank " + std::to_string(from) + ": " + f.message;
+  mark_collective_failure();
+  switch (f.kind) {
+    case Failure::input: throw InputError(f.message);
+    case Failure::refused_setting: throw SettingError(f.setting, f.message);
+    case Failure::io: throw IoError(f.message);
+    case Failure::memory: throw std::bad_alloc();
+    default: throw std::runtime_error(f.message);
+  }
+}
+
+bool collective_failure = false;
+
+}  // namespace
+
+void mark_collective_failure() { collective_failure = true; }
+
+void end_every_rank(int status) {
+  if (world_size() > 1) MPI_Abort(MPI_COMM_WORLD, status);
+}
+bool failure_is_collective() { return collective_failure; }
+
 void on_lead_rank(const std::function<void()>& step) {
   if (world_size() == 1) {
     step();
     return;
   }
-  // kind: 0 none, 1 InputError, 2 SettingError, 3 IoError, 4 any other
-  int kind = 0;
-  std::string setting, message;
-  if (world_rank() == 0) {
-    try {
-      step();
-    } catch (const SettingError& e) {
-      kind = 2, setting = e.setting(), message = e.message();
-    } catch (const InputError& e) {
-      kind = 1, message = e.what();
-    } catch (const IoError& e) {
-      kind = 3, message = e.what();
-    } catch (const std::exception& e) {
-      kind = 4, message = e.what();
-    }
-  }
+  Failure f;
+  if (world_rank() == 0) f = caught(step);
+  int kind = f.kind;
   MPI_Bcast(&kind, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (kind == 0) return;
-  for (std::string* text : {&setting, &message}) {
-    int length = static_cast<int>(text->size());
-    MPI_Bcast(&length, 1, MPI_INT, 0, MPI_COMM_WORLD);
-    text->resize(static_cast<std::size_t>(length));
-    MPI_Bcast(text->data(), length, MPI_CHAR, 0, MPI_COMM_WORLD);
+  if (kind != Failure::none) thrown_everywhere(std::move(f), 0);
+}
+
+void on_every_rank(const std::function<void()>& step) {
+  if (world_size() == 1) {
+    step();
+    return;
   }
-  switch (kind) {
-    case 1: throw InputError(message);
-    case 2: throw SettingError(setting, message);
-    case 3: throw IoError(message);
-    default: throw std::runtime_error(message);
-  }
+  Failure f = caught(step);
+  const int mine = f.kind != Failure::none ? world_rank() : std::numeric_limits<int>::max();
+  int first = mine;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (first != std::numeric_limits<int>::max()) thrown_everywhere(std::move(f), first);
 }
 
 }  // namespace hemotree

@@ -25,10 +25,25 @@ int world_rank();
 // started on MPI (PETSc) finalised before it.
 void at_session_end(std::function<void()> step);
 
-// Runs a step that only rank 0 takes (the output folder, the files) and makes its failure
-// every rank's: the same kind of error (InputError, SettingError, IoError; any other a
-// std::runtime_error) with the same message on each, so that no rank waits in a collective
-// for one that has left. Collective; on one process, the step itself.
+// A failure one rank meets alone would leave the others waiting in their next collective
+// call. So steps that can fail run under one of these, which make a failure every rank's:
+// the same kind of error (InputError, SettingError, IoError, std::bad_alloc; any other a
+// std::runtime_error) with the same words, "rank K: " before them where rank K > 0 failed,
+// thrown on every rank and marked collective. Collective; on one process, the step itself.
+//   on_lead_rank: a step that only rank 0 takes (the output folder, the files).
+//   on_every_rank: a step every rank takes (reading the network on its own node, setting up
+//                  its share): the lowest failing rank's failure.
 void on_lead_rank(const std::function<void()>& step);
+void on_every_rank(const std::function<void()>& step);
+
+// Whether the failure being handled was made every rank's (above, or by a distributed solve's
+// own status: mark_collective_failure): then rank 0 alone says it and every rank ends alike;
+// any other failure under several ranks is said by its rank and ends the run (MPI_Abort), so
+// that no rank is left waiting (cli/tool.cpp).
+void mark_collective_failure();
+bool failure_is_collective();
+// Ends the run on every rank with this exit status (MPI_Abort) where there are several;
+// returns at once on one process.
+void end_every_rank(int status);
 
 }  // namespace hemotree

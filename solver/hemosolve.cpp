@@ -15,6 +15,7 @@
 
 #include "cli/interrupt.hpp"
 #include "cli/setting_words.hpp"
+#include "mpi/session.hpp"
 #include "cli/tool.hpp"
 #include "core/units.hpp"
 #include "core/errors.hpp"
@@ -289,46 +290,52 @@ int run_command_line(CommandLine& line, int cores) {
   const bool quiet = line.quiet, vtk = config.vtk;
   const int frames = config.frames;
   config.words = hemosolve_words();
-  // ---- every option, before any work ----------------------------------------------------
-  if (out_dir.empty() && resume_dir.empty()) throw InputError("--out DIR is required (or --resume DIR)");
-  if (!resume_dir.empty() && !out_dir.empty() &&
-      std::filesystem::absolute(out_dir).lexically_normal() != std::filesystem::absolute(resume_dir).lexically_normal())
-    throw InputError("--resume " + resume_dir + " continues the run in that folder; --out must name it too or be left out");
-  config.out_dir = out_dir.empty() ? resume_dir : out_dir;
-  config.resume = !resume_dir.empty();
-  config.until_periodic = line.until_periodic->count() > 0;
-  check_configuration(config);
-  options.scheme = time_scheme_named(line.scheme);
-  options.model = model_named(line.model);
-  options.start = start_named(line.start);
-  if (!line.rheology.empty()) options.rheology_override = static_cast<int>(rheology_named(line.rheology));
-  options.degree = degree_named(line.degree_text);
-  options.lumped_step = lumped_step_named(line.lumped_step_text);
-  options.coupling_passes = coupling_passes_named(line.coupling_passes_text);
-  config.settling_degree = settling_degree_named(line.settling_degree_text);
-  config.results_format = results_format_named(line.format);
-  if (!line.dt_text.empty()) options.dt = parse_quantity(line.dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");
-  if (options.threads < 1 || options.threads > cores)
-    throw InputError("--threads must lie in [1, " + std::to_string(cores) + "] (got " +
-                     std::to_string(options.threads) + ")");
-  options.external_pressure = parse_quantity(line.external_text, Dimension::pressure, "--external-pressure",
-                                             {-100 * pascal_per_mmhg, 100 * pascal_per_mmhg}, "mmHg");
-  config.sample_interval =
-      parse_quantity(line.sample_text, Dimension::time, "--sample-interval", {0, 1e6, true, false}, "s");
-
   // Ctrl-C and kill are answered at a step's end from here on (cli/interrupt.hpp).
   InterruptRequests interrupts;
   CommandLineObserver observer(interrupts, quiet);
-  Network net = read_network(config.network_name);
-  fix_pressures(net, line.pressure_at_texts, quiet);
-  if (!vtk_min_text.empty()) {
-    if (!vtk && frames == 0) throw InputError("--vtk-min-diameter applies to --vtk and --frames only");
-    config.vtk_keep = vtk_vessels(net, vtk_min_text, quiet);
-  }
-  if ((vtk || frames > 0) && net.x.empty())
-    throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
-  config.red_cells = red_cells_named(line.red_cells);
-  config.tracers = parse_tracers(line.tracer_texts, net);
+  // The options and the network, checked on every rank alike before any rank goes on to the
+  // run (over MPI ranks a refusal is then every rank's: mpi/session.hpp).
+  Network net;
+  on_every_rank([&] {
+    // ---- every option, before any work ----------------------------------------------------
+    if (out_dir.empty() && resume_dir.empty()) throw InputError("--out DIR is required (or --resume DIR)");
+    if (!resume_dir.empty() && !out_dir.empty() &&
+        std::filesystem::absolute(out_dir).lexically_normal() != std::filesystem::absolute(resume_dir).lexically_normal())
+      throw InputError("--resume " + resume_dir +
+                       " continues the run in that folder; --out must name it too or be left out");
+    config.out_dir = out_dir.empty() ? resume_dir : out_dir;
+    config.resume = !resume_dir.empty();
+    config.until_periodic = line.until_periodic->count() > 0;
+    check_configuration(config);
+    options.scheme = time_scheme_named(line.scheme);
+    options.model = model_named(line.model);
+    options.start = start_named(line.start);
+    if (!line.rheology.empty()) options.rheology_override = static_cast<int>(rheology_named(line.rheology));
+    options.degree = degree_named(line.degree_text);
+    options.lumped_step = lumped_step_named(line.lumped_step_text);
+    options.coupling_passes = coupling_passes_named(line.coupling_passes_text);
+    config.settling_degree = settling_degree_named(line.settling_degree_text);
+    config.results_format = results_format_named(line.format);
+    if (!line.dt_text.empty()) options.dt = parse_quantity(line.dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");
+    if (options.threads < 1 || options.threads > cores)
+      throw InputError("--threads must lie in [1, " + std::to_string(cores) + "] (got " +
+                       std::to_string(options.threads) + ")");
+    options.external_pressure = parse_quantity(line.external_text, Dimension::pressure, "--external-pressure",
+                                               {-100 * pascal_per_mmhg, 100 * pascal_per_mmhg}, "mmHg");
+    config.sample_interval =
+        parse_quantity(line.sample_text, Dimension::time, "--sample-interval", {0, 1e6, true, false}, "s");
+
+    net = read_network(config.network_name);
+    fix_pressures(net, line.pressure_at_texts, quiet);
+    if (!vtk_min_text.empty()) {
+      if (!vtk && frames == 0) throw InputError("--vtk-min-diameter applies to --vtk and --frames only");
+      config.vtk_keep = vtk_vessels(net, vtk_min_text, quiet);
+    }
+    if ((vtk || frames > 0) && net.x.empty())
+      throw InputError("--vtk and --frames need node coordinates (x, y, z) in the network file");
+    config.red_cells = red_cells_named(line.red_cells);
+    config.tracers = parse_tracers(line.tracer_texts, net);
+  });
   if (line.steady) {
     run_steady(net, config, observer);
     return 0;

@@ -84,4 +84,16 @@ expect_refused "an output folder rank 0 refuses" "hemosolve: error: --out $WORK/
   -np 3 "$HEMOSOLVE" "$WORK/tree.json" --steady --out "$WORK/not-ours"
 expect_refused "a network every rank refuses" "hemosolve: error: " \
   -np 2 "$HEMOSOLVE" "$WORK/missing.json" --steady --out "$WORK/refused-out"
+# A failure of one rank alone (its node cannot read the network): said once, naming the rank;
+# no rank left waiting (the timeout would end it with 124).
+mkdir -p "$WORK/node0" "$WORK/node1"
+cp "$WORK/tree.json" "$WORK/node0/net.json"
+hemosolve_path=$(cd "$(dirname "$HEMOSOLVE")" && pwd)/hemosolve
+$MPIRUN -np 2 bash -c "cd '$WORK'/node\$OMPI_COMM_WORLD_RANK && exec '$hemosolve_path' net.json --steady --out run" \
+  >"$WORK/alone" 2>&1
+status=$?
+count=$(grep -c "^hemosolve: error: rank 1: cannot open net.json" "$WORK/alone")
+[ $status -ne 0 ] && [ $status -ne 124 ] && [ "$count" -eq 1 ] && [ ! -e "$WORK/node0/run" ] \
+  && pass "one rank's own failure: said once naming the rank, no rank left waiting" \
+  || fail "one rank's own failure: status $status, said $count times: $(head -3 "$WORK/alone")"
 finish

@@ -119,6 +119,15 @@ int main(int argc, char** argv) {
     MPI_Allreduce(&singular, &lowest, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
     MPI_Allreduce(&singular, &highest, 1, MPI_INT64_T, MPI_MAX, MPI_COMM_WORLD);
     check(singular >= 0 && lowest == highest, "singular said as " + std::to_string(singular));
+    // A solve after that factorisation: refused on every rank alike, no rank left waiting.
+    try {
+      system.solve(my_x2);
+      check(false, "a solve after a singular factorisation");
+    } catch (const std::logic_error& e) {
+      check(std::string(e.what()).find("no factorisation succeeded on every rank") != std::string::npos ||
+                std::string(e.what()).find("refused its numbers") != std::string::npos,
+            std::string("refused as: ") + e.what());
+    }
   }
   int total = 0;
   MPI_Allreduce(&failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
