@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -97,10 +98,7 @@ TreeShare::TreeShare(const TreeCut& cut, int rank) : nodes_(cut.share_nodes(rank
   // The roots come in elimination order, as cut.roots lists them.
   for (std::size_t j = 0; j < nodes_.size(); ++j) {
     const std::int32_t p = cut.parent[static_cast<std::size_t>(nodes_[j])];
-    if (p < 0 || cut.owner[static_cast<std::size_t>(p)] == TreeCut::top) {
-      roots_.push_back(static_cast<std::int32_t>(j));
-      root_has_parent_.push_back(p >= 0);
-    }
+    if (p >= 0 && cut.owner[static_cast<std::size_t>(p)] == TreeCut::top) roots_.push_back(static_cast<std::int32_t>(j));
   }
 }
 
@@ -114,7 +112,7 @@ std::vector<double> TreeShare::factorize_forward(std::span<const double> conduct
   // A root's edge into the top is the top's to eliminate, but this share's to answer for.
   for (std::size_t k = 0; k < roots_.size(); ++k) {
     const double g = conductance[static_cast<std::size_t>(roots_[k])];
-    if (root_has_parent_[k] && !(g > 0 && g < std::numeric_limits<double>::infinity()))
+    if (!(g > 0 && g < std::numeric_limits<double>::infinity()))
       throw std::invalid_argument("TreeShare::factorize_forward: the conductance of node " +
                                   std::to_string(nodes_[static_cast<std::size_t>(roots_[k])]) +
                                   "'s edge into the top is " + std::to_string(g));
@@ -137,8 +135,8 @@ std::vector<double> TreeShare::forward(std::span<double> y) const {
 }
 
 void TreeShare::backward(std::span<const double> root_potential, std::span<double> y) const {
-  if (root_potential.size() != roots_.size())
-    throw std::invalid_argument("TreeShare::backward: one potential per root");
+  if (root_potential.size() != roots_.size() || y.size() != nodes_.size())
+    throw std::invalid_argument("TreeShare::backward: one potential per root, one number per node");
   for (std::size_t k = 0; k < roots_.size(); ++k) y[static_cast<std::size_t>(roots_[k])] = root_potential[k];
   system_.backward(y, y);
 }
@@ -168,6 +166,29 @@ TreeTop::TreeTop(const TreeCut& cut) {
   edge_conductance_.resize(edge_place_.size());
   shunt_.resize(nodes_.size());
   y_.resize(nodes_.size());
+  // The lowest node below each place, for naming a singular component as the whole forest's
+  // system does (its lowest node): an own node stands for itself, a share root for its
+  // subtree. And each place's parent's place (-1 at the forest's roots).
+  std::vector<std::int32_t> lowest(cut.order.size());
+  std::iota(lowest.begin(), lowest.end(), 0);
+  for (std::size_t k = cut.order.size(); k-- > 0;) {
+    const auto c = static_cast<std::size_t>(cut.order[k]);
+    if (const std::int32_t p = cut.parent[c]; p >= 0)
+      lowest[static_cast<std::size_t>(p)] = std::min(lowest[static_cast<std::size_t>(p)], lowest[c]);
+  }
+  lowest_.assign(nodes_.begin(), nodes_.end());
+  for (const std::int32_t k : root_place_) lowest_[static_cast<std::size_t>(k)] = lowest[static_cast<std::size_t>(nodes_[static_cast<std::size_t>(k)])];
+  parent_place_.assign(nodes_.size(), -1);
+  for (std::size_t e = 0; e < edge_place_.size(); ++e) {
+    const auto below = static_cast<std::size_t>(edge_place_[e]);
+    const std::int32_t p = cut.parent[static_cast<std::size_t>(nodes_[below])];
+    // The parent is a node of the top's system: the node before it there with that label.
+    const auto it = std::lower_bound(nodes_.begin(), nodes_.begin() + static_cast<std::ptrdiff_t>(below), p,
+                                     [&](std::int32_t n, std::int32_t key) {
+                                       return cut.place[static_cast<std::size_t>(n)] < cut.place[static_cast<std::size_t>(key)];
+                                     });
+    parent_place_[below] = static_cast<std::int32_t>(it - nodes_.begin());
+  }
 }
 
 void TreeTop::gather(std::span<const double> b, std::span<const double> messages, std::size_t stride,
@@ -215,7 +236,17 @@ std::int64_t TreeTop::factorize_solve(std::span<const double> conductance, std::
     throw std::invalid_argument("TreeTop::factorize_solve: a conductance and a shunt per own node");
   gather(b, messages, 3, conductance, shunt);
   const std::int64_t singular = system_.factorize_forward(edge_conductance_, shunt_, y_);
-  if (singular >= 0) return nodes_[static_cast<std::size_t>(singular)];
+  if (singular >= 0) {
+    // Its component: the places whose root is the singular place's (parents come first).
+    std::vector<std::int32_t> root(nodes_.size());
+    for (std::size_t k = 0; k < nodes_.size(); ++k)
+      root[k] = parent_place_[k] < 0 ? static_cast<std::int32_t>(k) : root[static_cast<std::size_t>(parent_place_[k])];
+    const std::int32_t component = root[static_cast<std::size_t>(singular)];
+    std::int32_t named = std::numeric_limits<std::int32_t>::max();
+    for (std::size_t k = 0; k < nodes_.size(); ++k)
+      if (root[k] == component) named = std::min(named, lowest_[k]);
+    return named;
+  }
   solve_and_scatter(x, answer);
   return -1;
 }

@@ -44,16 +44,17 @@ struct TreeCut {
   // every node hangs from a lower one, else peeled leaves reversed); each node's place in it,
   // its parent and the edge to it (-1 at roots).
   std::vector<std::int32_t> order, place, parent, parent_edge;
-  // Per rank, its share's roots in elimination order: the nodes whose parent is on the top or
-  // who have none. The top's rank receives their (g, S, y) in rank order, then this order.
+  // Per rank, its share's roots in elimination order: the nodes whose parent is on the top
+  // (every root of the forest is on the top). The top's rank receives their (g, S, y) in rank
+  // order, then this order.
   std::vector<std::vector<std::int32_t>> roots;
   std::vector<std::int32_t> share_nodes(int rank) const;  // in elimination order
   std::vector<std::int32_t> top_nodes() const;            // in elimination order
 };
 
 // One rank's share. Its arrays run over share_nodes(rank), in that order: per node the
-// conductance of its edge to its parent (a root's: of its edge into the top; unread where it
-// has no parent), its shunt, its right-hand side.
+// conductance of its edge to its parent (a root's: of its edge into the top), its shunt, its
+// right-hand side.
 class TreeShare {
  public:
   TreeShare(const TreeCut& cut, int rank);
@@ -73,7 +74,6 @@ class TreeShare {
  private:
   std::vector<std::int32_t> nodes_;       // global node per local place
   std::vector<std::int32_t> roots_;       // local places of the roots
-  std::vector<bool> root_has_parent_;     // per root: whether an edge joins it to the top
   std::vector<std::int32_t> edge_place_;  // per local edge, the local place of the node below it
   std::vector<double> edge_conductance_;  // scratch: per local edge
   NodalSystem system_;
@@ -89,8 +89,8 @@ class TreeTop {
 
   // Move 2 after every share's factorize_forward: eliminates the top, solves it (x: the top's
   // own potentials; answer: each share root's) and returns -1, or where the forest is
-  // singular (a component with no path to ground), the lowest node of that component in the
-  // top's system, as a node of the whole forest.
+  // singular (a component with no path to ground), that component's lowest node, as the
+  // whole forest's NodalSystem names it.
   std::int64_t factorize_solve(std::span<const double> conductance, std::span<const double> shunt,
                                std::span<const double> b, std::span<const double> messages, std::span<double> x,
                                std::span<double> answer);
@@ -104,6 +104,8 @@ class TreeTop {
   std::vector<std::int32_t> root_place_;  // the places of the share roots, by message slot
   std::vector<std::int32_t> edge_place_;  // per edge, the place of the node below it
   std::vector<double> edge_conductance_, shunt_, y_;  // scratch: per edge, per place
+  std::vector<std::int32_t> lowest_;       // per place: the lowest node it stands for (itself; a root: its subtree's)
+  std::vector<std::int32_t> parent_place_;  // per place: its parent's, -1 at the forest's roots
   NodalSystem system_;
   // y_ (and where given, shunt_ and edge_conductance_) from the top's own numbers and the
   // messages (one root's numbers every `stride` of them: g, S, y or y alone).

@@ -307,6 +307,9 @@ std::int64_t NodalSystem::factorize(std::span<const double> conductance, std::sp
 }
 
 void NodalSystem::solve(std::span<const double> b, std::span<double> x) const {
+  if (open_roots_)
+    throw std::logic_error("NodalSystem::solve: a share of a tree has no potentials of its own (forward, then backward "
+                           "from its roots' potentials)");
   if (b.size() != nodes_ || x.size() != nodes_)
     throw std::invalid_argument("NodalSystem::solve: right-hand side of " + std::to_string(b.size()) +
                                 " and solution of " + std::to_string(x.size()) + " for " + std::to_string(nodes_) +

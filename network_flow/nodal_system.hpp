@@ -84,9 +84,10 @@ class NodalSystem {
   // pivot, S_r, its subtree's conductance to ground seen from r (its shunt and its children
   // through their edges: open_root_conductance), the forward half leaves y_r summed over its
   // subtree, and the backward half takes x_r as given (the potential the rest of the tree
-  // found for it). Every other node's arithmetic is the closed system's, so that a tree cut
-  // into shares and swept share by share gives the bits of the whole. Tree elimination only
-  // (std::logic_error otherwise); the singular check is the rest of the tree's.
+  // found for it; solve(), which would need them, is refused: std::logic_error). Every other
+  // node's arithmetic is the closed system's, so that a tree cut into shares and swept share
+  // by share gives the bits of the whole. Tree elimination only (std::logic_error otherwise);
+  // the singular check is the rest of the tree's.
   void open_roots();
   bool roots_open() const { return open_roots_; }
   double open_root_conductance(std::size_t root) const;
