@@ -10,6 +10,8 @@
 
 namespace hemotree {
 
+// Every rank calls it with the same network and partition (partition_network is
+// deterministic), so every rank holds the same cut and refuses alike.
 // SettingError "ranks" where the partition cannot be swept so yet: a network with loops
 // (METIS's pieces need the distributed sparse solver) or a top spread over the ranks (more
 // ranks than about the square root of an eighth of the vessels).
