@@ -241,7 +241,8 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
   auto* steady_flag = app.add_flag(
       "--steady", steady,
       "the steady state alone, vessels at their file diameters (what NetFlow computes): flows, pressures and wall "
-      "shear stress in the same files as a run; any connected network with boundaries at nodes");
+      "shear stress in the same files as a run; any connected network with boundaries at nodes; under mpirun -np P "
+      "over P ranks (a tree: the same files byte for byte; loops: PETSc, to 1e-10)");
   auto* linear_flag = app.add_flag(
       "--linear", linear,
       "the linear periodic state about the steady one as the result, harmonic by harmonic (every vessel a "
