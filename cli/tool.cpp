@@ -41,8 +41,12 @@ int environment_number(std::initializer_list<const char*> names, int otherwise) 
 }
 }  // namespace
 
-int launched_ranks() { return environment_number({"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"}, 1); }
-int launched_rank() { return environment_number({"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"}, 0); }
+// Slurm's srun last: its PMIx plugin may not export PMIX_SIZE, and Open MPI's own variables
+// appear only once MPI starts; SLURM_STEP_NUM_TASKS is the step's, not the allocation's.
+int launched_ranks() {
+  return environment_number({"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "SLURM_STEP_NUM_TASKS"}, 1);
+}
+int launched_rank() { return environment_number({"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK", "SLURM_PROCID"}, 0); }
 
 // Over several MPI ranks every rank runs the same command: its notes and warnings are said
 // once, by rank 0.
@@ -139,16 +143,18 @@ int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, co
       return 1;
     }
   }
-  // Over several ranks a failure made every rank's (mpi/session.hpp: reading, checks, the
-  // distributed solve's status) is said by rank 0 alone, and every rank ends alike. Any other
-  // is one rank's own: said by it, naming it, and the run ends on every rank (no rank is left
-  // waiting in a collective call for it; the output folder stays DIR.partial).
-  auto said = [&](const std::string& kind, const std::string& message, int status) {
-    if (world_size() == 1) {
+  // Over several ranks a failure made every rank's (mpi/session.hpp's Collective: reading,
+  // checks, the distributed solve's status) is said by rank 0 alone, and every rank ends
+  // alike. So is one of a rank that has left every collective call (rank 0 writing the
+  // results: the others have finished). Any other is one rank's own: said by it, naming it,
+  // and the run ends on every rank (no rank is left waiting in a collective call for it; the
+  // output folder stays DIR.partial).
+  auto said = [&](const std::string& kind, const std::string& message, int status, const std::exception* e) {
+    if (world_size() == 1 || left_collectives()) {
       say(kind, message);
       return status;
     }
-    if (failure_is_collective()) {
+    if (e && dynamic_cast<const CollectiveFailure*>(e)) {
       if (world_rank() == 0) say(kind, message);
       return status;
     }
@@ -160,19 +166,20 @@ int run_tool(CLI::App& app, int argc, char** argv, const SettingWords& words, co
   try {
     return checked_success(body());
   } catch (const InterruptedExit& e) {
+    if (!left_collectives()) end_every_rank(e.status);  // the others may wait for this one
     return e.status;
   } catch (const SettingError& e) {
-    return said("error: ", e.in_words(words), 2);
+    return said("error: ", e.in_words(words), 2, &e);
   } catch (const InputError& e) {
-    return said("error: ", e.what(), 2);
+    return said("error: ", e.what(), 2, &e);
   } catch (const JsonError& e) {
-    return said("error: ", e.what(), 2);
+    return said("error: ", e.what(), 2, &e);
   } catch (const IoError& e) {
-    return said("error: ", e.what(), 1);
-  } catch (const std::bad_alloc&) {
-    return said("error: ", "out of memory", 1);
+    return said("error: ", e.what(), 1, &e);
+  } catch (const std::bad_alloc& e) {
+    return said("error: ", "out of memory", 1, &e);
   } catch (const std::exception& e) {
-    return said("internal error: ", e.what(), 70);
+    return said("internal error: ", e.what(), 70, &e);
   }
 }
 

@@ -158,10 +158,19 @@ std::int64_t MpiTreeSystem::exchange(std::span<const double> conductance, std::s
   const double status = answer[0];
   if (factorizing) factorized_ = status == solved;
   if (status <= -2) {
-    mark_collective_failure();
+    // The refusing rank's own words, on every rank.
     const int refusing = static_cast<int>(-2 - status);
-    if (refusing == rank_ && failure) std::rethrow_exception(failure);
-    throw std::invalid_argument("rank " + std::to_string(refusing) + " of the distributed solve refused its numbers");
+    std::string words;
+    if (refusing == rank_ && failure) {
+      try {
+        std::rethrow_exception(failure);
+      } catch (const std::exception& e) {
+        words = e.what();
+      } catch (...) {
+        words = "a failure";
+      }
+    }
+    throw Collective<std::invalid_argument>("the distributed solve: " + words_of(refusing, words));
   }
   if (status >= 0) return static_cast<std::int64_t>(status);
   std::vector<double> root_x(root_parents_.size());

@@ -33,9 +33,9 @@ class MpiTreeSystem {
   // the whole forest), its shunt; x: the right-hand side in, the potentials out. Collective.
   // Returns -1, or the node (of the whole forest) that names a component with no path to
   // ground, the same on every rank. Numbers one rank's system refuses (NodalSystem's
-  // std::invalid_argument), or any other failure of one rank's part, are thrown on every
-  // rank (marked collective: mpi/session.hpp): that rank's own error there, the rank named
-  // elsewhere.
+  // std::invalid_argument), or any other failure of one rank's part, are thrown on every rank
+  // alike (mpi/session.hpp's Collective<std::invalid_argument>): that rank's words, "rank K: "
+  // before them where K > 0.
   std::int64_t factorize_solve(std::span<const double> conductance, std::span<const double> shunt, std::span<double> x);
   // The same right-hand side in, potentials out, with the last factorisation (refused on
   // every rank where it did not succeed on every rank). Collective.

@@ -3,7 +3,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/errors.hpp"
 #include "core/setting_error.hpp"
+#include "mpi/session.hpp"
+#include "steady/steady_flow.hpp"
 
 namespace hemotree {
 
@@ -22,6 +25,14 @@ TreeCut tree_cut(const Network& net, const Partition& partition) {
     return TreeCut(net.node_count(), net.from, net.to, owner, partition.ranks, partition.top_rank);
   } catch (const std::invalid_argument& e) {
     throw SettingError("ranks", placeholder("ranks") + ": the partition is not whole subtrees below a top: " + e.what());
+  }
+}
+
+void refuse_floating_part_everywhere(const Network& net, std::int64_t node) {
+  try {
+    refuse_floating_part(net, node);
+  } catch (const InputError& e) {
+    throw Collective<InputError>(e.what());
   }
 }
 

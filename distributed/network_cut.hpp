@@ -8,6 +8,8 @@
 #include "formats/network.hpp"
 #include "partition/partition.hpp"
 
+#include <cstdint>
+
 namespace hemotree {
 
 // Every rank calls it with the same network and partition (partition_network is
@@ -16,5 +18,9 @@ namespace hemotree {
 // (METIS's pieces need the distributed sparse solver) or a top spread over the ranks (more
 // ranks than about the square root of an eighth of the vessels).
 TreeCut tree_cut(const Network& net, const Partition& partition);
+
+// steady/'s refusal of a tree whose part at `node` has no path to ground, thrown on every rank
+// alike (the distributed solve said it on every rank: mpi/session.hpp's Collective).
+[[noreturn]] void refuse_floating_part_everywhere(const Network& net, std::int64_t node);
 
 }  // namespace hemotree

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include <mpi.h>
 #include <petscksp.h>
 
 #include "core/errors.hpp"
@@ -16,7 +17,10 @@ namespace {
 
 // PETSc's error codes as exceptions; its own printing of a traceback is turned off.
 void check(PetscErrorCode code, const char* what) {
-  if (code != 0) throw std::runtime_error(std::string("PETSc: ") + what + " failed (error " + std::to_string(code) + ")");
+  if (code == 0) return;
+  const char* reason = nullptr;
+  PetscErrorMessage(code, &reason, nullptr);
+  throw std::runtime_error(std::string("PETSc: ") + what + " failed: " + (reason ? reason : "error " + std::to_string(code)));
 }
 
 // PETSc on the session's MPI, once, finalised before MPI when the session ends.
@@ -112,7 +116,12 @@ void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<cons
       }
     }
   }
+  // PETSc's calls are collective: a failure there (a bad PETSC_OPTIONS, say) is every rank's
+  // alike, passed on once all have left them (mpi/session.hpp's on_every_rank).
   Objects o;
+  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+  PetscReal residual = 0, scale = 0;
+  on_every_rank([&] {
   const auto n = static_cast<PetscInt>(rows_), all = static_cast<PetscInt>(all_rows_);
   check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
   check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
@@ -148,19 +157,38 @@ void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<cons
   check(PCSetType(preconditioner, PCHYPRE), "PCSetType");
   check(PCHYPRESetType(preconditioner, "boomeramg"), "PCHYPRESetType");
   check(KSPSetTolerances(o.solver, 1e-13, 0.0, PETSC_DEFAULT, 2000), "KSPSetTolerances");
-  check(KSPSetFromOptions(o.solver), "KSPSetFromOptions");  // PETSC_OPTIONS may tune it
+  // PETSC_OPTIONS may tune it: options it does not know are the user's input, refused so.
+  if (const PetscErrorCode code = KSPSetFromOptions(o.solver); code != 0) {
+    const char* reason = nullptr;
+    PetscErrorMessage(code, &reason, nullptr);
+    throw InputError(std::string("PETSC_OPTIONS: ") + (reason ? reason : "refused by PETSc"));
+  }
   check(KSPSolve(o.solver, o.rhs, o.x), "KSPSolve");
-  KSPConvergedReason reason;
   check(KSPGetConvergedReason(o.solver, &reason), "KSPGetConvergedReason");
   PetscInt iterations = 0;
   check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
   iterations_ = static_cast<int>(iterations);
-  if (reason < 0) {
-    mark_collective_failure();  // every rank's solver says the same
-    throw InputError("the distributed solve (conjugate gradients, BoomerAMG) did not converge in " +
-                     std::to_string(iterations) + " iterations (PETSc's reason " + std::to_string(reason) +
-                     "): a part of the network whose pressure nothing fixes, or resistances too far apart");
-  }
+  KSPType ksp_type = nullptr;
+  PCType pc_type = nullptr;
+  check(KSPGetType(o.solver, &ksp_type), "KSPGetType");
+  check(PCGetType(preconditioner, &pc_type), "PCGetType");
+  method_ = std::string(ksp_type ? ksp_type : "?") + " with " + (pc_type ? pc_type : "?");
+  // The true residual, whatever the options asked of the solver: |b - A x| / |b|.
+  check(VecDuplicate(o.rhs, &o.everywhere), "VecDuplicate");
+  check(MatMult(o.matrix, o.x, o.everywhere), "MatMult");
+  check(VecAYPX(o.everywhere, -1.0, o.rhs), "VecAYPX");
+  check(VecNorm(o.everywhere, NORM_2, &residual), "VecNorm");
+  check(VecNorm(o.rhs, NORM_2, &scale), "VecNorm");
+  check(VecDestroy(&o.everywhere), "VecDestroy");
+  });
+  // Every rank's solver and norms say the same: refused alike.
+  const double relative = scale > 0 ? residual / scale : residual;
+  if (reason < 0 || !(relative <= 1e-10))
+    throw Collective<InputError>("the distributed solve (PETSc's " + method_ + ") left a relative residual of " +
+                                 std::to_string(relative) + " after " + std::to_string(iterations_) +
+                                 " iterations (PETSc's reason " + std::to_string(reason) +
+                                 "; 1e-10 is needed): resistances too far apart for it, or PETSC_OPTIONS that ask too "
+                                 "little");
 
   // Every rank gets every free node's potential.
   check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");

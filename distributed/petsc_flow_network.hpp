@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace hemotree {
@@ -28,11 +29,12 @@ class PetscFlowNetwork {
   PetscFlowNetwork& operator=(const PetscFlowNetwork&) = delete;
 
   // conductance: per edge, > 0; shunt, inflow: per node; pressure: the prescribed nodes'
-  // values in, every node's out (on every rank). Collective. InputError where the solver does
-  // not converge (a part of the graph whose pressure nothing fixes).
+  // values in, every node's out (on every rank). Collective. InputError, every rank's alike,
+  // where the solve leaves a true relative residual above 1e-10 (whatever PETSC_OPTIONS asked).
   void solve(std::span<const double> conductance, std::span<const double> shunt, std::span<const double> inflow,
              std::span<double> pressure);
   int iterations() const { return iterations_; }  // of the last solve
+  const std::string& method() const { return method_; }  // PETSc's solver and preconditioner, e.g. "cg with hypre"
 
  private:
   std::size_t nodes_;
@@ -41,6 +43,7 @@ class PetscFlowNetwork {
   std::vector<std::int64_t> row_;    // per node: its global row, -1 where prescribed
   std::int64_t first_row_ = 0, rows_ = 0, all_rows_ = 0;  // this rank's rows: [first, first + rows)
   int iterations_ = 0;
+  std::string method_;
 };
 
 }  // namespace hemotree

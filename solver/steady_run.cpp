@@ -134,6 +134,7 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
       throw std::logic_error("run_steady: phase separation over MPI ranks (hemosolve refuses it before)");
     SteadyOverRanks over = solve_steady_flow_over_ranks(net, blood, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
     if (world_rank() != 0) return;
+    leave_collectives();  // the others have finished: a failure of the writing is rank 0's alone
     observer.note(over.partition);
     steady = std::move(over.flow);
   } else if (request.phase_separation) {
