@@ -1,5 +1,6 @@
 #include "distributed/distended_over_ranks.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -7,6 +8,7 @@
 #include <mpi.h>
 
 #include "distributed/mpi_tree_system.hpp"
+#include "distributed/network_cut.hpp"
 #include "mpi/session.hpp"
 #include "steady/distended_iteration.hpp"
 
@@ -35,6 +37,8 @@ DistendedOverRanks solve_distended_steady_flow_over_ranks(const Network& net, co
       out.resistance[static_cast<std::size_t>(v)] = vessel_resistance(net, blood, static_cast<std::size_t>(v));
     }
     conductance.assign(out.nodes.size(), 0.0);
+    out.nodes_by_label = out.nodes;
+    std::sort(out.nodes_by_label.begin(), out.nodes_by_label.end());
   });
   // A sweep's solve: the share's conductances 1 / R (as the one-process system takes them),
   // the distributed elimination, each vessel's flow from its nodes' pressures.
@@ -45,8 +49,7 @@ DistendedOverRanks solve_distended_steady_flow_over_ranks(const Network& net, co
     }
     std::vector<double> x = b;
     if (const std::int64_t floating = system->factorize_solve(conductance, shunt, x); floating >= 0) {
-      mark_collective_failure();  // said on every rank alike
-      refuse_floating_part(net, floating);
+      refuse_floating_part_everywhere(net, floating);
     }
     s.node_pressure.assign(net.node_count(), 0.0);
     for (std::size_t k = 0; k < out.nodes.size(); ++k) s.node_pressure[static_cast<std::size_t>(out.nodes[k])] = x[k];
@@ -57,8 +60,9 @@ DistendedOverRanks solve_distended_steady_flow_over_ranks(const Network& net, co
       const auto v = static_cast<std::size_t>(vessel);
       s.flow[v] = (s.node_pressure[static_cast<std::size_t>(net.from[v])] - s.node_pressure[static_cast<std::size_t>(net.to[v])]) / r[v];
     }
-    const bool holds_inlet = rows.inlet_node >= 0 && cut.owner[static_cast<std::size_t>(rows.inlet_node)] == TreeCut::top &&
-                             system->rank() == cut.top_rank;
+    // The inlet's node may lie on a share (where the forest's root is another node).
+    const bool holds_inlet = rows.inlet_node >= 0 && std::binary_search(out.nodes_by_label.begin(), out.nodes_by_label.end(),
+                                                                       static_cast<std::int32_t>(rows.inlet_node));
     s.inlet_pressure = holds_inlet ? s.node_pressure[static_cast<std::size_t>(rows.inlet_node)]
                                    : std::numeric_limits<double>::quiet_NaN();
     ++out.sweeps;

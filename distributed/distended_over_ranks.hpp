@@ -21,6 +21,7 @@ namespace hemotree {
 
 struct DistendedOverRanks {
   std::vector<std::int32_t> vessels, nodes;  // this rank's: its nodes' vessels to their parents, its nodes
+  std::vector<std::int32_t> nodes_by_label;  // its nodes in increasing labels
   // Per vessel and per node of the network, this rank's entries set: the pressures of its nodes
   // and of its share roots' parents, the flows and the last resistances of its vessels (the
   // rest 0); the inlet's pressure where this rank holds the inlet's node (NaN elsewhere).

@@ -43,7 +43,7 @@ SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, double in
   std::vector<double> pressure = rows.pressure;
   PetscFlowNetwork system(nodes, net.from, net.to, rows.prescribed, owner);
   system.solve(conductance, rows.shunt, inflow, pressure);
-  out.partition += "; conjugate gradients with BoomerAMG in " + std::to_string(system.iterations()) + " iterations";
+  out.partition += "; PETSc's " + system.method() + " in " + std::to_string(system.iterations()) + " iterations";
   if (world_rank() != 0) return out;
   SteadyFlow& s = out.flow;
   s.node_pressure = std::move(pressure);
@@ -74,7 +74,20 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
     if (2 * net.node_count() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
       throw SettingError("ranks", placeholder("ranks") + ": " + std::to_string(net.node_count()) +
                                       " nodes are more than the gathering of the results on one rank takes yet");
-    if (!iterative) cut.emplace(tree_cut(net, partition));
+    if (iterative) return;
+    // A tree whose node labels hang it from another node than its inlet (the nodal system's
+    // elimination starts at its lowest label) is not cut into subtrees of that elimination by
+    // the partition's flow subtrees: PETSc solves it instead (vgen's and vprune's labels start
+    // at the inlet).
+    if (!partition.top_spread && partition.top_rank >= 0) {
+      try {
+        cut.emplace(tree_cut(net, partition));
+      } catch (const SettingError&) {
+        iterative = true;
+      }
+    } else {
+      cut.emplace(tree_cut(net, partition));  // refused, in words
+    }
   });
   if (iterative) return solve_by_petsc(net, blood, inlet_flow, rows, partition);
 
@@ -101,8 +114,7 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
     }
   });
   if (const std::int64_t floating = system->factorize_solve(conductance, shunt, x); floating >= 0) {
-    mark_collective_failure();  // said on every rank alike
-    refuse_floating_part(net, floating);
+    refuse_floating_part_everywhere(net, floating);
   }
   const std::span<const std::int32_t> nodes = system->nodes();
 

@@ -48,7 +48,7 @@ if [ -f "$NETWORKS/mesentery-rat/network.dat" ]; then
   for ranks in 2 3; do
     $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/mesentery.json" --steady --out "$WORK/mesentery-$ranks" >"$WORK/m-out" 2>&1
     status=$?
-    grep -q "^hemosolve: $ranks ranks by METIS: .*; conjugate gradients with BoomerAMG in [0-9]* iterations" "$WORK/m-out" \
+    grep -q "^hemosolve: $ranks ranks by METIS: .*; PETSc's cg with hypre in [0-9]* iterations" "$WORK/m-out" \
       && [ $status -eq 0 ] && /usr/bin/python3 - "$WORK/mesentery-one/vessels.csv" "$WORK/mesentery-$ranks/vessels.csv" <<'PY' \
       && pass "the mesentery over $ranks ranks (METIS, PETSc): the plain run's within 1e-10" \
       || fail "the mesentery over $ranks ranks: status $status: $(head -3 "$WORK/m-out")"
@@ -93,7 +93,32 @@ $MPIRUN -np 2 bash -c "cd '$WORK'/node\$OMPI_COMM_WORLD_RANK && exec '$hemosolve
   >"$WORK/alone" 2>&1
 status=$?
 count=$(grep -c "^hemosolve: error: rank 1: cannot open net.json" "$WORK/alone")
-[ $status -ne 0 ] && [ $status -ne 124 ] && [ "$count" -eq 1 ] && [ ! -e "$WORK/node0/run" ] \
+[ $status -eq 1 ] && [ "$count" -eq 1 ] && ! grep -q MPI_ABORT "$WORK/alone" && [ ! -e "$WORK/node0/run" ] \
   && pass "one rank's own failure: said once naming the rank, no rank left waiting" \
   || fail "one rank's own failure: status $status, said $count times: $(head -3 "$WORK/alone")"
+# A network whose node labels hang the tree from a leaf, not its inlet: PETSc solves it (the
+# elimination's subtrees are not the partition's), the plain run's within 1e-10.
+/usr/bin/python3 - "$WORK/tree.json" "$WORK/from-a-leaf.json" <<'PY'
+import json, sys, collections
+net = json.load(open(sys.argv[1]))
+near = collections.defaultdict(list)
+for v in net["vessels"]:
+    near[v["from"]].append(v["to"]); near[v["to"]].append(v["from"])
+order, seen = [net["vessels"][-1]["to"]], {net["vessels"][-1]["to"]}
+for n in order:
+    for m in near[n]:
+        if m not in seen: seen.add(m); order.append(m)
+by_id = {n["id"]: n for n in net["nodes"]}
+net["nodes"] = [by_id[i] for i in order]
+json.dump(net, open(sys.argv[2], "w"))
+PY
+"$HEMOSOLVE" "$WORK/from-a-leaf.json" --steady --out "$WORK/leaf-one" 2>/dev/null
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/from-a-leaf.json" --steady --out "$WORK/leaf-3" >"$WORK/leaf-out" 2>&1
+grep -q "PETSc's cg with hypre" "$WORK/leaf-out" && /usr/bin/python3 - "$WORK/leaf-one/vessels.csv" "$WORK/leaf-3/vessels.csv" <<'PY' \
+  && pass "a tree labelled from a leaf over 3 ranks: PETSc, the plain run's within 1e-10" || fail "a tree labelled from a leaf: $(head -2 "$WORK/leaf-out")"
+import sys, pandas as pd, numpy as np
+a, b = pd.read_csv(sys.argv[1]), pd.read_csv(sys.argv[2])
+for c in ("mean_flow", "mean_pressure"):
+    assert np.abs(a[c] - b[c]).max() <= 1e-10 * np.abs(a[c]).max(), c
+PY
 finish

@@ -3,6 +3,7 @@
 // (distributed/distended_over_ranks.hpp) gives each rank its share of the one-process
 // solve_distended_steady_flow bit for bit: its nodes' pressures, its vessels' flows and
 // resistances. Exit 0 when every rank agrees.
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstdio>
@@ -65,6 +66,13 @@ int main(int argc, char** argv) {
       ++failures;
       std::fprintf(stderr, "rank %d: %zu numbers not the whole's bits (%zu nodes, %d sweeps)\n", rank, differ,
                    mine.nodes.size(), mine.sweeps);
+    }
+    // The inlet's pressure where this rank holds its node, as the whole's.
+    const auto inlet = static_cast<std::size_t>(net.from[0]);
+    if (std::binary_search(mine.nodes_by_label.begin(), mine.nodes_by_label.end(), static_cast<std::int32_t>(inlet)) &&
+        !same(mine.flow.inlet_pressure, whole.inlet_pressure)) {
+      ++failures;
+      std::fprintf(stderr, "rank %d: the inlet's pressure not the whole's\n", rank);
     }
     std::size_t held = mine.nodes.size(), all = 0;
     MPI_Allreduce(&held, &all, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
