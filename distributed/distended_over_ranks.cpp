@@ -20,7 +20,7 @@ DistendedOverRanks solve_distended_steady_flow_over_ranks(const Network& net, co
   DistendedOverRanks out;
   std::optional<MpiTreeSystem> system;
   SteadyRows rows;
-  std::vector<double> shunt, b, conductance;
+  std::vector<double> shunt, b, conductance, x;
   // What each rank sets up alone: its share's nodes and vessels, rows and rigid resistances.
   on_every_rank([&] {
     rows = steady_rows(net);
@@ -47,15 +47,17 @@ DistendedOverRanks solve_distended_steady_flow_over_ranks(const Network& net, co
       const std::int32_t v = cut.parent_edge[static_cast<std::size_t>(out.nodes[k])];
       conductance[k] = v >= 0 ? 1 / r[static_cast<std::size_t>(v)] : 0.0;
     }
-    std::vector<double> x = b;
+    x.assign(b.begin(), b.end());
     if (const std::int64_t floating = system->factorize_solve(conductance, shunt, x); floating >= 0) {
       refuse_floating_part_everywhere(net, floating);
     }
-    s.node_pressure.assign(net.node_count(), 0.0);
+    // Whole-network arrays, sized once: a sweep touches this rank's entries alone (the others
+    // stay 0), so that its work is its share's.
+    if (s.node_pressure.size() != net.node_count()) s.node_pressure.assign(net.node_count(), 0.0);
+    if (s.flow.size() != net.vessel_count()) s.flow.assign(net.vessel_count(), 0.0);
     for (std::size_t k = 0; k < out.nodes.size(); ++k) s.node_pressure[static_cast<std::size_t>(out.nodes[k])] = x[k];
     for (std::size_t k = 0; k < system->root_parents().size(); ++k)
       s.node_pressure[static_cast<std::size_t>(system->root_parents()[k])] = system->root_parent_potentials()[k];
-    s.flow.assign(net.vessel_count(), 0.0);
     for (const std::int32_t vessel : out.vessels) {
       const auto v = static_cast<std::size_t>(vessel);
       s.flow[v] = (s.node_pressure[static_cast<std::size_t>(net.from[v])] - s.node_pressure[static_cast<std::size_t>(net.to[v])]) / r[v];
@@ -74,6 +76,7 @@ DistendedOverRanks solve_distended_steady_flow_over_ranks(const Network& net, co
   };
   const DistendedPart part{out.vessels, out.nodes, solve, largest, [](const std::function<void()>& step) { on_every_rank(step); }};
   out.flow = iterate_distended(net, blood, laws, viscosity, part, out.resistance, threads);
+  out.traffic = system->traffic();
   return out;
 }
 

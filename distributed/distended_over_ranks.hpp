@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "distributed/mpi_tree_system.hpp"
 #include "distributed/tree_share.hpp"
 #include "formats/network.hpp"
 #include "physics/blood.hpp"
@@ -28,6 +29,7 @@ struct DistendedOverRanks {
   SteadyFlow flow;
   std::vector<double> resistance;
   int sweeps = 0;  // the linear solves it took
+  MpiTreeSystem::Traffic traffic;  // this rank's exchanges in them
 };
 
 // cut: the network's (distributed/network_cut.hpp), the same on every rank. InputError where
