@@ -320,7 +320,10 @@ int run_command_line(CommandLine& line, int cores) {
     if (!line.dt_text.empty()) options.dt = parse_quantity(line.dt_text, Dimension::time, "--dt", {0, 1, true, false}, "s");
     if (options.threads < 1 || options.threads > cores)
       throw InputError("--threads must lie in [1, " + std::to_string(cores) + "] (got " +
-                       std::to_string(options.threads) + ")");
+                       std::to_string(options.threads) + ")" +
+                       (launched_ranks() > 1 ? "; the cores this rank may use: mpirun binds each rank, --bind-to none "
+                                               "or --map-by slot:PE=N gives it more"
+                                             : ""));
     options.external_pressure = parse_quantity(line.external_text, Dimension::pressure, "--external-pressure",
                                                {-100 * pascal_per_mmhg, 100 * pascal_per_mmhg}, "mmHg");
     config.sample_interval =
