@@ -8,10 +8,9 @@
 
 #include "core/setting_error.hpp"
 #include "core/units.hpp"
-#include "mpi/session.hpp"
-#include "distributed/mpi_tree_system.hpp"
 #include "distributed/network_cut.hpp"
 #include "distributed/petsc_flow_network.hpp"
+#include "distributed/steady_share.hpp"
 #include "mpi/session.hpp"
 #include "partition/partition.hpp"
 
@@ -103,47 +102,24 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
                                                 "builds or METIS differ): run every rank from one build");
   if (iterative) return solve_by_petsc(net, blood, inlet_flow, rows, partition);
 
-  // This rank's numbers: per node, its edge's conductance (the vessel to its parent: 1 / R as
-  // the one-process system takes it), its shunt and its inflow (the inlet's added as there).
-  std::optional<MpiTreeSystem> system;
-  std::vector<double> conductance, shunt, x, resistance;
+  // This rank's share and its vessels' resistances (rigid), one solve.
+  std::optional<SteadyShare> share;
+  std::vector<double> resistance(net.vessel_count(), 0.0);
   on_every_rank([&] {
-    system.emplace(MPI_COMM_WORLD, *cut);
-    const std::span<const std::int32_t> nodes = system->nodes();
-    conductance.assign(nodes.size(), 0.0);
-    shunt.resize(nodes.size());
-    x.resize(nodes.size());
-    resistance.resize(nodes.size());
-    for (std::size_t k = 0; k < nodes.size(); ++k) {
-      const auto node = static_cast<std::size_t>(nodes[k]);
-      if (const std::int32_t v = cut->parent_edge[node]; v >= 0) {
-        resistance[k] = vessel_resistance(net, blood, static_cast<std::size_t>(v));
-        conductance[k] = 1 / resistance[k];
-      }
-      shunt[k] = rows.shunt[node];
-      x[k] = rows.inflow[node];
-      if (static_cast<std::int64_t>(node) == rows.inlet_node) x[k] += inlet_flow;
-    }
+    share.emplace(net, *cut, rows, inlet_flow);
+    for (const std::int32_t v : share->vessels())
+      resistance[static_cast<std::size_t>(v)] = vessel_resistance(net, blood, static_cast<std::size_t>(v));
   });
-  if (const std::int64_t floating = system->factorize_solve(conductance, shunt, x); floating >= 0) {
-    refuse_floating_part_everywhere(net, floating);
-  }
-  const std::span<const std::int32_t> nodes = system->nodes();
-
-  // Each vessel's flow on the rank of the node below it, from its nodes' pressures.
-  std::vector<double> pressure(net.node_count(), 0.0);
-  for (std::size_t k = 0; k < nodes.size(); ++k) pressure[static_cast<std::size_t>(nodes[k])] = x[k];
-  for (std::size_t k = 0; k < system->root_parents().size(); ++k)
-    if (const std::int32_t p = system->root_parents()[k]; p >= 0)
-      pressure[static_cast<std::size_t>(p)] = system->root_parent_potentials()[k];
+  SteadyFlow held_here;
+  share->solve(resistance, held_here);
+  // Per node of this rank, its pressure and the flow of its vessel to its parent.
+  const std::span<const std::int32_t> nodes = share->nodes();
   std::vector<double> mine(2 * nodes.size());
   for (std::size_t k = 0; k < nodes.size(); ++k) {
-    mine[2 * k] = x[k];
-    const std::int32_t v = cut->parent_edge[static_cast<std::size_t>(nodes[k])];
-    mine[2 * k + 1] = v >= 0 ? (pressure[static_cast<std::size_t>(net.from[static_cast<std::size_t>(v)])] -
-                                pressure[static_cast<std::size_t>(net.to[static_cast<std::size_t>(v)])]) /
-                                   resistance[k]
-                             : 0.0;
+    const auto node = static_cast<std::size_t>(nodes[k]);
+    mine[2 * k] = held_here.node_pressure[node];
+    const std::int32_t v = cut->parent_edge[node];
+    mine[2 * k + 1] = v >= 0 ? held_here.flow[static_cast<std::size_t>(v)] : 0.0;
   }
   // Gathered on rank 0 in rank order, each rank's nodes as MpiTreeSystem lists them (its
   // share's, then on the top's rank the top's): on rank 0 alone, bucketed in one pass.
@@ -168,7 +144,7 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
   std::vector<double> all(rank == 0 ? 2 * net.node_count() : 0);
   MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
               MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  const MpiTreeSystem::Traffic& traffic = system->traffic();
+  const MpiTreeSystem::Traffic& traffic = share->traffic();
   SteadyOverRanks out{{}, describe(partition) + "; the tree's exchange on rank 0: " + std::to_string(traffic.calls) +
                               " collective calls, " + std::to_string(traffic.bytes) + " bytes, " +
                               format_quantity(traffic.seconds, "s")};
