@@ -578,23 +578,25 @@ void File::write_attribute(const std::string& name, std::int64_t value) {
     throw IoError(with_reason(name_ + ": /: cannot write the attribute " + name));
 }
 
-// An attribute of one value (a list of them would be read over the one value's room).
-bool one_value(hid_t attribute) {
-  Handle space(H5Aget_space(attribute), H5Sclose);
-  return H5Sget_simple_extent_npoints(space.id()) == 1;
+std::optional<File::Attribute> File::root_attribute(const std::string& name, H5T_class_t kind, const char* what) const {
+  if (H5Aexists(file_.id(), name.c_str()) <= 0) return std::nullopt;
+  Attribute a{Handle(H5Aopen(file_.id(), name.c_str(), H5P_DEFAULT), H5Aclose), {}};
+  a.type = Handle(H5Aget_type(a.attribute.id()), H5Tclose);
+  Handle space(H5Aget_space(a.attribute.id()), H5Sclose);
+  if (H5Tget_class(a.type.id()) != kind || H5Sget_simple_extent_npoints(space.id()) != 1)
+    fail("/", "the attribute \"" + name + "\" must be one " + what);
+  return a;
 }
 
 std::optional<std::string> File::text_attribute(const std::string& name) const {
-  if (H5Aexists(file_.id(), name.c_str()) <= 0) return std::nullopt;
-  Handle attribute(H5Aopen(file_.id(), name.c_str(), H5P_DEFAULT), H5Aclose);
-  Handle type(H5Aget_type(attribute.id()), H5Tclose);
-  if (H5Tget_class(type.id()) != H5T_STRING || !one_value(attribute.id()))
-    fail("/", "the attribute \"" + name + "\" must be one text");
-  if (H5Tis_variable_str(type.id()) <= 0 && H5Tget_size(type.id()) > max_text_bytes)
+  const std::optional<Attribute> a = root_attribute(name, H5T_STRING, "text");
+  if (!a) return std::nullopt;
+  const hid_t attribute = a->attribute.id(), type = a->type.id();
+  if (H5Tis_variable_str(type) <= 0 && H5Tget_size(type) > max_text_bytes)
     fail("/", "the attribute \"" + name + "\" is longer than " + std::to_string(max_text_bytes) + " bytes");
   bool failed = false;
-  std::string text = read_string(type.id(), [&](hid_t memory, void* into) {
-    const herr_t status = H5Aread(attribute.id(), memory, into);
+  std::string text = read_string(type, [&](hid_t memory, void* into) {
+    const herr_t status = H5Aread(attribute, memory, into);
     failed = status < 0;
     return status;
   });
@@ -603,13 +605,10 @@ std::optional<std::string> File::text_attribute(const std::string& name) const {
 }
 
 std::optional<std::int64_t> File::integer_attribute(const std::string& name) const {
-  if (H5Aexists(file_.id(), name.c_str()) <= 0) return std::nullopt;
-  Handle attribute(H5Aopen(file_.id(), name.c_str(), H5P_DEFAULT), H5Aclose);
-  Handle type(H5Aget_type(attribute.id()), H5Tclose);
-  if (H5Tget_class(type.id()) != H5T_INTEGER || !one_value(attribute.id()))
-    fail("/", "the attribute \"" + name + "\" must be one integer");
+  const std::optional<Attribute> a = root_attribute(name, H5T_INTEGER, "integer");
+  if (!a) return std::nullopt;
   std::int64_t value = 0;
-  if (H5Aread(attribute.id(), H5T_NATIVE_INT64, &value) < 0)
+  if (H5Aread(a->attribute.id(), H5T_NATIVE_INT64, &value) < 0)
     throw InputError(with_reason(name_ + ": /: the attribute \"" + name + "\" cannot be read"));
   return value;
 }

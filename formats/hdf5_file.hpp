@@ -132,6 +132,12 @@ class File {
       : guard_(std::move(guard)), file_(std::move(file)), name_(std::move(name)) {}
   static File open_temporary(std::string name, const std::function<bool(int fd)>& fill);
   Handle open_dataset(const std::string& path) const;
+  // The root's attribute `name` and its type, where it exists: of class `kind` and one value
+  // (a list would be read over the one value's room), else refused as "must be one `what`".
+  struct Attribute {
+    Handle attribute, type;
+  };
+  std::optional<Attribute> root_attribute(const std::string& name, H5T_class_t kind, const char* what) const;
   // Creates the groups above path that do not exist yet; the link list to create it with.
   Handle links_for(const std::string& path);
   void write_column(const std::string& path, hid_t memory_type, hid_t file_type, const void* data,
