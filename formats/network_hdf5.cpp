@@ -4,7 +4,6 @@
 // A reader checks everything the JSON reader checks, naming the dataset and the row.
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <string>
 #include <vector>
 
@@ -118,20 +117,10 @@ class Hdf5Reader {
     return values;
   }
 
-  template <class Id>
-  void check_unique(const std::vector<Id>& ids, const std::string& path, const char* what) const {
-    bool identity = true;  // 0..n-1 in order: unique without sorting
-    for (std::size_t i = 0; i < ids.size() && identity; ++i) identity = ids[i] == static_cast<Id>(i);
-    if (identity) return;
-    std::vector<std::size_t> order(ids.size());
-    std::iota(order.begin(), order.end(), std::size_t{0});
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return ids[a] < ids[b] || (ids[a] == ids[b] && a < b);
-    });
-    for (std::size_t k = 1; k < order.size(); ++k)
-      if (ids[order[k]] == ids[order[k - 1]])
-        file_.fail(path, std::string(what) + " id " + std::to_string(ids[order[k]]) + " appears twice: rows " +
-                             std::to_string(order[k - 1]) + " and " + std::to_string(order[k]));
+  void check_unique(const std::vector<std::int64_t>& ids, const std::string& path, const char* what) const {
+    if (const auto twice = NodeIndex(ids).repeat())
+      file_.fail(path, std::string(what) + " id " + std::to_string(twice->id) + " appears twice: rows " +
+                           std::to_string(twice->first) + " and " + std::to_string(twice->second));
   }
 
   void read_nodes() {

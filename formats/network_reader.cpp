@@ -329,19 +329,9 @@ class Reader {
   // Ids name vessels in results and between stages: two vessels with one id would be
   // merged or written twice downstream.
   void check_unique_vessel_ids() const {
-    const std::vector<std::int64_t>& ids = net_.id;
-    bool identity = true;  // ids 0..n-1 in order, the usual case: unique without sorting
-    for (std::size_t i = 0; i < ids.size() && identity; ++i)
-      identity = ids[i] == static_cast<std::int64_t>(i);
-    if (identity) return;
-    std::vector<std::pair<std::int64_t, std::size_t>> sorted(ids.size());
-    for (std::size_t i = 0; i < ids.size(); ++i) sorted[i] = {ids[i], i};
-    std::sort(sorted.begin(), sorted.end());
-    for (std::size_t i = 1; i < sorted.size(); ++i)
-      if (sorted[i].first == sorted[i - 1].first)
-        throw InputError(source_ + ": vessel id " + std::to_string(sorted[i].first) +
-                         " appears twice: vessels[" + std::to_string(sorted[i - 1].second) +
-                         "] and vessels[" + std::to_string(sorted[i].second) + "]");
+    if (const auto twice = NodeIndex(net_.id).repeat())
+      throw InputError(source_ + ": vessel id " + std::to_string(twice->id) + " appears twice: vessels[" +
+                       std::to_string(twice->first) + "] and vessels[" + std::to_string(twice->second) + "]");
   }
 
   void resolve_nodes(bool nodes_given) {
@@ -356,13 +346,9 @@ class Reader {
       for (std::int64_t id : ids) net_.add_node(id);
     }
     const NodeIndex index(net_.node_id);
-    if (!index.identity) {
-      for (std::size_t i = 1; i < index.sorted.size(); ++i)
-        if (index.sorted[i].first == index.sorted[i - 1].first)
-          throw InputError(source_ + ": node id " + std::to_string(index.sorted[i].first) +
-                           " appears twice: nodes[" + std::to_string(index.sorted[i - 1].second) +
-                           "] and nodes[" + std::to_string(index.sorted[i].second) + "]");
-    }
+    if (const auto twice = index.repeat())
+      throw InputError(source_ + ": node id " + std::to_string(twice->id) + " appears twice: nodes[" +
+                       std::to_string(twice->first) + "] and nodes[" + std::to_string(twice->second) + "]");
     const std::size_t count = net_.node_count();
     for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
       const std::int32_t a = index.find(from_id_[v], count), b = index.find(to_id_[v], count);

@@ -1,10 +1,12 @@
 // Node ids to node indices: how a reader resolves the ids a file names nodes by (vessels'
-// ends, boundaries) once the nodes are read. Shared by the JSON and the HDF5 reader.
+// ends, boundaries) once the nodes are read, and finds an id given twice (of nodes, or of
+// vessels: any list of ids). Shared by the JSON and the HDF5 reader.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -24,6 +26,16 @@ struct NodeIndex {
     std::sort(sorted.begin(), sorted.end());
   }
   std::size_t size() const { return identity ? 0 : sorted.size(); }
+  // The lowest id given twice and its first two places; none where every id is one's own.
+  struct Repeat {
+    std::int64_t id;
+    std::int32_t first, second;
+  };
+  std::optional<Repeat> repeat() const {
+    for (std::size_t i = 1; i < sorted.size(); ++i)
+      if (sorted[i].first == sorted[i - 1].first) return Repeat{sorted[i].first, sorted[i - 1].second, sorted[i].second};
+    return std::nullopt;
+  }
   // -1 when unknown
   std::int32_t find(std::int64_t id, std::size_t count) const {
     if (identity) return id >= 0 && id < static_cast<std::int64_t>(count)
