@@ -59,6 +59,16 @@ struct BoundaryColumn {
   bool integers = true, texts = true, numbers = true;
 };
 
+// A column of `rows` rows none of whose entries has the member yet.
+BoundaryColumn empty_column(const std::string& name, std::size_t rows) {
+  BoundaryColumn c;
+  c.name = name;
+  c.number.assign(rows, null_number);
+  c.integer.assign(rows, 0);
+  c.code.assign(rows, 0);
+  return c;
+}
+
 // Entries [first, end) as columns of end - first rows.
 std::vector<BoundaryColumn> boundary_block(const SummaryArray& array, std::size_t first, std::size_t end) {
   std::vector<BoundaryColumn> columns;
@@ -67,12 +77,7 @@ std::vector<BoundaryColumn> boundary_block(const SummaryArray& array, std::size_
     const nlohmann::json entry = array.entry(i);
     for (const auto& [key, value] : entry.items()) {
       auto at = std::find_if(columns.begin(), columns.end(), [&](const BoundaryColumn& c) { return c.name == key; });
-      if (at == columns.end()) {
-        at = columns.insert(columns.end(), BoundaryColumn{key});
-        at->number.assign(rows, null_number);
-        at->integer.assign(rows, 0);
-        at->code.assign(rows, 0);
-      }
+      if (at == columns.end()) at = columns.insert(columns.end(), empty_column(key, rows));
       BoundaryColumn& c = *at;
       const std::size_t row = i - first;
       ++c.present;
@@ -113,12 +118,7 @@ void write_boundaries(hdf5::File& file, const SummaryArray& array, int threads) 
     const std::size_t first = b * array.size / blocks, rows = (b + 1) * array.size / blocks - first;
     for (BoundaryColumn& part : parts[b]) {
       auto at = std::find_if(columns.begin(), columns.end(), [&](const BoundaryColumn& c) { return c.name == part.name; });
-      if (at == columns.end()) {
-        at = columns.insert(columns.end(), BoundaryColumn{part.name});
-        at->number.assign(array.size, null_number);
-        at->integer.assign(array.size, 0);
-        at->code.assign(array.size, 0);
-      }
+      if (at == columns.end()) at = columns.insert(columns.end(), empty_column(part.name, array.size));
       BoundaryColumn& c = *at;
       c.present += part.present;
       c.integers = c.integers && part.integers;
