@@ -33,16 +33,12 @@ MpiTreeSystem::MpiTreeSystem(MPI_Comm comm, const TreeCut& cut)
     throw std::invalid_argument("MpiTreeSystem: a cut for " + std::to_string(cut.ranks) + " ranks on " +
                                 std::to_string(size));
   top_rank_ = cut.top_rank;
-  nodes_ = cut.share_nodes(rank_);
-  share_size_ = nodes_.size();
+  share_size_ = share_.node_count();
+  nodes_ = std::move(cut.held_nodes()[static_cast<std::size_t>(rank_)]);
   for (const std::int32_t r : cut.roots[static_cast<std::size_t>(rank_)])
     root_parents_.push_back(cut.parent[static_cast<std::size_t>(r)]);
   root_parent_potential_.assign(root_parents_.size(), 0.0);
-  if (rank_ == top_rank_) {
-    const std::vector<std::int32_t> top = cut.top_nodes();
-    nodes_.insert(nodes_.end(), top.begin(), top.end());
-    top_.emplace_back(cut);
-  }
+  if (rank_ == top_rank_) top_.emplace_back(cut);
   for (int r = 0; r < cut.ranks; ++r) {
     const int roots = static_cast<int>(cut.roots[static_cast<std::size_t>(r)].size());
     message_count_.push_back(1 + roots);  // for a solve; a factorisation sends 1 + 3 roots
@@ -52,7 +48,7 @@ MpiTreeSystem::MpiTreeSystem(MPI_Comm comm, const TreeCut& cut)
   for (std::size_t r = 1; r < answer_count_.size(); ++r) answer_offset_[r] = answer_offset_[r - 1] + answer_count_[r - 1];
   // The top's rank finds each root's parent among the top's own nodes, for its answer.
   if (rank_ == top_rank_) {
-    const std::vector<std::int32_t> top = cut.top_nodes();
+    const std::span<const std::int32_t> top(nodes_.data() + share_size_, nodes_.size() - share_size_);
     std::unordered_map<std::int32_t, std::int32_t> own;
     for (std::size_t i = 0; i < top.size(); ++i) own.emplace(top[i], static_cast<std::int32_t>(i));
     for (const auto& roots : cut.roots)

@@ -3,8 +3,8 @@
 // to the top's rank and one scatter of their potentials back, in rank order, so the
 // potentials are the whole system's bit for bit for any number of ranks.
 //
-// A rank holds the nodes of its share (TreeCut::share_nodes) and, on the top's rank, the
-// top's after them (TreeCut::top_nodes): its arrays run over nodes(), in that order.
+// A rank holds the nodes of its share and, on the top's rank, the top's after them
+// (TreeCut::held_nodes): its arrays run over nodes(), in that order.
 #pragma once
 
 #include <cstdint>

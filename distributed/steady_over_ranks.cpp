@@ -121,19 +121,11 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
     const std::int32_t v = cut->parent_edge[node];
     mine[2 * k + 1] = v >= 0 ? held_here.flow[static_cast<std::size_t>(v)] : 0.0;
   }
-  // Gathered on rank 0 in rank order, each rank's nodes as MpiTreeSystem lists them (its
-  // share's, then on the top's rank the top's): on rank 0 alone, bucketed in one pass.
+  // Gathered on rank 0 in rank order, each rank's nodes as it holds them.
   std::vector<std::vector<std::int32_t>> held;
   std::vector<int> counts, offsets;
   if (rank == 0) {
-    held.resize(static_cast<std::size_t>(ranks));
-    std::vector<std::int32_t> top;
-    for (const std::int32_t node : cut->order) {
-      const std::int32_t owner = cut->owner[static_cast<std::size_t>(node)];
-      (owner == TreeCut::top ? top : held[static_cast<std::size_t>(owner)]).push_back(node);
-    }
-    auto& top_rank = held[static_cast<std::size_t>(cut->top_rank)];
-    top_rank.insert(top_rank.end(), top.begin(), top.end());
+    held = cut->held_nodes();
     counts.resize(static_cast<std::size_t>(ranks));
     offsets.assign(static_cast<std::size_t>(ranks), 0);
     for (std::size_t r = 0; r < held.size(); ++r) {

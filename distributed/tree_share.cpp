@@ -62,6 +62,18 @@ std::vector<std::int32_t> TreeCut::share_nodes(int rank) const {
 
 std::vector<std::int32_t> TreeCut::top_nodes() const { return share_nodes(top); }
 
+std::vector<std::vector<std::int32_t>> TreeCut::held_nodes() const {
+  std::vector<std::vector<std::int32_t>> held(static_cast<std::size_t>(ranks));
+  std::vector<std::int32_t> top_part;
+  for (const std::int32_t node : order) {
+    const std::int32_t o = owner[static_cast<std::size_t>(node)];
+    (o == top ? top_part : held[static_cast<std::size_t>(o)]).push_back(node);
+  }
+  auto& top_rank_nodes = held[static_cast<std::size_t>(top_rank)];
+  top_rank_nodes.insert(top_rank_nodes.end(), top_part.begin(), top_part.end());
+  return held;
+}
+
 namespace {
 
 // A system of some of the forest's nodes (in elimination order) and, for each whose parent is

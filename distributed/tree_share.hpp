@@ -50,6 +50,9 @@ struct TreeCut {
   std::vector<std::vector<std::int32_t>> roots;
   std::vector<std::int32_t> share_nodes(int rank) const;  // in elimination order
   std::vector<std::int32_t> top_nodes() const;            // in elimination order
+  // Every rank's nodes as it holds them over MPI (distributed/mpi_tree_system.hpp): its
+  // share's, then on the top's rank the top's; in one pass.
+  std::vector<std::vector<std::int32_t>> held_nodes() const;
 };
 
 // One rank's share. Its arrays run over share_nodes(rank), in that order: per node the
