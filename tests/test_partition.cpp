@@ -8,23 +8,18 @@
 
 #include <gtest/gtest.h>
 
+#include "grown_trees.hpp"
+
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
 #include "formats/topology.hpp"
-#include "generator/growth_rules.hpp"
-#include "generator/tree_growth.hpp"
 #include "partition/partition.hpp"
 
 using namespace hemotree;
 
 namespace {
 
-Network grown_tree() {
-  GrowthParameters p;
-  p.root_diameter = 150e-6;
-  p.min_diameter = 7e-6;
-  return grow_tree(default_rules(), p);
-}
+using test_networks::grown_tree;
 
 // An n x n grid of nodes joined right and down: loops everywhere.
 Network grid(int n) {

@@ -11,11 +11,11 @@
 
 #include <gtest/gtest.h>
 
+#include "grown_trees.hpp"
+
 #include "core/setting_error.hpp"
 #include "distributed/network_cut.hpp"
 #include "distributed/tree_share.hpp"
-#include "generator/growth_rules.hpp"
-#include "generator/tree_growth.hpp"
 #include "network_flow/nodal_system.hpp"
 #include "partition/partition.hpp"
 
@@ -23,12 +23,7 @@ using namespace hemotree;
 
 namespace {
 
-Network grown_tree() {
-  GrowthParameters p;
-  p.root_diameter = 150e-6;
-  p.min_diameter = 7e-6;
-  return grow_tree(default_rules(), p);
-}
+using test_networks::grown_tree;
 
 // Conductances spread over decades, as a tree's are; a shunt at every leaf (outlets) and a
 // small one elsewhere (compliances); currents anywhere.

@@ -14,8 +14,7 @@
 
 #include "distributed/distended_over_ranks.hpp"
 #include "distributed/network_cut.hpp"
-#include "generator/growth_rules.hpp"
-#include "generator/tree_growth.hpp"
+#include "../grown_trees.hpp"
 #include "mpi/session.hpp"
 #include "partition/partition.hpp"
 #include "steady/vessel_laws.hpp"
@@ -27,10 +26,7 @@ int main(int argc, char** argv) {
   {
     MpiSession session(argc, argv);
     const int ranks = world_size(), rank = world_rank();
-    GrowthParameters parameters;
-    parameters.root_diameter = 150e-6;
-    parameters.min_diameter = 7e-6;
-    Network net = grow_tree(default_rules(), parameters);
+    Network net = test_networks::grown_tree();
     // Every leaf an outlet of 2e13 Pa s/m^3 to 10 mmHg; 1 ul/min in at the root.
     std::vector<unsigned char> leaves_from(net.node_count(), 0);
     for (std::size_t v = 0; v < net.vessel_count(); ++v) leaves_from[static_cast<std::size_t>(net.from[v])] = 1;

@@ -17,8 +17,7 @@
 
 #include "distributed/mpi_tree_system.hpp"
 #include "distributed/network_cut.hpp"
-#include "generator/growth_rules.hpp"
-#include "generator/tree_growth.hpp"
+#include "../grown_trees.hpp"
 #include "network_flow/nodal_system.hpp"
 #include "partition/partition.hpp"
 
@@ -43,10 +42,7 @@ int main(int argc, char** argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   {
-    GrowthParameters parameters;
-    parameters.root_diameter = 150e-6;
-    parameters.min_diameter = 7e-6;
-    const Network net = grow_tree(default_rules(), parameters);
+    const Network net = test_networks::grown_tree();
     const std::size_t nodes = net.node_count(), edges = net.vessel_count();
     // The same numbers on every rank: conductances over four decades, shunts at the leaves.
     std::mt19937_64 random(11);
