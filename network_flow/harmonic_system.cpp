@@ -55,44 +55,62 @@ void HarmonicSystem::solve_in_place(std::span<const TwoPort> edge, std::span<Com
   }
 }
 
+namespace {
+
+// The edge from node i to its parent: the parent p, the entry in i's row and p's column
+// (m_ip) and in p's row and i's column (m_pi).
+struct ToParent {
+  std::size_t p;
+  Complex m_ip, m_pi;
+};
 template <class Edge>
-void HarmonicSystem::eliminate_forest(std::span<const Edge> y, std::span<Complex> pivot, std::span<Complex> x) const {
-  const std::span<const std::int32_t> a = a_, b = b_;
+ToParent to_parent(std::span<const std::int32_t> a, std::span<const std::int32_t> b, std::span<const Edge> y,
+                         std::size_t i, std::int32_t edge) {
+  const auto e = static_cast<std::size_t>(edge);
+  const bool i_is_a = a[e] == static_cast<std::int32_t>(i);
+  return {static_cast<std::size_t>(i_is_a ? b[e] : a[e]), i_is_a ? y[e].ab : y[e].ba, i_is_a ? y[e].ba : y[e].ab};
+}
+
+}  // namespace
+
+template <class Edge>
+void HarmonicSystem::sweep_up(std::span<const Edge> y, std::span<Complex> pivot, std::span<Complex> x) const {
   // Leaves up: node i, its pivot final, hands its parent p m_pi m_ip / d_i of the pivot and
   // m_pi B_i / d_i of the current (m_pi: the entry in p's row and i's column).
-  auto couplings = [&](std::size_t i, std::int32_t edge, std::size_t& p, Complex& m_ip, Complex& m_pi) {
-    const auto e = static_cast<std::size_t>(edge);
-    const bool i_is_a = a[e] == static_cast<std::int32_t>(i);
-    p = static_cast<std::size_t>(i_is_a ? b[e] : a[e]);
-    m_ip = i_is_a ? y[e].ab : y[e].ba;
-    m_pi = i_is_a ? y[e].ba : y[e].ab;
-  };
   for (std::size_t k = 0; k < nodes_; ++k) {
     const std::size_t i = eliminated(k);
-    if (pivot[i] == Complex(0)) singular_at(i);
     const std::int32_t e = parent_edge_[i];
+    if (e < 0 && open_roots_) continue;  // d_r and y_r for the rest of the forest
+    if (pivot[i] == Complex(0)) singular_at(i);
     if (e < 0) continue;
-    std::size_t p;
-    Complex m_ip, m_pi;
-    couplings(i, e, p, m_ip, m_pi);
+    const ToParent up = to_parent(std::span<const std::int32_t>(a_), std::span<const std::int32_t>(b_), y, i, e);
     pivot[i] = reciprocal(pivot[i]);  // kept as 1 / d_i for the way down
-    const Complex m_pi_over_d = m_pi * pivot[i];
-    pivot[p] -= m_pi_over_d * m_ip;
-    x[p] -= m_pi_over_d * x[i];
+    const Complex m_pi_over_d = up.m_pi * pivot[i];
+    pivot[up.p] -= m_pi_over_d * up.m_ip;
+    x[up.p] -= m_pi_over_d * x[i];
   }
-  // Roots down: X_i = (B_i - m_ip X_p) / d_i.
+}
+
+template <class Edge>
+void HarmonicSystem::sweep_down(std::span<const Edge> y, std::span<const Complex> pivot, std::span<Complex> x) const {
+  // Roots down: X_i = (B_i - m_ip X_p) / d_i; an open root's X_r is given.
   for (auto k = nodes_; k-- > 0;) {
     const std::size_t i = eliminated(k);
     const std::int32_t e = parent_edge_[i];
     if (e < 0) {
-      x[i] /= pivot[i];
+      if (!open_roots_) x[i] /= pivot[i];
       continue;
     }
-    std::size_t p;
-    Complex m_ip, m_pi;
-    couplings(i, e, p, m_ip, m_pi);
-    x[i] = (x[i] - m_ip * x[p]) * pivot[i];
+    const ToParent up = to_parent(std::span<const std::int32_t>(a_), std::span<const std::int32_t>(b_), y, i, e);
+    x[i] = (x[i] - up.m_ip * x[up.p]) * pivot[i];
   }
+}
+
+template <class Edge>
+void HarmonicSystem::eliminate_forest(std::span<const Edge> y, std::span<Complex> pivot, std::span<Complex> x) const {
+  if (open_roots_) throw std::logic_error("HarmonicSystem: a solve with open roots needs the rest of the forest");
+  sweep_up(y, pivot, x);
+  sweep_down(y, std::span<const Complex>(pivot), x);
 }
 
 void HarmonicSystem::solve_forest(std::span<const TwoPort> edge, std::span<Complex> pivot, std::span<Complex> x) const {
@@ -104,12 +122,28 @@ void HarmonicSystem::solve_forest(std::span<const TwoPort> edge, std::span<Compl
   eliminate_forest(edge, pivot, x);
 }
 
+void HarmonicSystem::check_forest_sizes(std::size_t couplings, std::size_t diagonal, std::size_t current) const {
+  if (!forest_) throw std::logic_error("HarmonicSystem: the graph is not a forest");
+  if (couplings != a_.size() || diagonal != nodes_ || current != nodes_)
+    throw std::invalid_argument("harmonic system: one coupling per edge, one diagonal and current per node");
+}
+
 void HarmonicSystem::solve_forest_in_place(std::span<const Coupling> coupling, std::span<Complex> diagonal,
                                            std::span<Complex> current) const {
-  if (!forest_) throw std::logic_error("HarmonicSystem::solve_forest_in_place: the graph is not a forest");
-  if (coupling.size() != a_.size() || diagonal.size() != nodes_ || current.size() != nodes_)
-    throw std::invalid_argument("harmonic system: one coupling per edge, one diagonal and current per node");
+  check_forest_sizes(coupling.size(), diagonal.size(), current.size());
   eliminate_forest(coupling, diagonal, current);
+}
+
+void HarmonicSystem::eliminate_forest_up(std::span<const Coupling> coupling, std::span<Complex> diagonal,
+                                         std::span<Complex> current) const {
+  check_forest_sizes(coupling.size(), diagonal.size(), current.size());
+  sweep_up(coupling, diagonal, current);
+}
+
+void HarmonicSystem::substitute_forest_down(std::span<const Coupling> coupling, std::span<const Complex> diagonal,
+                                            std::span<Complex> current) const {
+  check_forest_sizes(coupling.size(), diagonal.size(), current.size());
+  sweep_down(coupling, diagonal, current);
 }
 
 // Loops: the assembled matrix and a sparse LU.

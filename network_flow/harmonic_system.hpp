@@ -69,6 +69,23 @@ class HarmonicSystem {
   std::span<const std::int32_t> edge_b() const { return b_; }
   void solve_forest_in_place(std::span<const Coupling> coupling, std::span<Complex> diagonal,
                              std::span<Complex> current) const;
+  // The same solve in its two sweeps, for a caller that works between them (a share of a
+  // larger forest): leaves up, each non-root node's diagonal becomes its pivot's reciprocal
+  // and hands its parent its terms; roots down, current becomes the potentials.
+  void eliminate_forest_up(std::span<const Coupling> coupling, std::span<Complex> diagonal,
+                           std::span<Complex> current) const;
+  void substitute_forest_down(std::span<const Coupling> coupling, std::span<const Complex> diagonal,
+                              std::span<Complex> current) const;
+
+  // A share of a larger forest (distributed/harmonic_tree_share.hpp): every root of this
+  // forest hangs from a node held elsewhere. The sweep up then leaves at each root r its
+  // pivot d_r (its diagonal less its children's terms) and its current y_r as they are, with
+  // no check (the rest of the forest's), and the sweep down takes x_r from current[r] as
+  // given; solve_forest_in_place, which would need them, is refused (std::logic_error). Every
+  // other node's arithmetic is the closed forest's, so a forest swept share by share gives
+  // the bits of the whole.
+  void open_roots() { open_roots_ = true; }
+  bool roots_open() const { return open_roots_; }
 
  private:
   void solve_forest(std::span<const TwoPort> edge, std::span<Complex> pivot, std::span<Complex> x) const;
@@ -76,11 +93,16 @@ class HarmonicSystem {
   // reads ab and ba.
   template <class Edge>
   void eliminate_forest(std::span<const Edge> edge, std::span<Complex> pivot, std::span<Complex> x) const;
+  template <class Edge>
+  void sweep_up(std::span<const Edge> edge, std::span<Complex> pivot, std::span<Complex> x) const;
+  template <class Edge>
+  void sweep_down(std::span<const Edge> edge, std::span<const Complex> pivot, std::span<Complex> x) const;
+  void check_forest_sizes(std::size_t couplings, std::size_t diagonal, std::size_t current) const;
   void solve_sparse(std::span<const TwoPort> edge, std::span<const Complex> shunt, std::span<Complex> x) const;
 
   std::size_t nodes_;
   std::vector<std::int32_t> a_, b_;
-  bool forest_ = false;
+  bool forest_ = false, open_roots_ = false;
   // A forest's elimination order (leaves first; empty where every parent's label lies below
   // its children's: the labels from the highest down) and each node's edge to its parent (-1
   // at a root).
