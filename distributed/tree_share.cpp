@@ -74,37 +74,68 @@ std::vector<std::vector<std::int32_t>> TreeCut::held_nodes() const {
   return held;
 }
 
-namespace {
-
-// A system of some of the forest's nodes (in elimination order) and, for each whose parent is
-// among them, the edge to it: (parent's place, its place); edge_place: the node below each.
-NodalSystem system_of(const TreeCut& cut, std::span<const std::int32_t> nodes, std::vector<std::int32_t>& edge_place) {
-  std::vector<std::int32_t> local(nodes.size()), a, b;
+CutForest cut_forest(const TreeCut& cut, std::vector<std::int32_t> nodes) {
+  CutForest out{std::move(nodes), {}, {}, {}};
+  const std::vector<std::int32_t>& on = out.nodes;
   // Places by binary search in the forest's order: the nodes are a subsequence of it.
   auto local_place = [&](std::int32_t node) -> std::int32_t {
     const std::int32_t k = cut.place[static_cast<std::size_t>(node)];
-    const auto it = std::lower_bound(nodes.begin(), nodes.end(), k, [&](std::int32_t n, std::int32_t key) {
+    const auto it = std::lower_bound(on.begin(), on.end(), k, [&](std::int32_t n, std::int32_t key) {
       return cut.place[static_cast<std::size_t>(n)] < key;
     });
-    return it != nodes.end() && *it == node ? static_cast<std::int32_t>(it - nodes.begin()) : -1;
+    return it != on.end() && *it == node ? static_cast<std::int32_t>(it - on.begin()) : -1;
   };
-  edge_place.clear();
-  for (std::size_t j = 0; j < nodes.size(); ++j) {
-    const std::int32_t p = cut.parent[static_cast<std::size_t>(nodes[j])];
+  out.parent_place.assign(on.size(), -1);
+  for (std::size_t j = 0; j < on.size(); ++j) {
+    const std::int32_t p = cut.parent[static_cast<std::size_t>(on[j])];
     if (p < 0) continue;
     const std::int32_t above = local_place(p);
     if (above < 0) continue;
-    a.push_back(above);
-    b.push_back(static_cast<std::int32_t>(j));
-    edge_place.push_back(static_cast<std::int32_t>(j));
+    out.parent_place[j] = above;
+    out.a.push_back(above);
+    out.b.push_back(static_cast<std::int32_t>(j));
   }
-  return NodalSystem(nodes.size(), std::move(a), std::move(b), NodalSystem::Method::tree_elimination);
+  return out;
+}
+
+TopPlaces top_places(const TreeCut& cut) {
+  std::vector<std::pair<std::int32_t, std::int32_t>> members;  // (place in the forest, source)
+  const std::vector<std::int32_t> own = cut.top_nodes();
+  for (std::size_t i = 0; i < own.size(); ++i)
+    members.emplace_back(cut.place[static_cast<std::size_t>(own[i])], static_cast<std::int32_t>(i));
+  std::int32_t slot = 0;
+  for (const auto& rank_roots : cut.roots)
+    for (const std::int32_t r : rank_roots) members.emplace_back(cut.place[static_cast<std::size_t>(r)], ~slot++);
+  std::sort(members.begin(), members.end());
+  std::vector<std::int32_t> nodes(members.size());
+  TopPlaces out;
+  out.own.resize(own.size());
+  out.root_place.resize(static_cast<std::size_t>(slot));
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const auto [where, source] = members[k];
+    nodes[k] = cut.order[static_cast<std::size_t>(where)];
+    if (source >= 0)
+      out.own[static_cast<std::size_t>(source)] = static_cast<std::int32_t>(k);
+    else
+      out.root_place[static_cast<std::size_t>(~source)] = static_cast<std::int32_t>(k);
+  }
+  out.forest = cut_forest(cut, std::move(nodes));
+  return out;
+}
+
+namespace {
+
+NodalSystem system_of(const CutForest& forest) {
+  return NodalSystem(forest.nodes.size(), forest.a, forest.b, NodalSystem::Method::tree_elimination);
 }
 
 }  // namespace
 
-TreeShare::TreeShare(const TreeCut& cut, int rank) : nodes_(cut.share_nodes(rank)) {
-  system_ = system_of(cut, nodes_, edge_place_);
+TreeShare::TreeShare(const TreeCut& cut, int rank) {
+  CutForest forest = cut_forest(cut, cut.share_nodes(rank));
+  system_ = system_of(forest);
+  nodes_ = std::move(forest.nodes);
+  edge_place_ = std::move(forest.b);
   system_.open_roots();
   edge_conductance_.resize(edge_place_.size());
   // The roots come in elimination order, as cut.roots lists them.
@@ -153,34 +184,15 @@ void TreeShare::backward(std::span<const double> root_potential, std::span<doubl
   system_.backward(y, y);
 }
 
-TreeTop::TreeTop(const TreeCut& cut) {
-  // The top's own nodes and every share's roots, merged in elimination order.
-  std::vector<std::pair<std::int32_t, std::int32_t>> members;  // (place in the forest, source)
-  const std::vector<std::int32_t> own = cut.top_nodes();
-  for (std::size_t i = 0; i < own.size(); ++i)
-    members.emplace_back(cut.place[static_cast<std::size_t>(own[i])], static_cast<std::int32_t>(i));
-  std::int32_t slot = 0;
-  for (const auto& rank_roots : cut.roots)
-    for (const std::int32_t r : rank_roots) members.emplace_back(cut.place[static_cast<std::size_t>(r)], ~slot++);
-  std::sort(members.begin(), members.end());
-  nodes_.resize(members.size());
-  own_.resize(own.size());
-  root_place_.resize(static_cast<std::size_t>(slot));
-  for (std::size_t k = 0; k < members.size(); ++k) {
-    const auto [where, source] = members[k];
-    nodes_[k] = cut.order[static_cast<std::size_t>(where)];
-    if (source >= 0)
-      own_[static_cast<std::size_t>(source)] = static_cast<std::int32_t>(k);
-    else
-      root_place_[static_cast<std::size_t>(~source)] = static_cast<std::int32_t>(k);
-  }
-  system_ = system_of(cut, nodes_, edge_place_);
-  edge_conductance_.resize(edge_place_.size());
-  shunt_.resize(nodes_.size());
-  y_.resize(nodes_.size());
+TreeTop::TreeTop(const TreeCut& cut) : places_(top_places(cut)) {
+  const std::vector<std::int32_t>& nodes = places_.forest.nodes;
+  system_ = system_of(places_.forest);
+  edge_conductance_.resize(places_.forest.b.size());
+  shunt_.resize(nodes.size());
+  y_.resize(nodes.size());
   // The lowest node below each place, for naming a singular component as the whole forest's
   // system does (its lowest node): an own node stands for itself, a share root for its
-  // subtree. And each place's parent's place (-1 at the forest's roots).
+  // subtree.
   std::vector<std::int32_t> lowest(cut.order.size());
   std::iota(lowest.begin(), lowest.end(), 0);
   for (std::size_t k = cut.order.size(); k-- > 0;) {
@@ -188,39 +200,29 @@ TreeTop::TreeTop(const TreeCut& cut) {
     if (const std::int32_t p = cut.parent[c]; p >= 0)
       lowest[static_cast<std::size_t>(p)] = std::min(lowest[static_cast<std::size_t>(p)], lowest[c]);
   }
-  lowest_.assign(nodes_.begin(), nodes_.end());
-  for (const std::int32_t k : root_place_) lowest_[static_cast<std::size_t>(k)] = lowest[static_cast<std::size_t>(nodes_[static_cast<std::size_t>(k)])];
-  parent_place_.assign(nodes_.size(), -1);
-  for (std::size_t e = 0; e < edge_place_.size(); ++e) {
-    const auto below = static_cast<std::size_t>(edge_place_[e]);
-    const std::int32_t p = cut.parent[static_cast<std::size_t>(nodes_[below])];
-    // The parent is a node of the top's system: the node before it there with that label.
-    const auto it = std::lower_bound(nodes_.begin(), nodes_.begin() + static_cast<std::ptrdiff_t>(below), p,
-                                     [&](std::int32_t n, std::int32_t key) {
-                                       return cut.place[static_cast<std::size_t>(n)] < cut.place[static_cast<std::size_t>(key)];
-                                     });
-    parent_place_[below] = static_cast<std::int32_t>(it - nodes_.begin());
-  }
+  lowest_.assign(nodes.begin(), nodes.end());
+  for (const std::int32_t k : places_.root_place)
+    lowest_[static_cast<std::size_t>(k)] = lowest[static_cast<std::size_t>(nodes[static_cast<std::size_t>(k)])];
 }
 
 void TreeTop::gather(std::span<const double> b, std::span<const double> messages, std::size_t stride,
                      std::span<const double> conductance, std::span<const double> shunt) {
-  if (b.size() != own_.size() || messages.size() != stride * root_place_.size())
-    throw std::invalid_argument("TreeTop: " + std::to_string(own_.size()) + " own numbers and " +
-                                std::to_string(stride * root_place_.size()) + " from the shares expected");
+  if (b.size() != places_.own.size() || messages.size() != stride * places_.root_place.size())
+    throw std::invalid_argument("TreeTop: " + std::to_string(places_.own.size()) + " own numbers and " +
+                                std::to_string(stride * places_.root_place.size()) + " from the shares expected");
   const bool factorizing = stride == 3;
   std::vector<double> below_conductance;  // per place: the conductance of its edge to its parent
-  if (factorizing) below_conductance.assign(nodes_.size(), 0.0);
-  for (std::size_t i = 0; i < own_.size(); ++i) {
-    const auto k = static_cast<std::size_t>(own_[i]);
+  if (factorizing) below_conductance.assign(places_.forest.nodes.size(), 0.0);
+  for (std::size_t i = 0; i < places_.own.size(); ++i) {
+    const auto k = static_cast<std::size_t>(places_.own[i]);
     y_[k] = b[i];
     if (factorizing) {
       shunt_[k] = shunt[i];
       below_conductance[k] = conductance[i];
     }
   }
-  for (std::size_t s = 0; s < root_place_.size(); ++s) {
-    const auto k = static_cast<std::size_t>(root_place_[s]);
+  for (std::size_t s = 0; s < places_.root_place.size(); ++s) {
+    const auto k = static_cast<std::size_t>(places_.root_place[s]);
     const double* m = messages.data() + stride * s;
     y_[k] = m[stride - 1];
     if (factorizing) {
@@ -229,33 +231,33 @@ void TreeTop::gather(std::span<const double> b, std::span<const double> messages
     }
   }
   if (factorizing)
-    for (std::size_t e = 0; e < edge_place_.size(); ++e)
-      edge_conductance_[e] = below_conductance[static_cast<std::size_t>(edge_place_[e])];
+    for (std::size_t e = 0; e < places_.forest.b.size(); ++e)
+      edge_conductance_[e] = below_conductance[static_cast<std::size_t>(places_.forest.b[e])];
 }
 
 void TreeTop::solve_and_scatter(std::span<double> x, std::span<double> answer) {
-  if (x.size() != own_.size() || answer.size() != root_place_.size())
+  if (x.size() != places_.own.size() || answer.size() != places_.root_place.size())
     throw std::invalid_argument("TreeTop: a potential per own node and per share root");
   system_.backward(y_, y_);
-  for (std::size_t i = 0; i < own_.size(); ++i) x[i] = y_[static_cast<std::size_t>(own_[i])];
-  for (std::size_t s = 0; s < root_place_.size(); ++s) answer[s] = y_[static_cast<std::size_t>(root_place_[s])];
+  for (std::size_t i = 0; i < places_.own.size(); ++i) x[i] = y_[static_cast<std::size_t>(places_.own[i])];
+  for (std::size_t s = 0; s < places_.root_place.size(); ++s) answer[s] = y_[static_cast<std::size_t>(places_.root_place[s])];
 }
 
 std::int64_t TreeTop::factorize_solve(std::span<const double> conductance, std::span<const double> shunt,
                                       std::span<const double> b, std::span<const double> messages, std::span<double> x,
                                       std::span<double> answer) {
-  if (conductance.size() != own_.size() || shunt.size() != own_.size())
+  if (conductance.size() != places_.own.size() || shunt.size() != places_.own.size())
     throw std::invalid_argument("TreeTop::factorize_solve: a conductance and a shunt per own node");
   gather(b, messages, 3, conductance, shunt);
   const std::int64_t singular = system_.factorize_forward(edge_conductance_, shunt_, y_);
   if (singular >= 0) {
     // Its component: the places whose root is the singular place's (parents come first).
-    std::vector<std::int32_t> root(nodes_.size());
-    for (std::size_t k = 0; k < nodes_.size(); ++k)
-      root[k] = parent_place_[k] < 0 ? static_cast<std::int32_t>(k) : root[static_cast<std::size_t>(parent_place_[k])];
+    std::vector<std::int32_t> root(places_.forest.nodes.size());
+    for (std::size_t k = 0; k < places_.forest.nodes.size(); ++k)
+      root[k] = places_.forest.parent_place[k] < 0 ? static_cast<std::int32_t>(k) : root[static_cast<std::size_t>(places_.forest.parent_place[k])];
     const std::int32_t component = root[static_cast<std::size_t>(singular)];
     std::int32_t named = std::numeric_limits<std::int32_t>::max();
-    for (std::size_t k = 0; k < nodes_.size(); ++k)
+    for (std::size_t k = 0; k < places_.forest.nodes.size(); ++k)
       if (root[k] == component) named = std::min(named, lowest_[k]);
     return named;
   }

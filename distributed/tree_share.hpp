@@ -55,6 +55,26 @@ struct TreeCut {
   std::vector<std::vector<std::int32_t>> held_nodes() const;
 };
 
+// Some of a cut forest's nodes as a forest of their own: a share's, or the top's with every
+// share root (TreeCut::top_places). Each node's place is its rank among them in the whole
+// forest's elimination order, so every system built on these places eliminates in the whole
+// forest's order: its edges (a[e], b[e]) run from a parent's place to its child's.
+struct CutForest {
+  std::vector<std::int32_t> nodes;         // per place, the forest's node
+  std::vector<std::int32_t> a, b;          // per edge: its parent's place, its child's
+  std::vector<std::int32_t> parent_place;  // per place: its parent's, -1 where that is not among them
+};
+// nodes: a subsequence of cut.order.
+CutForest cut_forest(const TreeCut& cut, std::vector<std::int32_t> nodes);
+// The top's system: its own nodes and every share's roots, merged in elimination order; the
+// places of the own nodes (in top_nodes() order) and of the roots (rank after rank, each
+// rank's in TreeCut::roots order: the messages' slots).
+struct TopPlaces {
+  CutForest forest;
+  std::vector<std::int32_t> own, root_place;
+};
+TopPlaces top_places(const TreeCut& cut);
+
 // One rank's share. Its arrays run over share_nodes(rank), in that order: per node the
 // conductance of its edge to its parent (a root's: of its edge into the top), its shunt, its
 // right-hand side.
@@ -87,8 +107,8 @@ class TreeShare {
 class TreeTop {
  public:
   explicit TreeTop(const TreeCut& cut);
-  std::size_t node_count() const { return own_.size(); }
-  std::size_t root_count() const { return root_place_.size(); }
+  std::size_t node_count() const { return places_.own.size(); }
+  std::size_t root_count() const { return places_.root_place.size(); }
 
   // Move 2 after every share's factorize_forward: eliminates the top, solves it (x: the top's
   // own potentials; answer: each share root's) and returns -1, or where the forest is
@@ -102,13 +122,9 @@ class TreeTop {
              std::span<double> answer);
 
  private:
-  std::vector<std::int32_t> nodes_;       // per place of the top's system, the forest's node
-  std::vector<std::int32_t> own_;         // the places of the top's own nodes, in their order
-  std::vector<std::int32_t> root_place_;  // the places of the share roots, by message slot
-  std::vector<std::int32_t> edge_place_;  // per edge, the place of the node below it
+  TopPlaces places_;
   std::vector<double> edge_conductance_, shunt_, y_;  // scratch: per edge, per place
-  std::vector<std::int32_t> lowest_;       // per place: the lowest node it stands for (itself; a root: its subtree's)
-  std::vector<std::int32_t> parent_place_;  // per place: its parent's, -1 at the forest's roots
+  std::vector<std::int32_t> lowest_;  // per place: the lowest node it stands for (itself; a root: its subtree's)
   NodalSystem system_;
   // y_ (and where given, shunt_ and edge_conductance_) from the top's own numbers and the
   // messages (one root's numbers every `stride` of them: g, S, y or y alone).
