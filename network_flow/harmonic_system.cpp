@@ -15,8 +15,8 @@ namespace hemotree {
 namespace {
 
 [[noreturn]] void singular_at(std::size_t node) {
-  throw std::invalid_argument("harmonic system: node " + std::to_string(node) +
-                              " lies in a part with no admittance to ground");
+  throw SingularHarmonicSystem(node, "harmonic system: node " + std::to_string(node) +
+                                         " lies in a part with no admittance to ground");
 }
 
 }  // namespace

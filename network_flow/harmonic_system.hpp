@@ -18,6 +18,8 @@
 #include <complex>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace hemotree {
@@ -34,6 +36,12 @@ inline Complex reciprocal(Complex z) {
   const double inverse = 1.0 / size;
   return {z.real() * inverse, -z.imag() * inverse};
 }
+
+// A zero pivot: the part of the network that holds `node` has no admittance to ground.
+struct SingularHarmonicSystem : std::invalid_argument {
+  SingularHarmonicSystem(std::size_t node_, const std::string& what) : std::invalid_argument(what), node(node_) {}
+  std::size_t node;
+};
 
 struct TwoPort {
   Complex aa, ab, ba, bb;
