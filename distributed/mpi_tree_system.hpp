@@ -13,6 +13,7 @@
 
 #include <mpi.h>
 
+#include "distributed/root_exchange.hpp"
 #include "distributed/tree_share.hpp"
 
 namespace hemotree {
@@ -41,30 +42,19 @@ class MpiTreeSystem {
   // every rank where it did not succeed on every rank). Collective.
   void solve(std::span<double> x);
 
-  // What this rank's exchanges have cost so far: the collective calls it made (a gather and a
-  // scatter a solve), the bytes it sent and received in them, and the seconds inside them
-  // (waiting for the slowest rank included).
-  struct Traffic {
-    int calls = 0;
-    std::size_t bytes = 0;
-    double seconds = 0;
-  };
-  const Traffic& traffic() const { return traffic_; }
+  // What this rank's exchanges have cost so far (a gather and a scatter a solve).
+  using Traffic = RootExchange::Traffic;
+  const Traffic& traffic() const { return exchange_.traffic(); }
 
  private:
-  MPI_Comm comm_;
   int rank_ = 0, top_rank_ = 0;
   std::vector<std::int32_t> nodes_, root_parents_;
   std::vector<double> root_parent_potential_;
   std::size_t share_size_ = 0;
   TreeShare share_;
   std::vector<TreeTop> top_;  // one, on the top's rank
-  // Per rank: 1 + its roots (a solve's message: a status and y_r each; a factorisation's
-  // sends 1 + 3 roots: g_r, S_r, y_r), 1 + 2 roots (the answer: a status, x_r and x_parent
-  // each), and where its answer starts.
-  std::vector<int> message_count_, answer_count_, answer_offset_;
   std::vector<std::int32_t> parent_of_slot_;  // top's rank: per share root, its parent among the top's own nodes
-  Traffic traffic_;
+  RootExchange exchange_;
   bool factorized_ = false;  // the last factorisation succeeded on every rank
   std::int64_t exchange(std::span<const double> conductance, std::span<const double> shunt, std::span<double> x,
                         bool factorizing);

@@ -1,0 +1,59 @@
+// The messages of a cut tree's distributed solve (distributed/tree_share.hpp's three moves)
+// over MPI: every rank's numbers for the top, a few per share root, gathered to the top's
+// rank in rank order behind a status (one MPI_Gatherv), and the top's answers scattered back
+// behind one (one MPI_Scatterv). A rank that fails in its move says so in its status instead
+// of leaving the collective calls the others are in; the top's rank answers every rank with
+// the first refusal, and every rank throws that rank's words alike.
+#pragma once
+
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include <mpi.h>
+
+namespace hemotree {
+
+class RootExchange {
+ public:
+  // roots: per rank of comm, its share roots (TreeCut::roots' sizes). No communication.
+  RootExchange(MPI_Comm comm, int top_rank, std::vector<int> roots);
+  int rank() const { return rank_; }
+  bool top() const { return rank_ == top_rank_; }
+
+  // An answer's status: solved, or (>= 0) a node the top's solve names (a singular forest).
+  static constexpr double solved = -1;
+
+  // The top's move: every rank's message (`send` numbers per root, rank after rank) in; the
+  // answers (`back` numbers per root, rank after rank) out; returns solved or a node >= 0.
+  using TopMove = std::function<double(std::span<const double> messages, std::span<double> answers)>;
+
+  // One round, collective. message: this rank's `send` numbers per root, or `failure` set
+  // where its move failed (its words, said by every rank). top_move runs on the top's rank
+  // only, once every message came without failure; what it throws is the top's refusal.
+  // Returns this rank's answer: the status, then `back` numbers per root. A refusal is thrown
+  // on every rank: mpi/session.hpp's Collective<std::invalid_argument>, `what` and the
+  // refusing rank's words ("rank K: " before them where K > 0).
+  std::vector<double> round(std::span<const double> message, std::exception_ptr failure, std::size_t send,
+                            std::size_t back, const TopMove& top_move, const char* what);
+
+  // What this rank's rounds have cost so far: the collective calls (two a round), the bytes
+  // sent and received in them, and the seconds inside them (waiting for the slowest rank
+  // included).
+  struct Traffic {
+    int calls = 0;
+    std::size_t bytes = 0;
+    double seconds = 0;
+  };
+  const Traffic& traffic() const { return traffic_; }
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0, top_rank_ = 0;
+  std::vector<int> roots_;
+  Traffic traffic_;
+};
+
+}  // namespace hemotree
