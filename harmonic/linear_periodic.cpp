@@ -83,17 +83,17 @@ struct LineAbout {
   }
 };
 
-// The network's oscillation at one angular frequency w: every node's pressure amplitude,
-// left in work.current; line_of(v) gives vessel v's line. threads: the vessels' two-ports
-// built in parallel (each its own: the same numbers for any count).
+// One harmonic's rows at the nodes, into shunt and current (of every node): the boundaries'
+// terms in their order, the currents of extra_current (the mean shift's), the vessels that end
+// at a held node, and a unit diagonal where no edge of the system reaches a node: everything
+// of the nodal system but its edges' two-ports. line_of(v) gives vessel v's line.
 template <class LineOf>
-void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBoundaries& boundaries,
-                    const std::vector<FourierSeries>& series, const LineOf& line_of, int k, double w,
-                    HarmonicWorkspace& work, int threads = 1, std::span<const double> extra_current = {}) {
+void node_terms(const Network& net, const HarmonicNetwork& h, const RunBoundaries& boundaries,
+                const std::vector<FourierSeries>& series, const LineOf& line_of, int k, double w,
+                std::vector<Complex>& shunt, std::vector<Complex>& current, std::span<const double> extra_current) {
   const std::size_t nodes = net.node_count();
   // A held node's current is its held pressure: nothing else flows into it (one boundary a
   // node; a vessel to it draws its current at its other node), and its row is x = current.
-  std::vector<Complex>&shunt = work.shunt, &current = work.current;
   shunt.assign(nodes, 0.0), current.assign(nodes, 0.0);
   std::size_t next = 0;  // series holds the boundaries' that are not outlets, in their order
   for (std::size_t i = 0; i < boundaries.size(); ++i) {
@@ -112,8 +112,8 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBound
   }
   for (std::size_t node = 0; node < extra_current.size(); ++node)
     if (!h.held[node]) current[node] += extra_current[node];
-  // Each vessel's two-port; a vessel ending at a held node becomes, at its other node, a
-  // shunt and the current the held pressure drives through it.
+  // A vessel ending at a held node becomes, at its other node, a shunt and the current the
+  // held pressure drives through it.
   for (const std::int32_t vessel : h.held_end_vessel) {
     const auto v = static_cast<std::size_t>(vessel);
     const TwoPort y = line_of(v).two_port(w);
@@ -129,6 +129,17 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBound
   for (std::size_t node = 0; node < nodes; ++node) {
     if (h.held[node] || !h.touched[node]) shunt[node] = 1.0;  // no edge of the system reaches it
   }
+}
+
+// The network's oscillation at one angular frequency w: every node's pressure amplitude,
+// left in work.current; line_of(v) gives vessel v's line. threads: the vessels' two-ports
+// built in parallel (each its own: the same numbers for any count).
+template <class LineOf>
+void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBoundaries& boundaries,
+                    const std::vector<FourierSeries>& series, const LineOf& line_of, int k, double w,
+                    HarmonicWorkspace& work, int threads = 1, std::span<const double> extra_current = {}) {
+  std::vector<Complex>&shunt = work.shunt, &current = work.current;
+  node_terms(net, h, boundaries, series, line_of, k, w, shunt, current, extra_current);
   std::vector<TwoPort>& edge = work.edge;
   const std::size_t edges = h.edge_vessel.size();
   // Two-ports built in parallel, a block of edges at a time on a forest (its elimination
@@ -233,18 +244,27 @@ void solve_harmonics(const Network& net, const HarmonicNetwork& network, const L
 
 namespace {
 
-// value(v) for every vessel v < n, a block at a time in parallel, each handed to consume(v,
-// value) in the order of v: a loop that adds into shared sums keeps its one-thread order
-// (and bits) without an array of n values.
+// The vessels a loop runs over, in increasing order: those listed, or every one of `all`.
+struct VesselList {
+  const std::vector<std::int32_t>* listed = nullptr;
+  std::size_t all = 0;
+  std::size_t size() const { return listed ? listed->size() : all; }
+  std::size_t operator[](std::size_t i) const { return listed ? static_cast<std::size_t>((*listed)[i]) : i; }
+};
+
+// value(v) for every vessel v of the list, a block at a time in parallel, each handed to
+// consume(v, value) in the list's order: a loop that adds into shared sums keeps its
+// one-thread order (and bits) without an array of a value a vessel.
 template <class Value, class Consume>
-void in_blocks(std::size_t n, int threads, const Value& value, const Consume& consume) {
+void in_blocks(const VesselList& vessels, int threads, const Value& value, const Consume& consume) {
+  const std::size_t n = vessels.size();
   std::vector<double> block(std::min<std::size_t>(n, std::size_t{1} << 16));
   for (std::size_t first = 0; first < n; first += block.size()) {
     const std::size_t count = std::min(block.size(), n - first);
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
     for (std::int64_t j = 0; j < static_cast<std::int64_t>(count); ++j)
-      block[static_cast<std::size_t>(j)] = value(first + static_cast<std::size_t>(j));
-    for (std::size_t j = 0; j < count; ++j) consume(first + j, block[j]);
+      block[static_cast<std::size_t>(j)] = value(vessels[first + static_cast<std::size_t>(j)]);
+    for (std::size_t j = 0; j < count; ++j) consume(vessels[first + j], block[j]);
   }
 }
 
@@ -267,12 +287,16 @@ LumenSlopes lumen_slopes(const TubeLaw& law, const ViscosityTable& viscosity, do
 // ends. Adds each node's shift to node_pressure and hands every vessel's to
 // apply(v, dq, profile, dx_from, dx_to): its flow's, its static pressure's along it where it
 // is sourced (sampled evenly from `from` to `to`; else empty: its nodes') and its nodes'.
-template <class Apply>
+//   Over a share of the network (HarmonicShare), `held` lists the vessels whose terms it sums
+// (every one where null), `answered` those it hands to apply (every held one where null), and
+// solve_at_zero(current) solves the system at w = 0 with the mean shift's currents (every
+// node's array, the share's nodes' entries set), returning the potentials there.
+template <class SolveAtZero, class Apply>
 void solve_mean_shift(const Network& net, const Blood& blood, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
-                      const RunBoundaries& boundaries, const HarmonicNetwork& network, const std::vector<FourierSeries>& series,
-                      const LineAbout& line_of, const LinearPeriodic& along, const std::vector<bool>& sourced,
-                      std::span<const double> node_variance, std::vector<double>& node_pressure, HarmonicWorkspace& work,
-                      int threads, Apply&& apply) {
+                      const RunBoundaries& boundaries, const LineAbout& line_of, const LinearPeriodic& along,
+                      const std::vector<bool>& sourced, std::span<const double> node_variance,
+                      std::vector<double>& node_pressure, int threads, const VesselList& held,
+                      const VesselList& answered, SolveAtZero&& solve_at_zero, Apply&& apply) {
   const std::size_t nodes = net.node_count(), n = net.vessel_count();
   const double k_friction = friction_coefficient(blood.alpha), rho = blood.density;
   // Per node, a byte: a junction (two ends or more, no boundary), and a 1D end there.
@@ -304,7 +328,8 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
   // The 0D vessels' kinetic pressure at the junctions of 1D ends, weighted by their mean flows
   // (the vessels `along` holds beside the 1D ends): sum and weight per node.
   std::unordered_map<std::size_t, std::array<double, 2>> beside;
-  for (std::size_t v = 0; v < n; ++v) {
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    const std::size_t v = held[i];
     if (sourced[v] || !along.holds(v)) continue;
     for (const bool distal : {false, true}) {
       const auto node = static_cast<std::size_t>(distal ? net.to[v] : net.from[v]);
@@ -322,7 +347,8 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
   };
   std::unordered_map<std::size_t, Source> source;
   std::vector<double> current(nodes, 0.0);
-  for (std::size_t v = 0; v < n; ++v) {
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    const std::size_t v = held[i];
     if (!sourced[v]) continue;
     const VesselLine& line = along.line(v);
     const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);
@@ -355,20 +381,16 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
     const auto a = static_cast<std::size_t>(net.from[v]), b = static_cast<std::size_t>(net.to[v]);
     return (capacity_slope(a) * node_variance[a] - capacity_slope(b) * node_variance[b]) / (2 * net.length[v]);
   };
-  in_blocks(n, threads, [&](std::size_t v) { return sourced[v] ? 0.0 : through(v); },
+  in_blocks(held, threads, [&](std::size_t v) { return sourced[v] ? 0.0 : through(v); },
             [&](std::size_t v, double j) {
               if (sourced[v]) return;
               current[static_cast<std::size_t>(net.from[v])] -= j;
               current[static_cast<std::size_t>(net.to[v])] += j;
             });
-  std::vector<FourierSeries> none = series;
-  for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
-  solve_harmonic(net, network, boundaries, none, line_of, 0, 0.0, work, threads, current);
-  std::vector<double>().swap(current);
-  const std::vector<Complex>& x = work.current;
+  const std::vector<Complex>& x = solve_at_zero(std::move(current));
   auto line_at = [&](std::size_t v) { return (along.holds(v) ? along.line(v) : line_of(v)).two_port(0.0); };
   in_blocks(
-      n, threads,
+      answered, threads,
       [&](std::size_t v) {  // an unforced vessel's: its line between its nodes' shifts, and its own current
         if (sourced[v]) return 0.0;
         const TwoPort y = line_at(v);
@@ -392,6 +414,25 @@ void solve_mean_shift(const Network& net, const Blood& blood, std::span<const Tu
       });
   for (std::size_t node = 0; node < nodes; ++node) node_pressure[node] += x[node].real();
 }
+
+// The plain solve at w = 0 with the mean shift's currents (the boundaries' waveforms held
+// still): the whole system's.
+struct WholeAtZero {
+  const Network& net;
+  const HarmonicNetwork& network;
+  const RunBoundaries& boundaries;
+  const std::vector<FourierSeries>& series;
+  const LineAbout& line_of;
+  HarmonicWorkspace& work;
+  int threads;
+  const std::vector<Complex>& operator()(std::vector<double>&& current) const {
+    std::vector<FourierSeries> none = series;
+    for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
+    solve_harmonic(net, network, boundaries, none, line_of, 0, 0.0, work, threads, current);
+    std::vector<double>().swap(current);  // its 8 B a node gone before the vessels' shifts
+    return work.current;
+  }
+};
 
 }  // namespace
 
@@ -420,8 +461,9 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
         variance[static_cast<std::size_t>(i)] += 0.5 * std::norm(p[static_cast<std::size_t>(i)]);
     }
     HarmonicWorkspace work;
-    solve_mean_shift(net, blood, laws, viscosity, boundaries, network, series, line_of, out, shift_sources, variance,
-                     node_shift, work, threads,
+    const VesselList every{nullptr, net.vessel_count()};
+    solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, out, shift_sources, variance, node_shift, threads,
+                     every, every, WholeAtZero{net, network, boundaries, series, line_of, work, threads},
                      [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
                        out.mean_flow_[v] += dq;
                        if (!shift_sources[v]) return;  // its nodes' means move below, and it with them
@@ -510,7 +552,9 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
     along.node_pressure_.push_back(std::move(kept));
   }
   if (shift_mean)
-    solve_mean_shift(net, blood, laws, viscosity, boundaries, network, series, line_of, along, keep, variance, out.node_pressure, work, threads,
+    solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, along, keep, variance, out.node_pressure, threads,
+                     VesselList{nullptr, net.vessel_count()}, VesselList{nullptr, net.vessel_count()},
+                     WholeAtZero{net, network, boundaries, series, line_of, work, threads},
                      [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
                        out.middle_flow[v] += dq;
                        if (!along.holds(v)) return;
