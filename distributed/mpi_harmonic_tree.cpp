@@ -43,7 +43,11 @@ MpiHarmonicTree::MpiHarmonicTree(MPI_Comm comm, const TreeCut& cut)
   std::unordered_map<std::int32_t, std::int32_t> own;
   for (std::size_t i = share_size_; i < nodes_.size(); ++i) own.emplace(nodes_[i], static_cast<std::int32_t>(i - share_size_));
   for (const auto& roots : cut.roots)
-    for (const std::int32_t r : roots) parent_of_slot_.push_back(own.at(cut.parent[static_cast<std::size_t>(r)]));
+    for (const std::int32_t r : roots) {
+      parent_of_slot_.push_back(own.at(cut.parent[static_cast<std::size_t>(r)]));
+      share_roots_.push_back(r);
+    }
+  share_root_potential_.assign(share_roots_.size(), 0.0);
 }
 
 void MpiHarmonicTree::solve(std::span<const Complex> shunt, std::span<const EdgeToParent> edge, std::span<Complex> x) {
@@ -66,6 +70,7 @@ void MpiHarmonicTree::solve(std::span<const Complex> shunt, std::span<const Edge
     std::vector<Complex> root_x(parent_of_slot_.size());
     top_[0].solve(shunt.subspan(share_size_), x.subspan(share_size_), edge.subspan(share_size_), as_complex(messages), top_x,
                   root_x);
+    std::copy(root_x.begin(), root_x.end(), share_root_potential_.begin());
     for (std::size_t slot = 0; slot < root_x.size(); ++slot) {
       const Complex p = top_x[static_cast<std::size_t>(parent_of_slot_[slot])];
       answers[4 * slot] = root_x[slot].real();

@@ -29,6 +29,10 @@ class MpiHarmonicTree {
   // after the last solve: what a vessel into the share needs of the node above it.
   std::span<const std::int32_t> root_parents() const { return root_parents_; }
   std::span<const Complex> root_parent_potentials() const { return root_parent_potential_; }
+  // On the top's rank, every share root (TreeCut::roots, rank after rank) and its potential
+  // after the last solve; empty elsewhere.
+  std::span<const std::int32_t> share_roots() const { return share_roots_; }
+  std::span<const Complex> share_root_potentials() const { return share_root_potential_; }
 
   // Per node of this rank: its shunt (its diagonal before any edge's term), its edge to its
   // parent (unread at a root of the forest), its current in and its potential out.
@@ -46,6 +50,8 @@ class MpiHarmonicTree {
   HarmonicTreeShare share_;
   std::vector<HarmonicTreeTop> top_;          // one, on the top's rank
   std::vector<std::int32_t> parent_of_slot_;  // top's rank: per share root, its parent among the top's own nodes
+  std::vector<std::int32_t> share_roots_;     // top's rank: every share root, by slot
+  std::vector<Complex> share_root_potential_;
   RootExchange exchange_;
 };
 

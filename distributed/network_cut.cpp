@@ -1,5 +1,6 @@
 #include "distributed/network_cut.hpp"
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +27,17 @@ TreeCut tree_cut(const Network& net, const Partition& partition) {
   } catch (const std::invalid_argument& e) {
     throw SettingError("ranks", placeholder("ranks") + ": the partition is not whole subtrees below a top: " + e.what());
   }
+}
+
+void check_one_partition(const Partition& partition) {
+  std::uint64_t hash = 14695981039346656037ull;  // FNV-1a over the ranks of the vessels
+  for (const std::int32_t r : partition.rank_of_vessel) hash = (hash ^ static_cast<std::uint32_t>(r)) * 1099511628211ull;
+  std::uint64_t least = hash, greatest = hash;
+  MPI_Allreduce(&hash, &least, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&hash, &greatest, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
+  if (least != greatest)
+    throw Collective<SettingError>("ranks", placeholder("ranks") + ": the ranks split the vessels differently (their "
+                                                "builds or METIS differ): run every rank from one build");
 }
 
 void refuse_floating_part_everywhere(const Network& net, std::int64_t node) {

@@ -19,6 +19,12 @@ namespace hemotree {
 // ranks than about the square root of an eighth of the vessels).
 TreeCut tree_cut(const Network& net, const Partition& partition);
 
+// Every rank computed the partition itself: the same one where every rank runs the same
+// build. Checked (a hash of it, its least and greatest over the ranks: collective), since
+// ranks that split the vessels differently would each solve a different system; refused on
+// every rank alike (SettingError "ranks").
+void check_one_partition(const Partition& partition);
+
 // steady/'s refusal of a tree whose part at `node` has no path to ground, thrown on every rank
 // alike (the distributed solve said it on every rank: mpi/session.hpp's Collective).
 [[noreturn]] void refuse_floating_part_everywhere(const Network& net, std::int64_t node);

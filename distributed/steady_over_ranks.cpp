@@ -89,17 +89,7 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
       cut.emplace(tree_cut(net, partition));  // refused, in words
     }
   });
-  // Every rank computed the partition itself: the same one where every rank runs the same
-  // build. Checked (a hash of it, the least and the greatest over the ranks), since ranks
-  // that split the vessels differently would each solve a different system.
-  std::uint64_t hash = 14695981039346656037ull;  // FNV-1a over the ranks of the vessels
-  for (const std::int32_t r : partition.rank_of_vessel) hash = (hash ^ static_cast<std::uint32_t>(r)) * 1099511628211ull;
-  std::uint64_t least = hash, greatest = hash;
-  MPI_Allreduce(&hash, &least, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(&hash, &greatest, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
-  if (least != greatest)
-    throw Collective<SettingError>("ranks", placeholder("ranks") + ": the ranks split the vessels differently (their "
-                                                "builds or METIS differ): run every rank from one build");
+  check_one_partition(partition);
   if (iterative) return solve_by_petsc(net, blood, inlet_flow, rows, partition);
 
   // This rank's share and its vessels' resistances (rigid), one solve.

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <exception>
 #include <functional>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -477,6 +478,89 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
                      });
     for (std::size_t node = 0; node < node_shift.size(); ++node) out.mean_node_pressure_[node] += node_shift[node];
   }
+  return out;
+}
+
+LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady,
+                                     const RunBoundaries& boundaries, int harmonics, int threads,
+                                     const std::function<bool(const VesselLine&)>& shift_source,
+                                     const HarmonicShare& share) {
+  if (harmonics < 1) throw std::invalid_argument("solve_linear_periodic: at least one harmonic");
+  LinearPeriodic out;
+  out.net_ = &net;
+  out.period_ = driving_waveform(net).period;
+  const LineAbout line_of{net, laws, viscosity, steady, friction_coefficient(blood.alpha), blood.density};
+  // What it holds: its vessels and ghosts, and their ends, each at a place of its own.
+  std::vector<std::int32_t> held;
+  std::merge(share.vessels.begin(), share.vessels.end(), share.ghosts.begin(), share.ghosts.end(), std::back_inserter(held));
+  out.kept_.assign(net.node_count(), -1);
+  out.kept_vessel_.assign(net.vessel_count(), -1);
+  std::vector<std::size_t> kept_node;
+  for (const std::int32_t vessel : held) {
+    const auto v = static_cast<std::size_t>(vessel);
+    out.kept_vessel_[v] = static_cast<std::int32_t>(out.mean_flow_.size());
+    out.mean_flow_.push_back(steady.flow[v]);
+    for (const std::int64_t node : {net.from[v], net.to[v]}) {
+      auto& slot = out.kept_[static_cast<std::size_t>(node)];
+      if (slot >= 0) continue;
+      slot = static_cast<std::int32_t>(kept_node.size());
+      kept_node.push_back(static_cast<std::size_t>(node));
+      out.mean_node_pressure_.push_back(steady.node_pressure[static_cast<std::size_t>(node)]);
+    }
+  }
+  out.line_.resize(held.size());
+  const auto held_count = static_cast<std::int64_t>(held.size());
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t i = 0; i < held_count; ++i)
+    out.line_[static_cast<std::size_t>(i)] = line_of(static_cast<std::size_t>(held[static_cast<std::size_t>(i)]));
+  const std::function<const VesselLine&(std::size_t)> line = [&](std::size_t v) -> const VesselLine& { return out.line(v); };
+  // A line for the node terms: a vessel ending at a held pressure may be another share's.
+  auto any_line = [&](std::size_t v) { return out.holds(v) ? out.line(v) : line_of(v); };
+  const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
+  const HarmonicNetwork network = harmonic_network(net, boundaries);
+  std::vector<Complex> shunt, current;
+  for (int k = 1; k <= harmonics; ++k) {
+    node_terms(net, network, boundaries, series, any_line, k, out.omega(k), shunt, current, {});
+    share.solve(out.omega(k), shunt, current, line);
+    std::vector<Complex> kept(kept_node.size());
+    for (std::size_t j = 0; j < kept_node.size(); ++j) kept[j] = current[kept_node[j]];
+    out.node_pressure_.push_back(std::move(kept));
+  }
+  if (!shift_source) return out;
+  std::vector<bool> sourced(net.vessel_count(), false);
+  share.on_every_share([&] {
+    for (const std::int32_t v : held) sourced[static_cast<std::size_t>(v)] = shift_source(out.line(static_cast<std::size_t>(v)));
+    for (const std::int32_t v : share.ghosts)
+      if (sourced[static_cast<std::size_t>(v)])
+        throw InputError("vessel " + std::to_string(net.id[static_cast<std::size_t>(v)]) +
+                         " carries a wave across the ranks' cut: run the linear periodic state on fewer ranks");
+  });
+  std::vector<double> variance(net.node_count(), 0.0);  // <p1^2> at each node it holds, as the whole sums it
+  for (const std::vector<Complex>& p : out.node_pressure_)
+    for (std::size_t j = 0; j < kept_node.size(); ++j) variance[kept_node[j]] += 0.5 * std::norm(p[j]);
+  std::vector<double> node_shift(net.node_count(), 0.0);
+  auto at_zero = [&](std::vector<double>&& extra) -> const std::vector<Complex>& {
+    std::vector<FourierSeries> none = series;
+    for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
+    node_terms(net, network, boundaries, none, any_line, 0, 0.0, shunt, current, extra);
+    std::vector<double>().swap(extra);
+    share.solve(0.0, shunt, current, line);
+    return current;
+  };
+  solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, out, sourced, variance, node_shift, threads,
+                   VesselList{&held, 0}, VesselList{&share.vessels, 0}, at_zero,
+                   [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
+                     out.mean_flow_[out.vessel_place(v)] += dq;
+                     if (!sourced[v]) return;
+                     const double last = static_cast<double>(profile.size() - 1);
+                     for (std::size_t i = 0; i < profile.size(); ++i) {
+                       const double s = static_cast<double>(i) / last;
+                       profile[i] -= (1 - s) * dx_from + s * dx_to;
+                     }
+                     out.mean_shift_[v] = std::move(profile);
+                   });
+  for (std::size_t j = 0; j < kept_node.size(); ++j) out.mean_node_pressure_[j] += node_shift[kept_node[j]];
   return out;
 }
 

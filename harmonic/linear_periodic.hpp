@@ -39,6 +39,7 @@
 namespace hemotree {
 
 struct PeriodicInstant;
+struct HarmonicShare;
 
 class LinearPeriodic {
  public:
@@ -58,6 +59,9 @@ class LinearPeriodic {
   // solution's; an instant's keeps its kept nodes and vessels only, by their places).
   const std::vector<double>& mean_node_pressure() const { return mean_node_pressure_; }
   const std::vector<double>& mean_flow() const { return mean_flow_; }
+  // The same of one node, one vessel (one the solve kept).
+  double mean_node_pressure(std::size_t node) const { return mean_node_pressure_[node_place(node)]; }
+  double mean_flow(std::size_t vessel) const { return mean_flow_[vessel_place(vessel)]; }
   // Harmonic k >= 1 at a node, and in a vessel at a fraction s of its length from `from`
   // (one the solve kept).
   Complex node_pressure(int k, std::size_t node) const {
@@ -79,6 +83,10 @@ class LinearPeriodic {
                                               const ViscosityTable&, const SteadyFlow&,
                                               const RunBoundaries&, int, int,
                                               const std::function<bool(const VesselLine&)>&);
+  friend LinearPeriodic solve_linear_periodic(const Network&, const Blood&, std::span<const TubeLaw>,
+                                              const ViscosityTable&, const SteadyFlow&,
+                                              const RunBoundaries&, int, int,
+                                              const std::function<bool(const VesselLine&)>&, const HarmonicShare&);
   friend PeriodicInstant solve_periodic_instant(const Network&, const Blood&, std::span<const TubeLaw>,
                                                 const ViscosityTable&, const SteadyFlow&,
                                                 const RunBoundaries&, int, double,
@@ -121,6 +129,38 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
                                      const ViscosityTable& viscosity, const SteadyFlow& steady,
                                      const RunBoundaries& boundaries, int harmonics, int threads = 1,
                                      const std::function<bool(const VesselLine&)>& shift_source = {});
+
+// A share of the network whose linear periodic state this process solves with others, each
+// harmonic's nodal system over them all (distributed/linear_periodic_over_ranks.hpp).
+struct HarmonicShare {
+  // Its vessels, increasing: those it answers for (their lines, amplitudes and shifts).
+  std::vector<std::int32_t> vessels;
+  // Vessels it does not answer for but whose terms it sums at its nodes, increasing (a
+  // distributed top's edges into the shares): with them every vessel at a node it holds is
+  // its own or a ghost, so every sum at such a node runs over the whole network's terms.
+  std::vector<std::int32_t> ghosts;
+  // One harmonic's nodal system at angular frequency w, solved with every other share:
+  // per node of the network its shunt and current (this share's nodes' entries as the whole
+  // system's), the lines of its vessels (line(v)); the amplitudes at the ends of its vessels
+  // and ghosts into current.
+  std::function<void(double w, std::span<const Complex> shunt, std::span<Complex> current,
+                     const std::function<const VesselLine&(std::size_t)>& line)>
+      solve;
+  // Runs a step that may fail on one share alone so that its failure is every share's
+  // (mpi/session.hpp's on_every_rank).
+  std::function<void(const std::function<void()>&)> on_every_share;
+};
+
+// The linear periodic state of a share: the lines, amplitudes, mean and shift of its vessels
+// and ghosts (those it holds: `holds`), each the bits of the one-process solve. steady: the
+// distended state's pressures at the ends of its vessels and ghosts and their flows. Every
+// share calls it alike. A ghost that is a shift source (a 1D vessel across a cut) is refused
+// on every share: InputError.
+LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                     const ViscosityTable& viscosity, const SteadyFlow& steady,
+                                     const RunBoundaries& boundaries, int harmonics, int threads,
+                                     const std::function<bool(const VesselLine&)>& shift_source,
+                                     const HarmonicShare& share);
 
 // The linear periodic state at one instant t: every node's pressure and every vessel's flow
 // at its middle, summed harmonic by harmonic as each is solved, and the whole state (`along`)

@@ -1,0 +1,114 @@
+#include "distributed/linear_periodic_over_ranks.hpp"
+
+#include <algorithm>
+#include <exception>
+
+#include <mpi.h>
+
+#include "core/errors.hpp"
+#include "distributed/distended_over_ranks.hpp"
+#include "distributed/harmonic_tree_share.hpp"
+#include "distributed/mpi_harmonic_tree.hpp"
+#include "formats/run_boundaries.hpp"
+#include "mpi/session.hpp"
+
+namespace hemotree {
+
+namespace {
+
+std::vector<int> root_counts(const TreeCut& cut) {
+  std::vector<int> out;
+  for (const auto& roots : cut.roots) out.push_back(static_cast<int>(roots.size()));
+  return out;
+}
+
+// The top's rank receives, per share root r, the steady pressure at r and the flow of its
+// vessel into the top (the ghosts' steady state), into its whole-network arrays.
+void send_ghosts_to_top(const TreeCut& cut, SteadyFlow& steady) {
+  const int rank = world_rank();
+  RootExchange exchange(MPI_COMM_WORLD, cut.top_rank, root_counts(cut));
+  std::vector<double> message;
+  for (const std::int32_t r : cut.roots[static_cast<std::size_t>(rank)]) {
+    const auto node = static_cast<std::size_t>(r);
+    message.push_back(steady.node_pressure[node]);
+    message.push_back(steady.flow[static_cast<std::size_t>(cut.parent_edge[node])]);
+  }
+  exchange.round(message, nullptr, 2, 0,
+                 [&](std::span<const double> all, std::span<double>) {
+                   std::size_t slot = 0;
+                   for (const auto& roots : cut.roots)
+                     for (const std::int32_t r : roots) {
+                       const auto node = static_cast<std::size_t>(r);
+                       steady.node_pressure[node] = all[2 * slot];
+                       steady.flow[static_cast<std::size_t>(cut.parent_edge[node])] = all[2 * slot + 1];
+                       ++slot;
+                     }
+                   return RootExchange::solved;
+                 },
+                 "the ghosts' steady state");
+}
+
+}  // namespace
+
+LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const TreeCut& cut, const Blood& blood,
+                                                         std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                                                         int harmonics, int threads,
+                                                         const std::function<bool(const VesselLine&)>& shift_source) {
+  const RunBoundaries boundaries(net);
+  on_every_rank([&] {
+    for (std::size_t i = 0; i < boundaries.size(); ++i)
+      if (boundaries.type(i) == BoundaryType::pressure)
+        throw InputError("node " + std::to_string(net.node_id[static_cast<std::size_t>(boundaries.node(i))]) +
+                         " holds a pressure: the linear periodic state over ranks takes a tree fed by its inflow into "
+                         "outlets; run this network on one rank");
+  });
+  DistendedOverRanks distended = solve_distended_steady_flow_over_ranks(
+      net, cut, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0, threads);
+  send_ghosts_to_top(cut, distended.flow);
+  MpiHarmonicTree system(MPI_COMM_WORLD, cut);
+  const bool top = world_rank() == cut.top_rank;
+
+  HarmonicShare share;
+  share.vessels = distended.vessels;
+  std::sort(share.vessels.begin(), share.vessels.end());
+  if (top) {
+    for (int r = 0; r < cut.ranks; ++r)  // the vessels into the other ranks' shares
+      if (r != cut.top_rank)
+        for (const std::int32_t root : cut.roots[static_cast<std::size_t>(r)])
+          share.ghosts.push_back(cut.parent_edge[static_cast<std::size_t>(root)]);
+    std::sort(share.ghosts.begin(), share.ghosts.end());
+  }
+  const std::span<const std::int32_t> nodes = system.nodes();
+  std::vector<Complex> shunt_here(nodes.size()), x_here(nodes.size());
+  std::vector<EdgeToParent> edge_here(nodes.size());
+  share.solve = [&](double w, std::span<const Complex> shunt, std::span<Complex> current,
+                    const std::function<const VesselLine&(std::size_t)>& line) {
+    const auto count = static_cast<std::int64_t>(nodes.size());
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+    for (std::int64_t k = 0; k < count; ++k) {
+      const auto node = static_cast<std::size_t>(nodes[static_cast<std::size_t>(k)]);
+      const std::int32_t v = cut.parent_edge[node];
+      edge_here[static_cast<std::size_t>(k)] =
+          v >= 0 ? EdgeToParent::of(line(static_cast<std::size_t>(v)).two_port(w),
+                                    net.from[static_cast<std::size_t>(v)] == static_cast<std::int64_t>(node))
+                 : EdgeToParent{};
+    }
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      shunt_here[k] = shunt[static_cast<std::size_t>(nodes[k])];
+      x_here[k] = current[static_cast<std::size_t>(nodes[k])];
+    }
+    system.solve(shunt_here, edge_here, x_here);
+    for (std::size_t k = 0; k < nodes.size(); ++k) current[static_cast<std::size_t>(nodes[k])] = x_here[k];
+    for (std::size_t k = 0; k < system.root_parents().size(); ++k)
+      current[static_cast<std::size_t>(system.root_parents()[k])] = system.root_parent_potentials()[k];
+    for (std::size_t k = 0; k < system.share_roots().size(); ++k)
+      current[static_cast<std::size_t>(system.share_roots()[k])] = system.share_root_potentials()[k];
+  };
+  share.on_every_share = [](const std::function<void()>& step) { on_every_rank(step); };
+  LinearPeriodicOverRanks out{solve_linear_periodic(net, blood, laws, viscosity, distended.flow, boundaries, harmonics,
+                                                    threads, shift_source, share),
+                              share.vessels, std::vector<std::int32_t>(nodes.begin(), nodes.end()), system.traffic()};
+  return out;
+}
+
+}  // namespace hemotree

@@ -1,0 +1,42 @@
+// The linear periodic state (harmonic/linear_periodic.hpp) of a tree network over the ranks of
+// the MPI session: the distended steady state over them (distributed/distended_over_ranks.hpp),
+// then each rank's share of the vessels' lines, of each harmonic's nodal system and of the mean
+// shift's one solve at w = 0, every solve the distributed elimination
+// (distributed/mpi_harmonic_tree.hpp). The top's rank holds the vessels into the shares as
+// ghosts (the steady state at their share ends sent to it once; their amplitudes there are its
+// own solve's), so that every sum at a node of the top runs over the whole network's terms in
+// the whole's order. Each rank ends with its share of the one-process solution, bit for bit,
+// for any number of ranks. Collective.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "distributed/root_exchange.hpp"
+#include "distributed/tree_share.hpp"
+#include "formats/network.hpp"
+#include "harmonic/linear_periodic.hpp"
+#include "physics/blood.hpp"
+#include "physics/tube_law.hpp"
+#include "physics/viscosity_table.hpp"
+
+namespace hemotree {
+
+struct LinearPeriodicOverRanks {
+  LinearPeriodic periodic;                   // what this rank holds of it (periodic.holds)
+  std::vector<std::int32_t> vessels, nodes;  // this rank's: increasing vessels, its nodes (TreeCut::held_nodes)
+  RootExchange::Traffic traffic;             // this rank's exchanges in the harmonics' solves
+};
+
+// cut: the network's (distributed/network_cut.hpp), the same on every rank. The arguments of
+// the one-process solve_linear_periodic (the steady state is solved here, at the inlet's mean
+// flow). InputError as there, on every rank alike; a network with a pressure held at a node
+// is refused (its harmonic system is not the cut's forest): InputError.
+LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const TreeCut& cut, const Blood& blood,
+                                                         std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                                                         int harmonics, int threads,
+                                                         const std::function<bool(const VesselLine&)>& shift_source);
+
+}  // namespace hemotree

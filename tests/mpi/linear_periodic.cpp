@@ -1,0 +1,122 @@
+// Under mpirun (ctest label mpi, 1 to 4 ranks): the linear periodic state of a grown tree (a
+// half-sine inflow at its root, RCR outlets at its leaves, the mean shift forced in its
+// largest vessels) over the ranks (distributed/linear_periodic_over_ranks.hpp) gives each rank
+// its share of the one-process solve_linear_periodic bit for bit: every own vessel's line,
+// mean flow, middle amplitudes and shifted mean pressure, every own node's amplitudes and
+// mean; forcing a vessel across the cut is refused on every rank alike. Exit 0 when every
+// rank agrees.
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <mpi.h>
+
+#include "core/errors.hpp"
+#include "distributed/linear_periodic_over_ranks.hpp"
+#include "distributed/network_cut.hpp"
+#include "../grown_trees.hpp"
+#include "mpi/session.hpp"
+#include "partition/partition.hpp"
+#include "steady/vessel_laws.hpp"
+
+using namespace hemotree;
+
+namespace {
+
+bool same(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
+bool same(std::complex<double> a, std::complex<double> b) { return same(a.real(), b.real()) && same(a.imag(), b.imag()); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int failures = 0;
+  {
+    MpiSession session(argc, argv);
+    const int ranks = world_size(), rank = world_rank();
+    Network net = test_networks::grown_tree();
+    std::vector<unsigned char> leaves_from(net.node_count(), 0);
+    for (std::size_t v = 0; v < net.vessel_count(); ++v) leaves_from[static_cast<std::size_t>(net.from[v])] = 1;
+    for (std::size_t v = 0; v < net.vessel_count(); ++v)
+      if (!leaves_from[static_cast<std::size_t>(net.to[v])]) {
+        Outlet o;
+        o.vessel = static_cast<std::int32_t>(v);
+        o.type = BoundaryType::rcr;
+        o.r1 = 4e12;
+        o.r2 = 1.6e13;
+        o.c = 1e-14;
+        o.p_out = 1333.2;
+        net.outlets.push_back(o);
+      }
+    Waveform inflow;  // half sine, 1 s, 1 ul/min on average
+    inflow.mean = 1e-9 / 60;
+    net.inlet = Inlet{net.id[0], inflow};
+    const Blood blood = net.blood.value_or(Blood{});
+    const std::vector<TubeLaw> laws = vessel_laws(net, blood, 0.0, 0.1);
+    const ViscosityTable viscosity(blood);
+    const int harmonics = 6;
+    // The mean shift forced in the vessels of more than 0.8 of the root's lumen: the top's.
+    const double root_area = blood.density / [&] {
+      const SteadyFlow s = solve_distended_steady_flow(net, blood, laws, viscosity, inflow.mean_value(), nullptr);
+      return solve_linear_periodic(net, blood, laws, viscosity, s, RunBoundaries(net), 1).line(0).inertance;
+    }();
+    auto large = [&](const VesselLine& line) { return blood.density / line.inertance > 0.8 * root_area; };
+    const LinearPeriodic whole = solve_linear_periodic(net, blood, laws, viscosity, harmonics, 1, large);
+
+    const Partition partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), ranks);
+    const TreeCut cut = tree_cut(net, partition);
+    const LinearPeriodicOverRanks mine = solve_linear_periodic_over_ranks(net, cut, blood, laws, viscosity, harmonics, 1, large);
+    std::size_t differ = 0, shifted = 0;
+    std::size_t kinds[5] = {0, 0, 0, 0, 0};
+    for (const std::int32_t vessel : mine.vessels) {
+      const auto v = static_cast<std::size_t>(vessel);
+      const VesselLine &a = mine.periodic.line(v), &b = whole.line(v);
+      kinds[0] += !same(a.resistance, b.resistance) + !same(a.compliance, b.compliance) + !same(a.kappa, b.kappa) +
+                !same(a.mean_velocity, b.mean_velocity);
+      kinds[1] += !same(mine.periodic.mean_flow(v), whole.mean_flow()[v]);
+      for (const double s : {0.0, 0.3, 0.5, 1.0}) kinds[2] += !same(mine.periodic.mean_pressure_at(v, s), whole.mean_pressure_at(v, s));
+      for (int k = 1; k <= harmonics; ++k) {
+        const VesselLine::Point p = mine.periodic.middle(k, v), q = whole.middle(k, v);
+        kinds[3] += !same(p.pressure, q.pressure) + !same(p.flow, q.flow);
+      }
+      shifted += large(b);
+    }
+    for (const std::int32_t node : mine.nodes) {
+      const auto i = static_cast<std::size_t>(node);
+      differ += !same(mine.periodic.mean_node_pressure(i), whole.mean_node_pressure()[i]);
+      for (int k = 1; k <= harmonics; ++k) kinds[4] += !same(mine.periodic.node_pressure(k, i), whole.node_pressure(k, i));
+    }
+    for (const std::size_t k : kinds) differ += k;
+    if (differ != 0 || mine.vessels.empty()) {
+      ++failures;
+      std::fprintf(stderr, "rank %d: %zu numbers not the whole's bits (%zu vessels; lines %zu, mean flows %zu, mean pressures %zu, middles %zu, nodes %zu)\n",
+                   rank, differ, mine.vessels.size(), kinds[0], kinds[1], kinds[2], kinds[3], kinds[4]);
+    }
+    std::size_t counts[2] = {mine.vessels.size(), shifted}, all[2] = {0, 0};
+    MPI_Allreduce(counts, all, 2, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
+    if (all[0] != net.vessel_count() || all[1] == 0) {
+      ++failures;
+      std::fprintf(stderr, "rank %d: the ranks hold %zu vessels of %zu, %zu forced\n", rank, all[0], net.vessel_count(), all[1]);
+    }
+    // Every vessel forced: over several ranks a vessel across the cut is, refused everywhere.
+    if (ranks > 1) {
+      try {
+        solve_linear_periodic_over_ranks(net, cut, blood, laws, viscosity, 2, 1, [](const VesselLine&) { return true; });
+        ++failures;
+        std::fprintf(stderr, "rank %d: a forced vessel across the cut solved\n", rank);
+      } catch (const InputError& e) {
+        if (std::string(e.what()).find("carries a wave across the ranks' cut") == std::string::npos) {
+          ++failures;
+          std::fprintf(stderr, "rank %d: refused as %s\n", rank, e.what());
+        }
+      }
+    }
+    int total = 0;
+    MPI_Allreduce(&failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    failures = total;
+    if (rank == 0 && total == 0) std::printf("%d ranks: the whole linear periodic state's bits\n", ranks);
+  }
+  return failures == 0 ? 0 : 1;
+}
