@@ -63,10 +63,82 @@ double middle_mean_pressure(const Network& net, const TubeLaw& law, const Viscos
   return shifted + steady_profile_pressure(pa, pb, capacity(pa), capacity(pb), 0.5) - 0.5 * (pa + pb);
 }
 
-LinearCycle linear_cycle(const Network& net, const Blood& blood, const ViscosityTable& viscosity,
-                         std::span<const TubeLaw> laws, const LinearPeriodic& periodic, const SolverOptions& options,
-                         double analysis) {
-  const double k_friction = friction_coefficient(blood.alpha);
+// One vessel's results, of those the linear periodic state holds.
+struct LinearVessel {
+  VesselCycle cycle;
+  bool wave_travels = false;
+  double womersley = 0, pwv_elastic = 0, pwv_theory = 0;
+};
+
+class LinearVessels {
+ public:
+  LinearVessels(const Network& net, const Blood& blood, const ViscosityTable& viscosity, std::span<const TubeLaw> laws,
+                const LinearPeriodic& periodic, const SolverOptions& options, double analysis)
+      : net_(net), blood_(blood), viscosity_(viscosity), laws_(laws), periodic_(periodic), options_(options),
+        analysis_(analysis), k_friction_(friction_coefficient(blood.alpha)), extremes_(periodic.harmonics()),
+        analysed_(static_cast<int>(std::lround(analysis * periodic.period()))) {}
+
+  // Per thread: the harmonics at a vessel's middle and the extremes' samples.
+  struct Scratch {
+    std::vector<std::complex<double>> p, q;
+    std::vector<double> samples;
+  };
+  LinearVessel operator()(std::size_t v, Scratch& s) const {
+    const int harmonics = periodic_.harmonics();
+    const double period = periodic_.period(), omega = 2 * std::numbers::pi / period;
+    s.p.resize(static_cast<std::size_t>(harmonics));
+    s.q.resize(s.p.size());
+    const VesselLine& line = periodic_.line(v);
+    LinearVessel out;
+    VesselCycle& c = out.cycle;
+    const double area = blood_.density / line.inertance, radius = std::sqrt(area / std::numbers::pi);
+    const double mu = viscosity_(area);
+    for (int k = 1; k <= harmonics; ++k) {
+      const VesselLine::Point middle = periodic_.middle(k, v);
+      s.p[static_cast<std::size_t>(k - 1)] = middle.pressure;
+      s.q[static_cast<std::size_t>(k - 1)] = middle.flow;
+    }
+    const Extremes dp = extremes_(s.p, s.samples), dq = extremes_(s.q, s.samples);
+    c.mean_flow = periodic_.mean_flow(v);
+    c.mean_pressure = middle_mean_pressure(net_, laws_[v], viscosity_, k_friction_, periodic_, v);
+    c.systolic_pressure = c.mean_pressure + dp.greatest;
+    c.diastolic_pressure = c.mean_pressure + dp.least;
+    c.peak_flow = c.mean_flow + dq.greatest;
+    c.least_flow = c.mean_flow + dq.least;
+    const double u = c.mean_flow / area;
+    c.mean_wss = wall_shear_stress(mu, u, radius, blood_.alpha);  // linear in u: its cycle mean
+    c.reynolds = blood_.density * u * 2 * radius / mu;
+    const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
+    out.wave_travels = wave_travels(line, options_, omega, period);
+    const double w = 2 * std::numbers::pi * analysis_;
+    out.pwv_elastic = c0;
+    out.womersley = womersley_number(2 * radius, blood_.density, mu, w);
+    out.pwv_theory = womersley_wave(c0, out.womersley, w).phase_velocity;
+    return out;
+  }
+  // The measured wave speeds where the report gives them: where a wave travels, at the
+  // analysed harmonic when it is one of those solved.
+  bool measures_waves() const { return analysed_ >= 1 && analysed_ <= periodic_.harmonics(); }
+  WaveSpeeds wave_speeds(std::size_t v) const {
+    const auto points = periodic_.ends_and_middle(analysed_, v);
+    const double w = periodic_.omega(analysed_), length = periodic_.line(v).length;
+    return {phase_velocity(points[0].pressure, points[2].pressure, w, length),
+            phase_velocity(points[0].flow, points[2].flow, w, length)};
+  }
+
+ private:
+  const Network& net_;
+  const Blood& blood_;
+  const ViscosityTable& viscosity_;
+  std::span<const TubeLaw> laws_;
+  const LinearPeriodic& periodic_;
+  const SolverOptions& options_;
+  double analysis_, k_friction_;
+  TrigonometricExtremes extremes_;
+  int analysed_;
+};
+
+LinearCycle linear_cycle(const Network& net, const LinearVessels& results, const LinearPeriodic& periodic, int threads) {
   const std::size_t n = net.vessel_count();
   LinearCycle out;
   out.cycle.vessels.resize(n);  // every number of each is set below
@@ -75,54 +147,24 @@ LinearCycle linear_cycle(const Network& net, const Blood& blood, const Viscosity
   out.womersley.assign(n, 0.0);
   out.pwv_elastic.assign(n, 0.0);
   out.pwv_theory.assign(n, 0.0);
-  const int harmonics = periodic.harmonics();
-  const double period = periodic.period(), omega = 2 * std::numbers::pi / period;
-  const int analysed = static_cast<int>(std::lround(analysis * period));
-  const TrigonometricExtremes extremes(harmonics);
   const auto vessels = static_cast<std::int64_t>(n);
-#pragma omp parallel num_threads(options.threads) if (options.threads > 1)
+#pragma omp parallel num_threads(threads) if (threads > 1)
   {
-    std::vector<std::complex<double>> p(static_cast<std::size_t>(harmonics)), q(p.size());
-    std::vector<double> scratch;
+    LinearVessels::Scratch scratch;
 #pragma omp for schedule(dynamic, 1024)
     for (std::int64_t i = 0; i < vessels; ++i) {
       const auto v = static_cast<std::size_t>(i);
-      const VesselLine& line = periodic.line(v);
-      VesselCycle& c = out.cycle.vessels[v];
-      const double area = blood.density / line.inertance, radius = std::sqrt(area / std::numbers::pi);
-      const double mu = viscosity(area);
-      for (int k = 1; k <= harmonics; ++k) {
-        const VesselLine::Point middle = periodic.middle(k, v);
-        p[static_cast<std::size_t>(k - 1)] = middle.pressure;
-        q[static_cast<std::size_t>(k - 1)] = middle.flow;
-      }
-      const Extremes dp = extremes(p, scratch), dq = extremes(q, scratch);
-      c.mean_flow = periodic.mean_flow()[v];
-      c.mean_pressure = middle_mean_pressure(net, laws[v], viscosity, k_friction, periodic, v);
-      c.systolic_pressure = c.mean_pressure + dp.greatest;
-      c.diastolic_pressure = c.mean_pressure + dp.least;
-      c.peak_flow = c.mean_flow + dq.greatest;
-      c.least_flow = c.mean_flow + dq.least;
-      const double u = c.mean_flow / area;
-      c.mean_wss = wall_shear_stress(mu, u, radius, blood.alpha);  // linear in u: its cycle mean
-      c.reynolds = blood.density * u * 2 * radius / mu;
-      const double c0 = 1 / std::sqrt(line.inertance * line.compliance);
-      out.wave_travels[v] = wave_travels(line, options, omega, period);
-      const double w = 2 * std::numbers::pi * analysis;
-      out.pwv_elastic[v] = c0;
-      out.womersley[v] = womersley_number(2 * radius, blood.density, mu, w);
-      out.pwv_theory[v] = womersley_wave(c0, out.womersley[v], w).phase_velocity;
+      const LinearVessel r = results(v, scratch);
+      out.cycle.vessels[v] = r.cycle;
+      out.wave_travels[v] = r.wave_travels;
+      out.womersley[v] = r.womersley;
+      out.pwv_elastic[v] = r.pwv_elastic;
+      out.pwv_theory[v] = r.pwv_theory;
     }
   }
-  // The measured wave speeds where the report gives them: where a wave travels.
-  if (analysed >= 1 && analysed <= harmonics)
+  if (results.measures_waves())
     for (std::size_t v = 0; v < n; ++v)
-      if (out.wave_travels[v]) {
-        const auto points = periodic.ends_and_middle(analysed, v);
-        const double w = periodic.omega(analysed), length = periodic.line(v).length;
-        out.cycle.waves.emplace_back(v, WaveSpeeds{phase_velocity(points[0].pressure, points[2].pressure, w, length),
-                                                   phase_velocity(points[0].flow, points[2].flow, w, length)});
-      }
+      if (out.wave_travels[v]) out.cycle.waves.emplace_back(v, results.wave_speeds(v));
   return out;
 }
 
@@ -156,7 +198,8 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   const LinearPeriodic periodic =
       solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics, options.threads,
                             [&](const VesselLine& line) { return wave_travels(line, options, omega, driving.period); });
-  const LinearCycle linear = linear_cycle(net, blood, viscosity, laws, periodic, options, analysis);
+  const LinearCycle linear =
+      linear_cycle(net, LinearVessels(net, blood, viscosity, laws, periodic, options, analysis), periodic, options.threads);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   const std::size_t n = net.vessel_count();
