@@ -38,9 +38,11 @@ std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> ra
   return static_cast<std::size_t>(std::count(cut.begin(), cut.end(), std::uint8_t{1}));
 }
 
-Partition partition_network(const Network& net, std::span<const double> cost, int ranks) {
+Partition partition_network(const Network& net, std::span<const double> cost, int ranks,
+                            std::span<const std::uint8_t> on_top) {
   const std::size_t n = net.vessel_count();
   if (cost.size() != n) throw std::invalid_argument("partition_network: one cost per vessel");
+  if (!on_top.empty() && on_top.size() != n) throw std::invalid_argument("partition_network: on_top: a byte per vessel");
   if (ranks < 1)
     throw SettingError("ranks", placeholder("ranks") + " must be at least 1 (got " + std::to_string(ranks) + ")");
   if (n == 0) throw SettingError("ranks", placeholder("ranks") + ": the network has no vessels to split");
@@ -54,7 +56,7 @@ Partition partition_network(const Network& net, std::span<const double> cost, in
   if (ranks == 1) {
     p.rank_of_vessel.assign(n, 0);
   } else {
-    p = is_forest(net) ? partition_subtrees(net, cost, ranks) : partition_with_metis(net, cost, ranks);
+    p = is_forest(net) ? partition_subtrees(net, cost, ranks, on_top) : partition_with_metis(net, cost, ranks);
   }
   p.ranks = ranks;
   p.cost.assign(static_cast<std::size_t>(ranks), 0.0);

@@ -41,8 +41,11 @@ const char* to_string(Partition::Method method);  // "one rank", "subtrees", "ME
 
 // P in [1, vessel count]: SettingError "ranks" for P < 1, for more ranks than vessels, and
 // for a partition that would leave a rank without a vessel. cost: one positive number per
-// vessel.
-Partition partition_network(const Network& net, std::span<const double> cost, int ranks);
+// vessel. on_top (a tree's, where given: a byte per vessel): the vessels to keep on the top,
+// with every vessel above them (a distributed run's vessels that no cut may cross: the
+// linear periodic state's forced 1D vessels); ignored by METIS.
+Partition partition_network(const Network& net, std::span<const double> cost, int ranks,
+                            std::span<const std::uint8_t> on_top = {});
 
 // Nodes whose vessels lie on more than one rank.
 std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> rank_of_vessel);

@@ -4,6 +4,7 @@
 // METIS on looped networks, the cut nodes counted again here, the same answer every time, and
 // the refusals.
 #include <algorithm>
+#include <cstdint>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -84,6 +85,36 @@ TEST(Partition, ATreeIntoWholeSubtreesWithinTheBoundOfItsPieces) {
     // The same partition every time.
     EXPECT_EQ(partition_network(net, cost, ranks).rank_of_vessel, p.rank_of_vessel);
   }
+}
+
+// Vessels asked for on the top (a distributed run's forced 1D vessels) lie there with every
+// vessel above them, the rest still whole subtrees on the ranks.
+TEST(Partition, VesselsAskedForOnTheTopLieThereWithThoseAboveThem) {
+  const Network net = grown_tree();
+  const std::vector<double> cost(net.vessel_count(), 1.0);
+  const Children children = children_of(net);
+  std::vector<std::int32_t> parent(net.vessel_count(), -1);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    for (std::int64_t c = children.offset[v]; c < children.offset[v + 1]; ++c)
+      parent[static_cast<std::size_t>(children.index[c])] = static_cast<std::int32_t>(v);
+  // Two vessels deep in the tree, on different branches.
+  std::vector<std::uint8_t> on_top(net.vessel_count(), 0);
+  const std::size_t deep[] = {net.vessel_count() / 3, 2 * net.vessel_count() / 3};
+  for (const std::size_t v : deep) on_top[v] = 1;
+  const Partition plain = partition_network(net, cost, 4);
+  const Partition p = partition_network(net, cost, 4, on_top);
+  expect_consistent(net, cost, p);
+  const std::set<std::int32_t> top(p.top.begin(), p.top.end());
+  for (const std::size_t v : deep) {
+    EXPECT_FALSE(std::count(plain.top.begin(), plain.top.end(), static_cast<std::int32_t>(v))) << "already on the top";
+    for (std::int32_t u = static_cast<std::int32_t>(v); u >= 0; u = parent[static_cast<std::size_t>(u)])
+      EXPECT_TRUE(top.count(u)) << "vessel " << u << " above " << v;
+  }
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    for (std::int64_t c = children.offset[v]; c < children.offset[v + 1]; ++c)
+      if (p.rank_of_vessel[static_cast<std::size_t>(children.index[c])] != p.rank_of_vessel[v])
+        EXPECT_TRUE(top.count(static_cast<std::int32_t>(v))) << "vessel " << v;
+  EXPECT_THROW(partition_network(net, cost, 4, std::vector<std::uint8_t>(3, 1)), std::invalid_argument);
 }
 
 TEST(Partition, BalancesCostNotCount) {
