@@ -2,13 +2,18 @@
 
 #include <algorithm>
 #include <exception>
+#include <optional>
+#include <tuple>
+#include <utility>
 
 #include <mpi.h>
 
 #include "core/errors.hpp"
+#include "core/setting_error.hpp"
 #include "distributed/distended_over_ranks.hpp"
 #include "distributed/harmonic_tree_share.hpp"
 #include "distributed/mpi_harmonic_tree.hpp"
+#include "distributed/network_cut.hpp"
 #include "formats/run_boundaries.hpp"
 #include "mpi/session.hpp"
 
@@ -48,9 +53,60 @@ void send_ghosts_to_top(const TreeCut& cut, SteadyFlow& steady) {
                  "the ghosts' steady state");
 }
 
+// The vessels split over the ranks by whole subtrees (one a vessel), those marked kept on the
+// top, and the tree cut by it; refusals in words on every rank alike.
+std::pair<Partition, TreeCut> split(const Network& net, std::span<const std::uint8_t> on_top) {
+  Partition partition;
+  std::optional<TreeCut> cut;
+  on_every_rank([&] {
+    try {
+      partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), world_size(), on_top);
+    } catch (const SettingError& e) {
+      if (on_top.empty()) throw;
+      const auto kept = std::count(on_top.begin(), on_top.end(), std::uint8_t{1});
+      throw SettingError(e.setting(), e.message() + " (the " + std::to_string(kept) +
+                                          " vessels a wave travels in stay on one rank, with those above them)");
+    }
+    cut.emplace(tree_cut(net, partition));  // loops, a spread top: refused in words
+  });
+  check_one_partition(partition);
+  return {std::move(partition), std::move(*cut)};
+}
+
+// Every rank's forced vessels, known to every rank, where one crosses from the top's rank into
+// another's share: a byte per vessel of the network for the next split, or empty
+// where none crosses.
+std::vector<std::uint8_t> forced_across(const Network& net, const TreeCut& cut, const Blood& blood,
+                                        std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                                        const DistendedOverRanks& distended,
+                                        const std::function<bool(const VesselLine&)>& shift_source) {
+  std::vector<std::int32_t> mine;  // every forced vessel of this rank
+  on_every_rank([&] {
+    for (const std::int32_t v : distended.vessels)
+      if (shift_source(loaded_line(net, blood, laws, viscosity, distended.flow, static_cast<std::size_t>(v))))
+        mine.push_back(v);
+  });
+  int count = static_cast<int>(mine.size());
+  const int ranks = world_size();
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(static_cast<std::size_t>(ranks), 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<std::int32_t> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_INT32_T, all.data(), counts.data(), offsets.data(), MPI_INT32_T, MPI_COMM_WORLD);
+  std::vector<std::uint8_t> forced(net.vessel_count(), 0);
+  bool crosses = false;
+  for (const std::int32_t v : all) forced[static_cast<std::size_t>(v)] = 1;
+  for (int rank = 0; rank < cut.ranks; ++rank)  // the vessels into another rank's share than the top's
+    if (rank != cut.top_rank)
+      for (const std::int32_t r : cut.roots[static_cast<std::size_t>(rank)])
+        crosses |= forced[static_cast<std::size_t>(cut.parent_edge[static_cast<std::size_t>(r)])] != 0;
+  if (!crosses) forced.clear();
+  return forced;
+}
+
 }  // namespace
 
-LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const TreeCut& cut, const Blood& blood,
+LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const Blood& blood,
                                                          std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                                                          int harmonics, int threads,
                                                          const std::function<bool(const VesselLine&)>& shift_source) {
@@ -62,8 +118,16 @@ LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, con
                          " holds a pressure: the linear periodic state over ranks takes a tree fed by its inflow into "
                          "outlets; run this network on one rank");
   });
-  DistendedOverRanks distended = solve_distended_steady_flow_over_ranks(
-      net, cut, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0, threads);
+  const double inflow = net.inlet ? net.inlet->waveform.mean_value() : 0.0;
+  auto [partition, cut] = split(net, {});
+  DistendedOverRanks distended = solve_distended_steady_flow_over_ranks(net, cut, blood, laws, viscosity, inflow, threads);
+  if (shift_source) {
+    const std::vector<std::uint8_t> forced = forced_across(net, cut, blood, laws, viscosity, distended, shift_source);
+    if (!forced.empty()) {
+      std::tie(partition, cut) = split(net, forced);
+      distended = solve_distended_steady_flow_over_ranks(net, cut, blood, laws, viscosity, inflow, threads);
+    }
+  }
   send_ghosts_to_top(cut, distended.flow);
   MpiHarmonicTree system(MPI_COMM_WORLD, cut);
   const bool top = world_rank() == cut.top_rank;
@@ -105,10 +169,10 @@ LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, con
       current[static_cast<std::size_t>(system.share_roots()[k])] = system.share_root_potentials()[k];
   };
   share.on_every_share = [](const std::function<void()>& step) { on_every_rank(step); };
-  LinearPeriodicOverRanks out{solve_linear_periodic(net, blood, laws, viscosity, distended.flow, boundaries, harmonics,
-                                                    threads, shift_source, share),
-                              share.vessels, std::vector<std::int32_t>(nodes.begin(), nodes.end()), system.traffic()};
-  return out;
+  LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, distended.flow, boundaries, harmonics,
+                                                  threads, shift_source, share);
+  return {std::move(periodic), share.vessels, std::vector<std::int32_t>(nodes.begin(), nodes.end()), std::move(partition),
+          std::move(cut), system.traffic()};
 }
 
 }  // namespace hemotree

@@ -5,8 +5,9 @@
 // (distributed/mpi_harmonic_tree.hpp). The top's rank holds the vessels into the shares as
 // ghosts (the steady state at their share ends sent to it once; their amplitudes there are its
 // own solve's), so that every sum at a node of the top runs over the whole network's terms in
-// the whole's order. Each rank ends with its share of the one-process solution, bit for bit,
-// for any number of ranks. Collective.
+// the whole's order; the forced vessels (the run's 1D ones, whose mean shift reads both ends'
+// junctions) are kept on the top. Each rank ends with its share of the one-process solution,
+// bit for bit, for any number of ranks. Collective.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +18,7 @@
 #include "distributed/root_exchange.hpp"
 #include "distributed/tree_share.hpp"
 #include "formats/network.hpp"
+#include "partition/partition.hpp"
 #include "harmonic/linear_periodic.hpp"
 #include "physics/blood.hpp"
 #include "physics/tube_law.hpp"
@@ -27,14 +29,19 @@ namespace hemotree {
 struct LinearPeriodicOverRanks {
   LinearPeriodic periodic;                   // what this rank holds of it (periodic.holds)
   std::vector<std::int32_t> vessels, nodes;  // this rank's: increasing vessels, its nodes (TreeCut::held_nodes)
+  Partition partition;                       // the vessels' split (the same on every rank)
+  TreeCut cut;                               // and the tree's, by it
   RootExchange::Traffic traffic;             // this rank's exchanges in the harmonics' solves
 };
 
-// cut: the network's (distributed/network_cut.hpp), the same on every rank. The arguments of
-// the one-process solve_linear_periodic (the steady state is solved here, at the inlet's mean
-// flow). InputError as there, on every rank alike; a network with a pressure held at a node
-// is refused (its harmonic system is not the cut's forest): InputError.
-LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const TreeCut& cut, const Blood& blood,
+// The arguments of the one-process solve_linear_periodic (the steady state is solved here, at
+// the inlet's mean flow). The vessels are split by whole subtrees, one a vessel; where a
+// forced vessel (shift_source: a 1D vessel of the run) would cross the cut, the split is made
+// again with every forced vessel and those above it on the top, and the steady state solved
+// again on it (the same bits). InputError as the one-process solve, on every rank alike; a
+// network with loops, a spread top or a pressure held at a node (its harmonic system is not
+// the cut's forest) is refused: SettingError "ranks", InputError.
+LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const Blood& blood,
                                                          std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                                                          int harmonics, int threads,
                                                          const std::function<bool(const VesselLine&)>& shift_source);

@@ -123,6 +123,15 @@ TopPlaces top_places(const TreeCut& cut) {
   return out;
 }
 
+std::vector<std::int32_t> TreeCut::edge_ranks() const {
+  // A forest's every edge is one node's edge to its parent.
+  const auto edges = static_cast<std::size_t>(std::count_if(parent_edge.begin(), parent_edge.end(), [](std::int32_t e) { return e >= 0; }));
+  std::vector<std::int32_t> out(edges, top_rank);
+  for (std::size_t c = 0; c < parent_edge.size(); ++c)
+    if (const std::int32_t e = parent_edge[c]; e >= 0) out[static_cast<std::size_t>(e)] = owner[c] == top ? top_rank : owner[c];
+  return out;
+}
+
 namespace {
 
 NodalSystem system_of(const CutForest& forest) {

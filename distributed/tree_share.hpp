@@ -53,6 +53,8 @@ struct TreeCut {
   // Every rank's nodes as it holds them over MPI (distributed/mpi_tree_system.hpp): its
   // share's, then on the top's rank the top's; in one pass.
   std::vector<std::vector<std::int32_t>> held_nodes() const;
+  // Per edge, the rank that holds it: its lower node's (the top's rank for the top's edges).
+  std::vector<std::int32_t> edge_ranks() const;
 };
 
 // Some of a cut forest's nodes as a forest of their own: a share's, or the top's with every

@@ -176,6 +176,11 @@ void solve_harmonic(const Network& net, const HarmonicNetwork& h, const RunBound
 
 }  // namespace
 
+VesselLine loaded_line(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                       const ViscosityTable& viscosity, const SteadyFlow& steady, std::size_t v) {
+  return LineAbout{net, laws, viscosity, steady, friction_coefficient(blood.alpha), blood.density}(v);
+}
+
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, int harmonics, int threads,
                                      const std::function<bool(const VesselLine&)>& shift_source) {

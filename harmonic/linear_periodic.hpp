@@ -130,6 +130,11 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
                                      const RunBoundaries& boundaries, int harmonics, int threads = 1,
                                      const std::function<bool(const VesselLine&)>& shift_source = {});
 
+// Vessel v's line about a distended steady state (the one solve_linear_periodic takes it about):
+// its R', L', C' at the lumen of its mean pressure, its length, mean velocity and profile.
+VesselLine loaded_line(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                       const ViscosityTable& viscosity, const SteadyFlow& steady, std::size_t v);
+
 // A share of the network whose linear periodic state this process solves with others, each
 // harmonic's nodal system over them all (distributed/linear_periodic_over_ranks.hpp).
 struct HarmonicShare {

@@ -247,7 +247,8 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
       "--linear", linear,
       "the linear periodic state about the steady one as the result, harmonic by harmonic (every vessel a "
       "transmission line, every outlet its impedance): the same files as a run, in seconds on 100,000 vessels and about 12 s on 3.8 million from and to HDF5 (two threads), for "
-      "screening (docs/solver.md §6a gives its error against a run)");
+      "screening (docs/solver.md §6a gives its error against a run); under mpirun -np P over P ranks on a tree fed by its "
+      "inflow (the same files byte for byte)");
   app.add_option("--harmonics", options.periodic_harmonics,
                  "the inflow's harmonics the linear periodic state takes (--linear, --start periodic), in [1, 1000]")
       ->capture_default_str();
@@ -344,8 +345,10 @@ int run_command_line(CommandLine& line, int cores) {
     run_steady(net, config, observer);
     return 0;
   }
-  check_pulsatile(net, config);
-  for (const auto& t : line.probe_texts) config.probes.push_back(parse_probe(t, net));
+  on_every_rank([&] {
+    check_pulsatile(net, config);
+    for (const auto& t : line.probe_texts) config.probes.push_back(parse_probe(t, net));
+  });
   if (line.linear) {
     run_linear(net, config, observer);
     return 0;
@@ -362,9 +365,10 @@ int main(int argc, char** argv) {
   CommandLine line;
   const int cores = omp_get_num_procs();
   bind_options(app, line, cores);
-  // Over MPI ranks: the steady flow with red cells fixed, so far (issue 24).
+  // Over MPI ranks: the steady flow with red cells fixed and the linear periodic state, so far (issue 24).
   auto over_ranks = [&]() -> std::string {
-    if (!line.steady) return "hemosolve runs --steady over MPI ranks so far; its pulsatile and --linear runs are one process";
+    if (line.linear) return "";
+    if (!line.steady) return "hemosolve runs --steady and --linear over MPI ranks so far; its pulsatile runs are one process";
     if (line.red_cells != "fixed") return "--steady with --red-cells " + line.red_cells + " runs as one process";
     return "";
   };

@@ -2,17 +2,26 @@
 
 #include "solver/results_files.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <complex>
 #include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
 #include <limits>
 #include <numbers>
 #include <span>
 #include <vector>
 
 #include "core/units.hpp"
+#include "distributed/gather_rows.hpp"
+#include "distributed/linear_periodic_over_ranks.hpp"
+#include "distributed/network_cut.hpp"
+#include "mpi/session.hpp"
+#include "partition/partition.hpp"
 #include "harmonic/linear_periodic.hpp"
 #include "harmonic/trigonometric_extremes.hpp"
 #include "physics/poiseuille.hpp"
@@ -54,8 +63,8 @@ double middle_mean_pressure(const Network& net, const TubeLaw& law, const Viscos
                             const LinearPeriodic& periodic, std::size_t v) {
   const double shifted = periodic.mean_pressure_at(v, 0.5);
   if (net.is_tapered(v)) return shifted;
-  const double pa = periodic.mean_node_pressure()[static_cast<std::size_t>(net.from[v])];
-  const double pb = periodic.mean_node_pressure()[static_cast<std::size_t>(net.to[v])];
+  const double pa = periodic.mean_node_pressure(static_cast<std::size_t>(net.from[v]));
+  const double pb = periodic.mean_node_pressure(static_cast<std::size_t>(net.to[v]));
   auto capacity = [&](double p) {
     const double area = law.area(p);
     return flow_capacity(area, viscosity(area), k_friction);
@@ -182,24 +191,160 @@ ProbeRecorder linear_probes(const std::vector<TubeLaw>& laws, const LinearPeriod
   return recorder;
 }
 
+// The linear periodic state's results: the table's numbers, the probes' period, the mean
+// flows and node pressures (the boundaries'), the harmonics solved.
+struct LinearOutcome {
+  LinearCycle linear;
+  ProbeRecorder probes;
+  SteadyFlow mean;
+  int harmonics = 0;
+  std::string partition;  // over ranks: the partition and the exchanges, in one line
+};
+
+LinearOutcome linear_here(const Network& net, const Blood& blood, const ViscosityTable& viscosity,
+                          const std::vector<TubeLaw>& laws, const SolverOptions& options, double analysis,
+                          const std::function<bool(const VesselLine&)>& travels, const std::vector<Probe>& probes) {
+  const LinearPeriodic periodic =
+      solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics, options.threads, travels);
+  return {linear_cycle(net, LinearVessels(net, blood, viscosity, laws, periodic, options, analysis), periodic, options.threads),
+          linear_probes(laws, periodic, probes), SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0},
+          periodic.harmonics(), ""};
+}
+
+// Over the MPI session's ranks (distributed/linear_periodic_over_ranks.hpp): each rank the
+// results of its vessels, nodes and probes, gathered on rank 0 in the whole network's order,
+// each number the one-process run's. Rank 0's outcome; the others' empty.
+LinearOutcome linear_over_ranks(const Network& net, const Blood& blood, const ViscosityTable& viscosity,
+                                const std::vector<TubeLaw>& laws, const SolverOptions& options, double analysis,
+                                const std::function<bool(const VesselLine&)>& travels, const std::vector<Probe>& probes) {
+  const int ranks = world_size(), rank = world_rank();
+  const std::size_t n = net.vessel_count();
+  const LinearPeriodicOverRanks mine =
+      solve_linear_periodic_over_ranks(net, blood, laws, viscosity, options.periodic_harmonics, options.threads, travels);
+  const LinearPeriodic& periodic = mine.periodic;
+  const TreeCut* cut = &mine.cut;
+  const LinearVessels results(net, blood, viscosity, laws, periodic, options, analysis);
+  // Per vessel: its cycle's eight numbers, whether a wave travels, its Womersley number and
+  // wave speeds of theory, and the two measured where a wave travels (else NaN).
+  constexpr std::size_t width = 14;
+  std::vector<double> vessel_rows(width * mine.vessels.size());
+  const auto count = static_cast<std::int64_t>(mine.vessels.size());
+#pragma omp parallel num_threads(options.threads) if (options.threads > 1)
+  {
+    LinearVessels::Scratch scratch;
+#pragma omp for schedule(dynamic, 1024)
+    for (std::int64_t i = 0; i < count; ++i) {
+      const auto v = static_cast<std::size_t>(mine.vessels[static_cast<std::size_t>(i)]);
+      const LinearVessel r = results(v, scratch);
+      const WaveSpeeds speeds = r.wave_travels && results.measures_waves() ? results.wave_speeds(v) : WaveSpeeds{};
+      const VesselCycle& c = r.cycle;
+      const double row[width] = {c.mean_flow,   c.mean_pressure,  c.systolic_pressure, c.diastolic_pressure,
+                                 c.peak_flow,   c.least_flow,     c.mean_wss,          c.reynolds,
+                                 r.wave_travels ? 1.0 : 0.0, r.womersley, r.pwv_elastic, r.pwv_theory,
+                                 speeds.pressure, speeds.velocity};
+      std::copy(row, row + width, vessel_rows.begin() + static_cast<std::ptrdiff_t>(width) * i);
+    }
+  }
+  std::vector<double> node_rows;
+  for (const std::int32_t node : mine.nodes) node_rows.push_back(periodic.mean_node_pressure(static_cast<std::size_t>(node)));
+  // Each probe's period, by the rank that holds its vessel.
+  const std::vector<std::int32_t> vessel_rank = cut->edge_ranks();
+  constexpr std::size_t probe_width = 3 * (samples_per_period + 1);
+  std::vector<double> probe_rows;
+  for (const Probe& probe : probes) {
+    if (vessel_rank[probe.vessel] != rank) continue;
+    for (int m = 0; m <= samples_per_period; ++m) {
+      const double t = periodic.period() * m / samples_per_period;
+      const double p = periodic.pressure_at(probe.vessel, probe.x, t), q = periodic.flow_at(probe.vessel, probe.x, t);
+      probe_rows.insert(probe_rows.end(), {p, q, laws[probe.vessel].area(p)});
+    }
+  }
+  // Every rank's lists, on rank 0: its vessels (its nodes' edges to their parents, increasing),
+  // its nodes, its probes.
+  std::vector<std::vector<std::int32_t>> vessels_of, nodes_of, probes_of;
+  if (rank == 0) {
+    nodes_of = cut->held_nodes();
+    for (const auto& nodes : nodes_of) {
+      std::vector<std::int32_t> edges;
+      for (const std::int32_t node : nodes)
+        if (const std::int32_t e = cut->parent_edge[static_cast<std::size_t>(node)]; e >= 0) edges.push_back(e);
+      std::sort(edges.begin(), edges.end());
+      vessels_of.push_back(std::move(edges));
+    }
+    probes_of.resize(static_cast<std::size_t>(ranks));
+    for (std::size_t j = 0; j < probes.size(); ++j)
+      probes_of[static_cast<std::size_t>(vessel_rank[probes[j].vessel])].push_back(static_cast<std::int32_t>(j));
+  }
+  const std::vector<double> all_vessels = gather_rows(vessel_rows, width, vessels_of, n);
+  const std::vector<double> all_nodes = gather_rows(node_rows, 1, nodes_of, net.node_count());
+  const std::vector<double> all_probes = gather_rows(probe_rows, probe_width, probes_of, probes.size());
+  const RootExchange::Traffic& traffic = mine.traffic;
+  LinearOutcome out{{}, ProbeRecorder(probes), {}, periodic.harmonics(),
+                    describe(mine.partition) + "; the harmonics' exchanges on rank 0: " + std::to_string(traffic.calls) +
+                        " collective calls, " + std::to_string(traffic.bytes) + " bytes, " +
+                        format_quantity(traffic.seconds, "s")};
+  if (rank != 0) return out;
+  LinearCycle& linear = out.linear;
+  linear.cycle.vessels.resize(n);
+  linear.wave_travels.assign(n, 0);
+  linear.womersley.assign(n, 0.0);
+  linear.pwv_elastic.assign(n, 0.0);
+  linear.pwv_theory.assign(n, 0.0);
+  out.mean.flow.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const double* row = all_vessels.data() + width * v;
+    linear.cycle.vessels[v] = {row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7]};
+    linear.wave_travels[v] = row[8] != 0;
+    linear.womersley[v] = row[9];
+    linear.pwv_elastic[v] = row[10];
+    linear.pwv_theory[v] = row[11];
+    out.mean.flow[v] = row[0];
+  }
+  if (results.measures_waves())
+    for (std::size_t v = 0; v < n; ++v)
+      if (linear.wave_travels[v]) linear.cycle.waves.emplace_back(v, WaveSpeeds{all_vessels[width * v + 12], all_vessels[width * v + 13]});
+  out.mean.node_pressure = all_nodes;
+  add_boundary_flows(net, out.mean, linear.cycle);
+  for (int m = 0; m <= samples_per_period; ++m) {
+    const double t = periodic.period() * m / samples_per_period;
+    std::size_t j = 0;
+    out.probes.add_row(t, [&](const Probe&) {
+      const double* x = all_probes.data() + probe_width * j++ + 3 * static_cast<std::size_t>(m);
+      return ProbeRecorder::Values{x[0], x[1], x[2]};
+    });
+  }
+  return out;
+}
+
 }  // namespace
 
 void run_linear(const Network& net, const RunConfiguration& config, RunObserver& observer) {
   const SolverOptions& options = config.solver;
   Blood blood = net.blood.value_or(Blood{});
   if (options.rheology_override >= 0) blood.rheology = static_cast<Rheology>(options.rheology_override);
-  OutputFolder folder(config.out_dir);
+  // Over MPI ranks rank 0 alone takes the folder and writes; its refusal is every rank's
+  // before any of them solves.
+  std::optional<OutputFolder> taken;
+  on_lead_rank([&] { taken.emplace(config.out_dir); });
   const auto started = std::chrono::steady_clock::now();
   const ViscosityTable viscosity(blood);
   const std::vector<TubeLaw> laws = vessel_laws(net, blood, options.external_pressure, options.thick_wall_ratio);
   const Waveform driving = driving_waveform(net);
   const double analysis = analysis_frequency(driving), omega = 2 * std::numbers::pi / driving.period;
   // The mean moves by its second-order shift, forced where a run's --model auto keeps a vessel 1D.
-  const LinearPeriodic periodic =
-      solve_linear_periodic(net, blood, laws, viscosity, options.periodic_harmonics, options.threads,
-                            [&](const VesselLine& line) { return wave_travels(line, options, omega, driving.period); });
-  const LinearCycle linear =
-      linear_cycle(net, LinearVessels(net, blood, viscosity, laws, periodic, options, analysis), periodic, options.threads);
+  const std::function<bool(const VesselLine&)> travels = [&](const VesselLine& line) {
+    return wave_travels(line, options, omega, driving.period);
+  };
+  const bool over_ranks = world_size() > 1;
+  const LinearOutcome outcome = over_ranks
+                                    ? linear_over_ranks(net, blood, viscosity, laws, options, analysis, travels, config.probes)
+                                    : linear_here(net, blood, viscosity, laws, options, analysis, travels, config.probes);
+  if (over_ranks) {
+    if (world_rank() != 0) return;
+    leave_collectives();  // the others have finished: a failure of the writing is rank 0's alone
+    observer.note(outcome.partition);
+  }
+  const LinearCycle& linear = outcome.linear;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   const std::size_t n = net.vessel_count();
@@ -213,7 +358,7 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
                              {"network", config.network_name},
                              {"mode", "linear"},
                              {"model", "linear"},
-                             {"harmonics", periodic.harmonics()},
+                             {"harmonics", outcome.harmonics},
                              {"vessels_1d", 0},
                              {"vessels_0d", 0},
                              {"rheology", to_string(blood.rheology)},
@@ -225,17 +370,14 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
                              {"cycles", 0},
                              {"wall_time", wall}};
   run_info["statistics"] = group_statistics(net, results, options.threads);
+  OutputFolder& folder = *taken;
   folder.open();
   const std::filesystem::path dir = folder.staging();
-  const ProbeRecorder probes = linear_probes(laws, periodic, config.probes);
-  write_results(dir,
-                {run_info, results, linear.cycle,
-                 boundary_results(net, SteadyFlow{periodic.mean_flow(), periodic.mean_node_pressure(), 0.0}), &probes,
-                 options.threads},
+  write_results(dir, {run_info, results, linear.cycle, boundary_results(net, outcome.mean), &outcome.probes, options.threads},
                 config.results_format);
   if (config.vtk) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
   folder.publish();
-  observer.note("linear periodic state of " + std::to_string(n) + " vessels (" + std::to_string(periodic.harmonics()) +
+  observer.note("linear periodic state of " + std::to_string(n) + " vessels (" + std::to_string(outcome.harmonics) +
                 " harmonics) in " + format_quantity(wall, "s") + "; results in " + config.out_dir);
 }
 

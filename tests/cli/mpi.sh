@@ -1,7 +1,8 @@
-# hemosolve --steady under mpirun (issue 24): the tree's nodal system solved over 1 to 4
-# ranks gives the plain command's outputs byte for byte (but the wall time), text or HDF5; a
-# looped network (PETSc) the plain run's to 1e-10; the partition is said in one line; what
-# does not run over ranks yet is refused in one line, said once, nothing written.
+# hemosolve --steady and --linear under mpirun (issue 24): the tree's nodal system solved over
+# 1 to 4 ranks gives the plain command's outputs byte for byte (but the wall time), text or
+# HDF5, and so does the linear periodic state over 2 and 3; a looped network (PETSc) the plain
+# run's to 1e-10; the partition is said in one line; what does not run over ranks yet is
+# refused in one line, said once, nothing written.
 source "$(dirname "$0")/lib.sh"
 HEMOSOLVE=$BUILD/solver/hemosolve
 if ! command -v mpirun >/dev/null; then
@@ -37,6 +38,31 @@ for group in ("vessels", "boundaries"):
         x, y = a[group][name][()], b[group][name][()]
         assert x.dtype == y.dtype and x.shape == y.shape, name
         assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), name  # bit for bit, NaNs too
+PY
+# --linear, the linear periodic state, over 2 and 3 ranks: the plain run's files byte for byte
+# (but the wall time), text and HDF5, probes included.
+"$HEMOSOLVE" "$WORK/tree.json" --linear --probe 1 --probe 40:0.3 --out "$WORK/linear-one" 2>/dev/null || fail "hemosolve --linear"
+"$HEMOSOLVE" "$WORK/tree.json" --linear --format h5 --out "$WORK/linear-one-h5" 2>/dev/null || fail "hemosolve --linear --format h5"
+for ranks in 2 3; do
+  $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/tree.json" --linear --probe 1 --probe 40:0.3 --out "$WORK/linear$ranks" \
+    >"$WORK/lout$ranks" 2>&1
+  status=$?
+  said=$(grep -c "^hemosolve: $ranks ranks by subtrees: .*; the harmonics' exchanges on rank 0: " "$WORK/lout$ranks")
+  [ $status -eq 0 ] && [ "$said" -eq 1 ] && cmp -s "$WORK/linear-one/vessels.csv" "$WORK/linear$ranks/vessels.csv" \
+    && cmp -s "$WORK/linear-one/probes.csv" "$WORK/linear$ranks/probes.csv" \
+    && diff <(grep -v '"wall_time"' "$WORK/linear-one/summary.json") <(grep -v '"wall_time"' "$WORK/linear$ranks/summary.json") >/dev/null \
+    && pass "mpirun -np $ranks hemosolve --linear: the plain run's bytes, probes too, the partition said once" \
+    || fail "mpirun -np $ranks --linear: status $status, partition said $said times: $(head -3 "$WORK/lout$ranks")"
+done
+$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/tree.json" --linear --format h5 --out "$WORK/linear-h5" >/dev/null 2>&1
+/usr/bin/python3 - "$WORK/linear-one-h5/results.h5" "$WORK/linear-h5/results.h5" <<'PY' && pass "mpirun -np 2 --linear --format h5: the plain run's values" || fail "--linear --format h5 over ranks"
+import sys, h5py, numpy as np
+a, b = h5py.File(sys.argv[1]), h5py.File(sys.argv[2])
+for group in ("vessels", "boundaries"):
+    assert list(a[group]) == list(b[group]), group
+    for name in a[group]:
+        x, y = a[group][name][()], b[group][name][()]
+        assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), name
 PY
 # A network with loops and pressures prescribed at nodes (the rat mesentery): PETSc's
 # conjugate gradients over the ranks, within 1e-10 of the plain run (relative to each
@@ -75,10 +101,15 @@ expect_refused() {  # name, text, command...: status 2, said once, no folder
     && pass "$name: refused, said once, nothing written" \
     || fail "$name: status $status, said $count times: $(head -3 "$WORK/refused")"
 }
-expect_refused "a pulsatile run over 2 ranks" "hemosolve: error: started on 2 MPI ranks: hemosolve runs --steady over MPI ranks so far" \
+expect_refused "a pulsatile run over 2 ranks" "hemosolve: error: started on 2 MPI ranks: hemosolve runs --steady and --linear over MPI ranks so far" \
   -np 2 "$HEMOSOLVE" "$WORK/tree.json" --out "$WORK/refused-out"
 expect_refused "phase separation over 2 ranks" "--steady with --red-cells transport runs as one process" \
   -np 2 "$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport --out "$WORK/refused-out"
+if [ -f "$WORK/mesentery.json" ]; then
+  expect_refused "--linear over 2 ranks on the mesentery (pressures at nodes)" \
+    "holds a pressure: the linear periodic state over ranks takes a tree fed by its inflow into outlets" \
+    -np 2 "$HEMOSOLVE" "$WORK/mesentery.json" --linear --out "$WORK/refused-out"
+fi
 mkdir -p "$WORK/not-ours" && touch "$WORK/not-ours/file"
 expect_refused "an output folder rank 0 refuses" "hemosolve: error: --out $WORK/not-ours: exists and is not a hemosolve results folder" \
   -np 3 "$HEMOSOLVE" "$WORK/tree.json" --steady --out "$WORK/not-ours"

@@ -1,0 +1,41 @@
+#include "distributed/gather_rows.hpp"
+
+#include <limits>
+#include <string>
+
+#include <mpi.h>
+
+#include "core/setting_error.hpp"
+#include "mpi/session.hpp"
+
+namespace hemotree {
+
+std::vector<double> gather_rows(std::span<const double> rows, std::size_t width,
+                                const std::vector<std::vector<std::int32_t>>& lists, std::size_t count) {
+  if (count * width > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw Collective<SettingError>("ranks", placeholder("ranks") + ": " + std::to_string(count) + " rows of " +
+                                                std::to_string(width) +
+                                                " numbers are more than the gathering of the results on one rank takes yet");
+  const bool lead = world_rank() == 0;
+  std::vector<int> counts, offsets;
+  if (lead) {
+    for (const auto& list : lists) {
+      offsets.push_back(counts.empty() ? 0 : offsets.back() + counts.back());
+      counts.push_back(static_cast<int>(list.size() * width));
+    }
+  }
+  std::vector<double> all(lead ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
+  MPI_Gatherv(rows.data(), static_cast<int>(rows.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
+              0, MPI_COMM_WORLD);
+  if (!lead) return {};
+  std::vector<double> out(count * width, std::numeric_limits<double>::quiet_NaN());
+  std::size_t from = 0;
+  for (const auto& list : lists)
+    for (const std::int32_t item : list) {
+      for (std::size_t j = 0; j < width; ++j) out[static_cast<std::size_t>(item) * width + j] = all[from + j];
+      from += width;
+    }
+  return out;
+}
+
+}  // namespace hemotree
