@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <exception>
 #include <optional>
-#include <tuple>
 #include <utility>
 
 #include <mpi.h>
@@ -53,24 +52,60 @@ void send_ghosts_to_top(const TreeCut& cut, SteadyFlow& steady) {
                  "the ghosts' steady state");
 }
 
-// The vessels split over the ranks by whole subtrees (one a vessel), those marked kept on the
-// top, and the tree cut by it; refusals in words on every rank alike.
-std::pair<Partition, TreeCut> split(const Network& net, std::span<const std::uint8_t> on_top) {
+// The vessels split over the ranks by whole subtrees (one a vessel) and the tree cut by it;
+// refusals in words on every rank alike.
+std::pair<Partition, TreeCut> split(const Network& net) {
   Partition partition;
   std::optional<TreeCut> cut;
   on_every_rank([&] {
-    try {
-      partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), world_size(), on_top);
-    } catch (const SettingError& e) {
-      if (on_top.empty()) throw;
-      const auto kept = std::count(on_top.begin(), on_top.end(), std::uint8_t{1});
-      throw SettingError(e.setting(), e.message() + " (the " + std::to_string(kept) +
-                                          " vessels a wave travels in stay on one rank, with those above them)");
-    }
+    partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), world_size());
     cut.emplace(tree_cut(net, partition));  // loops, a spread top: refused in words
   });
   check_one_partition(partition);
   return {std::move(partition), std::move(*cut)};
+}
+
+// The forced vessels moved to the top's rank (keep_on_top) and the tree cut again; their
+// steady state (flow, end pressures) sent there from the ranks that held them, and every
+// rank's vessels and nodes those of the new cut: the distended state of the new cut, without
+// solving it again.
+void keep_forced_on_top(const Network& net, std::span<const std::uint8_t> forced, Partition& partition, TreeCut& cut,
+                        DistendedOverRanks& distended) {
+  const std::vector<std::int32_t> old_rank = cut.edge_ranks();
+  on_every_rank([&] {
+    try {
+      keep_on_top(net, std::vector<double>(net.vessel_count(), 1.0), forced, partition);
+    } catch (const SettingError& e) {
+      const auto kept = std::count(forced.begin(), forced.end(), std::uint8_t{1});
+      throw SettingError(e.setting(), e.message() + " (the " + std::to_string(kept) +
+                                          " vessels a wave travels in stay on one rank, with those above them)");
+    }
+    cut = tree_cut(net, partition);
+  });
+  const int rank = world_rank(), top = cut.top_rank;
+  std::vector<double> moved;  // per vessel this rank hands the top: its index, flow and end pressures
+  SteadyFlow& s = distended.flow;
+  if (rank != top)
+    for (std::size_t v = 0; v < net.vessel_count(); ++v)
+      if (old_rank[v] == rank && partition.rank_of_vessel[v] == top)
+        moved.insert(moved.end(), {static_cast<double>(v), s.flow[v], s.node_pressure[static_cast<std::size_t>(net.from[v])],
+                                   s.node_pressure[static_cast<std::size_t>(net.to[v])]});
+  int count = static_cast<int>(moved.size());
+  std::vector<int> counts(static_cast<std::size_t>(world_size())), offsets(counts.size(), 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, top, MPI_COMM_WORLD);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<double> all(rank == top ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
+  MPI_Gatherv(moved.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, top, MPI_COMM_WORLD);
+  for (std::size_t k = 0; k < all.size(); k += 4) {
+    const auto v = static_cast<std::size_t>(all[k]);
+    s.flow[v] = all[k + 1];
+    s.node_pressure[static_cast<std::size_t>(net.from[v])] = all[k + 2];
+    s.node_pressure[static_cast<std::size_t>(net.to[v])] = all[k + 3];
+  }
+  distended.nodes = cut.held_nodes()[static_cast<std::size_t>(rank)];
+  distended.vessels.clear();
+  for (const std::int32_t node : distended.nodes)
+    if (const std::int32_t v = cut.parent_edge[static_cast<std::size_t>(node)]; v >= 0) distended.vessels.push_back(v);
 }
 
 // Every rank's forced vessels, known to every rank, where one crosses from the top's rank into
@@ -119,14 +154,11 @@ LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, con
                          "outlets; run this network on one rank");
   });
   const double inflow = net.inlet ? net.inlet->waveform.mean_value() : 0.0;
-  auto [partition, cut] = split(net, {});
+  auto [partition, cut] = split(net);
   DistendedOverRanks distended = solve_distended_steady_flow_over_ranks(net, cut, blood, laws, viscosity, inflow, threads);
   if (shift_source) {
     const std::vector<std::uint8_t> forced = forced_across(net, cut, blood, laws, viscosity, distended, shift_source);
-    if (!forced.empty()) {
-      std::tie(partition, cut) = split(net, forced);
-      distended = solve_distended_steady_flow_over_ranks(net, cut, blood, laws, viscosity, inflow, threads);
-    }
+    if (!forced.empty()) keep_forced_on_top(net, forced, partition, cut, distended);
   }
   send_ghosts_to_top(cut, distended.flow);
   MpiHarmonicTree system(MPI_COMM_WORLD, cut);

@@ -36,9 +36,9 @@ struct LinearPeriodicOverRanks {
 
 // The arguments of the one-process solve_linear_periodic (the steady state is solved here, at
 // the inlet's mean flow). The vessels are split by whole subtrees, one a vessel; where a
-// forced vessel (shift_source: a 1D vessel of the run) would cross the cut, the split is made
-// again with every forced vessel and those above it on the top, and the steady state solved
-// again on it (the same bits). InputError as the one-process solve, on every rank alike; a
+// forced vessel (shift_source: a 1D vessel of the run) crosses the cut, every forced vessel
+// and those above it move to the top's rank (partition/'s keep_on_top), their steady state
+// with them. InputError as the one-process solve, on every rank alike; a
 // network with loops, a spread top or a pressure held at a node (its harmonic system is not
 // the cut's forest) is refused: SettingError "ranks", InputError.
 LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const Blood& blood,

@@ -1,5 +1,7 @@
 #include "partition/partition.hpp"
 
+#include "formats/topology.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -38,11 +40,31 @@ std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> ra
   return static_cast<std::size_t>(std::count(cut.begin(), cut.end(), std::uint8_t{1}));
 }
 
-Partition partition_network(const Network& net, std::span<const double> cost, int ranks,
-                            std::span<const std::uint8_t> on_top) {
+namespace {
+
+// Each rank's cost and vessels, and the cut nodes, from the ranks of the vessels; a rank left
+// without a vessel refused.
+void count_ranks(const Network& net, std::span<const double> cost, Partition& p) {
+  const std::size_t n = net.vessel_count();
+  p.cost.assign(static_cast<std::size_t>(p.ranks), 0.0);
+  p.vessels.assign(static_cast<std::size_t>(p.ranks), 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    p.cost[static_cast<std::size_t>(p.rank_of_vessel[v])] += cost[v];
+    ++p.vessels[static_cast<std::size_t>(p.rank_of_vessel[v])];
+  }
+  for (int r = 0; r < p.ranks; ++r)
+    if (p.vessels[static_cast<std::size_t>(r)] == 0)
+      throw SettingError("ranks", placeholder("ranks") + ": a partition of " + std::to_string(n) + " vessels into " +
+                                      std::to_string(p.ranks) + " ranks leaves rank " + std::to_string(r) +
+                                      " without a vessel (" + to_string(p.method) + "): use fewer ranks");
+  p.cut_nodes = count_cut_nodes(net, p.rank_of_vessel);
+}
+
+}  // namespace
+
+Partition partition_network(const Network& net, std::span<const double> cost, int ranks) {
   const std::size_t n = net.vessel_count();
   if (cost.size() != n) throw std::invalid_argument("partition_network: one cost per vessel");
-  if (!on_top.empty() && on_top.size() != n) throw std::invalid_argument("partition_network: on_top: a byte per vessel");
   if (ranks < 1)
     throw SettingError("ranks", placeholder("ranks") + " must be at least 1 (got " + std::to_string(ranks) + ")");
   if (n == 0) throw SettingError("ranks", placeholder("ranks") + ": the network has no vessels to split");
@@ -56,22 +78,37 @@ Partition partition_network(const Network& net, std::span<const double> cost, in
   if (ranks == 1) {
     p.rank_of_vessel.assign(n, 0);
   } else {
-    p = is_forest(net) ? partition_subtrees(net, cost, ranks, on_top) : partition_with_metis(net, cost, ranks);
+    p = is_forest(net) ? partition_subtrees(net, cost, ranks) : partition_with_metis(net, cost, ranks);
   }
   p.ranks = ranks;
-  p.cost.assign(static_cast<std::size_t>(ranks), 0.0);
-  p.vessels.assign(static_cast<std::size_t>(ranks), 0);
-  for (std::size_t v = 0; v < n; ++v) {
-    p.cost[static_cast<std::size_t>(p.rank_of_vessel[v])] += cost[v];
-    ++p.vessels[static_cast<std::size_t>(p.rank_of_vessel[v])];
-  }
-  for (int r = 0; r < ranks; ++r)
-    if (p.vessels[static_cast<std::size_t>(r)] == 0)
-      throw SettingError("ranks", placeholder("ranks") + ": a partition of " + std::to_string(n) + " vessels into " + std::to_string(ranks) +
-                       " ranks leaves rank " + std::to_string(r) + " without a vessel (" + to_string(p.method) +
-                       "): use fewer ranks");
-  p.cut_nodes = count_cut_nodes(net, p.rank_of_vessel);
+  count_ranks(net, cost, p);
   return p;
+}
+
+void keep_on_top(const Network& net, std::span<const double> cost, std::span<const std::uint8_t> on_top, Partition& p) {
+  if (on_top.size() != net.vessel_count()) throw std::invalid_argument("keep_on_top: a byte per vessel");
+  if (p.method != Partition::Method::subtrees || p.top_spread) return;  // one rank; METIS and a spread top have none
+  const Children children = children_of(net);
+  std::vector<std::int32_t> parent(net.vessel_count(), -1);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    for (std::int64_t c = children.offset[v]; c < children.offset[v + 1]; ++c)
+      parent[static_cast<std::size_t>(children.index[c])] = static_cast<std::int32_t>(v);
+  std::vector<std::uint8_t> top(net.vessel_count(), 0);
+  for (const std::int32_t v : p.top) top[static_cast<std::size_t>(v)] = 1;
+  // Up from each vessel asked for to the top: every vessel on the way joins it, parents
+  // before their daughters.
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    if (!on_top[v] || top[v]) continue;
+    std::vector<std::int32_t> path;
+    for (auto u = static_cast<std::int32_t>(v); u >= 0 && !top[static_cast<std::size_t>(u)]; u = parent[static_cast<std::size_t>(u)])
+      path.push_back(u);
+    for (auto u = path.rbegin(); u != path.rend(); ++u) {
+      top[static_cast<std::size_t>(*u)] = 1;
+      p.top.push_back(*u);
+      p.rank_of_vessel[static_cast<std::size_t>(*u)] = p.top_rank;
+    }
+  }
+  count_ranks(net, cost, p);
 }
 
 std::string describe(const Partition& p) {

@@ -41,11 +41,16 @@ const char* to_string(Partition::Method method);  // "one rank", "subtrees", "ME
 
 // P in [1, vessel count]: SettingError "ranks" for P < 1, for more ranks than vessels, and
 // for a partition that would leave a rank without a vessel. cost: one positive number per
-// vessel. on_top (a tree's, where given: a byte per vessel): the vessels to keep on the top,
-// with every vessel above them (a distributed run's vessels that no cut may cross: the
-// linear periodic state's forced 1D vessels); ignored by METIS.
-Partition partition_network(const Network& net, std::span<const double> cost, int ranks,
-                            std::span<const std::uint8_t> on_top = {});
+// vessel.
+Partition partition_network(const Network& net, std::span<const double> cost, int ranks);
+
+// A tree's partition by subtrees with the vessels marked in on_top (a byte per vessel) moved
+// to the top's rank, with every vessel above them: a distributed run's vessels that no cut
+// may cross (the linear periodic state's 1D vessels). Every other vessel keeps its rank, so
+// the subtrees below a moved vessel become pieces of their own on the rank they were on, and
+// only the moved vessels change hands. Nothing to do on one rank (and METIS's partitions and
+// a spread top have no top to keep). SettingError "ranks" where a rank is left without a vessel.
+void keep_on_top(const Network& net, std::span<const double> cost, std::span<const std::uint8_t> on_top, Partition& p);
 
 // Nodes whose vessels lie on more than one rank.
 std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> rank_of_vessel);

@@ -3,7 +3,6 @@
 // counts the costs, the vessels and the cut nodes.
 #pragma once
 
-#include <cstdint>
 #include <span>
 
 #include "partition/partition.hpp"
@@ -14,8 +13,7 @@ namespace hemotree {
 // `from` node none enters: a forest of rooted trees.
 bool is_forest(const Network& net);
 
-Partition partition_subtrees(const Network& net, std::span<const double> cost, int ranks,
-                              std::span<const std::uint8_t> on_top = {});
+Partition partition_subtrees(const Network& net, std::span<const double> cost, int ranks);
 Partition partition_with_metis(const Network& net, std::span<const double> cost, int ranks);
 
 }  // namespace hemotree

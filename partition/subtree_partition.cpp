@@ -121,8 +121,7 @@ bool is_forest(const Network& net) {
   return breadth_first_order(children_of(net), inlet_vessels(net)).size() == net.vessel_count();
 }
 
-Partition partition_subtrees(const Network& net, std::span<const double> cost, int ranks,
-                              std::span<const std::uint8_t> on_top) {
+Partition partition_subtrees(const Network& net, std::span<const double> cost, int ranks) {
   const std::size_t n = net.vessel_count();
   const Children children = children_of(net);
   const std::vector<std::int32_t> roots = inlet_vessels(net);
@@ -190,32 +189,7 @@ Partition partition_subtrees(const Network& net, std::span<const double> cost, i
   };
   std::size_t best_splits = 0, unused = 0;
   cut_after(SIZE_MAX, true, best_splits);
-  Cut cut = cut_after(best_splits, false, unused);
-  if (!on_top.empty()) {
-    // Every piece that holds a vessel asked for on the top is split again, its root to the
-    // top and its daughters' subtrees pieces, until none holds one: the top then holds those
-    // vessels and every vessel above them.
-    std::vector<std::uint8_t> holds(on_top.begin(), on_top.end());
-    for (std::size_t k = n; k-- > 0;) {
-      const auto v = static_cast<std::size_t>(order[k]);
-      for (std::int64_t c = children.offset[v]; c < children.offset[v + 1]; ++c)
-        holds[v] |= holds[static_cast<std::size_t>(children.index[c])];
-    }
-    std::vector<std::int32_t> pieces, pending(cut.pieces.rbegin(), cut.pieces.rend());
-    while (!pending.empty()) {
-      const std::int32_t v = pending.back();
-      pending.pop_back();
-      if (!holds[static_cast<std::size_t>(v)]) {
-        pieces.push_back(v);
-        continue;
-      }
-      cut.top.push_back(v);
-      cut.top_cost += cost[static_cast<std::size_t>(v)];
-      for (std::int64_t c = children.offset[static_cast<std::size_t>(v) + 1]; c-- > children.offset[static_cast<std::size_t>(v)];)
-        pending.push_back(children.index[c]);
-    }
-    cut.pieces = std::move(pieces);
-  }
+  const Cut cut = cut_after(best_splits, false, unused);
   const Deal deal = dealer.deal(cut);
 
   Partition p;

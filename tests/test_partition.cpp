@@ -87,9 +87,9 @@ TEST(Partition, ATreeIntoWholeSubtreesWithinTheBoundOfItsPieces) {
   }
 }
 
-// Vessels asked for on the top (a distributed run's forced 1D vessels) lie there with every
-// vessel above them, the rest still whole subtrees on the ranks.
-TEST(Partition, VesselsAskedForOnTheTopLieThereWithThoseAboveThem) {
+// Vessels kept on the top (a distributed run's forced 1D vessels) move there with every vessel
+// above them; every other vessel keeps its rank, so the rest stay whole subtrees.
+TEST(Partition, VesselsKeptOnTheTopMoveThereWithThoseAboveThem) {
   const Network net = grown_tree();
   const std::vector<double> cost(net.vessel_count(), 1.0);
   const Children children = children_of(net);
@@ -102,7 +102,8 @@ TEST(Partition, VesselsAskedForOnTheTopLieThereWithThoseAboveThem) {
   const std::size_t deep[] = {net.vessel_count() / 3, 2 * net.vessel_count() / 3};
   for (const std::size_t v : deep) on_top[v] = 1;
   const Partition plain = partition_network(net, cost, 4);
-  const Partition p = partition_network(net, cost, 4, on_top);
+  Partition p = plain;
+  keep_on_top(net, cost, on_top, p);
   expect_consistent(net, cost, p);
   const std::set<std::int32_t> top(p.top.begin(), p.top.end());
   for (const std::size_t v : deep) {
@@ -114,7 +115,17 @@ TEST(Partition, VesselsAskedForOnTheTopLieThereWithThoseAboveThem) {
     for (std::int64_t c = children.offset[v]; c < children.offset[v + 1]; ++c)
       if (p.rank_of_vessel[static_cast<std::size_t>(children.index[c])] != p.rank_of_vessel[v])
         EXPECT_TRUE(top.count(static_cast<std::int32_t>(v))) << "vessel " << v;
-  EXPECT_THROW(partition_network(net, cost, 4, std::vector<std::uint8_t>(3, 1)), std::invalid_argument);
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (p.rank_of_vessel[v] != plain.rank_of_vessel[v]) {
+      ++moved;
+      EXPECT_TRUE(top.count(static_cast<std::int32_t>(v))) << "vessel " << v << " moved off the top";
+    }
+  EXPECT_GT(moved, 2u);
+  EXPECT_THROW(keep_on_top(net, cost, std::vector<std::uint8_t>(3, 1), p), std::invalid_argument);
+  // Every vessel on the top leaves the other ranks without one.
+  Partition all = plain;
+  EXPECT_THROW(keep_on_top(net, cost, std::vector<std::uint8_t>(net.vessel_count(), 1), all), SettingError);
 }
 
 TEST(Partition, BalancesCostNotCount) {
