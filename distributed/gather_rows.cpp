@@ -10,8 +10,8 @@
 
 namespace hemotree {
 
-std::vector<double> gather_rows(std::span<const double> rows, std::size_t width,
-                                const std::vector<std::vector<std::int32_t>>& lists, std::size_t count) {
+void gather_rows(std::span<const double> rows, std::size_t width, const std::vector<std::vector<std::int32_t>>& lists,
+                 std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place) {
   if (count * width > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     throw Collective<SettingError>("ranks", placeholder("ranks") + ": " + std::to_string(count) + " rows of " +
                                                 std::to_string(width) +
@@ -24,18 +24,16 @@ std::vector<double> gather_rows(std::span<const double> rows, std::size_t width,
       counts.push_back(static_cast<int>(list.size() * width));
     }
   }
-  std::vector<double> all(lead ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
+  std::vector<double> all(lead && !counts.empty() ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
   MPI_Gatherv(rows.data(), static_cast<int>(rows.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
               0, MPI_COMM_WORLD);
-  if (!lead) return {};
-  std::vector<double> out(count * width, std::numeric_limits<double>::quiet_NaN());
+  if (!lead) return;
   std::size_t from = 0;
   for (const auto& list : lists)
     for (const std::int32_t item : list) {
-      for (std::size_t j = 0; j < width; ++j) out[static_cast<std::size_t>(item) * width + j] = all[from + j];
+      place(item, all.data() + from);
       from += width;
     }
-  return out;
 }
 
 }  // namespace hemotree

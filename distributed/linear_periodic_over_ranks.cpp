@@ -83,13 +83,16 @@ void keep_forced_on_top(const Network& net, std::span<const std::uint8_t> forced
     cut = tree_cut(net, partition);
   });
   const int rank = world_rank(), top = cut.top_rank;
-  std::vector<double> moved;  // per vessel this rank hands the top: its index, flow and end pressures
+  // Per vessel this rank hands the top: its index, flow and the pressure of its node below
+  // (the node above is the top's already, or another moved vessel's below).
+  std::vector<double> moved;
   SteadyFlow& s = distended.flow;
   if (rank != top)
-    for (std::size_t v = 0; v < net.vessel_count(); ++v)
-      if (old_rank[v] == rank && partition.rank_of_vessel[v] == top)
-        moved.insert(moved.end(), {static_cast<double>(v), s.flow[v], s.node_pressure[static_cast<std::size_t>(net.from[v])],
-                                   s.node_pressure[static_cast<std::size_t>(net.to[v])]});
+    for (std::size_t c = 0; c < cut.parent_edge.size(); ++c) {
+      const std::int32_t v = cut.parent_edge[c];
+      if (v >= 0 && old_rank[static_cast<std::size_t>(v)] == rank && partition.rank_of_vessel[static_cast<std::size_t>(v)] == top)
+        moved.insert(moved.end(), {static_cast<double>(v), s.flow[static_cast<std::size_t>(v)], static_cast<double>(c), s.node_pressure[c]});
+    }
   int count = static_cast<int>(moved.size());
   std::vector<int> counts(static_cast<std::size_t>(world_size())), offsets(counts.size(), 0);
   MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, top, MPI_COMM_WORLD);
@@ -97,12 +100,12 @@ void keep_forced_on_top(const Network& net, std::span<const std::uint8_t> forced
   std::vector<double> all(rank == top ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
   MPI_Gatherv(moved.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, top, MPI_COMM_WORLD);
   for (std::size_t k = 0; k < all.size(); k += 4) {
-    const auto v = static_cast<std::size_t>(all[k]);
-    s.flow[v] = all[k + 1];
-    s.node_pressure[static_cast<std::size_t>(net.from[v])] = all[k + 2];
-    s.node_pressure[static_cast<std::size_t>(net.to[v])] = all[k + 3];
+    s.flow[static_cast<std::size_t>(all[k])] = all[k + 1];
+    s.node_pressure[static_cast<std::size_t>(all[k + 2])] = all[k + 3];
   }
   distended.nodes = cut.held_nodes()[static_cast<std::size_t>(rank)];
+  distended.nodes_by_label = distended.nodes;
+  std::sort(distended.nodes_by_label.begin(), distended.nodes_by_label.end());
   distended.vessels.clear();
   for (const std::int32_t node : distended.nodes)
     if (const std::int32_t v = cut.parent_edge[static_cast<std::size_t>(node)]; v >= 0) distended.vessels.push_back(v);
@@ -175,6 +178,7 @@ LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, con
     std::sort(share.ghosts.begin(), share.ghosts.end());
   }
   const std::span<const std::int32_t> nodes = system.nodes();
+  share.nodes.assign(nodes.begin(), nodes.end());
   std::vector<Complex> shunt_here(nodes.size()), x_here(nodes.size());
   std::vector<EdgeToParent> edge_here(nodes.size());
   share.solve = [&](double w, std::span<const Complex> shunt, std::span<Complex> current,
@@ -193,7 +197,12 @@ LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, con
       shunt_here[k] = shunt[static_cast<std::size_t>(nodes[k])];
       x_here[k] = current[static_cast<std::size_t>(nodes[k])];
     }
-    system.solve(shunt_here, edge_here, x_here);
+    try {
+      system.solve(shunt_here, edge_here, x_here);
+    } catch (const Collective<std::invalid_argument>& e) {  // every rank alike
+      if (std::string(e.what()).find("no admittance to ground") == std::string::npos) throw;
+      throw Collective<InputError>("the linear periodic solution: a part of the network has no path to an outlet or a pressure");
+    }
     for (std::size_t k = 0; k < nodes.size(); ++k) current[static_cast<std::size_t>(nodes[k])] = x_here[k];
     for (std::size_t k = 0; k < system.root_parents().size(); ++k)
       current[static_cast<std::size_t>(system.root_parents()[k])] = system.root_parent_potentials()[k];

@@ -21,12 +21,15 @@ std::vector<int> root_counts(const TreeCut& cut) {
   return out;
 }
 
-// A complex number travels as its two doubles (std::complex's layout is double[2]).
+// A complex number travels as its two doubles (std::complex<double> may be read as double[2];
+// the way back is copied).
 std::span<const double> as_doubles(std::span<const Complex> z) {
   return {reinterpret_cast<const double*>(z.data()), 2 * z.size()};
 }
-std::span<const Complex> as_complex(std::span<const double> d) {
-  return {reinterpret_cast<const Complex*>(d.data()), d.size() / 2};
+std::vector<Complex> as_complex(std::span<const double> d) {
+  std::vector<Complex> z(d.size() / 2);
+  for (std::size_t k = 0; k < z.size(); ++k) z[k] = {d[2 * k], d[2 * k + 1]};
+  return z;
 }
 
 }  // namespace
@@ -84,7 +87,7 @@ void MpiHarmonicTree::solve(std::span<const Complex> shunt, std::span<const Edge
                                                   top_move, "the distributed harmonic solve");
   // Move 3: this rank's share down from its roots' potentials.
   if (exchange_.top()) std::copy(top_x.begin(), top_x.end(), x.begin() + static_cast<std::ptrdiff_t>(share_size_));
-  const std::span<const Complex> answer = as_complex(std::span<const double>(got).subspan(1));
+  const std::vector<Complex> answer = as_complex(std::span<const double>(got).subspan(1));
   std::vector<Complex> root_x(root_parents_.size());
   for (std::size_t k = 0; k < root_x.size(); ++k) {
     root_x[k] = answer[2 * k];

@@ -32,6 +32,11 @@ std::string words(const std::exception_ptr& failure) {
 
 RootExchange::RootExchange(MPI_Comm comm, int top_rank, std::vector<int> roots)
     : comm_(comm), rank_(rank_in(comm)), top_rank_(top_rank), roots_(std::move(roots)) {
+  // A refusal's words travel over MPI_COMM_WORLD (mpi/session.hpp's words_of).
+  int same = MPI_UNEQUAL;
+  MPI_Comm_compare(comm_, MPI_COMM_WORLD, &same);
+  if (same != MPI_IDENT && same != MPI_CONGRUENT)
+    throw std::invalid_argument("RootExchange: a communicator of MPI_COMM_WORLD's ranks, in its order");
   int size = 0;
   MPI_Comm_size(comm_, &size);
   if (static_cast<std::size_t>(size) != roots_.size() || top_rank < 0 || top_rank >= size)

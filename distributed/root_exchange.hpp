@@ -18,7 +18,8 @@ namespace hemotree {
 
 class RootExchange {
  public:
-  // roots: per rank of comm, its share roots (TreeCut::roots' sizes). No communication.
+  // roots: per rank of comm (MPI_COMM_WORLD or a copy of it), its share roots (TreeCut::roots'
+  // sizes). No communication.
   RootExchange(MPI_Comm comm, int top_rank, std::vector<int> roots);
   int rank() const { return rank_; }
   bool top() const { return rank_ == top_rank_; }

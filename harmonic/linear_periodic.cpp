@@ -294,7 +294,7 @@ LumenSlopes lumen_slopes(const TubeLaw& law, const ViscosityTable& viscosity, do
 // apply(v, dq, profile, dx_from, dx_to): its flow's, its static pressure's along it where it
 // is sourced (sampled evenly from `from` to `to`; else empty: its nodes') and its nodes'.
 //   Over a share of the network (HarmonicShare), `held` lists the vessels whose terms it sums
-// (every one where null), `answered` those it hands to apply (every held one where null), and
+// and `answered` those it hands to apply (each list every vessel where it is null), and
 // solve_at_zero(current) solves the system at w = 0 with the mean shift's currents (every
 // node's array, the share's nodes' entries set), returning the potentials there.
 template <class SolveAtZero, class Apply>
@@ -502,18 +502,20 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
   out.kept_.assign(net.node_count(), -1);
   out.kept_vessel_.assign(net.vessel_count(), -1);
   std::vector<std::size_t> kept_node;
+  auto keep_node = [&](std::int64_t node) {
+    auto& slot = out.kept_[static_cast<std::size_t>(node)];
+    if (slot >= 0) return;
+    slot = static_cast<std::int32_t>(kept_node.size());
+    kept_node.push_back(static_cast<std::size_t>(node));
+    out.mean_node_pressure_.push_back(steady.node_pressure[static_cast<std::size_t>(node)]);
+  };
   for (const std::int32_t vessel : held) {
     const auto v = static_cast<std::size_t>(vessel);
     out.kept_vessel_[v] = static_cast<std::int32_t>(out.mean_flow_.size());
     out.mean_flow_.push_back(steady.flow[v]);
-    for (const std::int64_t node : {net.from[v], net.to[v]}) {
-      auto& slot = out.kept_[static_cast<std::size_t>(node)];
-      if (slot >= 0) continue;
-      slot = static_cast<std::int32_t>(kept_node.size());
-      kept_node.push_back(static_cast<std::size_t>(node));
-      out.mean_node_pressure_.push_back(steady.node_pressure[static_cast<std::size_t>(node)]);
-    }
+    for (const std::int64_t node : {net.from[v], net.to[v]}) keep_node(node);
   }
+  for (const std::int32_t node : share.nodes) keep_node(node);
   out.line_.resize(held.size());
   const auto held_count = static_cast<std::int64_t>(held.size());
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
@@ -525,9 +527,10 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
   const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
   const HarmonicNetwork network = harmonic_network(net, boundaries);
   std::vector<Complex> shunt, current;
+  auto solve = [&](double w) { share.solve(w, shunt, current, line); };
   for (int k = 1; k <= harmonics; ++k) {
     node_terms(net, network, boundaries, series, any_line, k, out.omega(k), shunt, current, {});
-    share.solve(out.omega(k), shunt, current, line);
+    solve(out.omega(k));
     std::vector<Complex> kept(kept_node.size());
     for (std::size_t j = 0; j < kept_node.size(); ++j) kept[j] = current[kept_node[j]];
     out.node_pressure_.push_back(std::move(kept));
@@ -550,7 +553,7 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
     for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
     node_terms(net, network, boundaries, none, any_line, 0, 0.0, shunt, current, extra);
     std::vector<double>().swap(extra);
-    share.solve(0.0, shunt, current, line);
+    solve(0.0);
     return current;
   };
   solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, out, sourced, variance, node_shift, threads,

@@ -56,7 +56,8 @@ class LinearPeriodic {
   // two samples; linear between them).
   void shift_mean(std::size_t vessel, double dq, std::vector<double>&& shift);
   // The loaded (mean) state: per node [Pa], per vessel [m^3/s, from -> to] (a whole
-  // solution's; an instant's keeps its kept nodes and vessels only, by their places).
+  // solution's; an instant's and a share's keep their kept nodes and vessels only, by their
+  // places: read those by node and vessel below).
   const std::vector<double>& mean_node_pressure() const { return mean_node_pressure_; }
   const std::vector<double>& mean_flow() const { return mean_flow_; }
   // The same of one node, one vessel (one the solve kept).
@@ -144,10 +145,14 @@ struct HarmonicShare {
   // distributed top's edges into the shares): with them every vessel at a node it holds is
   // its own or a ghost, so every sum at such a node runs over the whole network's terms.
   std::vector<std::int32_t> ghosts;
+  // Its nodes, whose amplitudes and mean it answers for: with the ends of its vessels and
+  // ghosts, those it keeps (a node no vessel reaches is one of some share's).
+  std::vector<std::int32_t> nodes;
   // One harmonic's nodal system at angular frequency w, solved with every other share:
   // per node of the network its shunt and current (this share's nodes' entries as the whole
   // system's), the lines of its vessels (line(v)); the amplitudes at the ends of its vessels
-  // and ghosts into current.
+  // and ghosts into current. A part with no path to ground: InputError, as the one-process
+  // solve says it.
   std::function<void(double w, std::span<const Complex> shunt, std::span<Complex> current,
                      const std::function<const VesselLine&(std::size_t)>& line)>
       solve;

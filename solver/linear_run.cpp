@@ -275,35 +275,44 @@ LinearOutcome linear_over_ranks(const Network& net, const Blood& blood, const Vi
     for (std::size_t j = 0; j < probes.size(); ++j)
       probes_of[static_cast<std::size_t>(vessel_rank[probes[j].vessel])].push_back(static_cast<std::int32_t>(j));
   }
-  const std::vector<double> all_vessels = gather_rows(vessel_rows, width, vessels_of, n);
-  const std::vector<double> all_nodes = gather_rows(node_rows, 1, nodes_of, net.node_count());
-  const std::vector<double> all_probes = gather_rows(probe_rows, probe_width, probes_of, probes.size());
   const RootExchange::Traffic& traffic = mine.traffic;
   LinearOutcome out{{}, ProbeRecorder(probes), {}, periodic.harmonics(),
                     describe(mine.partition) + "; the harmonics' exchanges on rank 0: " + std::to_string(traffic.calls) +
                         " collective calls, " + std::to_string(traffic.bytes) + " bytes, " +
                         format_quantity(traffic.seconds, "s")};
-  if (rank != 0) return out;
   LinearCycle& linear = out.linear;
-  linear.cycle.vessels.resize(n);
-  linear.wave_travels.assign(n, 0);
-  linear.womersley.assign(n, 0.0);
-  linear.pwv_elastic.assign(n, 0.0);
-  linear.pwv_theory.assign(n, 0.0);
-  out.mean.flow.resize(n);
-  for (std::size_t v = 0; v < n; ++v) {
-    const double* row = all_vessels.data() + width * v;
+  std::vector<WaveSpeeds> speeds;
+  if (rank == 0) {
+    linear.cycle.vessels.resize(n);
+    linear.wave_travels.assign(n, 0);
+    linear.womersley.assign(n, 0.0);
+    linear.pwv_elastic.assign(n, 0.0);
+    linear.pwv_theory.assign(n, 0.0);
+    out.mean.flow.resize(n);
+    out.mean.node_pressure.resize(net.node_count());
+    speeds.resize(n);
+  }
+  gather_rows(vessel_rows, width, vessels_of, n, [&](std::int32_t vessel, const double* row) {
+    const auto v = static_cast<std::size_t>(vessel);
     linear.cycle.vessels[v] = {row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7]};
     linear.wave_travels[v] = row[8] != 0;
     linear.womersley[v] = row[9];
     linear.pwv_elastic[v] = row[10];
     linear.pwv_theory[v] = row[11];
+    speeds[v] = {row[12], row[13]};
     out.mean.flow[v] = row[0];
-  }
+  });
+  std::vector<double>().swap(vessel_rows);
+  gather_rows(node_rows, 1, nodes_of, net.node_count(),
+              [&](std::int32_t node, const double* row) { out.mean.node_pressure[static_cast<std::size_t>(node)] = row[0]; });
+  std::vector<double> all_probes(rank == 0 ? probe_width * probes.size() : 0);
+  gather_rows(probe_rows, probe_width, probes_of, probes.size(), [&](std::int32_t j, const double* row) {
+    std::copy(row, row + probe_width, all_probes.begin() + static_cast<std::ptrdiff_t>(probe_width) * j);
+  });
+  if (rank != 0) return out;
   if (results.measures_waves())
     for (std::size_t v = 0; v < n; ++v)
-      if (linear.wave_travels[v]) linear.cycle.waves.emplace_back(v, WaveSpeeds{all_vessels[width * v + 12], all_vessels[width * v + 13]});
-  out.mean.node_pressure = all_nodes;
+      if (linear.wave_travels[v]) linear.cycle.waves.emplace_back(v, speeds[v]);
   add_boundary_flows(net, out.mean, linear.cycle);
   for (int m = 0; m <= samples_per_period; ++m) {
     const double t = periodic.period() * m / samples_per_period;
@@ -327,9 +336,16 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   std::optional<OutputFolder> taken;
   on_lead_rank([&] { taken.emplace(config.out_dir); });
   const auto started = std::chrono::steady_clock::now();
-  const ViscosityTable viscosity(blood);
-  const std::vector<TubeLaw> laws = vessel_laws(net, blood, options.external_pressure, options.thick_wall_ratio);
-  const Waveform driving = driving_waveform(net);
+  // What each rank sets up alone (a vessel's wall refused, say): its failure every rank's.
+  std::optional<ViscosityTable> viscosity_table;
+  std::vector<TubeLaw> laws;
+  Waveform driving;
+  on_every_rank([&] {
+    viscosity_table.emplace(blood);
+    laws = vessel_laws(net, blood, options.external_pressure, options.thick_wall_ratio);
+    driving = driving_waveform(net);
+  });
+  const ViscosityTable& viscosity = *viscosity_table;
   const double analysis = analysis_frequency(driving), omega = 2 * std::numbers::pi / driving.period;
   // The mean moves by its second-order shift, forced where a run's --model auto keeps a vessel 1D.
   const std::function<bool(const VesselLine&)> travels = [&](const VesselLine& line) {

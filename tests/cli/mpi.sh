@@ -54,16 +54,45 @@ for ranks in 2 3; do
     && pass "mpirun -np $ranks hemosolve --linear: the plain run's bytes, probes too, the partition said once" \
     || fail "mpirun -np $ranks --linear: status $status, partition said $said times: $(head -3 "$WORK/lout$ranks")"
 done
-$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/tree.json" --linear --format h5 --out "$WORK/linear-h5" >/dev/null 2>&1
-/usr/bin/python3 - "$WORK/linear-one-h5/results.h5" "$WORK/linear-h5/results.h5" <<'PY' && pass "mpirun -np 2 --linear --format h5: the plain run's values" || fail "--linear --format h5 over ranks"
+# A tree whose larger vessels carry waves (855 of 875): their mean shift is forced, they are
+# moved to the top (the partition said so), the wave speeds are measured; probes given out of
+# the ranks' order; over 2 to 4 ranks, text and HDF5.
+"$VGEN" --seed 3 --root-diameter 3mm --min-diameter 300um 2>/dev/null | "$BUILD/pruner/vprune" --budget all \
+  -o "$WORK/waves.json" 2>/dev/null || fail "vgen | vprune (waves)"
+probes="--probe 870:0.2 --probe 3 --probe 431:0.9"
+"$HEMOSOLVE" "$WORK/waves.json" --linear $probes --out "$WORK/waves-one" 2>/dev/null || fail "hemosolve --linear (waves)"
+"$HEMOSOLVE" "$WORK/waves.json" --linear $probes --format h5 --out "$WORK/waves-one-h5" 2>/dev/null || fail "--format h5 (waves)"
+[ "$(cut -d, -f16 "$WORK/waves-one/vessels.csv" | grep -c '[0-9]')" -gt 100 ] || fail "the wave tree measures no wave speeds"
+for ranks in 2 3 4; do
+  $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/waves.json" --linear $probes --out "$WORK/waves$ranks" >"$WORK/wout$ranks" 2>&1
+  status=$?
+  [ $status -eq 0 ] && grep -q "the top's 855 vessels" "$WORK/wout$ranks" \
+    && cmp -s "$WORK/waves-one/vessels.csv" "$WORK/waves$ranks/vessels.csv" \
+    && cmp -s "$WORK/waves-one/probes.csv" "$WORK/waves$ranks/probes.csv" \
+    && diff <(grep -v '"wall_time"' "$WORK/waves-one/summary.json") <(grep -v '"wall_time"' "$WORK/waves$ranks/summary.json") >/dev/null \
+    && pass "mpirun -np $ranks --linear, a tree with waves (its 1D vessels moved to the top): the plain run's bytes" \
+    || fail "mpirun -np $ranks --linear (waves): status $status: $(head -3 "$WORK/wout$ranks")"
+done
+same_h5() {  # every dataset of /vessels, /boundaries and /probes bit for bit, NaNs too
+  /usr/bin/python3 - "$1" "$2" <<'PY'
 import sys, h5py, numpy as np
 a, b = h5py.File(sys.argv[1]), h5py.File(sys.argv[2])
-for group in ("vessels", "boundaries"):
+for group in ("vessels", "boundaries", "probes"):
+    if group not in a:
+        continue
     assert list(a[group]) == list(b[group]), group
     for name in a[group]:
         x, y = a[group][name][()], b[group][name][()]
+        assert x.dtype == y.dtype and x.shape == y.shape, name
         assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), name
 PY
+}
+$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/tree.json" --linear --format h5 --out "$WORK/linear-h5" >/dev/null 2>&1
+same_h5 "$WORK/linear-one-h5/results.h5" "$WORK/linear-h5/results.h5" \
+  && pass "mpirun -np 2 --linear --format h5: the plain run's values" || fail "--linear --format h5 over ranks"
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/waves.json" --linear $probes --format h5 --out "$WORK/waves-h5" >/dev/null 2>&1
+same_h5 "$WORK/waves-one-h5/results.h5" "$WORK/waves-h5/results.h5" \
+  && pass "mpirun -np 3 --linear --format h5, the tree with waves and probes: the plain run's values" || fail "--linear --format h5 (waves) over ranks"
 # A network with loops and pressures prescribed at nodes (the rat mesentery): PETSc's
 # conjugate gradients over the ranks, within 1e-10 of the plain run (relative to each
 # column's largest value).
@@ -110,6 +139,18 @@ if [ -f "$WORK/mesentery.json" ]; then
     "holds a pressure: the linear periodic state over ranks takes a tree fed by its inflow into outlets" \
     -np 2 "$HEMOSOLVE" "$WORK/mesentery.json" --linear --out "$WORK/refused-out"
 fi
+# What every rank sets up alone, refused on every rank alike and said once: a probe on no
+# vessel, a vessel whose wall the tube law cannot take.
+expect_refused "--linear over 2 ranks, a probe on no vessel" "hemosolve: error: --probe" \
+  -np 2 "$HEMOSOLVE" "$WORK/tree.json" --linear --probe 99999999 --out "$WORK/refused-out"
+/usr/bin/python3 - "$WORK/tree.json" "$WORK/no-wall.json" <<'PY'
+import json, sys
+net = json.load(open(sys.argv[1]))
+net["vessels"][500].pop("youngs_modulus", None)
+json.dump(net, open(sys.argv[2], "w"))
+PY
+expect_refused "--linear over 2 ranks, a vessel without a wall law" "hemosolve: error: vessel " \
+  -np 2 "$HEMOSOLVE" "$WORK/no-wall.json" --linear --out "$WORK/refused-out"
 mkdir -p "$WORK/not-ours" && touch "$WORK/not-ours/file"
 expect_refused "an output folder rank 0 refuses" "hemosolve: error: --out $WORK/not-ours: exists and is not a hemosolve results folder" \
   -np 3 "$HEMOSOLVE" "$WORK/tree.json" --steady --out "$WORK/not-ours"

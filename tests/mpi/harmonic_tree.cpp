@@ -1,7 +1,8 @@
 // Under mpirun (ctest label mpi, 1 to 4 ranks): a grown tree's harmonic system (complex
 // two-ports, not symmetric) solved over the ranks (distributed/mpi_harmonic_tree.hpp) gives
 // on every rank the whole system's potentials bit for bit, and each share root's parent
-// potential; a zero pivot is refused on every rank alike. Exit 0 when every rank agrees, 1
+// potential (and on the top's rank every share root's); a zero pivot, on the top or inside a
+// share, is refused on every rank alike. Exit 0 when every rank agrees, 1
 // otherwise, one line per failure on stderr.
 #include <bit>
 #include <cmath>
@@ -85,6 +86,9 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k < system.root_parents().size(); ++k)
       check(same_bits(system.root_parent_potentials()[k], x[static_cast<std::size_t>(system.root_parents()[k])]),
             "a root's parent potential");
+    for (std::size_t k = 0; k < system.share_roots().size(); ++k)
+      check(same_bits(system.share_root_potentials()[k], x[static_cast<std::size_t>(system.share_roots()[k])]),
+            "a share root's potential on the top's rank");
     std::size_t held = mine.size(), all = 0;
     MPI_Allreduce(&held, &all, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
     check(all == nodes, "the ranks hold " + std::to_string(all) + " nodes of " + std::to_string(nodes));
@@ -104,6 +108,19 @@ int main(int argc, char** argv) {
       check(false, "a forest with no admittance to ground solved");
     } catch (const std::invalid_argument& e) {
       check(std::string(e.what()).find("no admittance to ground") != std::string::npos, std::string("refused as: ") + e.what());
+    }
+    // A zero pivot inside the last rank's share (its last node, a leaf: its diagonal its shunt
+    // and its edge's term), refused on every rank alike.
+    {
+      std::vector<Complex> zero_leaf = my_shunt;
+      const std::size_t share_nodes = cut.share_nodes(rank).size();
+      if (rank == ranks - 1 && share_nodes > 0) zero_leaf[share_nodes - 1] = -my_edge[share_nodes - 1].own;
+      try {
+        system.solve(zero_leaf, my_edge, my_x);
+        check(false, "a zero pivot in a share solved");
+      } catch (const std::invalid_argument& e) {
+        check(std::string(e.what()).find("no admittance to ground") != std::string::npos, std::string("refused as: ") + e.what());
+      }
     }
     // Numbers of the wrong count on the last rank: its words on every rank.
     try {

@@ -3,7 +3,7 @@
 // largest vessels, or in those down to a tenth of the root's lumen, across a first cut) over the ranks (distributed/linear_periodic_over_ranks.hpp) gives each rank
 // its share of the one-process solve_linear_periodic bit for bit: every own vessel's line,
 // mean flow, middle amplitudes and shifted mean pressure, every own node's amplitudes and
-// mean; no forced vessel across the cut; every vessel forced leaves a rank without one: refused
+// mean (a node no vessel reaches too); no forced vessel across the cut; every vessel forced leaves a rank without one: refused
 // on every rank alike. Exit 0 when every
 // rank agrees.
 #include <bit>
@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
         o.p_out = 1333.2;
         net.outlets.push_back(o);
       }
+    net.add_node(net.node_id.back() + 1000);  // a node no vessel reaches (a file may list one)
     Waveform inflow;  // half sine, 1 s, 1 ul/min on average
     inflow.mean = 1e-9 / 60;
     net.inlet = Inlet{net.id[0], inflow};
@@ -84,8 +85,10 @@ int main(int argc, char** argv) {
         }
         shifted += large(b);
       }
+      bool lone = false;
       for (const std::int32_t node : mine.nodes) {
         const auto i = static_cast<std::size_t>(node);
+        lone |= i + 1 == net.node_count();
         kinds[4] += !same(mine.periodic.mean_node_pressure(i), whole.mean_node_pressure()[i]);
         for (int k = 1; k <= harmonics; ++k) kinds[4] += !same(mine.periodic.node_pressure(k, i), whole.node_pressure(k, i));
       }
@@ -102,9 +105,9 @@ int main(int argc, char** argv) {
                      "mean pressures %zu, middles %zu, nodes %zu), %zu forced vessels across the cut\n",
                      rank, fraction, differ, mine.vessels.size(), kinds[0], kinds[1], kinds[2], kinds[3], kinds[4], across);
       }
-      std::size_t counts[2] = {mine.vessels.size(), shifted}, all[2] = {0, 0};
-      MPI_Allreduce(counts, all, 2, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
-      if (all[0] != net.vessel_count() || all[1] == 0) {
+      std::size_t counts[3] = {mine.vessels.size(), shifted, lone ? 1u : 0u}, all[3] = {0, 0, 0};
+      MPI_Allreduce(counts, all, 3, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
+      if (all[0] != net.vessel_count() || all[1] == 0 || all[2] != 1) {
         ++failures;
         std::fprintf(stderr, "rank %d: the ranks hold %zu vessels of %zu, %zu forced\n", rank, all[0], net.vessel_count(), all[1]);
       }
