@@ -121,6 +121,14 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   allocate_system();
 }
 
+std::int32_t LumpedVessels::edge_vessel(std::size_t e) const {
+  if (e >= vessel_edges_) e = static_cast<std::size_t>(capacitor_vessel_edge_[e - vessel_edges_]);
+  if (first_edge_.empty()) return vessels_[e];
+  // The vessel whose sections hold e: the last whose first edge is at most e.
+  const auto after = std::upper_bound(first_edge_.begin(), first_edge_.end(), static_cast<std::int32_t>(e));
+  return vessels_[static_cast<std::size_t>(after - first_edge_.begin() - 1)];
+}
+
 void LumpedVessels::share_shunt_pressure() {
   if (!held_node_.empty()) return;  // a held node's changes every step
   // The same bits: no negative zero either, which would flip a zero current's sign.

@@ -215,6 +215,13 @@ class LumpedVessels {
     return node_constant(k) + 0.5 * (3 * volume_[k] - previous_volume_[k]);
   }
   std::size_t network_node_count() const { return network_nodes_; }
+  // The system's edges, by node_of's numbering (each 0D vessel's sections in the arrays'
+  // order, then the RCR outlets' R1 edges to their capacitor nodes), and the network vessel
+  // each belongs to (an R1 edge: the 0D vessel ending at its outlet): what a run over ranks
+  // cuts by its partition of the vessels (docs/scaling.md).
+  std::span<const std::int32_t> edge_a() const { return a_; }
+  std::span<const std::int32_t> edge_b() const { return b_; }
+  std::int32_t edge_vessel(std::size_t e) const;
   // A 0D vessel's nodes (its `from`, its `to`).
   std::int32_t from_node(std::int32_t index) const { return a_[first_edge(static_cast<std::size_t>(index))]; }
   std::int32_t to_node(std::int32_t index) const { return b_[first_edge(static_cast<std::size_t>(index) + 1) - 1]; }

@@ -18,6 +18,9 @@
 #include "distributed/tree_share.hpp"
 #include "network_flow/nodal_system.hpp"
 #include "partition/partition.hpp"
+#include "physics/viscosity_table.hpp"
+#include "pulse/lumped_vessels.hpp"
+#include "steady/vessel_laws.hpp"
 
 using namespace hemotree;
 
@@ -240,4 +243,56 @@ TEST(TreeShares, ANetworkCutOnlyWhereItsTopIsOneRanks) {
   spread.top_spread = true;
   spread.top_rank = -1;
   EXPECT_THROW(tree_cut(net, spread), SettingError);
+}
+
+// The 0D vessels' system of a pulsatile run (pulse/lumped_vessels), in its own numbering (the
+// subtree order, each RCR outlet's capacitor node after the network's nodes, the inner nodes
+// of vessels in sections after them), its edges owned as the partition owns their vessels: a
+// cut of whole subtrees whose shares, swept in turn, give its nodal system's bits: what a
+// pulsatile run over ranks will solve a step with (docs/scaling.md, "the plan").
+TEST(TreeShares, TheZeroDVesselsSystemInItsOwnNumberingCutsIntoShares) {
+  Network net = grown_tree();
+  std::vector<unsigned char> has_daughter(net.node_count(), 0);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) has_daughter[static_cast<std::size_t>(net.from[v])] = 1;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (!has_daughter[static_cast<std::size_t>(net.to[v])]) {
+      Outlet o;
+      o.vessel = static_cast<std::int32_t>(v);
+      o.type = BoundaryType::rcr;
+      o.r1 = 4e12;
+      o.r2 = 1.6e13;
+      o.c = 1e-14;
+      o.p_out = 1333.2;
+      net.outlets.push_back(o);
+    }
+  net.inlet = Inlet{net.id[0], Waveform::constant_value(1e-9 / 60)};
+  const Blood blood = net.blood.value_or(Blood{});
+  const std::vector<TubeLaw> laws = vessel_laws(net, blood, 0.0, 0.1);
+  const ViscosityTable viscosity(blood);
+  std::vector<std::uint8_t> sections(net.vessel_count(), 1);
+  for (std::size_t v = 3; v < sections.size(); v += 7) sections[v] = 3;  // inner nodes too
+  const LumpedVessels lumped(net, laws, viscosity, blood, std::vector<bool>(net.vessel_count(), true), {}, {}, sections);
+  const std::size_t nodes = lumped.node_count();
+  const std::vector<std::int32_t> a(lumped.edge_a().begin(), lumped.edge_a().end()), b(lumped.edge_b().begin(), lumped.edge_b().end());
+  ASSERT_GT(nodes, net.node_count() + net.outlets.size());  // capacitors and inner nodes
+  // Each vessel's edges: its sections, and an outlet's R1 edge.
+  std::vector<int> edges_of(net.vessel_count(), 0);
+  for (std::size_t e = 0; e < a.size(); ++e) ++edges_of[static_cast<std::size_t>(lumped.edge_vessel(e))];
+  std::vector<int> expected(sections.begin(), sections.end());
+  for (const Outlet& o : net.outlets) ++expected[static_cast<std::size_t>(o.vessel)];
+  EXPECT_EQ(edges_of, expected);
+  const Numbers n = numbers_for(nodes, a.size(), a, b, 4);
+  const std::vector<double> x = whole(nodes, a, b, n);
+  for (const int ranks : {2, 3, 5}) {
+    const Partition partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), ranks);
+    std::vector<std::int32_t> owner(a.size());
+    std::vector<std::uint8_t> top(net.vessel_count(), 0);
+    for (const std::int32_t v : partition.top) top[static_cast<std::size_t>(v)] = 1;
+    for (std::size_t e = 0; e < a.size(); ++e) {
+      const auto v = static_cast<std::size_t>(lumped.edge_vessel(e));
+      owner[e] = top[v] ? TreeCut::top : partition.rank_of_vessel[v];
+    }
+    const TreeCut cut(nodes, a, b, owner, ranks, partition.top_rank);  // refuses a cut that is not whole subtrees
+    EXPECT_EQ(bitwise_differences(played(cut, n), x), 0u) << ranks << " ranks";
+  }
 }
