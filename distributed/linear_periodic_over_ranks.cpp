@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <memory>
 #include <optional>
 #include <utility>
 
@@ -111,13 +112,10 @@ void keep_forced_on_top(const Network& net, std::span<const std::uint8_t> forced
     if (const std::int32_t v = cut.parent_edge[static_cast<std::size_t>(node)]; v >= 0) distended.vessels.push_back(v);
 }
 
-// Every rank's forced vessels, known to every rank, where one crosses from the top's rank into
-// another's share: a byte per vessel of the network for the next split, or empty
-// where none crosses.
-std::vector<std::uint8_t> forced_across(const Network& net, const TreeCut& cut, const Blood& blood,
-                                        std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
-                                        const DistendedOverRanks& distended,
-                                        const std::function<bool(const VesselLine&)>& shift_source) {
+// The forced vessels of every rank, known to every rank: a byte per vessel.
+std::vector<std::uint8_t> forced_everywhere(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                            const ViscosityTable& viscosity, const DistendedOverRanks& distended,
+                                            const std::function<bool(const VesselLine&)>& shift_source) {
   std::vector<std::int32_t> mine;  // every forced vessel of this rank
   on_every_rank([&] {
     for (const std::int32_t v : distended.vessels)
@@ -132,64 +130,97 @@ std::vector<std::uint8_t> forced_across(const Network& net, const TreeCut& cut, 
   std::vector<std::int32_t> all(static_cast<std::size_t>(offsets.back() + counts.back()));
   MPI_Allgatherv(mine.data(), count, MPI_INT32_T, all.data(), counts.data(), offsets.data(), MPI_INT32_T, MPI_COMM_WORLD);
   std::vector<std::uint8_t> forced(net.vessel_count(), 0);
-  bool crosses = false;
   for (const std::int32_t v : all) forced[static_cast<std::size_t>(v)] = 1;
-  for (int rank = 0; rank < cut.ranks; ++rank)  // the vessels into another rank's share than the top's
-    if (rank != cut.top_rank)
-      for (const std::int32_t r : cut.roots[static_cast<std::size_t>(rank)])
-        crosses |= forced[static_cast<std::size_t>(cut.parent_edge[static_cast<std::size_t>(r)])] != 0;
-  if (!crosses) forced.clear();
   return forced;
 }
 
-}  // namespace
+// Whether a forced vessel runs from the top's rank into another rank's share.
+bool crosses(const TreeCut& cut, std::span<const std::uint8_t> forced) {
+  for (int rank = 0; rank < cut.ranks; ++rank)
+    if (rank != cut.top_rank)
+      for (const std::int32_t r : cut.roots[static_cast<std::size_t>(rank)])
+        if (forced[static_cast<std::size_t>(cut.parent_edge[static_cast<std::size_t>(r)])]) return true;
+  return false;
+}
 
-LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const Blood& blood,
-                                                         std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
-                                                         int harmonics, int threads,
-                                                         const std::function<bool(const VesselLine&)>& shift_source) {
-  const RunBoundaries boundaries(net);
+// A tree fed by its inflow split: a pressure held at a node refused first (its harmonic system
+// is not the cut's forest), on every rank alike.
+std::pair<Partition, TreeCut> split_fed_tree(const Network& net, const RunBoundaries& boundaries) {
   on_every_rank([&] {
     for (std::size_t i = 0; i < boundaries.size(); ++i)
       if (boundaries.type(i) == BoundaryType::pressure)
         throw InputError("node " + std::to_string(net.node_id[static_cast<std::size_t>(boundaries.node(i))]) +
-                         " holds a pressure: the linear periodic state over ranks takes a tree fed by its inflow into "
+                         " holds a pressure: the periodic state over ranks takes a tree fed by its inflow into "
                          "outlets; run this network on one rank");
   });
-  const double inflow = net.inlet ? net.inlet->waveform.mean_value() : 0.0;
-  auto [partition, cut] = split(net);
-  DistendedOverRanks distended = solve_distended_steady_flow_over_ranks(net, cut, blood, laws, viscosity, inflow, threads);
-  if (shift_source) {
-    const std::vector<std::uint8_t> forced = forced_across(net, cut, blood, laws, viscosity, distended, shift_source);
-    if (!forced.empty()) keep_forced_on_top(net, forced, partition, cut, distended);
-  }
-  send_ghosts_to_top(cut, distended.flow);
-  MpiHarmonicTree system(MPI_COMM_WORLD, cut);
-  const bool top = world_rank() == cut.top_rank;
+  return split(net);
+}
 
-  HarmonicShare share;
-  share.vessels = distended.vessels;
-  std::sort(share.vessels.begin(), share.vessels.end());
-  if (top) {
-    for (int r = 0; r < cut.ranks; ++r)  // the vessels into the other ranks' shares
-      if (r != cut.top_rank)
-        for (const std::int32_t root : cut.roots[static_cast<std::size_t>(r)])
-          share.ghosts.push_back(cut.parent_edge[static_cast<std::size_t>(root)]);
-    std::sort(share.ghosts.begin(), share.ghosts.end());
+// A rank's part of a tree's periodic state over the ranks, set up: the vessels split (the
+// forced ones, which `forced` gives once the distended state is known, and every vessel above
+// them on the top), the distended state, the ghosts' steady state on the top, the distributed
+// harmonic system and the HarmonicShare that solves with it. Built in place (the share's
+// solve holds references to it).
+struct RankHarmonics {
+  using Forced = std::function<std::vector<std::uint8_t>(const DistendedOverRanks&)>;
+  RankHarmonics(const Network& net, const Blood& blood, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                int threads, const Forced& forced_of)
+      : boundaries(net), split_(split_fed_tree(net, boundaries)), partition(std::move(split_.first)),
+        cut(std::move(split_.second)) {
+    const double inflow = net.inlet ? net.inlet->waveform.mean_value() : 0.0;
+    distended = solve_distended_steady_flow_over_ranks(net, cut, blood, laws, viscosity, inflow, threads);
+    if (forced_of) {
+      const std::vector<std::uint8_t> forced = forced_of(distended);
+      if (crosses(cut, forced)) keep_forced_on_top(net, forced, partition, cut, distended);
+    }
+    send_ghosts_to_top(cut, distended.flow);
+    system.emplace(MPI_COMM_WORLD, cut);
+    share.vessels = distended.vessels;
+    std::sort(share.vessels.begin(), share.vessels.end());
+    if (world_rank() == cut.top_rank) {
+      for (int r = 0; r < cut.ranks; ++r)  // the vessels into the other ranks' shares
+        if (r != cut.top_rank)
+          for (const std::int32_t root : cut.roots[static_cast<std::size_t>(r)])
+            share.ghosts.push_back(cut.parent_edge[static_cast<std::size_t>(root)]);
+      std::sort(share.ghosts.begin(), share.ghosts.end());
+    }
+    const std::span<const std::int32_t> nodes = system->nodes();
+    share.nodes.assign(nodes.begin(), nodes.end());
+    shunt_here.resize(nodes.size());
+    x_here.resize(nodes.size());
+    edge_here.resize(nodes.size());
+    share.solve = [this, &net, threads](double w, std::span<const Complex> shunt, std::span<Complex> current,
+                                        const std::function<TwoPort(std::size_t)>& two_port) {
+      solve(net, threads, shunt, current, two_port);
+    };
+    share.on_every_share = [](const std::function<void()>& step) { on_every_rank(step); };
   }
-  const std::span<const std::int32_t> nodes = system.nodes();
-  share.nodes.assign(nodes.begin(), nodes.end());
-  std::vector<Complex> shunt_here(nodes.size()), x_here(nodes.size());
-  std::vector<EdgeToParent> edge_here(nodes.size());
-  share.solve = [&](double w, std::span<const Complex> shunt, std::span<Complex> current,
-                    const std::function<const VesselLine&(std::size_t)>& line) {
+  RankHarmonics(const RankHarmonics&) = delete;
+  RankHarmonics& operator=(const RankHarmonics&) = delete;
+
+  RunBoundaries boundaries;
+ private:
+  std::pair<Partition, TreeCut> split_;
+ public:
+  Partition partition;
+  TreeCut cut;
+  DistendedOverRanks distended;
+  std::optional<MpiHarmonicTree> system;
+  HarmonicShare share;
+
+ private:
+  std::vector<Complex> shunt_here, x_here;
+  std::vector<EdgeToParent> edge_here;
+  void solve(const Network& net, int threads, std::span<const Complex> shunt, std::span<Complex> current,
+             const std::function<TwoPort(std::size_t)>& two_port) {
+    const std::span<const std::int32_t> nodes = system->nodes();
     const auto count = static_cast<std::int64_t>(nodes.size());
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
     for (std::int64_t k = 0; k < count; ++k) {
       const auto node = static_cast<std::size_t>(nodes[static_cast<std::size_t>(k)]);
       const std::int32_t v = cut.parent_edge[node];
       edge_here[static_cast<std::size_t>(k)] =
-          v >= 0 ? EdgeToParent::of(line(static_cast<std::size_t>(v)).two_port(w),
+          v >= 0 ? EdgeToParent::of(two_port(static_cast<std::size_t>(v)),
                                     net.from[static_cast<std::size_t>(v)] == static_cast<std::int64_t>(node))
                  : EdgeToParent{};
     }
@@ -198,22 +229,33 @@ LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, con
       x_here[k] = current[static_cast<std::size_t>(nodes[k])];
     }
     try {
-      system.solve(shunt_here, edge_here, x_here);
+      system->solve(shunt_here, edge_here, x_here);
     } catch (const Collective<std::invalid_argument>& e) {  // every rank alike
       if (std::string(e.what()).find("no admittance to ground") == std::string::npos) throw;
       throw Collective<InputError>("the linear periodic solution: a part of the network has no path to an outlet or a pressure");
     }
     for (std::size_t k = 0; k < nodes.size(); ++k) current[static_cast<std::size_t>(nodes[k])] = x_here[k];
-    for (std::size_t k = 0; k < system.root_parents().size(); ++k)
-      current[static_cast<std::size_t>(system.root_parents()[k])] = system.root_parent_potentials()[k];
-    for (std::size_t k = 0; k < system.share_roots().size(); ++k)
-      current[static_cast<std::size_t>(system.share_roots()[k])] = system.share_root_potentials()[k];
-  };
-  share.on_every_share = [](const std::function<void()>& step) { on_every_rank(step); };
-  LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, distended.flow, boundaries, harmonics,
-                                                  threads, shift_source, share);
-  return {std::move(periodic), share.vessels, std::vector<std::int32_t>(nodes.begin(), nodes.end()), std::move(partition),
-          std::move(cut), system.traffic()};
+    for (std::size_t k = 0; k < system->root_parents().size(); ++k)
+      current[static_cast<std::size_t>(system->root_parents()[k])] = system->root_parent_potentials()[k];
+    for (std::size_t k = 0; k < system->share_roots().size(); ++k)
+      current[static_cast<std::size_t>(system->share_roots()[k])] = system->share_root_potentials()[k];
+  }
+};
+
+}  // namespace
+
+LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const Blood& blood,
+                                                         std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                                                         int harmonics, int threads,
+                                                         const std::function<bool(const VesselLine&)>& shift_source) {
+  RankHarmonics::Forced forced;
+  if (shift_source)
+    forced = [&](const DistendedOverRanks& d) { return forced_everywhere(net, blood, laws, viscosity, d, shift_source); };
+  const auto rank = std::make_unique<RankHarmonics>(net, blood, laws, viscosity, threads, forced);
+  LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, rank->distended.flow, rank->boundaries,
+                                                  harmonics, threads, shift_source, rank->share);
+  return {std::move(periodic), rank->share.vessels, rank->share.nodes, std::move(rank->partition), std::move(rank->cut),
+          rank->system->traffic()};
 }
 
 }  // namespace hemotree

@@ -164,13 +164,12 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
   for (std::int64_t i = 0; i < held_count; ++i)
     out.line_[static_cast<std::size_t>(i)] = line_of(static_cast<std::size_t>(held[static_cast<std::size_t>(i)]));
-  const std::function<const VesselLine&(std::size_t)> line = [&](std::size_t v) -> const VesselLine& { return out.line(v); };
   // A line for the node terms: a vessel ending at a held pressure may be another share's.
   auto any_line = [&](std::size_t v) { return out.holds(v) ? out.line(v) : line_of(v); };
   const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
   const HarmonicNetwork network = harmonic_network(net, boundaries);
   std::vector<Complex> shunt, current;
-  auto solve = [&](double w) { share.solve(w, shunt, current, line); };
+  auto solve = [&](double w) { share.solve(w, shunt, current, [&](std::size_t v) { return out.line(v).two_port(w); }); };
   for (int k = 1; k <= harmonics; ++k) {
     node_terms(net, network, boundaries, series, any_line, k, out.omega(k), shunt, current, {});
     solve(out.omega(k));

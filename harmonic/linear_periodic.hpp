@@ -150,11 +150,11 @@ struct HarmonicShare {
   std::vector<std::int32_t> nodes;
   // One harmonic's nodal system at angular frequency w, solved with every other share:
   // per node of the network its shunt and current (this share's nodes' entries as the whole
-  // system's), the lines of its vessels (line(v)); the amplitudes at the ends of its vessels
-  // and ghosts into current. A part with no path to ground: InputError, as the one-process
-  // solve says it.
+  // system's), each of its vessels' two-port at w (two_port(v)); the amplitudes at its nodes
+  // and at the ends of its vessels and ghosts into current. A part with no path to ground:
+  // InputError, as the one-process solve says it.
   std::function<void(double w, std::span<const Complex> shunt, std::span<Complex> current,
-                     const std::function<const VesselLine&(std::size_t)>& line)>
+                     const std::function<TwoPort(std::size_t)>& two_port)>
       solve;
   // Runs a step that may fail on one share alone so that its failure is every share's
   // (mpi/session.hpp's on_every_rank).
