@@ -258,4 +258,18 @@ LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, con
           rank->system->traffic()};
 }
 
+PeriodicInstantOverRanks solve_periodic_instant_over_ranks(const Network& net, const Blood& blood,
+                                                           std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                                                           int harmonics, double time, const std::vector<bool>& keep,
+                                                           int threads, bool shift_mean) {
+  const RankHarmonics::Forced forced = [&](const DistendedOverRanks&) {
+    std::vector<std::uint8_t> bytes(keep.begin(), keep.end());
+    return bytes;
+  };
+  const auto rank = std::make_unique<RankHarmonics>(net, blood, laws, viscosity, threads, forced);
+  PeriodicInstant instant = solve_periodic_instant(net, blood, laws, viscosity, rank->distended.flow, rank->boundaries,
+                                                   harmonics, time, keep, threads, shift_mean, rank->share);
+  return {std::move(instant), rank->share.vessels, rank->share.nodes, std::move(rank->partition), std::move(rank->cut)};
+}
+
 }  // namespace hemotree

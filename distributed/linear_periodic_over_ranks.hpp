@@ -46,4 +46,20 @@ LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, con
                                                          int harmonics, int threads,
                                                          const std::function<bool(const VesselLine&)>& shift_source);
 
+// The periodic state at one instant t over the ranks (harmonic/linear_periodic.hpp's
+// solve_periodic_instant, a pulsatile run's start): the same split and set-up, `keep` (the
+// run's 1D vessels, known to every rank) kept on the top. Each rank's nodes' pressures and
+// vessels' middle flows in `instant` (whole-network arrays, its entries set), `along` what it
+// holds of the kept vessels: the one-process instant's bits. Collective.
+struct PeriodicInstantOverRanks {
+  PeriodicInstant instant;
+  std::vector<std::int32_t> vessels, nodes;  // this rank's
+  Partition partition;
+  TreeCut cut;
+};
+PeriodicInstantOverRanks solve_periodic_instant_over_ranks(const Network& net, const Blood& blood,
+                                                           std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                                                           int harmonics, double time, const std::vector<bool>& keep,
+                                                           int threads, bool shift_mean);
+
 }  // namespace hemotree

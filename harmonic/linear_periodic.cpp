@@ -298,6 +298,109 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   return out;
 }
 
+PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                       const ViscosityTable& viscosity, const SteadyFlow& steady,
+                                       const RunBoundaries& boundaries, int harmonics, double time,
+                                       const std::vector<bool>& keep, int threads, bool shift_mean,
+                                       const HarmonicShare& share) {
+  if (harmonics < 1) throw std::invalid_argument("solve_periodic_instant: at least one harmonic");
+  share.on_every_share([&] {
+    for (const std::int32_t v : share.ghosts)
+      if (keep[static_cast<std::size_t>(v)])
+        throw InputError("vessel " + std::to_string(net.id[static_cast<std::size_t>(v)]) +
+                         " carries a wave across the ranks' cut: run the periodic start on fewer ranks");
+  });
+  PeriodicInstant out{steady.node_pressure, steady.flow, LinearPeriodic{}};
+  LinearPeriodic& along = out.along;
+  along.net_ = &net;
+  along.period_ = driving_waveform(net).period;
+  const LineAbout line_of{net, laws, viscosity, steady, friction_coefficient(blood.alpha), blood.density};
+  std::vector<std::int32_t> held;  // its vessels and ghosts
+  std::merge(share.vessels.begin(), share.vessels.end(), share.ghosts.begin(), share.ghosts.end(), std::back_inserter(held));
+  // What `along` keeps, as the one-process instant keeps it, of the vessels this share holds.
+  std::vector<bool> kept_vessel = keep;
+  if (shift_mean) {
+    std::vector<unsigned char> one_d_end(net.node_count(), 0);
+    for (std::size_t v = 0; v < net.vessel_count(); ++v)
+      if (keep[v]) one_d_end[static_cast<std::size_t>(net.from[v])] = one_d_end[static_cast<std::size_t>(net.to[v])] = 1;
+    for (const std::int32_t v : held)
+      if (one_d_end[static_cast<std::size_t>(net.from[static_cast<std::size_t>(v)])] ||
+          one_d_end[static_cast<std::size_t>(net.to[static_cast<std::size_t>(v)])])
+        kept_vessel[static_cast<std::size_t>(v)] = true;
+  }
+  along.kept_.assign(net.node_count(), -1);
+  along.kept_vessel_.assign(net.vessel_count(), -1);
+  std::vector<std::size_t> kept_node;
+  for (const std::int32_t vessel : held) {
+    const auto v = static_cast<std::size_t>(vessel);
+    if (!kept_vessel[v]) continue;
+    along.kept_vessel_[v] = static_cast<std::int32_t>(along.line_.size());
+    along.line_.push_back(line_of(v));
+    along.mean_flow_.push_back(steady.flow[v]);
+    for (const std::int64_t node : {net.from[v], net.to[v]}) {
+      auto& slot = along.kept_[static_cast<std::size_t>(node)];
+      if (slot >= 0) continue;
+      slot = static_cast<std::int32_t>(kept_node.size());
+      kept_node.push_back(static_cast<std::size_t>(node));
+      along.mean_node_pressure_.push_back(steady.node_pressure[static_cast<std::size_t>(node)]);
+    }
+  }
+  // The nodes whose sums it keeps: its own and the ends of its vessels and ghosts (the shift's
+  // variances there), each summed over the harmonics in their order as the whole sums it.
+  std::vector<std::int32_t> summed(share.nodes.begin(), share.nodes.end());
+  for (const std::int32_t v : held)
+    summed.insert(summed.end(), {static_cast<std::int32_t>(net.from[static_cast<std::size_t>(v)]),
+                                 static_cast<std::int32_t>(net.to[static_cast<std::size_t>(v)])});
+  std::sort(summed.begin(), summed.end());
+  summed.erase(std::unique(summed.begin(), summed.end()), summed.end());
+  const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
+  const HarmonicNetwork network = harmonic_network(net, boundaries);
+  std::vector<Complex> shunt, current;
+  std::vector<double> variance(shift_mean ? net.node_count() : 0, 0.0);
+  auto any_line = [&](std::size_t v) { return line_of(v); };
+  for (int k = 1; k <= harmonics; ++k) {
+    const double w = along.omega(k);
+    node_terms(net, network, boundaries, series, any_line, k, w, shunt, current, {});
+    share.solve(w, shunt, current, [&](std::size_t v) { return line_of(v).two_port(w); });
+    const Complex turn = std::polar(1.0, w * time);
+    for (const std::int32_t node : summed) {
+      const auto i = static_cast<std::size_t>(node);
+      out.node_pressure[i] += (current[i] * turn).real();
+      if (shift_mean) variance[i] += 0.5 * std::norm(current[i]);
+    }
+    const auto own = static_cast<std::int64_t>(share.vessels.size());
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+    for (std::int64_t i = 0; i < own; ++i) {
+      const auto v = static_cast<std::size_t>(share.vessels[static_cast<std::size_t>(i)]);
+      const VesselLine line = line_of(v);
+      const Complex q = line.flow(w, current[static_cast<std::size_t>(net.from[v])], current[static_cast<std::size_t>(net.to[v])],
+                                  0.5 * line.length);
+      out.middle_flow[v] += (q * turn).real();
+    }
+    std::vector<Complex> kept(kept_node.size());
+    for (std::size_t j = 0; j < kept_node.size(); ++j) kept[j] = current[kept_node[j]];
+    along.node_pressure_.push_back(std::move(kept));
+  }
+  if (!shift_mean) return out;
+  auto at_zero = [&](std::vector<double>&& extra) -> const std::vector<Complex>& {
+    std::vector<FourierSeries> none = series;
+    for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
+    node_terms(net, network, boundaries, none, any_line, 0, 0.0, shunt, current, extra);
+    std::vector<double>().swap(extra);
+    share.solve(0.0, shunt, current, [&](std::size_t v) { return line_of(v).two_port(0.0); });
+    return current;
+  };
+  solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, along, keep, variance, out.node_pressure, threads,
+                   VesselList{&held, 0}, VesselList{&share.vessels, 0}, at_zero,
+                   [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
+                     out.middle_flow[v] += dq;
+                     if (!along.holds(v)) return;
+                     if (profile.empty()) profile = {dx_from, dx_to};  // the kept 0D vessels: their nodes'
+                     along.shift_mean(v, dq, std::move(profile));
+                   });
+  return out;
+}
+
 void LinearPeriodic::shift_mean(std::size_t vessel, double dq, std::vector<double>&& shift) {
   mean_flow_[vessel_place(vessel)] += dq;
   mean_shift_[vessel] = std::move(shift);

@@ -92,6 +92,10 @@ class LinearPeriodic {
                                                 const ViscosityTable&, const SteadyFlow&,
                                                 const RunBoundaries&, int, double,
                                                 const std::vector<bool>&, int, bool);
+  friend PeriodicInstant solve_periodic_instant(const Network&, const Blood&, std::span<const TubeLaw>,
+                                                const ViscosityTable&, const SteadyFlow&,
+                                                const RunBoundaries&, int, double,
+                                                const std::vector<bool>&, int, bool, const HarmonicShare&);
 
  private:
   // The mean state and every vessel's line about it; no harmonic yet.
@@ -188,5 +192,14 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
                                        const ViscosityTable& viscosity, const SteadyFlow& steady,
                                        const RunBoundaries& boundaries, int harmonics, double time,
                                        const std::vector<bool>& keep, int threads = 1, bool shift_mean = false);
+// The same over a share (HarmonicShare): node_pressure and middle_flow hold the share's nodes'
+// and vessels' numbers (the other entries unspecified), `along` the kept vessels it holds,
+// each the bits of the one-process instant. A kept vessel must be none of its ghosts (the 1D
+// vessels are kept on the top): InputError on every share otherwise.
+PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                       const ViscosityTable& viscosity, const SteadyFlow& steady,
+                                       const RunBoundaries& boundaries, int harmonics, double time,
+                                       const std::vector<bool>& keep, int threads, bool shift_mean,
+                                       const HarmonicShare& share);
 
 }  // namespace hemotree

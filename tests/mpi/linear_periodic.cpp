@@ -5,7 +5,7 @@
 // mean flow, middle amplitudes and shifted mean pressure, every own node's amplitudes and
 // mean (a node no vessel reaches too); no forced vessel across the cut; every vessel forced leaves a rank without one: refused
 // on every rank alike. Exit 0 when every
-// rank agrees.
+// rank agrees. The periodic instant (a pulsatile run's start) over the ranks likewise.
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -112,6 +112,41 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "rank %d: the ranks hold %zu vessels of %zu, %zu forced\n", rank, all[0], net.vessel_count(), all[1]);
       }
       if (rank == 0) std::printf("%g of the root's lumen: %zu forced, the top's %zu vessels\n", fraction, all[1], mine.partition.top.size());
+    }
+    // The periodic instant (a pulsatile run's start) at t = 0.3 s, the vessels of more than a
+    // tenth of the root's lumen kept (the run's 1D ones), the mean shifted: each rank's nodes'
+    // pressures, vessels' middle flows and kept vessels' lines and amplitudes, the whole's bits.
+    {
+      std::vector<bool> keep(net.vessel_count(), false);
+      const SteadyFlow s = solve_distended_steady_flow(net, blood, laws, viscosity, inflow.mean_value(), nullptr);
+      for (std::size_t v = 0; v < keep.size(); ++v) keep[v] = blood.density / loaded_line(net, blood, laws, viscosity, s, v).inertance > 0.1 * root_area;
+      const PeriodicInstant whole =
+          solve_periodic_instant(net, blood, laws, viscosity, s, RunBoundaries(net), harmonics, 0.3, keep, 1, true);
+      const PeriodicInstantOverRanks mine =
+          solve_periodic_instant_over_ranks(net, blood, laws, viscosity, harmonics, 0.3, keep, 1, true);
+      std::size_t differ = 0, kept = 0;
+      for (const std::int32_t node : mine.nodes)
+        differ += !same(mine.instant.node_pressure[static_cast<std::size_t>(node)], whole.node_pressure[static_cast<std::size_t>(node)]);
+      for (const std::int32_t vessel : mine.vessels) {
+        const auto v = static_cast<std::size_t>(vessel);
+        differ += !same(mine.instant.middle_flow[v], whole.middle_flow[v]);
+        if (!whole.along.holds(v)) continue;
+        differ += !mine.instant.along.holds(v);
+        if (!mine.instant.along.holds(v)) continue;
+        ++kept;
+        for (const double x : {0.0, 0.5, 1.0}) differ += !same(mine.instant.along.mean_pressure_at(v, x), whole.along.mean_pressure_at(v, x));
+        for (int k = 1; k <= harmonics; ++k) {
+          const VesselLine::Point p = mine.instant.along.middle(k, v), q = whole.along.middle(k, v);
+          differ += !same(p.pressure, q.pressure) + !same(p.flow, q.flow);
+        }
+      }
+      std::size_t kept_all = 0;
+      MPI_Allreduce(&kept, &kept_all, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
+      if (differ != 0 || kept_all == 0) {
+        ++failures;
+        std::fprintf(stderr, "rank %d, the instant: %zu numbers not the whole's bits, %zu kept vessels in all\n", rank, differ,
+                     kept_all);
+      }
     }
     // Every vessel forced: over several ranks every vessel would be the top's, which leaves a
     // rank without one: refused on every rank alike.
