@@ -21,6 +21,22 @@
 
 namespace hemotree {
 
+namespace {
+
+// The kept vessels and every vessel that meets one at a node: the mean shift reads the pulse
+// of the 0D vessels at the nodes where 1D ends meet them.
+std::vector<bool> with_neighbours(const Network& net, const std::vector<bool>& keep) {
+  std::vector<unsigned char> end(net.node_count(), 0);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (keep[v]) end[static_cast<std::size_t>(net.from[v])] = end[static_cast<std::size_t>(net.to[v])] = 1;
+  std::vector<bool> out = keep;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (end[static_cast<std::size_t>(net.from[v])] || end[static_cast<std::size_t>(net.to[v])]) out[v] = true;
+  return out;
+}
+
+}  // namespace
+
 VesselLine loaded_line(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                        const ViscosityTable& viscosity, const SteadyFlow& steady, std::size_t v) {
   return LineAbout{net, laws, viscosity, steady, friction_coefficient(blood.alpha), blood.density}(v);
@@ -145,33 +161,19 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
   out.kept_.assign(net.node_count(), -1);
   out.kept_vessel_.assign(net.vessel_count(), -1);
   std::vector<std::size_t> kept_node;
-  auto keep_node = [&](std::int64_t node) {
-    auto& slot = out.kept_[static_cast<std::size_t>(node)];
-    if (slot >= 0) return;
-    slot = static_cast<std::int32_t>(kept_node.size());
-    kept_node.push_back(static_cast<std::size_t>(node));
-    out.mean_node_pressure_.push_back(steady.node_pressure[static_cast<std::size_t>(node)]);
-  };
-  for (const std::int32_t vessel : held) {
-    const auto v = static_cast<std::size_t>(vessel);
-    out.kept_vessel_[v] = static_cast<std::int32_t>(out.mean_flow_.size());
-    out.mean_flow_.push_back(steady.flow[v]);
-    for (const std::int64_t node : {net.from[v], net.to[v]}) keep_node(node);
-  }
-  for (const std::int32_t node : share.nodes) keep_node(node);
+  for (const std::int32_t v : held) out.keep_vessel(static_cast<std::size_t>(v), steady, kept_node);
+  for (const std::int32_t node : share.nodes) out.keep_node(static_cast<std::size_t>(node), steady, kept_node);
   out.line_.resize(held.size());
   const auto held_count = static_cast<std::int64_t>(held.size());
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
   for (std::int64_t i = 0; i < held_count; ++i)
     out.line_[static_cast<std::size_t>(i)] = line_of(static_cast<std::size_t>(held[static_cast<std::size_t>(i)]));
-  // A line for the node terms: a vessel ending at a held pressure may be another share's.
-  auto any_line = [&](std::size_t v) { return out.holds(v) ? out.line(v) : line_of(v); };
   const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
   const HarmonicNetwork network = harmonic_network(net, boundaries);
   std::vector<Complex> shunt, current;
   auto solve = [&](double w) { share.solve(w, shunt, current, [&](std::size_t v) { return out.line(v).two_port(w); }); };
   for (int k = 1; k <= harmonics; ++k) {
-    node_terms(net, network, boundaries, series, any_line, k, out.omega(k), shunt, current, {});
+    node_terms(net, network, boundaries, series, line_of, k, out.omega(k), shunt, current, {});
     solve(out.omega(k));
     std::vector<Complex> kept(kept_node.size());
     for (std::size_t j = 0; j < kept_node.size(); ++j) kept[j] = current[kept_node[j]];
@@ -190,16 +192,9 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
   for (const std::vector<Complex>& p : out.node_pressure_)
     for (std::size_t j = 0; j < kept_node.size(); ++j) variance[kept_node[j]] += 0.5 * std::norm(p[j]);
   std::vector<double> node_shift(net.node_count(), 0.0);
-  auto at_zero = [&](std::vector<double>&& extra) -> const std::vector<Complex>& {
-    std::vector<FourierSeries> none = series;
-    for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
-    node_terms(net, network, boundaries, none, any_line, 0, 0.0, shunt, current, extra);
-    std::vector<double>().swap(extra);
-    solve(0.0);
-    return current;
-  };
   solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, out, sourced, variance, node_shift, threads,
-                   VesselList{&held, 0}, VesselList{&share.vessels, 0}, at_zero,
+                   VesselList{&held, 0}, VesselList{&share.vessels, 0},
+                   ShareAtZero{net, network, boundaries, series, line_of, share, shunt, current},
                    [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
                      out.mean_flow_[out.vessel_place(v)] += dq;
                      if (!sourced[v]) return;
@@ -230,27 +225,11 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   along.kept_.assign(net.node_count(), -1);
   along.kept_vessel_.assign(net.vessel_count(), -1);
   std::vector<std::size_t> kept_node;
-  // The mean shift reads the pulse of the 0D vessels at the nodes where 1D ends meet them.
-  std::vector<bool> held = keep;
-  if (shift_mean) {
-    std::vector<unsigned char> one_d_end(net.node_count(), 0);
-    for (std::size_t v = 0; v < net.vessel_count(); ++v)
-      if (keep[v]) one_d_end[static_cast<std::size_t>(net.from[v])] = one_d_end[static_cast<std::size_t>(net.to[v])] = 1;
-    for (std::size_t v = 0; v < net.vessel_count(); ++v)
-      if (one_d_end[static_cast<std::size_t>(net.from[v])] || one_d_end[static_cast<std::size_t>(net.to[v])]) held[v] = true;
-  }
+  const std::vector<bool> held = shift_mean ? with_neighbours(net, keep) : keep;
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
     if (!held[v]) continue;
-    along.kept_vessel_[v] = static_cast<std::int32_t>(along.line_.size());
+    along.keep_vessel(v, steady, kept_node);
     along.line_.push_back(line_of(v));
-    along.mean_flow_.push_back(steady.flow[v]);
-    for (const std::int64_t node : {net.from[v], net.to[v]}) {
-      auto& slot = along.kept_[static_cast<std::size_t>(node)];
-      if (slot >= 0) continue;
-      slot = static_cast<std::int32_t>(kept_node.size());
-      kept_node.push_back(static_cast<std::size_t>(node));
-      along.mean_node_pressure_.push_back(steady.node_pressure[static_cast<std::size_t>(node)]);
-    }
   }
   const auto nodes = static_cast<std::int64_t>(net.node_count()), vessels = static_cast<std::int64_t>(net.vessel_count());
   // One harmonic at a time, the threads within it, each added to every sum as it is solved,
@@ -318,32 +297,15 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   std::vector<std::int32_t> held;  // its vessels and ghosts
   std::merge(share.vessels.begin(), share.vessels.end(), share.ghosts.begin(), share.ghosts.end(), std::back_inserter(held));
   // What `along` keeps, as the one-process instant keeps it, of the vessels this share holds.
-  std::vector<bool> kept_vessel = keep;
-  if (shift_mean) {
-    std::vector<unsigned char> one_d_end(net.node_count(), 0);
-    for (std::size_t v = 0; v < net.vessel_count(); ++v)
-      if (keep[v]) one_d_end[static_cast<std::size_t>(net.from[v])] = one_d_end[static_cast<std::size_t>(net.to[v])] = 1;
-    for (const std::int32_t v : held)
-      if (one_d_end[static_cast<std::size_t>(net.from[static_cast<std::size_t>(v)])] ||
-          one_d_end[static_cast<std::size_t>(net.to[static_cast<std::size_t>(v)])])
-        kept_vessel[static_cast<std::size_t>(v)] = true;
-  }
+  const std::vector<bool> kept_vessel = shift_mean ? with_neighbours(net, keep) : keep;
   along.kept_.assign(net.node_count(), -1);
   along.kept_vessel_.assign(net.vessel_count(), -1);
   std::vector<std::size_t> kept_node;
   for (const std::int32_t vessel : held) {
     const auto v = static_cast<std::size_t>(vessel);
     if (!kept_vessel[v]) continue;
-    along.kept_vessel_[v] = static_cast<std::int32_t>(along.line_.size());
+    along.keep_vessel(v, steady, kept_node);
     along.line_.push_back(line_of(v));
-    along.mean_flow_.push_back(steady.flow[v]);
-    for (const std::int64_t node : {net.from[v], net.to[v]}) {
-      auto& slot = along.kept_[static_cast<std::size_t>(node)];
-      if (slot >= 0) continue;
-      slot = static_cast<std::int32_t>(kept_node.size());
-      kept_node.push_back(static_cast<std::size_t>(node));
-      along.mean_node_pressure_.push_back(steady.node_pressure[static_cast<std::size_t>(node)]);
-    }
   }
   // The nodes whose sums it keeps: its own and the ends of its vessels and ghosts (the shift's
   // variances there), each summed over the harmonics in their order as the whole sums it.
@@ -357,10 +319,9 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   const HarmonicNetwork network = harmonic_network(net, boundaries);
   std::vector<Complex> shunt, current;
   std::vector<double> variance(shift_mean ? net.node_count() : 0, 0.0);
-  auto any_line = [&](std::size_t v) { return line_of(v); };
   for (int k = 1; k <= harmonics; ++k) {
     const double w = along.omega(k);
-    node_terms(net, network, boundaries, series, any_line, k, w, shunt, current, {});
+    node_terms(net, network, boundaries, series, line_of, k, w, shunt, current, {});
     share.solve(w, shunt, current, [&](std::size_t v) { return line_of(v).two_port(w); });
     const Complex turn = std::polar(1.0, w * time);
     for (const std::int32_t node : summed) {
@@ -382,16 +343,9 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
     along.node_pressure_.push_back(std::move(kept));
   }
   if (!shift_mean) return out;
-  auto at_zero = [&](std::vector<double>&& extra) -> const std::vector<Complex>& {
-    std::vector<FourierSeries> none = series;
-    for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
-    node_terms(net, network, boundaries, none, any_line, 0, 0.0, shunt, current, extra);
-    std::vector<double>().swap(extra);
-    share.solve(0.0, shunt, current, [&](std::size_t v) { return line_of(v).two_port(0.0); });
-    return current;
-  };
   solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, along, keep, variance, out.node_pressure, threads,
-                   VesselList{&held, 0}, VesselList{&share.vessels, 0}, at_zero,
+                   VesselList{&held, 0}, VesselList{&share.vessels, 0},
+                   ShareAtZero{net, network, boundaries, series, line_of, share, shunt, current},
                    [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
                      out.middle_flow[v] += dq;
                      if (!along.holds(v)) return;
@@ -399,6 +353,20 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
                      along.shift_mean(v, dq, std::move(profile));
                    });
   return out;
+}
+
+void LinearPeriodic::keep_node(std::size_t node, const SteadyFlow& steady, std::vector<std::size_t>& kept_node) {
+  auto& slot = kept_[node];
+  if (slot >= 0) return;
+  slot = static_cast<std::int32_t>(kept_node.size());
+  kept_node.push_back(node);
+  mean_node_pressure_.push_back(steady.node_pressure[node]);
+}
+
+void LinearPeriodic::keep_vessel(std::size_t v, const SteadyFlow& steady, std::vector<std::size_t>& kept_node) {
+  kept_vessel_[v] = static_cast<std::int32_t>(mean_flow_.size());
+  mean_flow_.push_back(steady.flow[v]);
+  for (const std::int64_t node : {net_->from[v], net_->to[v]}) keep_node(static_cast<std::size_t>(node), steady, kept_node);
 }
 
 void LinearPeriodic::shift_mean(std::size_t vessel, double dq, std::vector<double>&& shift) {

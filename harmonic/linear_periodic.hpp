@@ -112,6 +112,11 @@ class LinearPeriodic {
   std::vector<std::int32_t> kept_, kept_vessel_;  // per node, per vessel: its place, -1 (empty: its own)
   // Per vessel so moved, the mean pressure's second-order shift along it beyond its nodes' means.
   std::unordered_map<std::size_t, std::vector<double>> mean_shift_;
+  // Keeps vessel v at the next place (its mean flow from `steady`; the caller adds its line at
+  // the same place) and its nodes (their mean pressures) where they are not kept yet;
+  // kept_node lists the kept nodes by place. kept_ and kept_vessel_ sized first.
+  void keep_vessel(std::size_t v, const SteadyFlow& steady, std::vector<std::size_t>& kept_node);
+  void keep_node(std::size_t node, const SteadyFlow& steady, std::vector<std::size_t>& kept_node);
   std::size_t node_place(std::size_t node) const { return kept_.empty() ? node : static_cast<std::size_t>(kept_[node]); }
   std::size_t vessel_place(std::size_t v) const { return kept_vessel_.empty() ? v : static_cast<std::size_t>(kept_vessel_[v]); }
 };

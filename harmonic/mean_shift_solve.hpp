@@ -208,4 +208,24 @@ struct WholeAtZero {
   }
 };
 
+// The same over a share of the network (HarmonicShare): its rows' node terms, its solve with
+// the other shares, in its own arrays (shunt and current, every node's, kept by the caller).
+struct ShareAtZero {
+  const Network& net;
+  const HarmonicNetwork& network;
+  const RunBoundaries& boundaries;
+  const std::vector<FourierSeries>& series;
+  const LineAbout& line_of;
+  const HarmonicShare& share;
+  std::vector<Complex>&shunt, &current;
+  const std::vector<Complex>& operator()(std::vector<double>&& extra) const {
+    std::vector<FourierSeries> none = series;
+    for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
+    node_terms(net, network, boundaries, none, line_of, 0, 0.0, shunt, current, extra);
+    std::vector<double>().swap(extra);
+    share.solve(0.0, shunt, current, [&](std::size_t v) { return line_of(v).two_port(0.0); });
+    return current;
+  }
+};
+
 }  // namespace hemotree
