@@ -21,17 +21,11 @@ namespace hemotree {
 
 namespace {
 
-std::vector<int> root_counts(const TreeCut& cut) {
-  std::vector<int> out;
-  for (const auto& roots : cut.roots) out.push_back(static_cast<int>(roots.size()));
-  return out;
-}
-
 // The top's rank receives, per share root r, the steady pressure at r and the flow of its
 // vessel into the top (the ghosts' steady state), into its whole-network arrays.
 void send_ghosts_to_top(const TreeCut& cut, SteadyFlow& steady) {
   const int rank = world_rank();
-  RootExchange exchange(MPI_COMM_WORLD, cut.top_rank, root_counts(cut));
+  RootExchange exchange(MPI_COMM_WORLD, cut);
   std::vector<double> message;
   for (const std::int32_t r : cut.roots[static_cast<std::size_t>(rank)]) {
     const auto node = static_cast<std::size_t>(r);

@@ -9,18 +9,6 @@ namespace hemotree {
 
 namespace {
 
-int rank_in(MPI_Comm comm) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  return rank;
-}
-
-std::vector<int> root_counts(const TreeCut& cut) {
-  std::vector<int> out;
-  for (const auto& roots : cut.roots) out.push_back(static_cast<int>(roots.size()));
-  return out;
-}
-
 // A complex number travels as its two doubles (std::complex<double> may be read as double[2];
 // the way back is copied).
 std::span<const double> as_doubles(std::span<const Complex> z) {
@@ -35,7 +23,7 @@ std::vector<Complex> as_complex(std::span<const double> d) {
 }  // namespace
 
 MpiHarmonicTree::MpiHarmonicTree(MPI_Comm comm, const TreeCut& cut)
-    : rank_(rank_in(comm)), share_(cut, rank_in(comm)), exchange_(comm, cut.top_rank, root_counts(cut)) {
+    : rank_(rank_in(comm)), share_(cut, rank_in(comm)), exchange_(comm, cut) {
   share_size_ = share_.node_count();
   nodes_ = std::move(cut.held_nodes()[static_cast<std::size_t>(rank_)]);
   for (const std::int32_t r : cut.roots[static_cast<std::size_t>(rank_)])

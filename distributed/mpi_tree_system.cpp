@@ -10,24 +10,8 @@
 
 namespace hemotree {
 
-namespace {
-
-int rank_in(MPI_Comm comm) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  return rank;
-}
-
-std::vector<int> root_counts(const TreeCut& cut) {
-  std::vector<int> out;
-  for (const auto& roots : cut.roots) out.push_back(static_cast<int>(roots.size()));
-  return out;
-}
-
-}  // namespace
-
 MpiTreeSystem::MpiTreeSystem(MPI_Comm comm, const TreeCut& cut)
-    : rank_(rank_in(comm)), share_(cut, rank_in(comm)), exchange_(comm, cut.top_rank, root_counts(cut)) {
+    : rank_(rank_in(comm)), share_(cut, rank_in(comm)), exchange_(comm, cut) {
   top_rank_ = cut.top_rank;
   share_size_ = share_.node_count();
   nodes_ = std::move(cut.held_nodes()[static_cast<std::size_t>(rank_)]);

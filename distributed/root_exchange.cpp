@@ -12,12 +12,6 @@ namespace {
 // A status in an answer below solved: rank K refused (-2 - K).
 double refused_by(int rank) { return -2.0 - rank; }
 
-int rank_in(MPI_Comm comm) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  return rank;
-}
-
 std::string words(const std::exception_ptr& failure) {
   try {
     std::rethrow_exception(failure);
@@ -28,7 +22,21 @@ std::string words(const std::exception_ptr& failure) {
   }
 }
 
+std::vector<int> root_counts(const TreeCut& cut) {
+  std::vector<int> out;
+  for (const auto& roots : cut.roots) out.push_back(static_cast<int>(roots.size()));
+  return out;
+}
+
 }  // namespace
+
+int rank_in(MPI_Comm comm) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  return rank;
+}
+
+RootExchange::RootExchange(MPI_Comm comm, const TreeCut& cut) : RootExchange(comm, cut.top_rank, root_counts(cut)) {}
 
 RootExchange::RootExchange(MPI_Comm comm, int top_rank, std::vector<int> roots)
     : comm_(comm), rank_(rank_in(comm)), top_rank_(top_rank), roots_(std::move(roots)) {

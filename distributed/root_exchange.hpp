@@ -14,13 +14,20 @@
 
 #include <mpi.h>
 
+#include "distributed/tree_share.hpp"
+
 namespace hemotree {
+
+// This process's rank in comm.
+int rank_in(MPI_Comm comm);
 
 class RootExchange {
  public:
   // roots: per rank of comm (MPI_COMM_WORLD or a copy of it), its share roots (TreeCut::roots'
   // sizes). No communication.
   RootExchange(MPI_Comm comm, int top_rank, std::vector<int> roots);
+  // The same for a cut tree's shares and top (TreeCut::roots, TreeCut::top_rank).
+  RootExchange(MPI_Comm comm, const TreeCut& cut);
   int rank() const { return rank_; }
   bool top() const { return rank_ == top_rank_; }
 

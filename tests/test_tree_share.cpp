@@ -252,19 +252,7 @@ TEST(TreeShares, ANetworkCutOnlyWhereItsTopIsOneRanks) {
 // pulsatile run over ranks will solve a step with (docs/scaling.md, "the plan").
 TEST(TreeShares, TheZeroDVesselsSystemInItsOwnNumberingCutsIntoShares) {
   Network net = grown_tree();
-  std::vector<unsigned char> has_daughter(net.node_count(), 0);
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) has_daughter[static_cast<std::size_t>(net.from[v])] = 1;
-  for (std::size_t v = 0; v < net.vessel_count(); ++v)
-    if (!has_daughter[static_cast<std::size_t>(net.to[v])]) {
-      Outlet o;
-      o.vessel = static_cast<std::int32_t>(v);
-      o.type = BoundaryType::rcr;
-      o.r1 = 4e12;
-      o.r2 = 1.6e13;
-      o.c = 1e-14;
-      o.p_out = 1333.2;
-      net.outlets.push_back(o);
-    }
+  test_networks::add_leaf_outlets(net, BoundaryType::rcr);
   net.inlet = Inlet{net.id[0], Waveform::constant_value(1e-9 / 60)};
   const Blood blood = net.blood.value_or(Blood{});
   const std::vector<TubeLaw> laws = vessel_laws(net, blood, 0.0, 0.1);

@@ -28,17 +28,7 @@ int main(int argc, char** argv) {
     const int ranks = world_size(), rank = world_rank();
     Network net = test_networks::grown_tree();
     // Every leaf an outlet of 2e13 Pa s/m^3 to 10 mmHg; 1 ul/min in at the root.
-    std::vector<unsigned char> leaves_from(net.node_count(), 0);
-    for (std::size_t v = 0; v < net.vessel_count(); ++v) leaves_from[static_cast<std::size_t>(net.from[v])] = 1;
-    for (std::size_t v = 0; v < net.vessel_count(); ++v)
-      if (!leaves_from[static_cast<std::size_t>(net.to[v])]) {
-        Outlet o;
-        o.vessel = static_cast<std::int32_t>(v);
-        o.type = BoundaryType::resistance;
-        o.r = 2e13;
-        o.p_out = 1333.2;
-        net.outlets.push_back(o);
-      }
+    test_networks::add_leaf_outlets(net, BoundaryType::resistance);
     const double inflow = 1e-9 / 60;
     net.inlet = Inlet{net.id[0], Waveform::constant_value(inflow)};
     const Blood blood = net.blood.value_or(Blood{});

@@ -19,19 +19,13 @@
 #include "../grown_trees.hpp"
 #include "network_flow/harmonic_system.hpp"
 #include "partition/partition.hpp"
+#include "rank_checks.hpp"
 
 using namespace hemotree;
+using rank_checks::check;
+using rank_checks::rank;
 
 namespace {
-
-int failures = 0;
-int rank = 0;
-
-void check(bool ok, const std::string& what) {
-  if (ok) return;
-  ++failures;
-  std::fprintf(stderr, "rank %d: %s\n", rank, what.c_str());
-}
 
 bool same_bits(Complex a, Complex b) {
   return std::bit_cast<std::uint64_t>(a.real()) == std::bit_cast<std::uint64_t>(b.real()) &&
@@ -132,8 +126,7 @@ int main(int argc, char** argv) {
             std::string("refused as: ") + e.what());
     }
   }
-  int total = 0;
-  MPI_Allreduce(&failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  const int total = rank_checks::all_failures();
   if (rank == 0 && total == 0) std::printf("%d ranks: the whole harmonic system's bits\n", ranks);
   MPI_Finalize();
   return total == 0 ? 0 : 1;

@@ -39,19 +39,7 @@ int main(int argc, char** argv) {
     MpiSession session(argc, argv);
     const int ranks = world_size(), rank = world_rank();
     Network net = test_networks::grown_tree();
-    std::vector<unsigned char> leaves_from(net.node_count(), 0);
-    for (std::size_t v = 0; v < net.vessel_count(); ++v) leaves_from[static_cast<std::size_t>(net.from[v])] = 1;
-    for (std::size_t v = 0; v < net.vessel_count(); ++v)
-      if (!leaves_from[static_cast<std::size_t>(net.to[v])]) {
-        Outlet o;
-        o.vessel = static_cast<std::int32_t>(v);
-        o.type = BoundaryType::rcr;
-        o.r1 = 4e12;
-        o.r2 = 1.6e13;
-        o.c = 1e-14;
-        o.p_out = 1333.2;
-        net.outlets.push_back(o);
-      }
+    test_networks::add_leaf_outlets(net, BoundaryType::rcr);
     net.add_node(net.node_id.back() + 1000);  // a node no vessel reaches (a file may list one)
     Waveform inflow;  // half sine, 1 s, 1 ul/min on average
     inflow.mean = 1e-9 / 60;

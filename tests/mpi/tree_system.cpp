@@ -20,21 +20,11 @@
 #include "../grown_trees.hpp"
 #include "network_flow/nodal_system.hpp"
 #include "partition/partition.hpp"
+#include "rank_checks.hpp"
 
 using namespace hemotree;
-
-namespace {
-
-int failures = 0;
-int rank = 0;
-
-void check(bool ok, const std::string& what) {
-  if (ok) return;
-  ++failures;
-  std::fprintf(stderr, "rank %d: %s\n", rank, what.c_str());
-}
-
-}  // namespace
+using rank_checks::check;
+using rank_checks::rank;
 
 int main(int argc, char** argv) {
   MPI_Init(&argc, &argv);
@@ -124,8 +114,7 @@ int main(int argc, char** argv) {
             std::string("refused as: ") + e.what());
     }
   }
-  int total = 0;
-  MPI_Allreduce(&failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  const int total = rank_checks::all_failures();
   if (rank == 0 && total == 0) std::printf("%d ranks: the whole system's bits\n", ranks);
   MPI_Finalize();
   return total == 0 ? 0 : 1;
