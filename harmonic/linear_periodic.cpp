@@ -35,6 +35,17 @@ std::vector<bool> with_neighbours(const Network& net, const std::vector<bool>& k
   return out;
 }
 
+// What an instant takes of each vessel's mean shift: its middle flow's, and a kept vessel's
+// along it (a kept 0D vessel's: its nodes').
+auto shift_into(PeriodicInstant& out) {
+  return [&out](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
+    out.middle_flow[v] += dq;
+    if (!out.along.holds(v)) return;
+    if (profile.empty()) profile = {dx_from, dx_to};
+    out.along.shift_mean(v, dq, std::move(profile));
+  };
+}
+
 }  // namespace
 
 VesselLine loaded_line(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
@@ -268,12 +279,7 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
     solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, along, keep, variance, out.node_pressure, threads,
                      VesselList{nullptr, net.vessel_count()}, VesselList{nullptr, net.vessel_count()},
                      WholeAtZero{net, network, boundaries, series, line_of, work, threads},
-                     [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
-                       out.middle_flow[v] += dq;
-                       if (!along.holds(v)) return;
-                       if (profile.empty()) profile = {dx_from, dx_to};  // the kept 0D vessels: their nodes'
-                       along.shift_mean(v, dq, std::move(profile));
-                     });
+                     shift_into(out));
   return out;
 }
 
@@ -346,12 +352,7 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, along, keep, variance, out.node_pressure, threads,
                    VesselList{&held, 0}, VesselList{&share.vessels, 0},
                    ShareAtZero{net, network, boundaries, series, line_of, share, shunt, current},
-                   [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
-                     out.middle_flow[v] += dq;
-                     if (!along.holds(v)) return;
-                     if (profile.empty()) profile = {dx_from, dx_to};  // the kept 0D vessels: their nodes'
-                     along.shift_mean(v, dq, std::move(profile));
-                   });
+                   shift_into(out));
   return out;
 }
 

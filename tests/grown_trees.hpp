@@ -2,7 +2,11 @@
 // distributed solves): D_root 150 um to D_min 7 um, about 16,500 vessels, in milliseconds.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <numeric>
+#include <random>
+#include <utility>
 #include <vector>
 
 #include "formats/boundary_conditions.hpp"
@@ -17,6 +21,25 @@ inline Network grown_tree() {
   p.root_diameter = 150e-6;
   p.min_diameter = 7e-6;
   return grow_tree(default_rules(), p);
+}
+
+// A network's vessels (from, to) with its nodes labelled in a shuffled order (seed), and every
+// `reversed`-th vessel the other way round (0: none): a forest whose labels no longer hang
+// every node from a lower one.
+struct Edges {
+  std::vector<std::int32_t> a, b;
+};
+inline Edges shuffled_edges(const Network& net, unsigned seed, std::size_t reversed = 0) {
+  std::vector<std::int32_t> relabel(net.node_count());
+  std::iota(relabel.begin(), relabel.end(), 0);
+  std::shuffle(relabel.begin(), relabel.end(), std::mt19937(seed));
+  Edges e{std::vector<std::int32_t>(net.vessel_count()), std::vector<std::int32_t>(net.vessel_count())};
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    e.a[v] = relabel[static_cast<std::size_t>(net.from[v])];
+    e.b[v] = relabel[static_cast<std::size_t>(net.to[v])];
+    if (reversed > 0 && v % reversed == 0) std::swap(e.a[v], e.b[v]);
+  }
+  return e;
 }
 
 // Every leaf of a tree an outlet to 10 mmHg: a resistance of 2e13 Pa s/m^3, or an RCR of

@@ -131,15 +131,7 @@ TEST(HarmonicTreeShares, SweptShareByShareGiveTheWholeSystemsBitsForAnyRanks) {
 TEST(HarmonicTreeShares, PeeledOrderAndEitherOrientationGiveTheWholeSystemsBits) {
   const Network net = grown_tree();
   const std::size_t nodes = net.node_count();
-  std::vector<std::int32_t> relabel(nodes);
-  std::iota(relabel.begin(), relabel.end(), 0);
-  std::shuffle(relabel.begin(), relabel.end(), std::mt19937(7));
-  std::vector<std::int32_t> a(net.vessel_count()), b(net.vessel_count());
-  for (std::size_t v = 0; v < a.size(); ++v) {
-    a[v] = relabel[static_cast<std::size_t>(net.from[v])];
-    b[v] = relabel[static_cast<std::size_t>(net.to[v])];
-    if (v % 3 == 0) std::swap(a[v], b[v]);
-  }
+  const auto [a, b] = test_networks::shuffled_edges(net, 7, 3);
   const Numbers n = numbers_for(nodes, a, b, 2);
   const std::vector<Complex> x = whole(nodes, a, b, n);
   for (const int ranks : {2, 5}) {

@@ -168,14 +168,7 @@ TEST(TreeShares, SweptShareByShareGiveTheWholeSystemsBitsForAnyRanks) {
 TEST(TreeShares, PeeledOrderAlsoGivesTheWholeSystemsBits) {
   const Network net = grown_tree();
   const std::size_t nodes = net.node_count();
-  std::vector<std::int32_t> relabel(nodes);
-  std::iota(relabel.begin(), relabel.end(), 0);
-  std::shuffle(relabel.begin(), relabel.end(), std::mt19937(7));
-  std::vector<std::int32_t> a(net.vessel_count()), b(net.vessel_count());
-  for (std::size_t v = 0; v < a.size(); ++v) {
-    a[v] = relabel[static_cast<std::size_t>(net.from[v])];
-    b[v] = relabel[static_cast<std::size_t>(net.to[v])];
-  }
+  const auto [a, b] = test_networks::shuffled_edges(net, 7);
   const Numbers n = numbers_for(nodes, a.size(), a, b, 2);
   const std::vector<double> x = whole(nodes, a, b, n);
   const Partition partition = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), 5);
