@@ -90,31 +90,71 @@ struct LineAbout {
 // terms in their order, the currents of extra_current (the mean shift's), the vessels that end
 // at a held node, and a unit diagonal where no edge of the system reaches a node: everything
 // of the nodal system but its edges' two-ports. line_of(v) gives vessel v's line.
+// Some nodes of a network (a share's: the ones its solve reads) and the boundaries at them in
+// the boundaries' order, each with its place in the boundaries' series (-1: an outlet), so
+// that a harmonic's node terms cost those nodes, not the whole network's (node_terms below).
+struct NodeSubset {
+  std::vector<std::int32_t> nodes, boundary, series_index;
+  NodeSubset(const RunBoundaries& boundaries, std::span<const std::int32_t> subset, std::size_t node_count)
+      : nodes(subset.begin(), subset.end()) {
+    std::vector<unsigned char> in(node_count, 0);
+    for (const std::int32_t node : nodes) in[static_cast<std::size_t>(node)] = 1;
+    std::int32_t next = 0;
+    for (std::size_t i = 0; i < boundaries.size(); ++i) {
+      const std::int32_t place = boundaries.is_outlet(i) ? -1 : next++;
+      if (!in[static_cast<std::size_t>(boundaries.node(i))]) continue;
+      boundary.push_back(static_cast<std::int32_t>(i));
+      series_index.push_back(place);
+    }
+  }
+};
+
+// Boundary i's term in its node's row at harmonic k (series_place: its place in series, -1:
+// an outlet).
+inline void boundary_term(const Network& net, const RunBoundaries& boundaries, const std::vector<FourierSeries>& series,
+                          std::size_t i, std::int32_t series_place, int k, double w, std::vector<Complex>& shunt,
+                          std::vector<Complex>& current) {
+  const auto node = static_cast<std::size_t>(boundaries.node(i));
+  const Complex amplitude =
+      series_place < 0 ? Complex(0.0) : series[static_cast<std::size_t>(series_place)].amplitude[static_cast<std::size_t>(k)];
+  const Outlet& o = boundaries.outlet(i);
+  switch (boundaries.type(i)) {
+    case BoundaryType::flow: current[node] += amplitude; break;
+    case BoundaryType::pressure: current[node] = amplitude; break;
+    case BoundaryType::resistance: shunt[node] += 1.0 / ResistanceOutlet{o.r, o.p_out}.impedance(w); break;
+    case BoundaryType::rcr: shunt[node] += 1.0 / RcrOutlet{o.r1, o.c, o.r2, o.p_out}.impedance(w); break;
+    case BoundaryType::reflection:
+      throw InputError("node " + std::to_string(net.node_id[node]) + ": a reflection outlet has no steady state to linearise about");
+  }
+}
+
+// subset: where given, the rows of its nodes alone, each the whole's (the other entries of
+// shunt and current are left as they were; the arrays are sized to every node once).
 template <class LineOf>
 void node_terms(const Network& net, const HarmonicNetwork& h, const RunBoundaries& boundaries,
                 const std::vector<FourierSeries>& series, const LineOf& line_of, int k, double w,
-                std::vector<Complex>& shunt, std::vector<Complex>& current, std::span<const double> extra_current) {
+                std::vector<Complex>& shunt, std::vector<Complex>& current, std::span<const double> extra_current,
+                const NodeSubset* subset = nullptr) {
   const std::size_t nodes = net.node_count();
   // A held node's current is its held pressure: nothing else flows into it (one boundary a
   // node; a vessel to it draws its current at its other node), and its row is x = current.
-  shunt.assign(nodes, 0.0), current.assign(nodes, 0.0);
-  std::size_t next = 0;  // series holds the boundaries' that are not outlets, in their order
-  for (std::size_t i = 0; i < boundaries.size(); ++i) {
-    const auto node = static_cast<std::size_t>(boundaries.node(i));
-    const Complex amplitude = boundaries.is_outlet(i) ? Complex(0.0) : series[next++].amplitude[static_cast<std::size_t>(k)];
-    const Outlet& o = boundaries.outlet(i);
-    switch (boundaries.type(i)) {
-      case BoundaryType::flow: current[node] += amplitude; break;
-      case BoundaryType::pressure: current[node] = amplitude; break;
-      case BoundaryType::resistance: shunt[node] += 1.0 / ResistanceOutlet{o.r, o.p_out}.impedance(w); break;
-      case BoundaryType::rcr: shunt[node] += 1.0 / RcrOutlet{o.r1, o.c, o.r2, o.p_out}.impedance(w); break;
-      case BoundaryType::reflection:
-        throw InputError("node " + std::to_string(net.node_id[node]) +
-                         ": a reflection outlet has no steady state to linearise about");
-    }
+  if (!subset) {
+    shunt.assign(nodes, 0.0), current.assign(nodes, 0.0);
+    std::int32_t next = 0;  // series holds the boundaries' that are not outlets, in their order
+    for (std::size_t i = 0; i < boundaries.size(); ++i)
+      boundary_term(net, boundaries, series, i, boundaries.is_outlet(i) ? -1 : next++, k, w, shunt, current);
+    for (std::size_t node = 0; node < extra_current.size(); ++node)
+      if (!h.held[node]) current[node] += extra_current[node];
+  } else {
+    if (shunt.size() != nodes) shunt.assign(nodes, 0.0), current.assign(nodes, 0.0);
+    for (const std::int32_t node : subset->nodes) shunt[static_cast<std::size_t>(node)] = current[static_cast<std::size_t>(node)] = 0.0;
+    for (std::size_t j = 0; j < subset->boundary.size(); ++j)
+      boundary_term(net, boundaries, series, static_cast<std::size_t>(subset->boundary[j]), subset->series_index[j], k, w,
+                    shunt, current);
+    if (!extra_current.empty())
+      for (const std::int32_t node : subset->nodes)
+        if (!h.held[static_cast<std::size_t>(node)]) current[static_cast<std::size_t>(node)] += extra_current[static_cast<std::size_t>(node)];
   }
-  for (std::size_t node = 0; node < extra_current.size(); ++node)
-    if (!h.held[node]) current[node] += extra_current[node];
   // A vessel ending at a held node becomes, at its other node, a shunt and the current the
   // held pressure drives through it.
   for (const std::int32_t vessel : h.held_end_vessel) {
@@ -129,8 +169,13 @@ void node_terms(const Network& net, const HarmonicNetwork& h, const RunBoundarie
       current[i] -= y.ab * current[j];
     }
   }
-  for (std::size_t node = 0; node < nodes; ++node) {
-    if (h.held[node] || !h.touched[node]) shunt[node] = 1.0;  // no edge of the system reaches it
+  auto unreached = [&](std::size_t node) {  // no edge of the system reaches it
+    if (h.held[node] || !h.touched[node]) shunt[node] = 1.0;
+  };
+  if (!subset) {
+    for (std::size_t node = 0; node < nodes; ++node) unreached(node);
+  } else {
+    for (const std::int32_t node : subset->nodes) unreached(static_cast<std::size_t>(node));
   }
 }
 

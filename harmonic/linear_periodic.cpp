@@ -181,10 +181,11 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
     out.line_[static_cast<std::size_t>(i)] = line_of(static_cast<std::size_t>(held[static_cast<std::size_t>(i)]));
   const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
   const HarmonicNetwork network = harmonic_network(net, boundaries);
+  const NodeSubset subset(boundaries, share.nodes, net.node_count());  // the rows its solve reads
   std::vector<Complex> shunt, current;
   auto solve = [&](double w) { share.solve(w, shunt, current, [&](std::size_t v) { return out.line(v).two_port(w); }); };
   for (int k = 1; k <= harmonics; ++k) {
-    node_terms(net, network, boundaries, series, line_of, k, out.omega(k), shunt, current, {});
+    node_terms(net, network, boundaries, series, line_of, k, out.omega(k), shunt, current, {}, &subset);
     solve(out.omega(k));
     std::vector<Complex> kept(kept_node.size());
     for (std::size_t j = 0; j < kept_node.size(); ++j) kept[j] = current[kept_node[j]];
@@ -205,7 +206,7 @@ LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std
   std::vector<double> node_shift(net.node_count(), 0.0);
   solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, out, sourced, variance, node_shift, threads,
                    VesselList{&held, 0}, VesselList{&share.vessels, 0},
-                   ShareAtZero{net, network, boundaries, series, line_of, share, shunt, current},
+                   ShareAtZero{net, network, boundaries, series, line_of, share, subset, shunt, current},
                    [&](std::size_t v, double dq, std::vector<double>&& profile, double dx_from, double dx_to) {
                      out.mean_flow_[out.vessel_place(v)] += dq;
                      if (!sourced[v]) return;
@@ -323,11 +324,12 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   summed.erase(std::unique(summed.begin(), summed.end()), summed.end());
   const std::vector<FourierSeries> series = boundary_series(boundaries, harmonics);
   const HarmonicNetwork network = harmonic_network(net, boundaries);
+  const NodeSubset subset(boundaries, share.nodes, net.node_count());  // the rows its solve reads
   std::vector<Complex> shunt, current;
   std::vector<double> variance(shift_mean ? net.node_count() : 0, 0.0);
   for (int k = 1; k <= harmonics; ++k) {
     const double w = along.omega(k);
-    node_terms(net, network, boundaries, series, line_of, k, w, shunt, current, {});
+    node_terms(net, network, boundaries, series, line_of, k, w, shunt, current, {}, &subset);
     share.solve(w, shunt, current, [&](std::size_t v) { return line_of(v).two_port(w); });
     const Complex turn = std::polar(1.0, w * time);
     for (const std::int32_t node : summed) {
@@ -351,7 +353,7 @@ PeriodicInstant solve_periodic_instant(const Network& net, const Blood& blood, s
   if (!shift_mean) return out;
   solve_mean_shift(net, blood, laws, viscosity, boundaries, line_of, along, keep, variance, out.node_pressure, threads,
                    VesselList{&held, 0}, VesselList{&share.vessels, 0},
-                   ShareAtZero{net, network, boundaries, series, line_of, share, shunt, current},
+                   ShareAtZero{net, network, boundaries, series, line_of, share, subset, shunt, current},
                    shift_into(out));
   return out;
 }

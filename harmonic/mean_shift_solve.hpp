@@ -217,11 +217,12 @@ struct ShareAtZero {
   const std::vector<FourierSeries>& series;
   const LineAbout& line_of;
   const HarmonicShare& share;
+  const NodeSubset& subset;  // the share's nodes
   std::vector<Complex>&shunt, &current;
   const std::vector<Complex>& operator()(std::vector<double>&& extra) const {
     std::vector<FourierSeries> none = series;
     for (FourierSeries& f : none) std::fill(f.amplitude.begin(), f.amplitude.end(), Complex(0.0));
-    node_terms(net, network, boundaries, none, line_of, 0, 0.0, shunt, current, extra);
+    node_terms(net, network, boundaries, none, line_of, 0, 0.0, shunt, current, extra, &subset);
     std::vector<double>().swap(extra);
     share.solve(0.0, shunt, current, [&](std::size_t v) { return line_of(v).two_port(0.0); });
     return current;
