@@ -108,4 +108,18 @@ LumpedOrder subtree_lumped_order(const Network& net, const std::vector<bool>& ze
   return order;
 }
 
+LumpedOrder restrict_order(const LumpedOrder& order, const Network& net, const std::vector<bool>& keep) {
+  LumpedOrder out;
+  std::vector<unsigned char> end(net.node_count(), 0);
+  for (const std::int32_t v : order.vessels) {
+    if (!keep[static_cast<std::size_t>(v)]) continue;
+    out.vessels.push_back(v);
+    end[static_cast<std::size_t>(net.from[static_cast<std::size_t>(v)])] = 1;
+    end[static_cast<std::size_t>(net.to[static_cast<std::size_t>(v)])] = 1;
+  }
+  for (const std::int32_t node : order.nodes)
+    if (end[static_cast<std::size_t>(node)]) out.nodes.push_back(node);
+  return out;
+}
+
 }  // namespace hemotree

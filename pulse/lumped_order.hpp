@@ -37,5 +37,9 @@ LumpedOrder network_lumped_order(const Network& net, const std::vector<bool>& ze
 // The subtree order above; the network's below NodalSystem's task threshold, or where the 0D
 // vessels form a graph with a loop.
 LumpedOrder subtree_lumped_order(const Network& net, const std::vector<bool>& zero_d);
+// The vessels of `order` that `keep` marks and their nodes, each in the order's own order: a
+// share's 0D vessels as the whole run numbers them, so that every sum it takes at a node runs
+// in the whole's order (docs/scaling.md, the plan of the pulsatile run over ranks).
+LumpedOrder restrict_order(const LumpedOrder& order, const Network& net, const std::vector<bool>& keep);
 
 }  // namespace hemotree

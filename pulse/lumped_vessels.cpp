@@ -20,13 +20,14 @@ namespace hemotree {
 
 LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                              const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of,
-                             std::span<const VesselTaper> tapers, std::span<const std::uint8_t> sections)
+                             std::span<const VesselTaper> tapers, std::span<const std::uint8_t> sections,
+                             const LumpedOrder* given_order)
     : density_(blood.density), friction_k_(friction_coefficient(blood.alpha)), viscosity_(&viscosity) {
   const std::size_t n = net.vessel_count();
   node_of_.assign(net.node_count(), -1);
   index_of_vessel_.assign(n, -1);
   // Every subtree contiguous (pulse/lumped_order.hpp): the elimination's tasks stream.
-  LumpedOrder order = subtree_lumped_order(net, zero_d);
+  LumpedOrder order = given_order ? *given_order : subtree_lumped_order(net, zero_d);
   for (std::size_t k = 0; k < order.nodes.size(); ++k)
     node_of_[static_cast<std::size_t>(order.nodes[k])] = static_cast<std::int32_t>(k);
   auto sections_of = [&](std::size_t v) {

@@ -48,6 +48,7 @@
 #include "physics/viscosity_table.hpp"
 #include "formats/checkpoint_file.hpp"
 #include "physics/vessel_taper.hpp"
+#include "pulse/lumped_order.hpp"
 
 namespace hemotree {
 
@@ -67,9 +68,13 @@ class LumpedVessels {
   // rho int dx / A.
   // sections: per vessel, the pi sections of a 0D one (0 or 1: one; empty: all one). A
   // tapered vessel takes one.
+  // order: where given, the 0D vessels and their nodes in this order (a share of a run over
+  // ranks: its vessels in the whole run's order, pulse/lumped_order's restrict_order), else
+  // pulse/lumped_order's subtree order.
   LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                 const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of = {},
-                std::span<const VesselTaper> tapers = {}, std::span<const std::uint8_t> sections = {});
+                std::span<const VesselTaper> tapers = {}, std::span<const std::uint8_t> sections = {},
+                const LumpedOrder* order = nullptr);
   // Solves a step takes (1: the extrapolated linearisation alone), and the threads of its
   // loops over vessels and nodes and of the elimination's subtrees.
   void set_passes(int passes) { passes_ = passes; }
