@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <mpi.h>
@@ -54,10 +55,13 @@ int main(int argc, char** argv) {
     }();
     // The mean shift forced in the vessels of more than a fraction of the root's lumen: 0.8,
     // the top's; 0.1, deep enough that a first cut over several ranks crosses them.
-    for (const double fraction : {0.8, 0.1}) {
+    // Each rank with two threads too (the two-ports of a solve and the lines built in
+    // parallel): the same bits.
+    for (const auto [fraction, threads] : {std::pair{0.8, 1}, std::pair{0.1, 1}, std::pair{0.1, 2}}) {
       auto large = [&](const VesselLine& line) { return blood.density / line.inertance > fraction * root_area; };
       const LinearPeriodic whole = solve_linear_periodic(net, blood, laws, viscosity, harmonics, 1, large);
-      const LinearPeriodicOverRanks mine = solve_linear_periodic_over_ranks(net, blood, laws, viscosity, harmonics, 1, large);
+      const LinearPeriodicOverRanks mine =
+          solve_linear_periodic_over_ranks(net, blood, laws, viscosity, harmonics, threads, large);
       std::size_t differ = 0, shifted = 0, across = 0;
       std::size_t kinds[5] = {0, 0, 0, 0, 0};
       for (const std::int32_t vessel : mine.vessels) {
@@ -99,7 +103,9 @@ int main(int argc, char** argv) {
         ++failures;
         std::fprintf(stderr, "rank %d: the ranks hold %zu vessels of %zu, %zu forced\n", rank, all[0], net.vessel_count(), all[1]);
       }
-      if (rank == 0) std::printf("%g of the root's lumen: %zu forced, the top's %zu vessels\n", fraction, all[1], mine.partition.top.size());
+      if (rank == 0)
+        std::printf("%g of the root's lumen, %d thread(s) a rank: %zu forced, the top's %zu vessels\n", fraction, threads, all[1],
+                    mine.partition.top.size());
     }
     // The periodic instant (a pulsatile run's start) at t = 0.3 s, the vessels of more than a
     // tenth of the root's lumen kept (the run's 1D ones), the mean shifted: each rank's nodes'
