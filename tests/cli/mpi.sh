@@ -134,6 +134,16 @@ expect_refused "a pulsatile run over 2 ranks" "hemosolve: error: started on 2 MP
   -np 2 "$HEMOSOLVE" "$WORK/tree.json" --out "$WORK/refused-out"
 expect_refused "phase separation over 2 ranks" "--steady with --red-cells transport runs as one process" \
   -np 2 "$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport --out "$WORK/refused-out"
+# Started by Slurm's srun (its step's task count and this task's rank, no Open MPI variables):
+# the same refusal, said by rank 0 alone, nothing written.
+for procid in 0 1; do
+  SLURM_STEP_NUM_TASKS=2 SLURM_PROCID=$procid "$HEMOSOLVE" "$WORK/tree.json" --out "$WORK/refused-out" >"$WORK/slurm" 2>&1
+  status=$?
+  said=$(grep -c "hemosolve: error: started on 2 MPI ranks: " "$WORK/slurm")
+  [ $status -eq 2 ] && [ "$said" -eq $((1 - procid)) ] && [ ! -e "$WORK/refused-out" ] \
+    && pass "a pulsatile run under srun's variables, task $procid: refused, said by task 0 alone" \
+    || fail "srun's variables, task $procid: status $status, said $said times"
+done
 if [ -f "$WORK/mesentery.json" ]; then
   expect_refused "--linear over 2 ranks on the mesentery (pressures at nodes)" \
     "holds a pressure: the periodic state over ranks takes a tree fed by its inflow into outlets" \
