@@ -64,4 +64,12 @@ inline void add_leaf_outlets(Network& net, BoundaryType type) {
   }
 }
 
+// The grown tree fed at its root by `inflow` into outlets of the given type at its leaves.
+inline Network fed_tree(BoundaryType outlets, const Waveform& inflow) {
+  Network net = grown_tree();
+  add_leaf_outlets(net, outlets);
+  net.inlet = Inlet{net.id[0], inflow};
+  return net;
+}
+
 }  // namespace hemotree::test_networks

@@ -238,20 +238,36 @@ TEST(TreeShares, ANetworkCutOnlyWhereItsTopIsOneRanks) {
   EXPECT_THROW(tree_cut(net, spread), SettingError);
 }
 
+namespace {
+
+// A grown tree as a pulsatile run's 0D vessels take it: RCR outlets (capacitor nodes), a
+// constant inflow, every seventh vessel in three sections (inner nodes).
+struct ZeroDTree {
+  Network net = test_networks::fed_tree(BoundaryType::rcr, Waveform::constant_value(1e-9 / 60));
+  Blood blood = net.blood.value_or(Blood{});
+  std::vector<TubeLaw> laws = vessel_laws(net, blood, 0.0, 0.1);
+  ViscosityTable viscosity{blood};
+  std::vector<std::uint8_t> sections = [this] {
+    std::vector<std::uint8_t> s(net.vessel_count(), 1);
+    for (std::size_t v = 3; v < s.size(); v += 7) s[v] = 3;
+    return s;
+  }();
+};
+
+}  // namespace
+
 // The 0D vessels' system of a pulsatile run (pulse/lumped_vessels), in its own numbering (the
 // subtree order, each RCR outlet's capacitor node after the network's nodes, the inner nodes
 // of vessels in sections after them), its edges owned as the partition owns their vessels: a
 // cut of whole subtrees whose shares, swept in turn, give its nodal system's bits: what a
 // pulsatile run over ranks will solve a step with (docs/scaling.md, "the plan").
 TEST(TreeShares, TheZeroDVesselsSystemInItsOwnNumberingCutsIntoShares) {
-  Network net = grown_tree();
-  test_networks::add_leaf_outlets(net, BoundaryType::rcr);
-  net.inlet = Inlet{net.id[0], Waveform::constant_value(1e-9 / 60)};
-  const Blood blood = net.blood.value_or(Blood{});
-  const std::vector<TubeLaw> laws = vessel_laws(net, blood, 0.0, 0.1);
-  const ViscosityTable viscosity(blood);
-  std::vector<std::uint8_t> sections(net.vessel_count(), 1);
-  for (std::size_t v = 3; v < sections.size(); v += 7) sections[v] = 3;  // inner nodes too
+  const ZeroDTree t;
+  const Network& net = t.net;
+  const Blood& blood = t.blood;
+  const std::vector<TubeLaw>& laws = t.laws;
+  const ViscosityTable& viscosity = t.viscosity;
+  const std::vector<std::uint8_t>& sections = t.sections;
   const LumpedVessels lumped(net, laws, viscosity, blood, std::vector<bool>(net.vessel_count(), true), {}, {}, sections);
   const std::size_t nodes = lumped.node_count();
   const std::vector<std::int32_t> a(lumped.edge_a().begin(), lumped.edge_a().end()), b(lumped.edge_b().begin(), lumped.edge_b().end());
@@ -286,14 +302,12 @@ TEST(TreeShares, TheZeroDVesselsSystemInItsOwnNumberingCutsIntoShares) {
 // the shares: ten of them differ). Step 2 of the pulsatile run over ranks starts from these
 // arrays.
 TEST(TreeShares, AShareOfTheZeroDVesselsInTheWholeOrderHoldsTheWholesNodeSums) {
-  Network net = grown_tree();
-  test_networks::add_leaf_outlets(net, BoundaryType::rcr);
-  net.inlet = Inlet{net.id[0], Waveform::constant_value(1e-9 / 60)};
-  const Blood blood = net.blood.value_or(Blood{});
-  const std::vector<TubeLaw> laws = vessel_laws(net, blood, 0.0, 0.1);
-  const ViscosityTable viscosity(blood);
-  std::vector<std::uint8_t> sections(net.vessel_count(), 1);
-  for (std::size_t v = 3; v < sections.size(); v += 7) sections[v] = 3;
+  const ZeroDTree t;
+  const Network& net = t.net;
+  const Blood& blood = t.blood;
+  const std::vector<TubeLaw>& laws = t.laws;
+  const ViscosityTable& viscosity = t.viscosity;
+  const std::vector<std::uint8_t>& sections = t.sections;
   const std::vector<bool> all(net.vessel_count(), true);
   const LumpedOrder whole_order = subtree_lumped_order(net, all);
   LumpedVessels whole(net, laws, viscosity, blood, all, {}, {}, sections, &whole_order);

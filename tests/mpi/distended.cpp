@@ -26,11 +26,9 @@ int main(int argc, char** argv) {
   {
     MpiSession session(argc, argv);
     const int ranks = world_size(), rank = world_rank();
-    Network net = test_networks::grown_tree();
     // Every leaf an outlet of 2e13 Pa s/m^3 to 10 mmHg; 1 ul/min in at the root.
-    test_networks::add_leaf_outlets(net, BoundaryType::resistance);
     const double inflow = 1e-9 / 60;
-    net.inlet = Inlet{net.id[0], Waveform::constant_value(inflow)};
+    const Network net = test_networks::fed_tree(BoundaryType::resistance, Waveform::constant_value(inflow));
     const Blood blood = net.blood.value_or(Blood{});
     const std::vector<TubeLaw> laws = vessel_laws(net, blood, 0.0, 0.1);
     const ViscosityTable viscosity(blood);

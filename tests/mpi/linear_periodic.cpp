@@ -39,12 +39,10 @@ int main(int argc, char** argv) {
   {
     MpiSession session(argc, argv);
     const int ranks = world_size(), rank = world_rank();
-    Network net = test_networks::grown_tree();
-    test_networks::add_leaf_outlets(net, BoundaryType::rcr);
-    net.add_node(net.node_id.back() + 1000);  // a node no vessel reaches (a file may list one)
     Waveform inflow;  // half sine, 1 s, 1 ul/min on average
     inflow.mean = 1e-9 / 60;
-    net.inlet = Inlet{net.id[0], inflow};
+    Network net = test_networks::fed_tree(BoundaryType::rcr, inflow);
+    net.add_node(net.node_id.back() + 1000);  // a node no vessel reaches (a file may list one)
     const Blood blood = net.blood.value_or(Blood{});
     const std::vector<TubeLaw> laws = vessel_laws(net, blood, 0.0, 0.1);
     const ViscosityTable viscosity(blood);
