@@ -8,6 +8,7 @@
 
 #include "core/setting_error.hpp"
 #include "core/units.hpp"
+#include "distributed/gather_rows.hpp"
 #include "distributed/network_cut.hpp"
 #include "distributed/petsc_flow_network.hpp"
 #include "distributed/steady_share.hpp"
@@ -111,38 +112,23 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
     const std::int32_t v = cut->parent_edge[node];
     mine[2 * k + 1] = v >= 0 ? held_here.flow[static_cast<std::size_t>(v)] : 0.0;
   }
-  // Gathered on rank 0 in rank order, each rank's nodes as it holds them.
-  std::vector<std::vector<std::int32_t>> held;
-  std::vector<int> counts, offsets;
-  if (rank == 0) {
-    held = cut->held_nodes();
-    counts.resize(static_cast<std::size_t>(ranks));
-    offsets.assign(static_cast<std::size_t>(ranks), 0);
-    for (std::size_t r = 0; r < held.size(); ++r) {
-      counts[r] = 2 * static_cast<int>(held[r].size());
-      if (r > 0) offsets[r] = offsets[r - 1] + counts[r - 1];
-    }
-  }
-  std::vector<double> all(rank == 0 ? 2 * net.node_count() : 0);
-  MPI_Gatherv(mine.data(), static_cast<int>(mine.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
-              MPI_DOUBLE, 0, MPI_COMM_WORLD);
   const MpiTreeSystem::Traffic& traffic = share->traffic();
   SteadyOverRanks out{{}, describe(partition) + "; the tree's exchange on rank 0: " + std::to_string(traffic.calls) +
                               " collective calls, " + std::to_string(traffic.bytes) + " bytes, " +
                               format_quantity(traffic.seconds, "s")};
-  if (rank != 0) return out;
+  // Gathered on rank 0, each rank's nodes as it holds them.
   SteadyFlow& s = out.flow;
-  s.node_pressure.assign(net.node_count(), 0.0);
-  s.flow.assign(net.vessel_count(), 0.0);
-  for (int r = 0; r < ranks; ++r) {
-    const double* from = all.data() + offsets[static_cast<std::size_t>(r)];
-    const auto& list = held[static_cast<std::size_t>(r)];
-    for (std::size_t k = 0; k < list.size(); ++k) {
-      const auto node = static_cast<std::size_t>(list[k]);
-      s.node_pressure[node] = from[2 * k];
-      if (const std::int32_t v = cut->parent_edge[node]; v >= 0) s.flow[static_cast<std::size_t>(v)] = from[2 * k + 1];
-    }
+  if (rank == 0) {
+    s.node_pressure.assign(net.node_count(), 0.0);
+    s.flow.assign(net.vessel_count(), 0.0);
   }
+  gather_rows(mine, 2, rank == 0 ? cut->held_nodes() : std::vector<std::vector<std::int32_t>>{}, net.node_count(),
+              [&](std::int32_t node, const double* row) {
+                s.node_pressure[static_cast<std::size_t>(node)] = row[0];
+                if (const std::int32_t v = cut->parent_edge[static_cast<std::size_t>(node)]; v >= 0)
+                  s.flow[static_cast<std::size_t>(v)] = row[1];
+              });
+  if (rank != 0) return out;
   s.inlet_pressure = rows.inlet_node >= 0 ? s.node_pressure[static_cast<std::size_t>(rows.inlet_node)]
                                           : std::numeric_limits<double>::quiet_NaN();
   return out;
