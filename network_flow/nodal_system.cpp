@@ -518,6 +518,32 @@ void NodalSystem::open_roots() {
   factorized_ = false;
 }
 
+void NodalSystem::open_edges(std::span<const std::int32_t> edges) {
+  open_roots();
+  if (edges.empty()) return;
+  std::vector<unsigned char> cut(edges_, 0);
+  for (const std::int32_t e : edges) {
+    if (e < 0 || static_cast<std::size_t>(e) >= edges_)
+      throw std::invalid_argument("NodalSystem::open_edges: edge " + std::to_string(e) + " of " + std::to_string(edges_));
+    cut[static_cast<std::size_t>(e)] = 1;
+  }
+  std::size_t found = 0;
+  for (std::size_t c = 0; c < nodes_; ++c)
+    if (parent_[c] >= 0 && cut[edge_to_parent(c)]) {
+      parent_[c] = -1;
+      ++found;
+    }
+  if (found != edges.size())
+    throw std::invalid_argument("NodalSystem::open_edges: " + std::to_string(edges.size() - found) +
+                                " of the edges join no node to its parent (or come twice)");
+  // The sweeps' tasks anew: subtrees of the forest as it now is.
+  top_.clear();
+  task_nodes_.clear();
+  task_offset_.clear();
+  task_shift_.clear();
+  plan_subtrees();
+}
+
 double NodalSystem::open_root_conductance(std::size_t root) const {
   if (!open_roots_ || root >= nodes_ || parent_[root] >= 0)
     throw std::invalid_argument("NodalSystem::open_root_conductance: node " + std::to_string(root) +

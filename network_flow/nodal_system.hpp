@@ -88,6 +88,12 @@ class NodalSystem {
   // node's arithmetic is the closed system's, so that a tree cut into shares and swept share
   // by share gives the bits of the whole. Tree elimination only (std::logic_error otherwise);
   // the singular check is the rest of the tree's.
+  // The same where this forest's roots and the rest of the tree are not apart: each given
+  // edge (an edge to a parent, by its number) joins a node here to one held elsewhere, so the
+  // node below it is a root, held open (and the node above too, where no other edge reaches it).
+  // The edges keep their numbers: conductances are still given for every edge, and these are
+  // not read. std::invalid_argument for an edge that is not one to a parent.
+  void open_edges(std::span<const std::int32_t> edges);
   void open_roots();
   bool roots_open() const { return open_roots_; }
   double open_root_conductance(std::size_t root) const;

@@ -644,6 +644,73 @@ TEST(NodalSystem, TwoThreadsEliminateATreeToTheBitsOfOne) {
   }
 }
 
+// Opened edges cut a tree into the part above them and the subtrees below, each subtree's
+// root held open: given the whole system's potentials at those roots, every node below them
+// gets the whole's bits (its subtree is eliminated alike), on one thread or two.
+TEST(NodalSystem, OpenedEdgesLeaveTheSubtreesBelowThemTheWholesBits) {
+  std::mt19937_64 rng(23);
+  for (const std::size_t n : {std::size_t{3000}, std::size_t{200000}})
+    for (const bool shuffled : {false, true}) {
+      const Graph tree = random_tree(n, rng, shuffled);
+      const std::vector<double> g = log_uniform(tree.a.size(), 1e-2, 1e2, rng);
+      const std::vector<double> s = uniform(tree.nodes, 1e-4, 1e-3, rng);
+      const std::vector<double> rhs = uniform(tree.nodes, -1, 1, rng);
+      NodalSystem whole(tree.nodes, tree.a, tree.b);
+      std::vector<double> x(n);
+      ASSERT_EQ(whole.factorize(g, s), -1);
+      whole.solve(rhs, x);
+      // Twenty edges opened, none twice.
+      std::vector<std::int32_t> parent(n, -1), opened;
+      for (std::size_t e = 0; e < tree.a.size(); ++e) {
+        parent[static_cast<std::size_t>(tree.b[e])] = tree.a[e];
+      }
+      std::vector<unsigned char> cut_below(n, 0);
+      std::uniform_int_distribution<std::int32_t> any_edge(0, static_cast<std::int32_t>(tree.a.size()) - 1);
+      // As shares hang from a top: no opened edge below another.
+      auto above_or_below_a_cut = [&](std::int32_t c) {
+        for (std::int32_t k = c; k >= 0; k = parent[static_cast<std::size_t>(k)])
+          if (cut_below[static_cast<std::size_t>(k)]) return true;
+        for (std::size_t d = 0; d < n; ++d)
+          if (cut_below[d])
+            for (std::int32_t k = static_cast<std::int32_t>(d); k >= 0; k = parent[static_cast<std::size_t>(k)])
+              if (k == c) return true;
+        return false;
+      };
+      while (opened.size() < 20) {
+        const std::int32_t e = any_edge(rng);
+        if (above_or_below_a_cut(tree.b[static_cast<std::size_t>(e)])) continue;
+        opened.push_back(e);
+        cut_below[static_cast<std::size_t>(tree.b[static_cast<std::size_t>(e)])] = 1;
+      }
+      for (const int threads : {1, 2}) {
+        NodalSystem open(tree.nodes, tree.a, tree.b);
+        open.set_threads(threads);
+        open.open_edges(opened);
+        EXPECT_TRUE(open.roots_open());
+        std::vector<double> y = rhs, bad_g = g;
+        for (const std::int32_t e : opened) bad_g[static_cast<std::size_t>(e)] = -1;  // not read
+        open.factorize_forward(bad_g, s, y);
+        for (std::size_t c = 0; c < n; ++c)
+          if (cut_below[c] || parent[c] < 0) y[c] = x[c];
+        open.backward(y, y);
+        std::size_t checked = 0;
+        for (std::size_t c = 0; c < n; ++c) {
+          bool below = false;
+          for (std::int32_t k = static_cast<std::int32_t>(c); k >= 0 && !below; k = parent[static_cast<std::size_t>(k)])
+            below = cut_below[static_cast<std::size_t>(k)] != 0;
+          if (!below) continue;
+          ++checked;
+          ASSERT_EQ(y[c], x[c]) << "node " << c << " of " << n << ", threads " << threads;
+        }
+        EXPECT_GE(checked, 20u);
+      }
+    }
+  NodalSystem chain(3, {0, 1}, {1, 2});
+  EXPECT_THROW(chain.open_edges(std::vector<std::int32_t>{2}), std::invalid_argument);
+  NodalSystem again(3, {0, 1}, {1, 2});
+  EXPECT_THROW(again.open_edges(std::vector<std::int32_t>{1, 1}), std::invalid_argument);
+}
+
 namespace hemotree {
 namespace {
 
