@@ -41,7 +41,7 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
     const NodeBoundary bc = boundaries[i];
     if (bc.is_outlet()) ++k;
     const auto network_node = static_cast<std::size_t>(bc.node);
-    if (node_of_[network_node] < 0) continue;
+    if (node_of_[network_node] < 0 || is_ghost_node(static_cast<std::size_t>(node_of_[network_node]))) continue;  // another rank's
     const auto at = static_cast<std::size_t>(node_of_[network_node]);
     const auto v = static_cast<std::size_t>(vessel_at[network_node]);
     const auto boundary = static_cast<std::int32_t>(i);

@@ -20,13 +20,13 @@ namespace hemotree {
 LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                              const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of,
                              std::span<const VesselTaper> tapers, std::span<const std::uint8_t> sections,
-                             const LumpedOrder* given_order)
+                             const LumpedCut* cut)
     : density_(blood.density), friction_k_(friction_coefficient(blood.alpha)), viscosity_(&viscosity) {
   const std::size_t n = net.vessel_count();
   node_of_.assign(net.node_count(), -1);
   index_of_vessel_.assign(n, -1);
   // Every subtree contiguous (pulse/lumped_order.hpp): the elimination's tasks stream.
-  LumpedOrder order = given_order ? *given_order : subtree_lumped_order(net, zero_d);
+  LumpedOrder order = cut ? cut->order : subtree_lumped_order(net, zero_d);
   for (std::size_t k = 0; k < order.nodes.size(); ++k)
     node_of_[static_cast<std::size_t>(order.nodes[k])] = static_cast<std::int32_t>(k);
   auto sections_of = [&](std::size_t v) {
@@ -34,7 +34,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
     return sections.empty() || is_tapered ? std::size_t{1} : std::max<std::size_t>(sections[v], 1);
   };
   // The inner nodes of vessels in sections, numbered in the network's order of their vessels
-  // (a checkpoint's order; placed after the capacitors below): here ~j for the j-th.
+  // (a checkpoint's order; placed after the capacitors below): here ~j for the j-th. (Not over
+  // ranks: pulse/lumped_cut.hpp.)
   std::vector<std::int32_t> inner_first;
   std::int32_t inner = 0;
   if (!sections.empty()) {
@@ -68,10 +69,14 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   }
   vessel_edges_ = a_.size();
   if (!taper_edge_.empty()) taper_edge_.resize(vessel_edges_);
-  if (vessels_.empty()) return;
+  if (vessels_.empty()) {
+    if (cut) hold_cut(*cut);  // a rank with none still takes its part in every step's messages
+    return;
+  }
   network_nodes_ = order.nodes.size();
   std::vector<std::int32_t>().swap(order.nodes);
   nodes_ = network_nodes_;
+  if (cut) hold_cut(*cut);
   shunt_.assign(network_nodes_, 0.0);
   shunt_pressure_.assign(network_nodes_, 0.0);
   volume_b_.assign(network_nodes_, 0.0);
@@ -154,6 +159,12 @@ void LumpedVessels::share_shunt_pressure() {
 
 void LumpedVessels::allocate_system() {
   system_ = NodalSystem(nodes_, a_, b_);
+  if (share_.on) {
+    // The capacitors' and inner nodes' rows, and the R1 edges, are the rank's own.
+    if (!share_.ghost_node.empty()) share_.ghost_node.resize(nodes_, 0);
+    if (!share_.ghost_edge.empty()) share_.ghost_edge.resize(a_.size(), 0);
+    if (!share_.top) system_.open_edges(share_.root_edge);
+  }
   const std::size_t edges = a_.size();
   volume_.assign(nodes_, 0.0);
   previous_volume_ = pressure_ = previous_pressure_ = volume_;
@@ -198,6 +209,12 @@ void LumpedVessels::release_step_arrays() {
   for (std::vector<double>* v : {&rhs_, &conductance_, &history_}) std::vector<double>().swap(*v);
   linearised_dt_ = 0;  // the next step linearises its edges again
   system_.release_factorization();
+}
+
+void LumpedVessels::set_passes(int passes) {
+  if (share_.on && passes != 1)
+    throw std::invalid_argument("LumpedVessels: a run over ranks takes one linearisation a step, not " + std::to_string(passes));
+  passes_ = passes;
 }
 
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
@@ -487,6 +504,12 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
       }
     });
   linearised_dt_ = 0;
+  if (share_.on && share_.top)
+    for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
+      const auto e = static_cast<std::size_t>(share_.root_edge[j]);
+      conductance_[e] = share_.root_row[LumpedLink::up_per_root * j];
+      history_[e] = share_.root_row[LumpedLink::up_per_root * j + 3];
+    }
   std::int64_t collapsed = nodes_i;
   double* const system_shunt = system_.shunt_workspace().data();
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
@@ -496,6 +519,11 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
 #pragma omp for schedule(static) reduction(min : collapsed)
     for (std::int64_t i = 0; i < nodes_i; ++i) {
       const auto k = static_cast<std::size_t>(i);
+      if (is_ghost_node(k)) {  // another rank's row: a share's root (below), an open node above a share
+        system_shunt[k] = 0;
+        rhs_[k] = 0;
+        continue;
+      }
       const double ps = at(static_cast<std::int32_t>(i)), c = node_compliance(k, ps);
       system_shunt[k] = 1.5 * c / dt + shunt_[k];
       if (!(system_shunt[k] > 0)) collapsed = std::min<std::int64_t>(collapsed, i);  // a lumen closing there
@@ -509,6 +537,14 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
   }
   if (collapsed < nodes_i) throw CollapsedNode{vessel_at_node(static_cast<std::size_t>(collapsed))};
   for_each_source(coupled_inflow, 1.0, [&](std::size_t k, double inflow) { rhs_[k] += inflow; });
+  // On the top's rank, each share's root a leaf of its subtree's conductance and right-hand side.
+  if (share_.on && share_.top)
+    for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
+      const auto r = static_cast<std::size_t>(b_[static_cast<std::size_t>(share_.root_edge[j])]);
+      const std::size_t below = is_ghost_node(r) ? r : static_cast<std::size_t>(a_[static_cast<std::size_t>(share_.root_edge[j])]);
+      system_shunt[below] = share_.root_row[LumpedLink::up_per_root * j + 1];
+      rhs_[below] = share_.root_row[LumpedLink::up_per_root * j + 2];
+    }
 }
 
 void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, double inlet_flow) {
@@ -517,6 +553,30 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, d
 
 void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
                             std::span<const double> held_pressure) {
+  if (!share_.on) {
+    predict_step(dt, coupled_inflow, inflow, held_pressure);
+    return;
+  }
+  if (!share_.top) {
+    std::exception_ptr failure;
+    try {
+      predict_step(dt, coupled_inflow, inflow, held_pressure);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    send_roots(failure);
+    return;
+  }
+  take_roots();
+  try {
+    predict_step(dt, coupled_inflow, inflow, held_pressure);
+  } catch (...) {
+    abandon_step(std::current_exception());
+  }
+}
+
+void LumpedVessels::predict_step(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
+                                 std::span<const double> held_pressure) {
   if (empty()) return;
   if (inflow.size() != inflow_node_.size() || held_pressure.size() != held_node_.size())
     throw std::invalid_argument("LumpedVessels::predict: one value per boundary flow and pressure");
@@ -570,6 +630,25 @@ void LumpedVessels::hold_coupling_pressures() {
 
 void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
                              std::span<double> boundary_volume) {
+  if (!share_.on) {
+    complete_step(coupled_volume, exchanged_in, exchanged_out, boundary_volume);
+    return;
+  }
+  if (!share_.top) {
+    take_answers();
+    complete_step(coupled_volume, exchanged_in, exchanged_out, boundary_volume);
+    return;
+  }
+  try {
+    complete_step(coupled_volume, exchanged_in, exchanged_out, boundary_volume);
+  } catch (...) {
+    abandon_step(std::current_exception());
+  }
+  answer_roots();
+}
+
+void LumpedVessels::complete_step(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
+                                  std::span<double> boundary_volume) {
   if (empty()) return;
   const double dt = dt_;
   // The departure of the 1D ends' mean inflows from those held, into the forward half.
@@ -600,6 +679,11 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
       const std::size_t first = static_cast<std::size_t>(b) * block, last = std::min(first + block, nodes_);
       double outflow = 0;
       for (std::size_t k = first; k < last; ++k) {
+        if (is_ghost_node(k)) {  // its rank's to complete (a share's nodes above it: below)
+          previous_volume_[k] = volume_[k];
+          previous_pressure_[k] = pressure_[k];
+          continue;
+        }
         const double shunted = shunt_[k] * p1[k] - shunt_current(k);
         // A capacitor's R2 is not the network's; a held pressure's flow is counted below.
         if (k < network_nodes_ && (held_.empty() || !held_[k])) outflow += shunted;
@@ -632,6 +716,13 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, double& exc
     pressure_[k] = pressure_from_excess(k, volume_[k]);
   });
   previous_flow_.swap(flow_);  // the new flows went where the oldest were
+  if (share_.on && !share_.top)  // the top's nodes above the roots: their pressures as the top completed them
+    for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
+      const auto e = static_cast<std::size_t>(share_.root_edge[j]);
+      const auto u = static_cast<std::size_t>(is_ghost_node(static_cast<std::size_t>(a_[e])) ? a_[e] : b_[e]);
+      pressure_[u] = share_.root_row[j];
+      volume_[u] = node_excess(u, pressure_[u]);
+    }
   for (std::size_t e = 0; e < passed_.size(); ++e) passed_[e] += dt * flow_[e];
   update_resistances_and_linearise(dt);
   update_dynamic_pressures();

@@ -48,6 +48,7 @@
 #include "physics/viscosity_table.hpp"
 #include "formats/checkpoint_file.hpp"
 #include "physics/vessel_taper.hpp"
+#include "pulse/lumped_cut.hpp"
 #include "pulse/lumped_order.hpp"
 
 namespace hemotree {
@@ -68,16 +69,18 @@ class LumpedVessels {
   // rho int dx / A.
   // sections: per vessel, the pi sections of a 0D one (0 or 1: one; empty: all one). A
   // tapered vessel takes one.
-  // order: where given, the 0D vessels and their nodes in this order (a share of a run over
-  // ranks: its vessels in the whole run's order, pulse/lumped_order's restrict_order), else
-  // pulse/lumped_order's subtree order.
+  // cut: where given, one rank's part of a run over ranks (pulse/lumped_cut.hpp: its vessels
+  // and their nodes in the whole run's order, the top's rank with the other ranks' root vessels
+  // as ghosts), whose steps exchange their messages through set_link's link; else every 0D
+  // vessel, in pulse/lumped_order's subtree order.
   LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                 const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of = {},
                 std::span<const VesselTaper> tapers = {}, std::span<const std::uint8_t> sections = {},
-                const LumpedOrder* order = nullptr);
-  // Solves a step takes (1: the extrapolated linearisation alone), and the threads of its
-  // loops over vessels and nodes and of the elimination's subtrees.
-  void set_passes(int passes) { passes_ = passes; }
+                const LumpedCut* cut = nullptr);
+  // Solves a step takes (1: the extrapolated linearisation alone; the only one over ranks,
+  // std::invalid_argument for more), and the threads of its loops over vessels and nodes and
+  // of the elimination's subtrees.
+  void set_passes(int passes);
   void set_threads(int threads) {
     threads_ = threads;
     system_.set_threads(threads);
@@ -160,6 +163,18 @@ class LumpedVessels {
   // for a phase between steps that needs none of it (a run's cycle end). They are first made
   // at the first predict(), not before (a run's start needs none of them either).
   void release_step_arrays();
+
+  // A run over ranks (built with a LumpedCut): the transport of each step's two messages,
+  // which predict() and complete() send and wait for (every rank calls both every step). A
+  // step that fails on this rank between them (the top's 1D vessels) is abandoned through
+  // abandon_step, which tells every rank (the link's down) and throws its refusal.
+  void set_link(LumpedLink link) { share_.link = std::move(link); }
+  bool over_ranks() const { return share_.on; }
+  [[noreturn]] void abandon_step(std::exception_ptr failure);
+  // Whether a node or a 0D vessel is held for another rank's sums only (its numbers are that
+  // rank's): the top's rank's ghosts, a share's nodes above its roots.
+  bool ghost_node(std::int32_t node) const { return is_ghost_node(static_cast<std::size_t>(node)); }
+  bool ghost_vessel(std::int32_t index) const { return is_ghost_edge(first_edge(static_cast<std::size_t>(index))); }
 
   // The state a vessel's samples come from.
   double node_pressure(std::int32_t node) const { return pressure_[static_cast<std::size_t>(node)]; }
@@ -472,6 +487,30 @@ class LumpedVessels {
   }
   static constexpr std::size_t block = 4096;
   std::vector<double> block_outflow_;  // per block of nodes: the outlets' outflow (a fixed-order sum)
+  // A rank's part of a run over ranks (pulse/lumped_cut.hpp; `on` false where the run is whole).
+  struct Share {
+    bool on = false, top = true;
+    std::vector<std::int32_t> root_edge;    // the messages' edges in their order: a share's into the top, the top's ghosts
+    std::vector<unsigned char> ghost_node;  // per node (empty: none)
+    std::vector<unsigned char> ghost_edge;  // per edge: the top's ghosts (empty: none)
+    std::vector<double> root_row;           // the top's: per ghost edge, S_r and y_r of this step's message
+    LumpedLink link;
+  } share_;
+  bool is_ghost_node(std::size_t k) const { return !share_.ghost_node.empty() && share_.ghost_node[k]; }
+  bool is_ghost_edge(std::size_t e) const { return !share_.ghost_edge.empty() && share_.ghost_edge[e]; }
+  void hold_cut(const LumpedCut& cut);  // the constructor's: ghosts and root edges
+  // A step's messages (pulse/lumped_exchange.cpp): a share's roots up after its forward half
+  // (or its failure); the top's taken in before its linearisation (false: a rank failed);
+  // the top's answers down after its step; a share's taken in before its backward half.
+  void send_roots(std::exception_ptr failure);
+  void take_roots();
+  void answer_roots();
+  void take_answers();
+  // The step on this rank's vessels, between the messages (and the whole run's step).
+  void predict_step(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
+                    std::span<const double> held_pressure);
+  void complete_step(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
+                     std::span<double> boundary_volume);
   double dt_ = 0;
   int passes_ = 1, threads_ = 1;
 };
