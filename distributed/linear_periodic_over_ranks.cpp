@@ -183,7 +183,7 @@ struct RankHarmonics {
     shunt_here.resize(nodes.size());
     x_here.resize(nodes.size());
     edge_here.resize(nodes.size());
-    share.solve = [this, &net, threads](double w, std::span<const Complex> shunt, std::span<Complex> current,
+    share.solve = [this, &net, threads](double /*w: in the two-ports*/, std::span<const Complex> shunt, std::span<Complex> current,
                                         const std::function<TwoPort(std::size_t)>& two_port) {
       solve(net, threads, shunt, current, two_port);
     };

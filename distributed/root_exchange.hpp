@@ -47,6 +47,19 @@ class RootExchange {
   std::vector<double> round(std::span<const double> message, std::exception_ptr failure, std::size_t send,
                             std::size_t back, const TopMove& top_move, const char* what);
 
+  // A round in its two halves, for a caller whose top move runs between them with work of its
+  // own (a pulsatile step: the top's 1D vessels between the 0D step's halves). gather: this
+  // rank's `send` numbers per root, or its failure; on the top's rank returns every rank's,
+  // rank after rank, and sets `failed` where some rank failed (the top then scatters at once);
+  // elsewhere nothing. scatter: on the top's rank the answers (`back` numbers per root, rank
+  // after rank), or on any rank its failure (every rank passes the one it gathered with);
+  // returns this rank's numbers, or throws the first refusal (the gather's, else the top's)
+  // on every rank alike, as round() does. Every rank calls both, in turn.
+  std::vector<double> gather(std::span<const double> message, std::exception_ptr failure, std::size_t send,
+                             bool& failed);
+  std::vector<double> scatter(std::span<const double> answers, std::exception_ptr failure, std::size_t back,
+                              const char* what);
+
   // What this rank's rounds have cost so far: the collective calls (two a round), the bytes
   // sent and received in them, and the seconds inside them (waiting for the slowest rank
   // included).
@@ -62,6 +75,10 @@ class RootExchange {
   int rank_ = 0, top_rank_ = 0;
   std::vector<int> roots_;
   Traffic traffic_;
+  double refusal_ = -1;  // the top's, between the halves: solved, the gather's first refusal, or a node named
+  // scatter's answer with its status first (what round() returns).
+  std::vector<double> scatter_with_status(std::span<const double> answers, std::exception_ptr failure,
+                                          std::size_t back, const char* what);
 };
 
 }  // namespace hemotree

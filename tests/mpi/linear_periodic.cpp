@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
     // the top's; 0.1, deep enough that a first cut over several ranks crosses them.
     // Each rank with two threads too (the two-ports of a solve and the lines built in
     // parallel): the same bits.
-    for (const auto [fraction, threads] : {std::pair{0.8, 1}, std::pair{0.1, 1}, std::pair{0.1, 2}}) {
+    for (const auto& [fraction, threads] : {std::pair{0.8, 1}, std::pair{0.1, 1}, std::pair{0.1, 2}}) {
       auto large = [&](const VesselLine& line) { return blood.density / line.inertance > fraction * root_area; };
       const LinearPeriodic whole = solve_linear_periodic(net, blood, laws, viscosity, harmonics, 1, large);
       const LinearPeriodicOverRanks mine =
