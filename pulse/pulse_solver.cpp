@@ -53,7 +53,7 @@ Blood effective_blood(const Network& net, const SolverOptions& options) {
 }
 }  // namespace
 
-PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
+PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const PulseRanks* ranks)
     : net_(net), blood_(effective_blood(net, options)), viscosity_(blood_),
       scheme_(options.scheme) {
   if (options.degree < 0 && options.degree != SolverOptions::automatic)
@@ -140,7 +140,21 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
     }
   }
 
-  lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
+  if (ranks) {
+    // This rank's whole subtrees; the 1D vessels and every vessel above them the top's rank's.
+    const std::vector<std::int32_t> vessel_rank = ranks->vessel_ranks(zero_d_);
+    for (std::size_t v = 0; v < n; ++v)
+      if (!zero_d_[v] && vessel_rank[v] != ranks->top_rank)
+        throw std::invalid_argument("PulseSolver: 1D vessel " + std::to_string(net.id[v]) + " on rank " +
+                                    std::to_string(vessel_rank[v]) + ", not the top's");
+    const LumpedCut cut = lumped_cut(net, subtree_lumped_order(net, zero_d_), vessel_rank, ranks->ranks, ranks->top_rank,
+                                     ranks->rank, lumped_sections_);
+    lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_, &cut);
+    lumped_.set_link(ranks->link);
+    one_d_here_ = cut.top();
+  } else {
+    lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
+  }
   sectioned_count_ = static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t s) { return s > 1; }));
   std::vector<std::uint8_t>().swap(lumped_sections_);  // a byte a vessel the run no longer reads
   lumped_.set_passes(options.lumped_passes);
@@ -166,7 +180,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options)
   }
   choose_time_step(options);
   // The coupled ends' first linearisation needs their end states.
-  if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);
+  if (!boundaries_.coupled.empty() && one_d_here_) evaluate(time_, state_, rate_);
 
   law_beta_.resize(n);
   law_area_.resize(n);
@@ -225,6 +239,7 @@ void PulseSolver::couple_lumped_ends() {
   lumped_.set_entering(boundaries_.entering);
   lumped_inflow_.assign(lumped_.inflow_boundaries().size(), 0.0);
   lumped_held_.assign(lumped_.held_boundaries().size(), 0.0);
+  if (!one_d_here_) return;  // every coupled end is the top's
   for (const auto& c : boundaries_.coupled) coupled_node_.push_back(lumped_.node_of(c.node));
   std::vector<std::int32_t> nodes = coupled_node_;
   std::sort(nodes.begin(), nodes.end());
@@ -574,7 +589,7 @@ void PulseSolver::start_from(const PulseSolver& other) {
   restart_clock();
   have_previous_rate_ = false;  // the multistep history starts again
   // The coupled ends' first linearisation needs their end states (as after any start).
-  if (!boundaries_.coupled.empty()) evaluate(time_, state_, rate_);
+  if (!boundaries_.coupled.empty() && one_d_here_) evaluate(time_, state_, rate_);
 }
 
 void PulseSolver::set_viscosity_factors(std::span<const double> per_vessel) {

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <span>
@@ -118,9 +119,23 @@ struct PulseState {
   void add_scaled(double factor, const PulseState& other);  // this += factor * other
 };
 
+// A run over ranks (docs/scaling.md, "The pulsatile run over ranks"): this rank's whole
+// subtrees of 0D vessels and, on the top's rank, every 1D vessel and the 0D vessels above them
+// (pulse/lumped_cut.hpp). The caller partitions the vessels once the models are chosen
+// (vessel_ranks: per vessel its rank, given which are 0D), and carries each step's two messages
+// (link). One pi section a 0D vessel (SolverOptions::lumped_sections 1).
+struct PulseRanks {
+  int ranks = 1, rank = 0, top_rank = 0;
+  std::function<std::vector<std::int32_t>(const std::vector<bool>& zero_d)> vessel_ranks;
+  LumpedLink link;
+};
+
 class PulseSolver {
  public:
-  PulseSolver(const Network& net, const SolverOptions& options);
+  // ranks: where given, this rank's part of a run over ranks (every rank builds the whole
+  // network's laws, models, step and start alike; it steps its own 0D vessels, the top's
+  // rank also the 1D ones).
+  PulseSolver(const Network& net, const SolverOptions& options, const PulseRanks* ranks = nullptr);
 
   void step();  // advances one time step (one 0D step, with its 1D substeps, where there are 0D vessels)
   double time() const { return time_; }
@@ -134,6 +149,9 @@ class PulseSolver {
   void set_coupling_passes(int passes) { coupling_passes_ = passes < 1 ? 1 : passes; }
   double substep() const { return dt_ / substeps_; }
   bool is_lumped(std::size_t vessel) const { return zero_d_[vessel]; }
+  // The whole run's 0D vessels (over ranks, every rank's: what the step is chosen by, alike
+  // on every rank).
+  std::size_t lumped_vessels_in_run() const { return static_cast<std::size_t>(std::count(zero_d_.begin(), zero_d_.end(), true)); }
   // The 0D vessels in more than one pi section (their inner nodes are no network node's).
   std::size_t sectioned_count() const { return sectioned_count_; }
   std::size_t lumped_count() const {
@@ -222,6 +240,8 @@ class PulseSolver {
   // The 1D vessels (indices), in the order of their elements.
   const std::vector<std::int32_t>& one_d_vessels() const { return one_d_vessels_; }
   int threads() const { return threads_; }
+  // Whether this rank steps the 1D vessels (a run over ranks: the top's rank; else always).
+  bool holds_one_d() const { return one_d_here_; }
 
   // A vessel's tube law: at its `from` end (the whole vessel's unless it tapers), at one of
   // its ends, and at fraction x along it.
@@ -308,6 +328,7 @@ class PulseSolver {
   void step_exponential(double h);  // ETD2 in the friction, AB2 in the rest
   void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
   void step_coupled();     // a 0D step around its 1D substeps
+  void take_coupled_substeps();  // its 1D substeps, in every coupling pass; coupled_volume_ from them
   void take_substeps();    // the 1D substeps of the 0D step being taken, from its start
   void keep_pass_start();       // pass_start_ from the 1D vessels now (the step's start)
   void return_to_pass_start();  // the 1D vessels, and the clock, back to pass_start_
@@ -443,6 +464,7 @@ class PulseSolver {
   bool tracking_faces_ = false;
   TimeScheme scheme_;
   int threads_ = 1;
+  bool one_d_here_ = true;  // false on a share of a run over ranks (PulseRanks)
   double time_ = 0, dt_ = 0;
   std::string dt_reason_;
   double stable_dt_ = 0;

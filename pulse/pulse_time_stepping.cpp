@@ -22,7 +22,7 @@ namespace hemotree {
 
 void PulseSolver::set_time_step(double dt) {
   dt_ = dt;
-  substeps_ = lumped_.empty() || !std::isfinite(stable_1d_)
+  substeps_ = lumped_vessels_in_run() == 0 || !std::isfinite(stable_1d_)
                   ? 1
                   : static_cast<int>(std::max(1.0, std::ceil(dt / stable_1d_ - 1e-9)));
 }
@@ -32,7 +32,7 @@ void PulseSolver::choose_time_step(const SolverOptions& options) {
   stable_1d_ = dt_;
   stable_dt_ = dt_;
   stable_dt_reason_ = dt_reason_;
-  if (!lumped_.empty()) {
+  if (lumped_vessels_in_run() > 0) {
     // The 0D step follows the pulse (it has no stability limit); the 1D vessels take as
     // many substeps of at most their own limit as fit in it.
     coupling_passes_ = choose_coupling_passes(options);
@@ -73,7 +73,7 @@ int PulseSolver::choose_coupling_passes(const SolverOptions& options) const {
   double substep = step_cost::per_step;
   for (const DegreeBlock& b : blocks_) substep += static_cast<double>(b.count) * step_cost::element_step_seconds(b.degree);
   const double one_d = period_ / stable_1d_ * substep;
-  const double zero_d = static_cast<double>(lumped_.vessel_count()) * step_cost::per_lumped_vessel / step_per_coupling_pass;
+  const double zero_d = static_cast<double>(lumped_vessels_in_run()) * step_cost::per_lumped_vessel / step_per_coupling_pass;
   return step_cost::cheapest_coupling_passes(one_d, zero_d, most_coupling_passes);
 }
 
@@ -209,7 +209,7 @@ void PulseSolver::step_exponential(double h) {
 
 void PulseSolver::step() {
   if (lumped_count_after_release_) throw std::logic_error("PulseSolver::step after release_lumped_state");
-  if (lumped_.empty()) {
+  if (lumped_.empty() && !lumped_.over_ranks()) {
     step_1d(dt_);
     time_ += dt_;
   } else {
@@ -226,9 +226,9 @@ void PulseSolver::step_coupled() {
   // response of BDF2 (Z = (K^-1)_ii) it broke down at 4 substeps, with 3/2 Z, the backward
   // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §10). With
   // several coupling passes the substeps are taken again, each time with the inflows held at
-  // the means the pass before let through.
+  // the means the pass before let through. Over ranks, a share steps its 0D vessels alone.
   std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
-  for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
+  for (std::size_t k = 0; k < boundaries_.coupled.size() && one_d_here_; ++k) {
     const VesselEnd& end = boundaries_.coupled[k].end;
     const EndState& u = boundaries_.state_at(end);
     held_end_flow_[k] = end.distal ? u.flow : -u.flow;
@@ -247,32 +247,42 @@ void PulseSolver::step_coupled() {
     throw SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_);
   }
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
-  if (element_count() > 0) {
-    const Eigen::VectorXd before = state_.coupled;
-    if (coupling_passes_ > 1) keep_pass_start();
-    for (int pass = 1; pass < coupling_passes_; ++pass) {
-      // A pass before the last: its substeps, then the prediction again with each end's
-      // inflow held at the mean it let through, and the 1D vessels back at the step's start.
-      take_substeps();
-      std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
-      for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
-        const auto i = static_cast<Eigen::Index>(k);
-        held_end_flow_[k] = (state_.coupled(i) - before(i)) / dt_;
-        coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
-      }
-      lumped_.predict_again(coupled_inflow_);
-      return_to_pass_start();
+  if (element_count() > 0 && one_d_here_) {
+    try {
+      take_coupled_substeps();
+    } catch (...) {
+      // Over ranks every other rank waits for this step's answers: it is refused there too.
+      if (lumped_.over_ranks()) lumped_.abandon_step(std::current_exception());
+      throw;
     }
-    take_substeps();
-    std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
-    for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
-      coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
-          state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
   }
   // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
   lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1),
                    lumped_boundary_volume_);
   time_ = t1;
+}
+
+void PulseSolver::take_coupled_substeps() {
+  const Eigen::VectorXd before = state_.coupled;
+  if (coupling_passes_ > 1) keep_pass_start();
+  for (int pass = 1; pass < coupling_passes_; ++pass) {
+    // A pass before the last: its substeps, then the prediction again with each end's
+    // inflow held at the mean it let through, and the 1D vessels back at the step's start.
+    take_substeps();
+    std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
+    for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
+      const auto i = static_cast<Eigen::Index>(k);
+      held_end_flow_[k] = (state_.coupled(i) - before(i)) / dt_;
+      coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
+    }
+    lumped_.predict_again(coupled_inflow_);
+    return_to_pass_start();
+  }
+  take_substeps();
+  std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
+  for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
+    coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
+        state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
 }
 
 void PulseSolver::keep_pass_start() {

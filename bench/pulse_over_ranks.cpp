@@ -1,0 +1,151 @@
+// The pulsatile solver's steps over MPI ranks (issue 24; pulse/pulse_solver.hpp's PulseRanks):
+// a tree's 0D vessels cut into whole subtrees, its 1D vessels and every vessel above them on
+// the top's rank, one gather and one scatter a 0D step. Run under mpirun; rank 0 prints the
+// set-up's and the steps' seconds, the exchanges of rank 0 and of the top's rank (collective
+// calls, bytes, seconds inside them, waiting for the slowest rank included), each rank's peak
+// resident memory, and a fingerprint of every vessel's flow and pressure at its centre after
+// the last step, in the vessels' order: the same for any number of ranks where the bits are.
+//
+// usage: mpirun -np P build/bench/pulse_over_ranks NETWORK [STEPS] [THREADS]
+//        NETWORK a tree fed into outlets (vgen | vprune's); STEPS default: one cycle;
+//        THREADS a rank, default 1. The models --model auto chooses, one pi section a 0D
+//        vessel (--lumped-sections 1), the steady start.
+#include <sys/resource.h>
+
+#include <bit>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <mpi.h>
+
+#include "distributed/root_exchange.hpp"
+#include "formats/network_io.hpp"
+#include "mpi/session.hpp"
+#include "partition/partition.hpp"
+#include "pulse/pulse_solver.hpp"
+
+using namespace hemotree;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MpiSession session(argc, argv);
+  if (argc < 2 || argc > 4) {
+    if (world_rank() == 0) std::fprintf(stderr, "usage: mpirun -np P pulse_over_ranks NETWORK [STEPS] [THREADS]\n");
+    return 2;
+  }
+  const int ranks = world_size(), rank = world_rank();
+  const auto started = std::chrono::steady_clock::now();
+  const Network net = read_network(argv[1]);
+  SolverOptions options;
+  options.model = ModelChoice::automatic;
+  options.lumped_sections = 1;
+  options.start = StartChoice::steady;
+  options.threads = argc > 3 ? std::atoi(argv[3]) : 1;
+
+  PulseRanks part;
+  part.ranks = ranks;
+  part.rank = rank;
+  const std::vector<double> cost(net.vessel_count(), 1.0);
+  Partition partition = partition_network(net, cost, ranks);
+  part.top_rank = partition.top_rank;
+  std::vector<int> roots;
+  std::size_t one_d = 0, top_vessels = 0;
+  part.vessel_ranks = [&](const std::vector<bool>& zero_d) {
+    std::vector<std::uint8_t> on_top(zero_d.size());
+    for (std::size_t v = 0; v < zero_d.size(); ++v) one_d += on_top[v] = zero_d[v] ? 0 : 1;
+    keep_on_top(net, cost, on_top, partition);
+    std::vector<std::int32_t> r(partition.rank_of_vessel.begin(), partition.rank_of_vessel.end());
+    for (const std::int32_t v : partition.top) r[static_cast<std::size_t>(v)] = partition.top_rank;
+    for (const std::int32_t x : r) top_vessels += x == partition.top_rank ? 1 : 0;
+    roots = lumped_cut(net, subtree_lumped_order(net, zero_d), r, ranks, partition.top_rank, rank).roots;
+    return r;
+  };
+  std::unique_ptr<RootExchange> exchange;
+  part.link.up = [&](std::span<const double> numbers, std::exception_ptr failure, bool& failed) {
+    if (!exchange) exchange = std::make_unique<RootExchange>(MPI_COMM_WORLD, part.top_rank, roots);
+    return exchange->gather(numbers, failure, LumpedLink::up_per_root, failed);
+  };
+  part.link.down = [&](std::span<const double> answers, std::exception_ptr failure) {
+    return exchange->scatter(answers, failure, LumpedLink::down_per_root, "the 0D step");
+  };
+  PulseSolver solver(net, options, &part);
+  MPI_Barrier(MPI_COMM_WORLD);
+  const double set_up = seconds_since(started);
+  const std::size_t steps = argc > 2 ? static_cast<std::size_t>(std::atol(argv[2]))
+                                     : static_cast<std::size_t>(std::llround(solver.period() / solver.dt()));
+  const auto stepping = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < steps; ++k) solver.step();
+  MPI_Barrier(MPI_COMM_WORLD);
+  const double stepped = seconds_since(stepping);
+
+  // Each vessel's centre flow and pressure from the rank that steps it, in the vessels' order.
+  std::vector<double> mine;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    const std::int32_t i = solver.lumped().vessel_index(v);
+    const bool here = solver.is_lumped(v) ? i >= 0 && !solver.lumped().ghost_vessel(i) : solver.holds_one_d();
+    if (here) mine.insert(mine.end(), {static_cast<double>(v), solver.flow_at(v, 0.5), solver.pressure_at(v, 0.5)});
+  }
+  int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(counts.size(), 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<double> all(rank == 0 ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  long peak_kb = usage.ru_maxrss;
+  std::vector<long> peaks(static_cast<std::size_t>(ranks));
+  MPI_Gather(&peak_kb, 1, MPI_LONG, peaks.data(), 1, MPI_LONG, 0, MPI_COMM_WORLD);
+  // The top's exchanges too.
+  double top_traffic[3] = {0, 0, 0};
+  if (rank == part.top_rank && exchange)
+    top_traffic[0] = exchange->traffic().calls, top_traffic[1] = static_cast<double>(exchange->traffic().bytes),
+    top_traffic[2] = exchange->traffic().seconds;
+  if (part.top_rank != 0) {
+    if (rank == part.top_rank) MPI_Send(top_traffic, 3, MPI_DOUBLE, 0, 7, MPI_COMM_WORLD);
+    if (rank == 0) MPI_Recv(top_traffic, 3, MPI_DOUBLE, part.top_rank, 7, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  }
+  if (rank == 0) {
+    std::vector<double> flow(net.vessel_count(), 0.0), pressure(net.vessel_count(), 0.0);
+    std::vector<unsigned char> seen(net.vessel_count(), 0);
+    for (std::size_t k = 0; k < all.size(); k += 3) {
+      const auto v = static_cast<std::size_t>(all[k]);
+      flow[v] = all[k + 1];
+      pressure[v] = all[k + 2];
+      ++seen[v];
+    }
+    std::size_t missing = 0;
+    for (const unsigned char s : seen) missing += s != 1;
+    std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the numbers' bits
+    for (std::size_t v = 0; v < flow.size(); ++v)
+      for (const double x : {flow[v], pressure[v]}) {
+        std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
+        for (int b = 0; b < 8; ++b, bits >>= 8) hash = (hash ^ (bits & 0xff)) * 1099511628211ull;
+      }
+    std::printf("%d ranks x %d threads, %zu vessels (%zu 1D, %zu on the top's rank %d), %zu steps of %d substeps:\n"
+                "  set-up %.2f s, steps %.2f s (%.1f ms a step)\n",
+                ranks, options.threads, net.vessel_count(), one_d, top_vessels, part.top_rank, steps, solver.substeps(),
+                set_up, stepped, 1e3 * stepped / static_cast<double>(steps));
+    if (exchange)
+      std::printf("  rank 0's exchanges: %d calls, %zu B, %.3f s inside; the top's: %.0f calls, %.0f B, %.3f s\n",
+                  exchange->traffic().calls, exchange->traffic().bytes, exchange->traffic().seconds, top_traffic[0],
+                  top_traffic[1], top_traffic[2]);
+    std::printf("  peak resident memory a rank:");
+    for (const long kb : peaks) std::printf(" %.0f MiB", static_cast<double>(kb) / 1024);
+    std::printf("\n  fingerprint of the vessels' centre flows and pressures: %016llx%s\n",
+                static_cast<unsigned long long>(hash), missing ? " (vessels missing or twice!)" : "");
+  }
+  return 0;
+}

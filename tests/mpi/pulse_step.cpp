@@ -1,0 +1,132 @@
+// Under mpirun (ctest label mpi, 1 to 4 ranks): the pulsatile solver's steps over the ranks
+// (pulse/pulse_solver.hpp's PulseRanks): a grown tree whose larger vessels are 1D, kept with
+// every vessel above them on the top's rank, and whose 0D vessels are cut into whole subtrees;
+// after every step each rank's 0D vessels and, on the top's rank, the 1D vessels' whole state
+// are the one-process solver's bits (which every rank also steps here, alone). Exit 0 when
+// every rank agrees, 1 otherwise, one line per failure on stderr.
+#include <bit>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <mpi.h>
+
+#include "distributed/root_exchange.hpp"
+#include "generator/growth_rules.hpp"
+#include "generator/tree_growth.hpp"
+#include "partition/partition.hpp"
+#include "pruner/outlet_calibration.hpp"
+#include "pruner/pruning_strategies.hpp"
+#include "pulse/pulse_solver.hpp"
+#include "rank_checks.hpp"
+#include "solver/lumped_link_mpi.hpp"
+
+using namespace hemotree;
+using rank_checks::check;
+using rank_checks::rank;
+
+namespace {
+
+bool same(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
+
+// vgen --seed 3 --root-diameter 1mm --min-diameter 50um | vprune --budget all, in code: the
+// paper's half-sine inflow of 1.74 ml/min, outlets calibrated.
+Network tree_with_waves() {
+  GrowthParameters p;
+  p.root_diameter = 1e-3;
+  p.min_diameter = 50e-6;
+  p.seed = 3;
+  Network full = grow_tree(default_rules(), p);
+  full.blood = Blood{};
+  Inlet inlet;
+  inlet.vessel = full.id[0];
+  inlet.waveform.mean = 1.74e-6 / 60;
+  full.inlet = inlet;
+  const KeepMask keep(full.vessel_count(), 1);
+  Network net = extract(full, keep);
+  calibrate_outlets(full, keep, net, OutletParameters{});
+  return net;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  int ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  {
+    const Network net = tree_with_waves();
+    SolverOptions options;
+    options.model = ModelChoice::automatic;
+    options.lumped_sections = 1;
+    options.start = StartChoice::steady;
+    PulseSolver whole(net, options);
+    std::size_t one_d = 0;
+    for (std::size_t v = 0; v < net.vessel_count(); ++v) one_d += whole.is_lumped(v) ? 0 : 1;
+    check(one_d > 10 && one_d < net.vessel_count() / 4,
+          std::to_string(one_d) + " of " + std::to_string(net.vessel_count()) + " vessels 1D");
+
+    // The partition by subtrees, the 1D vessels and those above them on the top's rank.
+    PulseRanks part;
+    part.ranks = ranks;
+    part.rank = rank;
+    const std::vector<double> cost(net.vessel_count(), 1.0);
+    Partition partition = partition_network(net, cost, ranks);
+    std::vector<int> roots;
+    part.top_rank = partition.top_rank;
+    part.vessel_ranks = [&](const std::vector<bool>& zero_d) {
+      std::vector<std::uint8_t> on_top(zero_d.size());
+      for (std::size_t v = 0; v < zero_d.size(); ++v) on_top[v] = zero_d[v] ? 0 : 1;
+      keep_on_top(net, cost, on_top, partition);
+      std::vector<std::int32_t> r(partition.rank_of_vessel.begin(), partition.rank_of_vessel.end());
+      for (const std::int32_t v : partition.top) r[static_cast<std::size_t>(v)] = partition.top_rank;
+      const LumpedCut cut = lumped_cut(net, subtree_lumped_order(net, zero_d), r, ranks, partition.top_rank, rank);
+      roots = cut.roots;
+      return r;
+    };
+    // The exchange needs the roots per rank, known once the cut is: it is made on first use.
+    std::unique_ptr<RootExchange> exchange;
+    part.link.up = [&](std::span<const double> numbers, std::exception_ptr failure, bool& failed) {
+      if (!exchange) exchange = std::make_unique<RootExchange>(MPI_COMM_WORLD, part.top_rank, roots);
+      return exchange->gather(numbers, failure, LumpedLink::up_per_root, failed);
+    };
+    part.link.down = [&](std::span<const double> answers, std::exception_ptr failure) {
+      return exchange->scatter(answers, failure, LumpedLink::down_per_root, "the 0D step");
+    };
+    PulseSolver mine(net, options, &part);
+    check(mine.holds_one_d() == (rank == part.top_rank), "the 1D vessels held by a rank not the top's");
+    check(mine.dt() == whole.dt() && mine.substeps() == whole.substeps() && mine.coupling_passes() == whole.coupling_passes(),
+          "another step than the whole run's");
+    std::size_t differ = 0, compared = 0;
+    for (int n = 0; n < 25; ++n) {
+      whole.step();
+      mine.step();
+      compared = 0;
+      for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+        const std::int32_t i = mine.lumped().vessel_index(v);
+        const bool here = whole.is_lumped(v) ? i >= 0 && !mine.lumped().ghost_vessel(i) : mine.holds_one_d();
+        if (!here) continue;
+        ++compared;
+        for (const double x : {0.0, 0.5, 1.0})
+          differ += !same(mine.pressure_at(v, x), whole.pressure_at(v, x)) + !same(mine.flow_at(v, x), whole.flow_at(v, x));
+      }
+      if (mine.holds_one_d()) {
+        differ += mine.state().area != whole.state().area;
+        differ += mine.state().flow != whole.state().flow;
+      }
+    }
+    check(differ == 0, std::to_string(differ) + " numbers differ from the whole run's");
+    unsigned long held = compared, total = 0;
+    MPI_Allreduce(&held, &total, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
+    check(total == net.vessel_count(), std::to_string(total) + " vessels held over the ranks, of " + std::to_string(net.vessel_count()));
+    check(mine.time() == whole.time(), "another time than the whole run's");
+    if (rank == 0) std::printf("%zu vessels (%zu 1D), %zu steps of %d substeps\n", net.vessel_count(), one_d, mine.steps(), mine.substeps());
+  }
+  const int failures = rank_checks::all_failures();
+  if (rank == 0 && failures == 0) std::printf("pulsatile steps over %d ranks: the whole run's bits\n", ranks);
+  MPI_Finalize();
+  return failures == 0 ? 0 : 1;
+}
