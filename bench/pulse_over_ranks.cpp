@@ -7,7 +7,7 @@
 // the last step, in the vessels' order: the same for any number of ranks where the bits are.
 //
 // usage: mpirun -np P build/bench/pulse_over_ranks NETWORK [STEPS] [THREADS]
-//        NETWORK a tree fed into outlets (vgen | vprune's); STEPS default: one cycle;
+//        NETWORK a tree fed into outlets (vgen | vprune's); STEPS default (or 0): one cycle;
 //        THREADS a rank, default 1. The models --model auto chooses, one pi section a 0D
 //        vessel (--lumped-sections 1), the steady start.
 #include <sys/resource.h>
@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -83,8 +84,9 @@ int main(int argc, char** argv) {
   PulseSolver solver(net, options, &part);
   MPI_Barrier(MPI_COMM_WORLD);
   const double set_up = seconds_since(started);
-  const std::size_t steps = argc > 2 ? static_cast<std::size_t>(std::atol(argv[2]))
-                                     : static_cast<std::size_t>(std::llround(solver.period() / solver.dt()));
+  const long asked = argc > 2 ? std::atol(argv[2]) : 0;
+  const std::size_t steps = asked > 0 ? static_cast<std::size_t>(asked)
+                                      : static_cast<std::size_t>(std::llround(solver.period() / solver.dt()));
   const auto stepping = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < steps; ++k) solver.step();
   MPI_Barrier(MPI_COMM_WORLD);

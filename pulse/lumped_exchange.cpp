@@ -1,5 +1,6 @@
 // The 0D vessels of a run over ranks (pulse/lumped_cut.hpp): what a rank holds of the cut, and
 // the two messages of every step, as LumpedVessels' predict() and complete() send them.
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -22,10 +23,30 @@ void LumpedVessels::hold_cut(const LumpedCut& cut) {
     if (share_.top) share_.ghost_edge[e] = 1;
   }
   share_.root_row.assign(share_.root_edge.size() * (share_.top ? LumpedLink::up_per_root : 1), 0.0);
+  // The top's nodes above the roots: their rows wait for the messages.
+  if (share_.top) {
+    for (const std::int32_t edge : share_.root_edge) {
+      const auto e = static_cast<std::size_t>(edge);
+      const std::int32_t u = share_.ghost_node[static_cast<std::size_t>(a_[e])] == 1 ? b_[e] : a_[e];
+      if (share_.ghost_node[static_cast<std::size_t>(u)] == 0) share_.waiting_node.push_back(u);
+      share_.ghost_node[static_cast<std::size_t>(u)] = 2;
+    }
+    std::sort(share_.waiting_node.begin(), share_.waiting_node.end());
+  }
 }
 
 void LumpedVessels::abandon_step(std::exception_ptr failure) {
-  share_.link.down({}, failure);
+  // The top's rank takes the shares' messages in first (they are waiting to send them).
+  if (share_.top && share_.awaiting_roots) {
+    share_.awaiting_roots = false;
+    bool failed = false;
+    share_.link.up({}, failure, failed);
+  }
+  // Once: a failure after the step's answers went down (or its refusal) is this rank's alone.
+  if (!share_.answered) {
+    share_.answered = true;
+    share_.link.down({}, failure);
+  }
   std::rethrow_exception(failure);  // a link that did not throw it: this rank's own
 }
 
@@ -48,6 +69,7 @@ void LumpedVessels::send_roots(std::exception_ptr failure) {
 }
 
 void LumpedVessels::take_roots() {
+  share_.awaiting_roots = false;
   bool failed = false;
   const std::vector<double> message = share_.link.up({}, nullptr, failed);
   if (failed) abandon_step(std::make_exception_ptr(std::runtime_error("a rank's 0D step failed")));
@@ -68,6 +90,7 @@ void LumpedVessels::answer_roots() {
     const auto r = static_cast<std::size_t>(r_at_a ? a_[e] : b_[e]), u = static_cast<std::size_t>(r_at_a ? b_[e] : a_[e]);
     answers.insert(answers.end(), {rhs_[r], rhs_[u], pressure_[u]});
   }
+  share_.answered = true;
   share_.link.down(answers, nullptr);
 }
 

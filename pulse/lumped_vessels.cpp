@@ -504,41 +504,50 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
       }
     });
   linearised_dt_ = 0;
-  if (share_.on && share_.top)
+  double* const system_shunt = system_.shunt_workspace().data();
+  // BDF2 for a node's volume, V(p) linearised at p*:
+  // (3 (V* + C* (p - p*)) - 4 V^n + V^(n-1)) / (2 dt) = inflows at t1. False where the
+  // compliance is not positive (a lumen closing there).
+  auto node_row = [&](std::size_t k) {
+    const double ps = at(static_cast<std::int32_t>(k)), c = node_compliance(k, ps);
+    system_shunt[k] = 1.5 * c / dt + shunt_[k];
+    double rhs =
+        (1.5 * (c * ps - node_excess(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt + shunt_current(k);
+    for_each_incident(k, [&](std::int32_t e) {
+      rhs += e >= 0 ? -history_[static_cast<std::size_t>(e)] : history_[static_cast<std::size_t>(~e)];
+    });
+    rhs_[k] = rhs;
+    return system_shunt[k] > 0;
+  };
+  // On the top's rank the nodes above the shares' roots wait for their messages (their sums
+  // take the root vessels' lines): every other row is made first, while the shares make theirs.
+  const bool top = share_.on && share_.top;
+  std::int64_t collapsed = nodes_i;
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1) reduction(min : collapsed)
+  for (std::int64_t i = 0; i < nodes_i; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (is_ghost_node(k)) {  // another rank's row: a share's root (below), an open node above a share
+      system_shunt[k] = 0;
+      rhs_[k] = 0;
+      continue;
+    }
+    if (top && waits_for_roots(k)) continue;
+    if (!node_row(k)) collapsed = std::min<std::int64_t>(collapsed, i);
+  }
+  if (top) {
+    take_roots();
     for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
       const auto e = static_cast<std::size_t>(share_.root_edge[j]);
       conductance_[e] = share_.root_row[LumpedLink::up_per_root * j];
       history_[e] = share_.root_row[LumpedLink::up_per_root * j + 3];
     }
-  std::int64_t collapsed = nodes_i;
-  double* const system_shunt = system_.shunt_workspace().data();
-#pragma omp parallel num_threads(threads_) if (threads_ > 1)
-  {
-    // BDF2 for a node's volume, V(p) linearised at p*:
-    // (3 (V* + C* (p - p*)) - 4 V^n + V^(n-1)) / (2 dt) = inflows at t1.
-#pragma omp for schedule(static) reduction(min : collapsed)
-    for (std::int64_t i = 0; i < nodes_i; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      if (is_ghost_node(k)) {  // another rank's row: a share's root (below), an open node above a share
-        system_shunt[k] = 0;
-        rhs_[k] = 0;
-        continue;
-      }
-      const double ps = at(static_cast<std::int32_t>(i)), c = node_compliance(k, ps);
-      system_shunt[k] = 1.5 * c / dt + shunt_[k];
-      if (!(system_shunt[k] > 0)) collapsed = std::min<std::int64_t>(collapsed, i);  // a lumen closing there
-      double rhs =
-          (1.5 * (c * ps - node_excess(k, ps)) + 0.5 * (4 * volume_[k] - previous_volume_[k])) / dt + shunt_current(k);
-      for_each_incident(k, [&](std::int32_t e) {
-        rhs += e >= 0 ? -history_[static_cast<std::size_t>(e)] : history_[static_cast<std::size_t>(~e)];
-      });
-      rhs_[k] = rhs;
-    }
+    for (const std::int32_t k : share_.waiting_node)
+      if (!node_row(static_cast<std::size_t>(k))) collapsed = std::min<std::int64_t>(collapsed, k);
   }
   if (collapsed < nodes_i) throw CollapsedNode{vessel_at_node(static_cast<std::size_t>(collapsed))};
   for_each_source(coupled_inflow, 1.0, [&](std::size_t k, double inflow) { rhs_[k] += inflow; });
   // On the top's rank, each share's root a leaf of its subtree's conductance and right-hand side.
-  if (share_.on && share_.top)
+  if (top)
     for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
       const auto r = static_cast<std::size_t>(b_[static_cast<std::size_t>(share_.root_edge[j])]);
       const std::size_t below = is_ghost_node(r) ? r : static_cast<std::size_t>(a_[static_cast<std::size_t>(share_.root_edge[j])]);
@@ -557,6 +566,7 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
     predict_step(dt, coupled_inflow, inflow, held_pressure);
     return;
   }
+  share_.answered = false;
   if (!share_.top) {
     std::exception_ptr failure;
     try {
@@ -567,9 +577,11 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
     send_roots(failure);
     return;
   }
-  take_roots();
+  // The top's rank: its rows first, the shares' roots taken in its linearisation.
+  share_.awaiting_roots = true;
   try {
     predict_step(dt, coupled_inflow, inflow, held_pressure);
+    if (share_.awaiting_roots) take_roots();  // none of its own to make first
   } catch (...) {
     abandon_step(std::current_exception());
   }

@@ -493,10 +493,14 @@ class LumpedVessels {
     std::vector<std::int32_t> root_edge;    // the messages' edges in their order: a share's into the top, the top's ghosts
     std::vector<unsigned char> ghost_node;  // per node (empty: none)
     std::vector<unsigned char> ghost_edge;  // per edge: the top's ghosts (empty: none)
-    std::vector<double> root_row;           // the top's: per ghost edge, S_r and y_r of this step's message
+    std::vector<double> root_row;           // the top's: per ghost edge, its message; a share's: per root, u's pressure
+    std::vector<std::int32_t> waiting_node;  // the top's nodes above the shares' roots (their rows need the messages)
+    bool awaiting_roots = false, answered = false;  // the top's step: its messages not yet in, its answers out
     LumpedLink link;
   } share_;
-  bool is_ghost_node(std::size_t k) const { return !share_.ghost_node.empty() && share_.ghost_node[k]; }
+  // ghost_node: 1 a ghost, 2 a node of the top's that waits for the shares' roots.
+  bool is_ghost_node(std::size_t k) const { return !share_.ghost_node.empty() && share_.ghost_node[k] == 1; }
+  bool waits_for_roots(std::size_t k) const { return !share_.ghost_node.empty() && share_.ghost_node[k] == 2; }
   bool is_ghost_edge(std::size_t e) const { return !share_.ghost_edge.empty() && share_.ghost_edge[e]; }
   void hold_cut(const LumpedCut& cut);  // the constructor's: ghosts and root edges
   // A step's messages (pulse/lumped_exchange.cpp): a share's roots up after its forward half
