@@ -44,7 +44,6 @@ void CycleStatistics::start_sums() {
 }
 
 void CycleStatistics::begin(const PulseSolver& solver) {
-  exchanged_start_ = solver.state().exchanged;
   boundary_start_ = solver.boundary_volumes();
   volume_start_ = solver.network_volume();
 }
@@ -123,11 +122,17 @@ void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>
 CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   CycleSummary summary;
   if (sums_.empty()) start_sums();  // no sample since the last close
-  const Eigen::Vector2d exchanged = solver.state().exchanged - exchanged_start_;
+  // In and out: each boundary's volume, in the boundaries' order, to "in" or "out" as it
+  // counts (one sum per item whatever holds it: a run over ranks gathers the same numbers).
+  const Eigen::VectorXd through = solver.boundary_volumes() - boundary_start_;
+  Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();
+  for (Eigen::Index i = 0; i < through.size(); ++i) {
+    summary.boundary_mean_flow.push_back(through(i) / duration_);
+    if (solver.boundary_entering()[static_cast<std::size_t>(i)]) exchanged(0) += through(i);
+    else exchanged(1) -= through(i);
+  }
   summary.inlet_mean_flow = exchanged(0) / duration_;
   summary.outlets_mean_flow = exchanged(1) / duration_;
-  const Eigen::VectorXd through = solver.boundary_volumes() - boundary_start_;
-  for (Eigen::Index i = 0; i < through.size(); ++i) summary.boundary_mean_flow.push_back(through(i) / duration_);
   summary.inflow_measured = exchanged(0) > 1e-6 * volume_start_;
   summary.volume_change = solver.network_volume() - volume_start_;
   summary.conservation_error =

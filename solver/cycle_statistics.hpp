@@ -91,7 +91,6 @@ class CycleStatistics {
  private:
   const Network& net_;
   double omega_;
-  Eigen::Vector2d exchanged_start_ = Eigen::Vector2d::Zero();  // at begin()
   Eigen::VectorXd boundary_start_;                               // at begin()
   double volume_start_ = 0;
   // Per vessel, the cycle's results as they are gathered: the means' fields hold their
