@@ -18,17 +18,15 @@
 #include <cstdio>
 #include <cmath>
 #include <cstdlib>
-#include <memory>
 #include <string>
 #include <vector>
 
 #include <mpi.h>
 
-#include "distributed/root_exchange.hpp"
 #include "formats/network_io.hpp"
 #include "mpi/session.hpp"
-#include "partition/partition.hpp"
 #include "pulse/pulse_solver.hpp"
+#include "solver/pulse_ranks_mpi.hpp"
 
 using namespace hemotree;
 
@@ -55,35 +53,15 @@ int main(int argc, char** argv) {
   options.start = StartChoice::steady;
   options.threads = argc > 3 ? std::atoi(argv[3]) : 1;
 
-  PulseRanks part;
-  part.ranks = ranks;
-  part.rank = rank;
-  const std::vector<double> cost(net.vessel_count(), 1.0);
-  Partition partition = partition_network(net, cost, ranks);
-  part.top_rank = partition.top_rank;
-  std::vector<int> roots;
-  std::size_t one_d = 0, top_vessels = 0;
-  part.vessel_ranks = [&](const std::vector<bool>& zero_d) {
-    std::vector<std::uint8_t> on_top(zero_d.size());
-    for (std::size_t v = 0; v < zero_d.size(); ++v) one_d += on_top[v] = zero_d[v] ? 0 : 1;
-    keep_on_top(net, cost, on_top, partition);
-    std::vector<std::int32_t> r(partition.rank_of_vessel.begin(), partition.rank_of_vessel.end());
-    for (const std::int32_t v : partition.top) r[static_cast<std::size_t>(v)] = partition.top_rank;
-    for (const std::int32_t x : r) top_vessels += x == partition.top_rank ? 1 : 0;
-    roots = lumped_cut(net, subtree_lumped_order(net, zero_d), r, ranks, partition.top_rank, rank).roots;
-    return r;
-  };
-  std::unique_ptr<RootExchange> exchange;
-  part.link.up = [&](std::span<const double> numbers, std::exception_ptr failure, bool& failed) {
-    if (!exchange) exchange = std::make_unique<RootExchange>(MPI_COMM_WORLD, part.top_rank, roots);
-    return exchange->gather(numbers, failure, LumpedLink::up_per_root, failed);
-  };
-  part.link.down = [&](std::span<const double> answers, std::exception_ptr failure) {
-    return exchange->scatter(answers, failure, LumpedLink::down_per_root, "the 0D step");
-  };
+  MpiPulseRanks over_ranks(net, std::vector<double>(net.vessel_count(), 1.0));
+  const PulseRanks& part = over_ranks.ranks();
   PulseSolver solver(net, options, &part);
   MPI_Barrier(MPI_COMM_WORLD);
   const double set_up = seconds_since(started);
+  std::size_t one_d = 0;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) one_d += solver.is_lumped(v) ? 0 : 1;
+  const std::size_t top_vessels = over_ranks.top_vessels();
+  const RootExchange* exchange = over_ranks.exchange();
   const long asked = argc > 2 ? std::atol(argv[2]) : 0;
   const std::size_t steps = asked > 0 ? static_cast<std::size_t>(asked)
                                       : static_cast<std::size_t>(std::llround(solver.period() / solver.dt()));

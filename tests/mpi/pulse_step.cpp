@@ -7,21 +7,18 @@
 #include <bit>
 #include <cstdint>
 #include <cstdio>
-#include <memory>
 #include <string>
 #include <vector>
 
 #include <mpi.h>
 
-#include "distributed/root_exchange.hpp"
 #include "generator/growth_rules.hpp"
 #include "generator/tree_growth.hpp"
-#include "partition/partition.hpp"
 #include "pruner/outlet_calibration.hpp"
 #include "pruner/pruning_strategies.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "rank_checks.hpp"
-#include "solver/lumped_link_mpi.hpp"
+#include "solver/pulse_ranks_mpi.hpp"
 
 using namespace hemotree;
 using rank_checks::check;
@@ -70,32 +67,8 @@ int main(int argc, char** argv) {
           std::to_string(one_d) + " of " + std::to_string(net.vessel_count()) + " vessels 1D");
 
     // The partition by subtrees, the 1D vessels and those above them on the top's rank.
-    PulseRanks part;
-    part.ranks = ranks;
-    part.rank = rank;
-    const std::vector<double> cost(net.vessel_count(), 1.0);
-    Partition partition = partition_network(net, cost, ranks);
-    std::vector<int> roots;
-    part.top_rank = partition.top_rank;
-    part.vessel_ranks = [&](const std::vector<bool>& zero_d) {
-      std::vector<std::uint8_t> on_top(zero_d.size());
-      for (std::size_t v = 0; v < zero_d.size(); ++v) on_top[v] = zero_d[v] ? 0 : 1;
-      keep_on_top(net, cost, on_top, partition);
-      std::vector<std::int32_t> r(partition.rank_of_vessel.begin(), partition.rank_of_vessel.end());
-      for (const std::int32_t v : partition.top) r[static_cast<std::size_t>(v)] = partition.top_rank;
-      const LumpedCut cut = lumped_cut(net, subtree_lumped_order(net, zero_d), r, ranks, partition.top_rank, rank);
-      roots = cut.roots;
-      return r;
-    };
-    // The exchange needs the roots per rank, known once the cut is: it is made on first use.
-    std::unique_ptr<RootExchange> exchange;
-    part.link.up = [&](std::span<const double> numbers, std::exception_ptr failure, bool& failed) {
-      if (!exchange) exchange = std::make_unique<RootExchange>(MPI_COMM_WORLD, part.top_rank, roots);
-      return exchange->gather(numbers, failure, LumpedLink::up_per_root, failed);
-    };
-    part.link.down = [&](std::span<const double> answers, std::exception_ptr failure) {
-      return exchange->scatter(answers, failure, LumpedLink::down_per_root, "the 0D step");
-    };
+    MpiPulseRanks over_ranks(net, std::vector<double>(net.vessel_count(), 1.0));
+    const PulseRanks& part = over_ranks.ranks();
     PulseSolver mine(net, options, &part);
     check(mine.holds_one_d() == (rank == part.top_rank), "the 1D vessels held by a rank not the top's");
     check(mine.dt() == whole.dt() && mine.substeps() == whole.substeps() && mine.coupling_passes() == whole.coupling_passes(),

@@ -1,0 +1,45 @@
+// A pulsatile run over MPI ranks as the solver takes it (pulse/pulse_solver.hpp's PulseRanks):
+// the tree partitioned by subtrees, the 1D vessels and every vessel above them moved to the
+// top's rank once the solver has chosen the models (partition/keep_on_top), and each step's
+// messages over MPI (solver/lumped_link_mpi.hpp), their exchange made at the first step from
+// the cut's roots per rank.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "distributed/root_exchange.hpp"
+#include "formats/network.hpp"
+#include "partition/partition.hpp"
+#include "pulse/pulse_solver.hpp"
+
+namespace hemotree {
+
+class MpiPulseRanks {
+ public:
+  // Over MPI_COMM_WORLD's ranks; cost: per vessel, its weight in the partition. The network
+  // must outlive this.
+  MpiPulseRanks(const Network& net, std::vector<double> cost);
+  MpiPulseRanks(const MpiPulseRanks&) = delete;  // the link refers to this
+  MpiPulseRanks& operator=(const MpiPulseRanks&) = delete;
+
+  const PulseRanks& ranks() const { return ranks_; }
+  // After the solver is built: the partition with the 1D vessels kept on the top, and the
+  // vessels the top's rank holds.
+  const Partition& partition() const { return partition_; }
+  std::size_t top_vessels() const { return top_vessels_; }
+  const RootExchange* exchange() const { return exchange_.get(); }  // null before the first step
+
+ private:
+  const Network& net_;
+  std::vector<double> cost_;
+  Partition partition_;
+  PulseRanks ranks_;
+  std::vector<int> roots_;
+  std::size_t top_vessels_ = 0;
+  std::unique_ptr<RootExchange> exchange_;
+};
+
+}  // namespace hemotree
