@@ -572,7 +572,7 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
     try {
       predict_step(dt, coupled_inflow, inflow, held_pressure);
     } catch (...) {
-      failure = std::current_exception();
+      failure = in_words(std::current_exception());
     }
     send_roots(failure);
     return;
@@ -583,7 +583,7 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
     predict_step(dt, coupled_inflow, inflow, held_pressure);
     if (share_.awaiting_roots) take_roots();  // none of its own to make first
   } catch (...) {
-    abandon_step(std::current_exception());
+    abandon_step(in_words(std::current_exception()));
   }
 }
 

@@ -169,6 +169,12 @@ class LumpedVessels {
   // step that fails on this rank between them (the top's 1D vessels) is abandoned through
   // abandon_step, which tells every rank (the link's down) and throws its refusal.
   void set_link(LumpedLink link) { share_.link = std::move(link); }
+  // How a failure of this rank's step is put to every rank (its words there): a lumen
+  // closing (CollapsedNode) is named here by a network index alone, which the caller can
+  // turn into its own error (PulseSolver: the vessel's id and the time). Unset: as it is.
+  void set_failure_words(std::function<std::exception_ptr(std::exception_ptr)> words) {
+    share_.failure_words = std::move(words);
+  }
   bool over_ranks() const { return share_.on; }
   [[noreturn]] void abandon_step(std::exception_ptr failure);
   // Whether a node or a 0D vessel is held for another rank's sums only (its numbers are that
@@ -497,6 +503,7 @@ class LumpedVessels {
     std::vector<std::int32_t> waiting_node;  // the top's nodes above the shares' roots (their rows need the messages)
     bool awaiting_roots = false, answered = false;  // the top's step: its messages not yet in, its answers out
     LumpedLink link;
+    std::function<std::exception_ptr(std::exception_ptr)> failure_words;
   } share_;
   // ghost_node: 1 a ghost, 2 a node of the top's that waits for the shares' roots.
   bool is_ghost_node(std::size_t k) const { return !share_.ghost_node.empty() && share_.ghost_node[k] == 1; }
@@ -510,6 +517,9 @@ class LumpedVessels {
   void take_roots();
   void answer_roots();
   void take_answers();
+  std::exception_ptr in_words(std::exception_ptr failure) const {
+    return share_.failure_words ? share_.failure_words(failure) : failure;
+  }
   // The step on this rank's vessels, between the messages (and the whole run's step).
   void predict_step(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
                     std::span<const double> held_pressure);

@@ -17,6 +17,7 @@
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
 #include "core/parallel_errors.hpp"
+#include "pulse/solution_breakdown.hpp"
 #include "formats/connected_parts.hpp"
 #include "physics/poiseuille.hpp"
 #include "physics/wall_law.hpp"
@@ -151,6 +152,16 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
                                      ranks->rank, lumped_sections_);
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_, &cut);
     lumped_.set_link(ranks->link);
+    // A lumen closing on any rank is said on every rank as this rank would say it alone.
+    lumped_.set_failure_words([this](std::exception_ptr failure) {
+      try {
+        std::rethrow_exception(failure);
+      } catch (const LumpedVessels::CollapsedNode& collapsed) {
+        return std::make_exception_ptr(SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_));
+      } catch (...) {
+        return failure;
+      }
+    });
     one_d_here_ = cut.top();
   } else {
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);

@@ -276,3 +276,51 @@ TEST(LumpedCut, AStepAbandonedOnTheTopIsRefusedOnEveryRank) {
   for (std::thread& th : threads) th.join();
   EXPECT_EQ(refused, std::vector<int>(static_cast<std::size_t>(ranks), 1));
 }
+
+// A lumen closing in a share (a leaf's node at a pressure no lumen holds) is refused on every
+// rank in the words the share's caller gives it (PulseSolver: the vessel's id and the time).
+TEST(LumpedCut, ALumenClosingInAShareIsSaidOnEveryRank) {
+  const CutTree t;
+  const int ranks = 3;
+  const Partition p = partition_network(t.net, std::vector<double>(t.net.vessel_count(), 1.0), ranks);
+  const std::vector<std::int32_t> rank = t.vessel_rank(p);
+  std::vector<LumpedCut> cuts;
+  for (int r = 0; r < ranks; ++r) cuts.push_back(lumped_cut(t.net, t.whole_order, rank, ranks, p.top_rank, r));
+  std::vector<double> pressure(t.net.node_count(), 3000.0), flow(t.net.vessel_count(), 0.0);
+  std::size_t leaf = 0;  // an outlet's vessel on a share
+  for (const Outlet& o : t.net.outlets)
+    if (rank[static_cast<std::size_t>(o.vessel)] != p.top_rank) leaf = static_cast<std::size_t>(o.vessel);
+  pressure[static_cast<std::size_t>(t.net.to[leaf])] = -1e9;
+  PlayedLink played(ranks, p.top_rank, cuts[0].roots);
+  std::vector<LumpedVessels> part;
+  for (int r = 0; r < ranks; ++r) {
+    part.push_back(t.lumped(&cuts[static_cast<std::size_t>(r)]));
+    part.back().set_link(played.for_rank(r));
+    part.back().set_failure_words([](std::exception_ptr failure) {
+      try {
+        std::rethrow_exception(failure);
+      } catch (const LumpedVessels::CollapsedNode& c) {
+        return std::make_exception_ptr(std::runtime_error("the lumen of vessel " + std::to_string(c.vessel) + " closes"));
+      } catch (...) {
+        return failure;
+      }
+    });
+    part.back().start(pressure, flow);
+  }
+  std::vector<std::string> said(static_cast<std::size_t>(ranks));
+  std::vector<std::thread> threads;
+  for (int r = 0; r < ranks; ++r)
+    threads.emplace_back([&, r] {
+      LumpedVessels& mine = part[static_cast<std::size_t>(r)];
+      try {
+        double in = 0, out = 0;
+        mine.predict(1e-4, {}, std::vector<double>(mine.inflow_boundaries().size(), 1e-10), {});
+        mine.complete({}, in, out);
+      } catch (const std::runtime_error& e) {
+        said[static_cast<std::size_t>(r)] = e.what();
+      }
+    });
+  for (std::thread& th : threads) th.join();
+  const std::string words = "rank " + std::to_string(rank[leaf]) + ": the lumen of vessel " + std::to_string(leaf) + " closes";
+  for (int r = 0; r < ranks; ++r) EXPECT_NE(said[static_cast<std::size_t>(r)].find(words), std::string::npos) << said[static_cast<std::size_t>(r)];
+}
