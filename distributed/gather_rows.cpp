@@ -36,4 +36,20 @@ void gather_rows(std::span<const double> rows, std::size_t width, const std::vec
     }
 }
 
+void gather_rows(std::span<const std::int32_t> items, std::span<const double> rows, std::size_t width,
+                 std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place) {
+  const int ranks = world_size();
+  const bool lead = world_rank() == 0;
+  const int mine = static_cast<int>(items.size());
+  std::vector<int> sizes(lead ? static_cast<std::size_t>(ranks) : 0), offsets(sizes.size(), 0);
+  MPI_Gather(&mine, 1, MPI_INT, sizes.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  for (std::size_t r = 1; r < sizes.size(); ++r) offsets[r] = offsets[r - 1] + sizes[r - 1];
+  std::vector<std::int32_t> every(lead ? static_cast<std::size_t>(offsets.back() + sizes.back()) : 0);
+  MPI_Gatherv(items.data(), mine, MPI_INT32_T, every.data(), sizes.data(), offsets.data(), MPI_INT32_T, 0, MPI_COMM_WORLD);
+  std::vector<std::vector<std::int32_t>> lists(sizes.size());
+  for (std::size_t r = 0; r < sizes.size(); ++r)
+    lists[r].assign(every.begin() + offsets[r], every.begin() + offsets[r] + sizes[r]);
+  gather_rows(rows, width, lists, count, place);
+}
+
 }  // namespace hemotree

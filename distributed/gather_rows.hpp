@@ -19,4 +19,9 @@ namespace hemotree {
 void gather_rows(std::span<const double> rows, std::size_t width, const std::vector<std::vector<std::int32_t>>& lists,
                  std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place);
 
+// The same where rank 0 does not know the ranks' lists: each rank's `items` (its list) are
+// gathered first (one MPI_Gatherv more).
+void gather_rows(std::span<const std::int32_t> items, std::span<const double> rows, std::size_t width,
+                 std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place);
+
 }  // namespace hemotree

@@ -19,12 +19,14 @@ std::vector<double> PulseSolver::capacitor_pressures() const {
     if (o.capacitor >= 0) p[static_cast<std::size_t>(o.index)] = state_.capacitor(o.capacitor);
   for (std::size_t k = 0; k < p.size(); ++k)
     if (std::isnan(p[k])) p[k] = lumped_.capacitor_pressure(k);
+  if (make_whole_) make_whole_(p, holds_outlet_);  // over ranks: each outlet's from its rank
   return p;
 }
 
 std::vector<double> PulseSolver::vessel_volumes() const {
   std::vector<double> volume(net_.vessel_count(), 0.0);
   for (std::size_t v = 0; v < volume.size(); ++v) {
+    if (make_whole_ && !steps_vessel_[v]) continue;  // another rank's (below)
     if (zero_d_[v]) {  // half at each node's pressure, as the 0D scheme holds it
       const std::int32_t e = lumped_.vessel_index(v);
       const TubeLaw tube = law(v);
@@ -34,6 +36,7 @@ std::vector<double> PulseSolver::vessel_volumes() const {
     }
     for (auto el = first_element(v), end = end_element(v); el < end; ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
   }
+  if (make_whole_) make_whole_(volume, steps_vessel_);  // over ranks: each vessel's from its rank
   return volume;
 }
 
@@ -69,7 +72,7 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
   if (!tapers_.empty()) {
     element_area_per_pressure.assign(static_cast<std::size_t>(state_.area.rows()), 0.0);
     for (std::size_t v = 0; v < n; ++v) {
-      if (!is_tapered(v)) continue;
+      if (!is_tapered(v) || (make_whole_ && !steps_vessel_[v])) continue;
       double sum = 0;
       if (zero_d_[v]) {
         const std::int32_t e = lumped_.vessel_index(v);
@@ -88,6 +91,7 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
       }
       area_per_pressure[v] = sum;
     }
+    if (make_whole_) make_whole_(area_per_pressure, steps_vessel_);  // the tapered vessels' from their ranks
   }
   // Without RCR outlets no capacitor is balanced: their arrays stay empty (a tree's two
   // million capillary outlets would hold 15 MB of NaN or 0 in each).

@@ -101,6 +101,15 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
   }
 }
 
+std::vector<std::int32_t> LumpedVessels::boundaries() const {
+  std::vector<std::int32_t> out(inflow_boundary_.begin(), inflow_boundary_.end());
+  out.insert(out.end(), held_boundary_.begin(), held_boundary_.end());
+  for (const OutletNode& o : outlet_boundary_) out.push_back(o.boundary);
+  for (const OutletEdge& o : rcr_outlet_boundary_) out.push_back(o.boundary);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 void LumpedVessels::set_entering(std::span<const unsigned char> entering) {
   for (std::size_t j = 0; j < inflow_node_.size(); ++j) inflow_entering_[j] = entering[static_cast<std::size_t>(inflow_boundary_[j])];
   for (std::size_t j = 0; j < held_node_.size(); ++j) held_entering_[j] = entering[static_cast<std::size_t>(held_boundary_[j])];

@@ -103,6 +103,9 @@ class LumpedVessels {
   // (formats/run_boundaries.hpp): predict() takes their values in these orders.
   const std::vector<std::int32_t>& inflow_boundaries() const { return inflow_boundary_; }
   const std::vector<std::int32_t>& held_boundaries() const { return held_boundary_; }
+  // Every boundary of the run's list at its nodes (flows, pressures, outlets), increasing:
+  // over ranks, the boundaries this rank holds.
+  std::vector<std::int32_t> boundaries() const;
   // Per boundary of the run's list: whether its flow counts as "in" (else "out") in
   // complete()'s exchanged volumes. By default a flow by the sign of its mean, a pressure in.
   void set_entering(std::span<const unsigned char> entering);

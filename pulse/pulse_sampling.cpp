@@ -122,6 +122,22 @@ double PulseSolver::network_volume() const {
   return volume;
 }
 
+std::vector<double> PulseSolver::one_d_volumes() const {
+  std::vector<double> terms;
+  if (!one_d_here_) return terms;
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
+    for (auto el = first_element(v), end = end_element(v); el < end; ++el) terms.push_back(2 * half_length_(el) * state_.area(el, 0));
+  return terms;
+}
+
+std::vector<std::int32_t> PulseSolver::held_boundaries() const {
+  std::vector<std::int32_t> held = lumped_.boundaries();
+  for (std::size_t b = 0; b < boundary_slot_.size() && one_d_here_; ++b)
+    if (boundary_slot_[b] >= 0) held.push_back(static_cast<std::int32_t>(b));
+  std::sort(held.begin(), held.end());
+  return held;
+}
+
 void PulseSolver::check_solution() const {
   lumped_.check(time_, net_.id);
   for (Eigen::Index el = 0; el < state_.area.rows(); ++el)

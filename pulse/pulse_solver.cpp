@@ -152,6 +152,15 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
                                      ranks->rank, lumped_sections_);
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_, &cut);
     lumped_.set_link(ranks->link);
+    make_whole_ = ranks->make_whole;
+    steps_vessel_.assign(n, 0);
+    for (std::size_t v = 0; v < n; ++v) {
+      const std::int32_t i = lumped_.vessel_index(v);
+      steps_vessel_[v] = zero_d_[v] ? i >= 0 && !lumped_.ghost_vessel(i) : cut.top();
+    }
+    const RunBoundaries run(net);
+    for (std::size_t i = 0; i < run.size(); ++i)
+      if (run.is_outlet(i)) holds_outlet_.push_back(steps_vessel_[static_cast<std::size_t>(run.outlet(i).vessel)]);
     // A lumen closing on any rank is said on every rank as this rank would say it alone.
     lumped_.set_failure_words([this](std::exception_ptr failure) {
       try {

@@ -128,6 +128,9 @@ struct PulseRanks {
   int ranks = 1, rank = 0, top_rank = 0;
   std::function<std::vector<std::int32_t>(const std::vector<bool>& zero_d)> vessel_ranks;
   LumpedLink link;
+  // values: one per item (vessel, outlet), this rank's right where `mine` is set (each item
+  // is one rank's); after the call, every rank's values are every item's holder's. Collective.
+  std::function<void(std::vector<double>& values, const std::vector<unsigned char>& mine)> make_whole;
 };
 
 class PulseSolver {
@@ -267,6 +270,12 @@ class PulseSolver {
     return slot >= 0 ? state_.boundary(slot) : lumped_boundary_volume_[b];
   }
   Eigen::VectorXd boundary_volumes() const;
+  // The boundaries this rank holds (over ranks: its 0D vessels' and, on the top's rank, the
+  // 1D ends'; alone: every one at a vessel), increasing.
+  std::vector<std::int32_t> held_boundaries() const;
+  // network_volume()'s terms after the 0D vessels' stored volume, in its order: each 1D
+  // element's volume (on a share of a run over ranks: none).
+  std::vector<double> one_d_volumes() const;
   // Throws SolutionBreakdown when A <= 0 or a value is not finite.
   void check_solution() const;
 
@@ -465,6 +474,10 @@ class PulseSolver {
   TimeScheme scheme_;
   int threads_ = 1;
   bool one_d_here_ = true;  // false on a share of a run over ranks (PulseRanks)
+  // Over ranks: PulseRanks::make_whole, and whether this rank steps each vessel and holds each
+  // run outlet's state (the compliance balance's inputs, made whole on every rank).
+  std::function<void(std::vector<double>&, const std::vector<unsigned char>&)> make_whole_;
+  std::vector<unsigned char> steps_vessel_, holds_outlet_;
   double time_ = 0, dt_ = 0;
   std::string dt_reason_;
   double stable_dt_ = 0;

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "core/parallel_errors.hpp"
+#include "solver/cycle_over_ranks.hpp"
 
 namespace hemotree {
 
@@ -25,7 +26,8 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 }
 
 CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, double analysis_frequency)
-    : net_(net), omega_(2 * std::numbers::pi * analysis_frequency), one_d_(solver.one_d_vessels()) {
+    : net_(net), omega_(2 * std::numbers::pi * analysis_frequency),
+      one_d_(solver.holds_one_d() ? solver.one_d_vessels() : std::vector<std::int32_t>()) {
   const std::size_t n = one_d_.size();
   for (auto* sums : {&p_in_, &p_out_, &u_in_, &u_out_}) sums->assign(n, 0.0);
   first_.assign(4 * n, 0.0);
@@ -44,8 +46,10 @@ void CycleStatistics::start_sums() {
 }
 
 void CycleStatistics::begin(const PulseSolver& solver) {
-  boundary_start_ = solver.boundary_volumes();
-  volume_start_ = solver.network_volume();
+  // Over ranks, rank 0's: the whole run's (solver/cycle_over_ranks.hpp).
+  const bool over_ranks = solver.lumped().over_ranks();
+  boundary_start_ = over_ranks ? boundary_volumes_over_ranks(solver) : solver.boundary_volumes();
+  volume_start_ = over_ranks ? network_volume_over_ranks(net_, solver) : solver.network_volume();
 }
 
 void CycleStatistics::sample(const PulseSolver& solver, double t, double weight) {
@@ -110,6 +114,7 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
 void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>& values) {
   // Kept apart from sample(): the first and last samples alone (the drift between them),
   // rather than four more values written per vessel at every sample.
+  if (one_d_.empty()) return;  // (over ranks, a share's)
   for (const int end : {0, 1}) {
     solver.sample_one_d(end, area_end_, q_end_, p_end_);
     for (std::size_t j = 0; j < one_d_.size(); ++j) {
@@ -124,7 +129,9 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   if (sums_.empty()) start_sums();  // no sample since the last close
   // In and out: each boundary's volume, in the boundaries' order, to "in" or "out" as it
   // counts (one sum per item whatever holds it: a run over ranks gathers the same numbers).
-  const Eigen::VectorXd through = solver.boundary_volumes() - boundary_start_;
+  const bool over_ranks = solver.lumped().over_ranks();
+  const Eigen::VectorXd through =
+      (over_ranks ? boundary_volumes_over_ranks(solver) : solver.boundary_volumes()) - boundary_start_;
   Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();
   for (Eigen::Index i = 0; i < through.size(); ++i) {
     summary.boundary_mean_flow.push_back(through(i) / duration_);
@@ -134,7 +141,7 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   summary.inlet_mean_flow = exchanged(0) / duration_;
   summary.outlets_mean_flow = exchanged(1) / duration_;
   summary.inflow_measured = exchanged(0) > 1e-6 * volume_start_;
-  summary.volume_change = solver.network_volume() - volume_start_;
+  summary.volume_change = (over_ranks ? network_volume_over_ranks(net_, solver) : solver.network_volume()) - volume_start_;
   summary.conservation_error =
       (exchanged(0) - exchanged(1) - summary.volume_change) / exchange_scale(exchanged(0), exchanged(1), volume_start_);
   if (duration_ > 0) record_ends(solver, last_);  // the state of the cycle's last sample
@@ -164,6 +171,7 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   }
   std::ranges::sort(summary.waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
   duration_ = 0;
+  if (over_ranks) gather_cycle_vessels(net_, solver, summary);  // rank 0's: every vessel's
   return summary;
 }
 

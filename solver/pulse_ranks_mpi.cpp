@@ -28,6 +28,19 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
   ranks_.link.down = [this](std::span<const double> answers, std::exception_ptr failure) {
     return exchange_->scatter(answers, failure, LumpedLink::down_per_root, "the 0D step");
   };
+  ranks_.make_whole = [](std::vector<double>& values, const std::vector<unsigned char>& mine) {
+    // Every rank's (item, value) pairs to every rank.
+    std::vector<double> pairs;
+    for (std::size_t k = 0; k < values.size(); ++k)
+      if (mine[k]) pairs.insert(pairs.end(), {static_cast<double>(k), values[k]});
+    const int count = static_cast<int>(pairs.size());
+    std::vector<int> counts(static_cast<std::size_t>(world_size())), offsets(counts.size(), 0);
+    MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+    std::vector<double> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+    MPI_Allgatherv(pairs.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+    for (std::size_t j = 0; j < all.size(); j += 2) values[static_cast<std::size_t>(all[j])] = all[j + 1];
+  };
 }
 
 }  // namespace hemotree

@@ -2,7 +2,8 @@
 // the tree partitioned by subtrees, the 1D vessels and every vessel above them moved to the
 // top's rank once the solver has chosen the models (partition/keep_on_top), and each step's
 // messages over MPI (solver/lumped_link_mpi.hpp), their exchange made at the first step from
-// the cut's roots per rank.
+// the cut's roots per rank; per-item numbers made whole on every rank (MPI_Allgatherv of each
+// rank's items and values: the compliance balance's, once a cycle).
 #pragma once
 
 #include <cstddef>

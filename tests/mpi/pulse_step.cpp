@@ -1,8 +1,9 @@
 // Under mpirun (ctest label mpi, 1 to 4 ranks): the pulsatile solver's steps over the ranks
 // (pulse/pulse_solver.hpp's PulseRanks): a grown tree whose larger vessels are 1D, kept with
 // every vessel above them on the top's rank, and whose 0D vessels are cut into whole subtrees;
-// after every step each rank's 0D vessels and, on the top's rank, the 1D vessels' whole state
-// are the one-process solver's bits (which every rank also steps here, alone). Exit 0 when
+// after every step, and after two compliance balances, each rank's 0D vessels and, on the
+// top's rank, the 1D vessels' whole state are the one-process solver's bits (which every rank
+// also steps here, alone). Exit 0 when
 // every rank agrees, 1 otherwise, one line per failure on stderr.
 #include <bit>
 #include <cstdint>
@@ -74,7 +75,15 @@ int main(int argc, char** argv) {
     check(mine.dt() == whole.dt() && mine.substeps() == whole.substeps() && mine.coupling_passes() == whole.coupling_passes(),
           "another step than the whole run's");
     std::size_t differ = 0, compared = 0;
-    for (int n = 0; n < 25; ++n) {
+    // The compliance balance at "cycle ends" (steps 10 and 20: the first marks the volumes, the
+    // second moves every compliance) over ranks too: its inputs made whole on every rank.
+    std::size_t moved = 0;
+    for (int n = 0; n < 30; ++n) {
+      if (n == 10 || n == 20) {
+        const std::size_t a = whole.balance_compliances(whole.period()), b = mine.balance_compliances(mine.period());
+        check(a == b, "the balance moved " + std::to_string(b) + " vessels, the whole run's " + std::to_string(a));
+        moved += a;
+      }
       whole.step();
       mine.step();
       compared = 0;
@@ -96,6 +105,7 @@ int main(int argc, char** argv) {
     MPI_Allreduce(&held, &total, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
     check(total == net.vessel_count(), std::to_string(total) + " vessels held over the ranks, of " + std::to_string(net.vessel_count()));
     check(mine.time() == whole.time(), "another time than the whole run's");
+    check(moved == net.vessel_count(), "the balance moved " + std::to_string(moved) + " vessels");
     if (rank == 0) std::printf("%zu vessels (%zu 1D), %zu steps of %d substeps\n", net.vessel_count(), one_d, mine.steps(), mine.substeps());
   }
   const int failures = rank_checks::all_failures();

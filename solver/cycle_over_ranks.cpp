@@ -1,0 +1,104 @@
+#include "solver/cycle_over_ranks.hpp"
+
+#include <limits>
+#include <vector>
+
+#include <mpi.h>
+
+#include "distributed/gather_rows.hpp"
+#include "mpi/session.hpp"
+#include "pulse/lumped_order.hpp"
+
+namespace hemotree {
+
+namespace {
+
+// Whether this rank steps vessel v: a 0D vessel whose row it holds, or a 1D vessel on the top's rank.
+bool steps(const PulseSolver& solver, std::size_t v) {
+  if (!solver.is_lumped(v)) return solver.holds_one_d();
+  const std::int32_t i = solver.lumped().vessel_index(v);
+  return i >= 0 && !solver.lumped().ghost_vessel(i);
+}
+
+}  // namespace
+
+double network_volume_over_ranks(const Network& net, const PulseSolver& solver) {
+  const LumpedVessels& lumped = solver.lumped();
+  std::vector<std::int32_t> mine;
+  std::vector<double> volume;
+  for (std::size_t n = 0; n < net.node_count(); ++n) {
+    const std::int32_t k = lumped.node_of(static_cast<std::int64_t>(n));
+    if (k < 0 || lumped.ghost_node(k)) continue;
+    mine.push_back(static_cast<std::int32_t>(n));
+    volume.push_back(lumped.stored_volume(k));
+  }
+  std::vector<double> at_node(world_rank() == 0 ? net.node_count() : 0, 0.0);
+  gather_rows(mine, volume, 1, net.node_count(), [&](std::int32_t node, const double* v) { at_node[static_cast<std::size_t>(node)] = *v; });
+  // The top's 1D elements, sent to rank 0 where it is elsewhere.
+  std::vector<double> one_d = solver.one_d_volumes();
+  const int top = solver.holds_one_d() ? world_rank() : -1;
+  int top_rank = -1;
+  MPI_Allreduce(&top, &top_rank, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (top_rank > 0) {
+    int count = static_cast<int>(one_d.size());
+    if (world_rank() == top_rank) {
+      MPI_Send(&count, 1, MPI_INT, 0, 11, MPI_COMM_WORLD);
+      MPI_Send(one_d.data(), count, MPI_DOUBLE, 0, 12, MPI_COMM_WORLD);
+    } else if (world_rank() == 0) {
+      MPI_Recv(&count, 1, MPI_INT, top_rank, 11, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      one_d.resize(static_cast<std::size_t>(count));
+      MPI_Recv(one_d.data(), count, MPI_DOUBLE, top_rank, 12, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    }
+  }
+  if (world_rank() != 0) return std::numeric_limits<double>::quiet_NaN();
+  // The one-process sum: the 0D vessels' nodes by first appearance in the network's order of
+  // the 0D vessels (LumpedVessels::stored_volume), then the 1D elements.
+  std::vector<std::int32_t> zero_d;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (solver.is_lumped(v)) zero_d.push_back(static_cast<std::int32_t>(v));
+  double total = 0;
+  for (const std::int32_t node : nodes_by_first_appearance(zero_d, net.from, net.to, net.node_count()))
+    total += at_node[static_cast<std::size_t>(node)];
+  for (const double v : one_d) total += v;
+  return total;
+}
+
+Eigen::VectorXd boundary_volumes_over_ranks(const PulseSolver& solver) {
+  const std::vector<std::int32_t> mine = solver.held_boundaries();
+  const Eigen::VectorXd here = solver.boundary_volumes();
+  std::vector<double> rows;
+  for (const std::int32_t b : mine) rows.push_back(here(b));
+  const std::size_t count = solver.boundary_list().size();
+  Eigen::VectorXd all = Eigen::VectorXd::Zero(world_rank() == 0 ? static_cast<Eigen::Index>(count) : 0);
+  gather_rows(mine, rows, 1, count, [&](std::int32_t b, const double* v) { all(b) = *v; });
+  return all;
+}
+
+void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary) {
+  constexpr std::size_t width = 10;  // VesselCycle's eight numbers, the two wave speeds
+  std::vector<std::int32_t> mine;
+  std::vector<double> rows;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    if (!steps(solver, v)) continue;
+    const VesselCycle& c = summary.vessels[v];
+    const WaveSpeeds w = summary.wave_speeds(v);
+    mine.push_back(static_cast<std::int32_t>(v));
+    rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
+                             c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
+  }
+  std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
+  std::vector<VesselCycle> vessels(world_rank() == 0 ? net.vessel_count() : 0);
+  std::vector<WaveSpeeds> speeds(vessels.size());
+  gather_rows(mine, rows, width, net.vessel_count(), [&](std::int32_t v, const double* f) {
+    vessels[static_cast<std::size_t>(v)] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
+    speeds[static_cast<std::size_t>(v)] = {f[8], f[9]};
+  });
+  if (world_rank() != 0) return;
+  summary.vessels = std::move(vessels);
+  // Every 1D vessel's wave speeds (CycleSummary::waves), in the vessels' order.
+  summary.waves.clear();
+  for (std::size_t v = 0; v < speeds.size(); ++v)
+    if (!solver.is_lumped(v)) summary.waves.emplace_back(v, speeds[v]);
+}
+
+}  // namespace hemotree
