@@ -3,8 +3,9 @@
 // the top's rank, one gather and one scatter a 0D step. Run under mpirun; rank 0 prints the
 // set-up's and the steps' seconds, the exchanges of rank 0 and of the top's rank (collective
 // calls, bytes, seconds inside them, waiting for the slowest rank included), each rank's peak
-// resident memory, and a fingerprint of every vessel's flow and pressure at its centre after
-// the last step, in the vessels' order: the same for any number of ranks where the bits are.
+// resident memory, a fingerprint of every vessel's flow and pressure at its centre after the
+// last step, in the vessels' order, and one of the steps' statistics as a run takes them (500
+// samples, gathered on rank 0 at the close): the same for any number of ranks where the bits are.
 //
 // usage: mpirun -np P build/bench/pulse_over_ranks NETWORK [STEPS] [THREADS]
 //        NETWORK a tree fed into outlets (vgen | vprune's); STEPS default (or 0): one cycle;
@@ -12,6 +13,7 @@
 //        vessel (--lumped-sections 1), the steady start.
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cstdint>
@@ -26,6 +28,7 @@
 #include "formats/network_io.hpp"
 #include "mpi/session.hpp"
 #include "pulse/pulse_solver.hpp"
+#include "solver/cycle_statistics.hpp"
 #include "solver/pulse_ranks_mpi.hpp"
 
 using namespace hemotree;
@@ -61,14 +64,27 @@ int main(int argc, char** argv) {
   std::size_t one_d = 0;
   for (std::size_t v = 0; v < net.vessel_count(); ++v) one_d += solver.is_lumped(v) ? 0 : 1;
   const std::size_t top_vessels = over_ranks.top_vessels();
-  const RootExchange* exchange = over_ranks.exchange();
   const long asked = argc > 2 ? std::atol(argv[2]) : 0;
   const std::size_t steps = asked > 0 ? static_cast<std::size_t>(asked)
                                       : static_cast<std::size_t>(std::llround(solver.period() / solver.dt()));
+  // The cycle's statistics as a run samples them (solver/pulsatile_run.cpp: 500 samples a
+  // cycle with 0D vessels), gathered on rank 0 at the close.
+  CycleStatistics stats(net, solver, 1 / solver.period());
+  const auto stats_every = std::max<std::size_t>(1, static_cast<std::size_t>(static_cast<double>(steps) / 500));
   const auto stepping = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < steps; ++k) solver.step();
+  stats.begin(solver);
+  double sampled_until = solver.time();
+  for (std::size_t k = 0; k < steps; ++k) {
+    solver.step();
+    if ((k + 1) % stats_every == 0 || k + 1 == steps) {
+      stats.sample(solver, solver.time(), solver.time() - sampled_until);
+      sampled_until = solver.time();
+    }
+  }
+  const CycleSummary cycle = stats.close(solver);
   MPI_Barrier(MPI_COMM_WORLD);
   const double stepped = seconds_since(stepping);
+  const RootExchange* exchange = over_ranks.exchange();  // made at the first step
 
   // Each vessel's centre flow and pressure from the rank that steps it, in the vessels' order.
   std::vector<double> mine;
@@ -126,6 +142,19 @@ int main(int argc, char** argv) {
     for (const long kb : peaks) std::printf(" %.0f MiB", static_cast<double>(kb) / 1024);
     std::printf("\n  fingerprint of the vessels' centre flows and pressures: %016llx%s\n",
                 static_cast<unsigned long long>(hash), missing ? " (vessels missing or twice!)" : "");
+    std::uint64_t cycle_hash = 1469598103934665603ull;  // the statistics: every vessel's, then the totals
+    auto add = [&](double x) {
+      std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
+      for (int b = 0; b < 8; ++b, bits >>= 8) cycle_hash = (cycle_hash ^ (bits & 0xff)) * 1099511628211ull;
+    };
+    for (const VesselCycle& c : cycle.vessels)
+      for (const double x : {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
+                             c.least_flow, c.mean_wss, c.reynolds})
+        add(x);
+    for (const auto& [v, w] : cycle.waves) add(w.pressure), add(w.velocity);
+    for (const double x : {cycle.inlet_mean_flow, cycle.outlets_mean_flow, cycle.volume_change, cycle.conservation_error}) add(x);
+    std::printf("  the cycle's statistics: in %.6g ml/min, mass balance %.3g; fingerprint %016llx\n",
+                cycle.inlet_mean_flow * 6e7, cycle.conservation_error, static_cast<unsigned long long>(cycle_hash));
   }
   return 0;
 }
