@@ -89,9 +89,7 @@ int main(int argc, char** argv) {
   // Each vessel's centre flow and pressure from the rank that steps it, in the vessels' order.
   std::vector<double> mine;
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    const std::int32_t i = solver.lumped().vessel_index(v);
-    const bool here = solver.is_lumped(v) ? i >= 0 && !solver.lumped().ghost_vessel(i) : solver.holds_one_d();
-    if (here) mine.insert(mine.end(), {static_cast<double>(v), solver.flow_at(v, 0.5), solver.pressure_at(v, 0.5)});
+    if (solver.steps_vessel(v)) mine.insert(mine.end(), {static_cast<double>(v), solver.flow_at(v, 0.5), solver.pressure_at(v, 0.5)});
   }
   int count = static_cast<int>(mine.size());
   std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(counts.size(), 0);

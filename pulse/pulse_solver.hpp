@@ -243,8 +243,10 @@ class PulseSolver {
   // The 1D vessels (indices), in the order of their elements.
   const std::vector<std::int32_t>& one_d_vessels() const { return one_d_vessels_; }
   int threads() const { return threads_; }
-  // Whether this rank steps the 1D vessels (a run over ranks: the top's rank; else always).
+  // Whether this rank steps the 1D vessels (a run over ranks: the top's rank; else always),
+  // and a vessel (over ranks: its own 0D vessels, not the top's ghosts, and there the 1D ones).
   bool holds_one_d() const { return one_d_here_; }
+  bool steps_vessel(std::size_t vessel) const { return steps_vessel_.empty() || steps_vessel_[vessel]; }
 
   // A vessel's tube law: at its `from` end (the whole vessel's unless it tapers), at one of
   // its ends, and at fraction x along it.

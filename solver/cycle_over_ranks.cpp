@@ -11,17 +11,6 @@
 
 namespace hemotree {
 
-namespace {
-
-// Whether this rank steps vessel v: a 0D vessel whose row it holds, or a 1D vessel on the top's rank.
-bool steps(const PulseSolver& solver, std::size_t v) {
-  if (!solver.is_lumped(v)) return solver.holds_one_d();
-  const std::int32_t i = solver.lumped().vessel_index(v);
-  return i >= 0 && !solver.lumped().ghost_vessel(i);
-}
-
-}  // namespace
-
 double network_volume_over_ranks(const Network& net, const PulseSolver& solver) {
   const LumpedVessels& lumped = solver.lumped();
   std::vector<std::int32_t> mine;
@@ -79,7 +68,7 @@ void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSu
   std::vector<std::int32_t> mine;
   std::vector<double> rows;
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    if (!steps(solver, v)) continue;
+    if (!solver.steps_vessel(v)) continue;
     const VesselCycle& c = summary.vessels[v];
     const WaveSpeeds w = summary.wave_speeds(v);
     mine.push_back(static_cast<std::int32_t>(v));
