@@ -2,7 +2,8 @@
 // (solver/cycle_over_ranks.hpp): each rank samples the vessels it steps; at the cycle's close
 // rank 0 holds every vessel's results, the 1D vessels' wave speeds, every boundary's mean
 // flow, the in- and outflow, the volume change and the mass balance with the bits of the
-// one-process run's statistics (which every rank also takes here, alone). Exit 0 when every
+// one-process run's statistics (which every rank also takes here, alone); and the probes,
+// each sampled by the rank that steps its vessel, give rank 0 the one-process probes.csv rows. Exit 0 when every
 // rank agrees, 1 otherwise, one line per failure on stderr.
 #include <bit>
 #include <cstdint>
@@ -19,6 +20,7 @@
 #include "pulse/pulse_solver.hpp"
 #include "rank_checks.hpp"
 #include "solver/cycle_statistics.hpp"
+#include "solver/probes_over_ranks.hpp"
 #include "solver/pulse_ranks_mpi.hpp"
 
 using namespace hemotree;
@@ -67,12 +69,26 @@ int main(int argc, char** argv) {
     CycleStatistics whole_stats(net, whole, frequency), stats(net, mine, frequency);
     whole_stats.begin(whole);
     stats.begin(mine);
+    // Probes too: the root, a 1D vessel's end, 0D vessels deep in the tree, one twice.
+    const std::vector<Probe> probes = {{0, net.id[0], 0.5}, {net.vessel_count() - 1, net.id[net.vessel_count() - 1], 0.25},
+                                       {net.vessel_count() / 2, net.id[net.vessel_count() / 2], 1.0},
+                                       {0, net.id[0], 0.5}, {7, net.id[7], 0.0}};
+    ProbeRecorder whole_probes(probes), gathered(probes);
+    ProbesOverRanks probes_here(probes, mine);
     for (int n = 0; n < 30; ++n) {
       whole.step();
       mine.step();
       whole_stats.sample(whole, whole.time(), whole.dt());
       stats.sample(mine, mine.time(), mine.dt());
+      if (n % 3 == 0) {
+        whole_probes.sample(whole);
+        probes_here.sample(mine);
+      }
     }
+    probes_here.gather_into(gathered);
+    if (rank == 0)
+      check(gathered.rows() == whole_probes.rows() && !gathered.rows().empty(),
+            "the probes' rows differ from the whole run's:\n" + gathered.rows().substr(0, 300) + "\n" + whole_probes.rows().substr(0, 300));
     const CycleSummary a = whole_stats.close(whole), b = stats.close(mine);
     if (rank == 0) {
       std::size_t differ = 0;
