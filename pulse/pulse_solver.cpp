@@ -151,6 +151,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
     const LumpedCut cut = lumped_cut(net, subtree_lumped_order(net, zero_d_), vessel_rank, ranks->ranks, ranks->top_rank,
                                      ranks->rank, lumped_sections_);
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_, &cut);
+    if (ranks->cut_made) ranks->cut_made(cut);
     lumped_.set_link(ranks->link);
     make_whole_ = ranks->make_whole;
     steps_vessel_.assign(n, 0);

@@ -127,6 +127,8 @@ struct PulseState {
 struct PulseRanks {
   int ranks = 1, rank = 0, top_rank = 0;
   std::function<std::vector<std::int32_t>(const std::vector<bool>& zero_d)> vessel_ranks;
+  // Told the cut once it is made (the messages' sizes: LumpedCut::roots), before any step.
+  std::function<void(const LumpedCut& cut)> cut_made;
   LumpedLink link;
   // values: one per item (vessel, outlet), this rank's right where `mine` is set (each item
   // is one rank's); after the call, every rank's values are every item's holder's. Collective.

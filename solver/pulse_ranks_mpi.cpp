@@ -18,9 +18,9 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     for (const std::int32_t v : partition_.top) rank[static_cast<std::size_t>(v)] = partition_.top_rank;
     top_vessels_ = 0;
     for (const std::int32_t r : rank) top_vessels_ += r == partition_.top_rank ? 1 : 0;
-    roots_ = lumped_cut(net_, subtree_lumped_order(net_, zero_d), rank, ranks_.ranks, partition_.top_rank, ranks_.rank).roots;
     return rank;
   };
+  ranks_.cut_made = [this](const LumpedCut& cut) { roots_ = cut.roots; };
   ranks_.link.up = [this](std::span<const double> numbers, std::exception_ptr failure, bool& failed) {
     if (!exchange_) exchange_ = std::make_unique<RootExchange>(MPI_COMM_WORLD, ranks_.top_rank, roots_);
     return exchange_->gather(numbers, failure, LumpedLink::up_per_root, failed);
