@@ -108,6 +108,30 @@ struct CutTree {
   LumpedVessels lumped(const LumpedCut* cut = nullptr) const {
     return LumpedVessels(net, laws, viscosity, blood, all, {}, {}, {}, cut);
   }
+  // The tree cut for `ranks` by subtrees, each vessel weighing 1: each vessel's rank, every
+  // rank's cut.
+  struct Cut {
+    int top = 0;
+    std::vector<std::int32_t> rank;
+    std::vector<LumpedCut> cuts;
+  };
+  Cut cut(int ranks) const {
+    const Partition p = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), ranks);
+    Cut c{p.top_rank, vessel_rank(p), {}};
+    for (int r = 0; r < ranks; ++r) c.cuts.push_back(lumped_cut(net, whole_order, c.rank, ranks, c.top, r));
+    return c;
+  }
+  // Every rank's 0D vessels, linked through `played`, started at the given state.
+  std::vector<LumpedVessels> ranks_started(const Cut& c, PlayedLink& played, const std::vector<double>& pressure,
+                                           const std::vector<double>& flow) const {
+    std::vector<LumpedVessels> part;
+    for (std::size_t r = 0; r < c.cuts.size(); ++r) {
+      part.push_back(lumped(&c.cuts[r]));
+      part.back().set_link(played.for_rank(static_cast<int>(r)));
+      part.back().start(pressure, flow);
+    }
+    return part;
+  }
 };
 
 }  // namespace
@@ -152,11 +176,9 @@ TEST(LumpedCut, RanksHoldWholeSubtreesAndTheTopTheirRootsAsGhosts) {
 TEST(LumpedCut, EveryRankStepsToTheWholeRunsBits) {
   const CutTree t;
   for (const int ranks : {2, 3, 5}) {
-    const Partition p = partition_network(t.net, std::vector<double>(t.net.vessel_count(), 1.0), ranks);
-    const std::vector<std::int32_t> rank = t.vessel_rank(p);
-    const int top = p.top_rank;
-    std::vector<LumpedCut> cuts;
-    for (int r = 0; r < ranks; ++r) cuts.push_back(lumped_cut(t.net, t.whole_order, rank, ranks, top, r));
+    const CutTree::Cut c = t.cut(ranks);
+    const std::vector<std::int32_t>& rank = c.rank;
+    const int top = c.top;
     std::vector<double> pressure(t.net.node_count()), flow(t.net.vessel_count(), 0.0);
     for (std::size_t i = 0; i < pressure.size(); ++i) pressure[i] = 4000.0 - 1.3 * static_cast<double>(i % 997);
     // The coupling node: the root vessel's distal node, on the top's rank.
@@ -165,15 +187,9 @@ TEST(LumpedCut, EveryRankStepsToTheWholeRunsBits) {
     LumpedVessels whole = t.lumped();
     whole.start(pressure, flow);
     whole.set_coupling_nodes({whole.node_of(coupled)});
-    std::vector<LumpedVessels> part;
-    PlayedLink played(ranks, top, cuts[0].roots);
-    for (int r = 0; r < ranks; ++r) {
-      part.push_back(t.lumped(&cuts[static_cast<std::size_t>(r)]));
-      LumpedVessels& mine = part.back();
-      mine.set_link(played.for_rank(r));
-      mine.start(pressure, flow);
-      if (r == top) mine.set_coupling_nodes({mine.node_of(coupled)});
-    }
+    PlayedLink played(ranks, top, c.cuts[0].roots);
+    std::vector<LumpedVessels> part = t.ranks_started(c, played, pressure, flow);
+    part[static_cast<std::size_t>(top)].set_coupling_nodes({part[static_cast<std::size_t>(top)].node_of(coupled)});
     const double dt = 2e-4;
     std::vector<double> whole_exchanged(2, 0.0);
     std::size_t compared = 0, differ = 0;
@@ -246,18 +262,10 @@ TEST(LumpedCut, EveryRankStepsToTheWholeRunsBits) {
 TEST(LumpedCut, AStepAbandonedOnTheTopIsRefusedOnEveryRank) {
   const CutTree t;
   const int ranks = 3;
-  const Partition p = partition_network(t.net, std::vector<double>(t.net.vessel_count(), 1.0), ranks);
-  const std::vector<std::int32_t> rank = t.vessel_rank(p);
-  std::vector<LumpedCut> cuts;
-  for (int r = 0; r < ranks; ++r) cuts.push_back(lumped_cut(t.net, t.whole_order, rank, ranks, p.top_rank, r));
-  std::vector<double> pressure(t.net.node_count(), 3000.0), flow(t.net.vessel_count(), 0.0);
-  PlayedLink played(ranks, p.top_rank, cuts[0].roots);
-  std::vector<LumpedVessels> part;
-  for (int r = 0; r < ranks; ++r) {
-    part.push_back(t.lumped(&cuts[static_cast<std::size_t>(r)]));
-    part.back().set_link(played.for_rank(r));
-    part.back().start(pressure, flow);
-  }
+  const CutTree::Cut c = t.cut(ranks);
+  const std::vector<double> pressure(t.net.node_count(), 3000.0), flow(t.net.vessel_count(), 0.0);
+  PlayedLink played(ranks, c.top, c.cuts[0].roots);
+  std::vector<LumpedVessels> part = t.ranks_started(c, played, pressure, flow);
   EXPECT_THROW(part[0].set_passes(2), std::invalid_argument);
   std::vector<int> refused(static_cast<std::size_t>(ranks), 0);
   std::vector<std::thread> threads;
@@ -267,7 +275,7 @@ TEST(LumpedCut, AStepAbandonedOnTheTopIsRefusedOnEveryRank) {
       try {
         double in = 0, out = 0;
         mine.predict(1e-4, {}, std::vector<double>(mine.inflow_boundaries().size(), 1e-10), {});
-        if (r == p.top_rank) mine.abandon_step(std::make_exception_ptr(std::runtime_error("the 1D vessels failed")));
+        if (r == c.top) mine.abandon_step(std::make_exception_ptr(std::runtime_error("the 1D vessels failed")));
         mine.complete({}, in, out);
       } catch (const std::runtime_error&) {
         refused[static_cast<std::size_t>(r)] = 1;
@@ -282,21 +290,17 @@ TEST(LumpedCut, AStepAbandonedOnTheTopIsRefusedOnEveryRank) {
 TEST(LumpedCut, ALumenClosingInAShareIsSaidOnEveryRank) {
   const CutTree t;
   const int ranks = 3;
-  const Partition p = partition_network(t.net, std::vector<double>(t.net.vessel_count(), 1.0), ranks);
-  const std::vector<std::int32_t> rank = t.vessel_rank(p);
-  std::vector<LumpedCut> cuts;
-  for (int r = 0; r < ranks; ++r) cuts.push_back(lumped_cut(t.net, t.whole_order, rank, ranks, p.top_rank, r));
+  const CutTree::Cut c = t.cut(ranks);
+  const std::vector<std::int32_t>& rank = c.rank;
   std::vector<double> pressure(t.net.node_count(), 3000.0), flow(t.net.vessel_count(), 0.0);
   std::size_t leaf = 0;  // an outlet's vessel on a share
   for (const Outlet& o : t.net.outlets)
-    if (rank[static_cast<std::size_t>(o.vessel)] != p.top_rank) leaf = static_cast<std::size_t>(o.vessel);
+    if (rank[static_cast<std::size_t>(o.vessel)] != c.top) leaf = static_cast<std::size_t>(o.vessel);
   pressure[static_cast<std::size_t>(t.net.to[leaf])] = -1e9;
-  PlayedLink played(ranks, p.top_rank, cuts[0].roots);
-  std::vector<LumpedVessels> part;
-  for (int r = 0; r < ranks; ++r) {
-    part.push_back(t.lumped(&cuts[static_cast<std::size_t>(r)]));
-    part.back().set_link(played.for_rank(r));
-    part.back().set_failure_words([](std::exception_ptr failure) {
+  PlayedLink played(ranks, c.top, c.cuts[0].roots);
+  std::vector<LumpedVessels> part = t.ranks_started(c, played, pressure, flow);
+  for (LumpedVessels& mine : part)
+    mine.set_failure_words([](std::exception_ptr failure) {
       try {
         std::rethrow_exception(failure);
       } catch (const LumpedVessels::CollapsedNode& c) {
@@ -305,8 +309,6 @@ TEST(LumpedCut, ALumenClosingInAShareIsSaidOnEveryRank) {
         return failure;
       }
     });
-    part.back().start(pressure, flow);
-  }
   std::vector<std::string> said(static_cast<std::size_t>(ranks));
   std::vector<std::thread> threads;
   for (int r = 0; r < ranks; ++r)

@@ -5,7 +5,6 @@
 // one-process run's statistics (which every rank also takes here, alone); and the probes,
 // each sampled by the rank that steps its vessel, give rank 0 the one-process probes.csv rows. Exit 0 when every
 // rank agrees, 1 otherwise, one line per failure on stderr.
-#include <bit>
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -13,12 +12,9 @@
 
 #include <mpi.h>
 
-#include "generator/growth_rules.hpp"
-#include "generator/tree_growth.hpp"
-#include "pruner/outlet_calibration.hpp"
-#include "pruner/pruning_strategies.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "rank_checks.hpp"
+#include "tree_with_waves.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/probes_over_ranks.hpp"
 #include "solver/pulse_ranks_mpi.hpp"
@@ -27,41 +23,13 @@ using namespace hemotree;
 using rank_checks::check;
 using rank_checks::rank;
 
-namespace {
-
-bool same(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
-
-// As tests/mpi/pulse_step.cpp's: vgen --seed 3 --root-diameter 1mm --min-diameter 50um | vprune --budget all.
-Network tree_with_waves() {
-  GrowthParameters p;
-  p.root_diameter = 1e-3;
-  p.min_diameter = 50e-6;
-  p.seed = 3;
-  Network full = grow_tree(default_rules(), p);
-  full.blood = Blood{};
-  Inlet inlet;
-  inlet.vessel = full.id[0];
-  inlet.waveform.mean = 1.74e-6 / 60;
-  full.inlet = inlet;
-  const KeepMask keep(full.vessel_count(), 1);
-  Network net = extract(full, keep);
-  calibrate_outlets(full, keep, net, OutletParameters{});
-  return net;
-}
-
-}  // namespace
+using test_networks::same_bits;
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  int ranks = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const int ranks = rank_checks::start(&argc, &argv);
   {
-    const Network net = tree_with_waves();
-    SolverOptions options;
-    options.model = ModelChoice::automatic;
-    options.lumped_sections = 1;
-    options.start = StartChoice::steady;
+    const Network net = test_networks::tree_with_waves();
+    const SolverOptions options = test_networks::options_over_ranks();
     PulseSolver whole(net, options);
     MpiPulseRanks over_ranks(net, std::vector<double>(net.vessel_count(), 1.0));
     PulseSolver mine(net, options, &over_ranks.ranks());
@@ -95,26 +63,26 @@ int main(int argc, char** argv) {
       check(b.vessels.size() == a.vessels.size(), "the vessels' results of " + std::to_string(b.vessels.size()) + " vessels");
       for (std::size_t v = 0; v < a.vessels.size() && v < b.vessels.size(); ++v) {
         const VesselCycle &x = a.vessels[v], &y = b.vessels[v];
-        differ += !same(x.mean_flow, y.mean_flow) + !same(x.mean_pressure, y.mean_pressure) +
-                  !same(x.systolic_pressure, y.systolic_pressure) + !same(x.diastolic_pressure, y.diastolic_pressure) +
-                  !same(x.peak_flow, y.peak_flow) + !same(x.least_flow, y.least_flow) + !same(x.mean_wss, y.mean_wss) +
-                  !same(x.reynolds, y.reynolds);
+        differ += !same_bits(x.mean_flow, y.mean_flow) + !same_bits(x.mean_pressure, y.mean_pressure) +
+                  !same_bits(x.systolic_pressure, y.systolic_pressure) + !same_bits(x.diastolic_pressure, y.diastolic_pressure) +
+                  !same_bits(x.peak_flow, y.peak_flow) + !same_bits(x.least_flow, y.least_flow) + !same_bits(x.mean_wss, y.mean_wss) +
+                  !same_bits(x.reynolds, y.reynolds);
       }
       check(differ == 0, std::to_string(differ) + " vessel results differ from the whole run's");
       check(a.waves.size() == b.waves.size() && !a.waves.empty(), "the wave speeds of " + std::to_string(b.waves.size()) + " vessels");
       for (std::size_t k = 0; k < a.waves.size() && k < b.waves.size(); ++k)
-        check(a.waves[k].first == b.waves[k].first && same(a.waves[k].second.pressure, b.waves[k].second.pressure) &&
-                  same(a.waves[k].second.velocity, b.waves[k].second.velocity),
+        check(a.waves[k].first == b.waves[k].first && same_bits(a.waves[k].second.pressure, b.waves[k].second.pressure) &&
+                  same_bits(a.waves[k].second.velocity, b.waves[k].second.velocity),
               "the wave speeds of vessel " + std::to_string(a.waves[k].first));
       check(a.boundary_mean_flow.size() == b.boundary_mean_flow.size(), "the boundaries' mean flows");
       std::size_t flows = 0;
       for (std::size_t k = 0; k < a.boundary_mean_flow.size() && k < b.boundary_mean_flow.size(); ++k)
-        flows += !same(a.boundary_mean_flow[k], b.boundary_mean_flow[k]);
+        flows += !same_bits(a.boundary_mean_flow[k], b.boundary_mean_flow[k]);
       check(flows == 0, std::to_string(flows) + " boundaries' mean flows differ");
-      check(same(a.inlet_mean_flow, b.inlet_mean_flow) && same(a.outlets_mean_flow, b.outlets_mean_flow),
+      check(same_bits(a.inlet_mean_flow, b.inlet_mean_flow) && same_bits(a.outlets_mean_flow, b.outlets_mean_flow),
             "the in- and outflow differ");
-      check(same(a.volume_change, b.volume_change), "the volume change differs");
-      check(same(a.conservation_error, b.conservation_error) && a.inflow_measured == b.inflow_measured,
+      check(same_bits(a.volume_change, b.volume_change), "the volume change differs");
+      check(same_bits(a.conservation_error, b.conservation_error) && a.inflow_measured == b.inflow_measured,
             "the mass balance differs: " + std::to_string(a.conservation_error) + " and " + std::to_string(b.conservation_error));
       check(a.volume_change != 0 && a.inlet_mean_flow > 0, "nothing moved");
     }

@@ -37,10 +37,7 @@ bool same(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::b
 }  // namespace
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  int ranks = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const int ranks = rank_checks::start(&argc, &argv);
   {
     const Network net = test_networks::fed_tree(BoundaryType::rcr, Waveform::constant_value(1e-9 / 60));
     const Blood blood = net.blood.value_or(Blood{});

@@ -5,7 +5,6 @@
 // top's rank, the 1D vessels' whole state are the one-process solver's bits (which every rank
 // also steps here, alone). Exit 0 when
 // every rank agrees, 1 otherwise, one line per failure on stderr.
-#include <bit>
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -13,54 +12,22 @@
 
 #include <mpi.h>
 
-#include "generator/growth_rules.hpp"
-#include "generator/tree_growth.hpp"
-#include "pruner/outlet_calibration.hpp"
-#include "pruner/pruning_strategies.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "rank_checks.hpp"
+#include "tree_with_waves.hpp"
 #include "solver/pulse_ranks_mpi.hpp"
 
 using namespace hemotree;
 using rank_checks::check;
 using rank_checks::rank;
 
-namespace {
-
-bool same(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
-
-// vgen --seed 3 --root-diameter 1mm --min-diameter 50um | vprune --budget all, in code: the
-// paper's half-sine inflow of 1.74 ml/min, outlets calibrated.
-Network tree_with_waves() {
-  GrowthParameters p;
-  p.root_diameter = 1e-3;
-  p.min_diameter = 50e-6;
-  p.seed = 3;
-  Network full = grow_tree(default_rules(), p);
-  full.blood = Blood{};
-  Inlet inlet;
-  inlet.vessel = full.id[0];
-  inlet.waveform.mean = 1.74e-6 / 60;
-  full.inlet = inlet;
-  const KeepMask keep(full.vessel_count(), 1);
-  Network net = extract(full, keep);
-  calibrate_outlets(full, keep, net, OutletParameters{});
-  return net;
-}
-
-}  // namespace
+using test_networks::same_bits;
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  int ranks = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const int ranks = rank_checks::start(&argc, &argv);
   {
-    const Network net = tree_with_waves();
-    SolverOptions options;
-    options.model = ModelChoice::automatic;
-    options.lumped_sections = 1;
-    options.start = StartChoice::steady;
+    const Network net = test_networks::tree_with_waves();
+    const SolverOptions options = test_networks::options_over_ranks();
     PulseSolver whole(net, options);
     std::size_t one_d = 0;
     for (std::size_t v = 0; v < net.vessel_count(); ++v) one_d += whole.is_lumped(v) ? 0 : 1;
@@ -91,7 +58,7 @@ int main(int argc, char** argv) {
         if (!mine.steps_vessel(v)) continue;
         ++compared;
         for (const double x : {0.0, 0.5, 1.0})
-          differ += !same(mine.pressure_at(v, x), whole.pressure_at(v, x)) + !same(mine.flow_at(v, x), whole.flow_at(v, x));
+          differ += !same_bits(mine.pressure_at(v, x), whole.pressure_at(v, x)) + !same_bits(mine.flow_at(v, x), whole.flow_at(v, x));
       }
       if (mine.holds_one_d()) {
         differ += mine.state().area != whole.state().area;

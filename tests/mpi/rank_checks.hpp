@@ -18,6 +18,15 @@ inline void check(bool ok, const std::string& what) {
   std::fprintf(stderr, "rank %d: %s\n", rank, what.c_str());
 }
 
+// MPI started, this process's rank kept for the lines above; returns the number of ranks.
+inline int start(int* argc, char*** argv) {
+  MPI_Init(argc, argv);
+  int ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  return ranks;
+}
+
 inline int all_failures() {
   int total = 0;
   MPI_Allreduce(&failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);

@@ -27,10 +27,7 @@ using rank_checks::check;
 using rank_checks::rank;
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  int ranks = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const int ranks = rank_checks::start(&argc, &argv);
   {
     const Network net = test_networks::grown_tree();
     const std::size_t nodes = net.node_count(), edges = net.vessel_count();
