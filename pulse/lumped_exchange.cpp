@@ -27,9 +27,9 @@ void LumpedVessels::hold_cut(const LumpedCut& cut) {
   if (share_.top) {
     for (const std::int32_t edge : share_.root_edge) {
       const auto e = static_cast<std::size_t>(edge);
-      const std::int32_t u = share_.ghost_node[static_cast<std::size_t>(a_[e])] == 1 ? b_[e] : a_[e];
-      if (share_.ghost_node[static_cast<std::size_t>(u)] == 0) share_.waiting_node.push_back(u);
-      share_.ghost_node[static_cast<std::size_t>(u)] = 2;
+      const std::size_t u = root_upper(e);
+      if (share_.ghost_node[u] == 0) share_.waiting_node.push_back(static_cast<std::int32_t>(u));
+      share_.ghost_node[u] = 2;
     }
     std::sort(share_.waiting_node.begin(), share_.waiting_node.end());
   }
@@ -57,7 +57,7 @@ void LumpedVessels::send_roots(std::exception_ptr failure) {
       message.reserve(LumpedLink::up_per_root * share_.root_edge.size());
       for (const std::int32_t edge : share_.root_edge) {
         const auto e = static_cast<std::size_t>(edge);
-        const auto r = static_cast<std::size_t>(is_ghost_node(static_cast<std::size_t>(a_[e])) ? b_[e] : a_[e]);
+        const std::size_t r = root_lower(e);
         message.insert(message.end(), {conductance_[e], system_.open_root_conductance(r), rhs_[r], history_[e]});
       }
     } catch (...) {
@@ -86,8 +86,7 @@ void LumpedVessels::answer_roots() {
   answers.reserve(LumpedLink::down_per_root * share_.root_edge.size());
   for (const std::int32_t edge : share_.root_edge) {
     const auto e = static_cast<std::size_t>(edge);
-    const bool r_at_a = is_ghost_node(static_cast<std::size_t>(a_[e]));
-    const auto r = static_cast<std::size_t>(r_at_a ? a_[e] : b_[e]), u = static_cast<std::size_t>(r_at_a ? b_[e] : a_[e]);
+    const std::size_t r = root_lower(e), u = root_upper(e);
     answers.insert(answers.end(), {rhs_[r], rhs_[u], pressure_[u]});
   }
   share_.answered = true;
@@ -102,8 +101,7 @@ void LumpedVessels::take_answers() {
   if (empty()) return;
   for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
     const auto e = static_cast<std::size_t>(share_.root_edge[j]);
-    const bool u_at_a = is_ghost_node(static_cast<std::size_t>(a_[e]));
-    const auto u = static_cast<std::size_t>(u_at_a ? a_[e] : b_[e]), r = static_cast<std::size_t>(u_at_a ? b_[e] : a_[e]);
+    const std::size_t u = root_upper(e), r = root_lower(e);
     rhs_[r] = answer[LumpedLink::down_per_root * j];
     rhs_[u] = answer[LumpedLink::down_per_root * j + 1];
     share_.root_row[j] = answer[LumpedLink::down_per_root * j + 2];

@@ -549,10 +549,9 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
   // On the top's rank, each share's root a leaf of its subtree's conductance and right-hand side.
   if (top)
     for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
-      const auto r = static_cast<std::size_t>(b_[static_cast<std::size_t>(share_.root_edge[j])]);
-      const std::size_t below = is_ghost_node(r) ? r : static_cast<std::size_t>(a_[static_cast<std::size_t>(share_.root_edge[j])]);
-      system_shunt[below] = share_.root_row[LumpedLink::up_per_root * j + 1];
-      rhs_[below] = share_.root_row[LumpedLink::up_per_root * j + 2];
+      const std::size_t r = root_lower(static_cast<std::size_t>(share_.root_edge[j]));
+      system_shunt[r] = share_.root_row[LumpedLink::up_per_root * j + 1];
+      rhs_[r] = share_.root_row[LumpedLink::up_per_root * j + 2];
     }
 }
 
@@ -730,8 +729,7 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, double
   previous_flow_.swap(flow_);  // the new flows went where the oldest were
   if (share_.on && !share_.top)  // the top's nodes above the roots: their pressures as the top completed them
     for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
-      const auto e = static_cast<std::size_t>(share_.root_edge[j]);
-      const auto u = static_cast<std::size_t>(is_ghost_node(static_cast<std::size_t>(a_[e])) ? a_[e] : b_[e]);
+      const std::size_t u = root_upper(static_cast<std::size_t>(share_.root_edge[j]));
       pressure_[u] = share_.root_row[j];
       volume_[u] = node_excess(u, pressure_[u]);
     }

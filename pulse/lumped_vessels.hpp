@@ -513,6 +513,10 @@ class LumpedVessels {
   bool waits_for_roots(std::size_t k) const { return !share_.ghost_node.empty() && share_.ghost_node[k] == 2; }
   bool is_ghost_edge(std::size_t e) const { return !share_.ghost_edge.empty() && share_.ghost_edge[e]; }
   void hold_cut(const LumpedCut& cut);  // the constructor's: ghosts and root edges
+  // A root vessel's (edge e's) ends: u, the top's node above it, and r, the share's root below
+  // it. Every node hangs from one before it in the whole run's order, and so in a rank's.
+  std::size_t root_upper(std::size_t e) const { return static_cast<std::size_t>(std::min(a_[e], b_[e])); }
+  std::size_t root_lower(std::size_t e) const { return static_cast<std::size_t>(std::max(a_[e], b_[e])); }
   // A step's messages (pulse/lumped_exchange.cpp): a share's roots up after its forward half
   // (or its failure); the top's taken in before its linearisation (false: a rank failed);
   // the top's answers down after its step; a share's taken in before its backward half.
