@@ -141,41 +141,10 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
     }
   }
 
-  if (ranks) {
-    // This rank's whole subtrees; the 1D vessels and every vessel above them the top's rank's.
-    const std::vector<std::int32_t> vessel_rank = ranks->vessel_ranks(zero_d_);
-    for (std::size_t v = 0; v < n; ++v)
-      if (!zero_d_[v] && vessel_rank[v] != ranks->top_rank)
-        throw std::invalid_argument("PulseSolver: 1D vessel " + std::to_string(net.id[v]) + " on rank " +
-                                    std::to_string(vessel_rank[v]) + ", not the top's");
-    const LumpedCut cut = lumped_cut(net, subtree_lumped_order(net, zero_d_), vessel_rank, ranks->ranks, ranks->top_rank,
-                                     ranks->rank, lumped_sections_);
-    lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_, &cut);
-    if (ranks->cut_made) ranks->cut_made(cut);
-    lumped_.set_link(ranks->link);
-    make_whole_ = ranks->make_whole;
-    steps_vessel_.assign(n, 0);
-    for (std::size_t v = 0; v < n; ++v) {
-      const std::int32_t i = lumped_.vessel_index(v);
-      steps_vessel_[v] = zero_d_[v] ? i >= 0 && !lumped_.ghost_vessel(i) : cut.top();
-    }
-    const RunBoundaries run(net);
-    for (std::size_t i = 0; i < run.size(); ++i)
-      if (run.is_outlet(i)) holds_outlet_.push_back(steps_vessel_[static_cast<std::size_t>(run.outlet(i).vessel)]);
-    // A lumen closing on any rank is said on every rank as this rank would say it alone.
-    lumped_.set_failure_words([this](std::exception_ptr failure) {
-      try {
-        std::rethrow_exception(failure);
-      } catch (const LumpedVessels::CollapsedNode& collapsed) {
-        return std::make_exception_ptr(SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_));
-      } catch (...) {
-        return failure;
-      }
-    });
-    one_d_here_ = cut.top();
-  } else {
+  if (ranks)
+    take_rank_share(*ranks);
+  else
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
-  }
   sectioned_count_ = static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t s) { return s > 1; }));
   std::vector<std::uint8_t>().swap(lumped_sections_);  // a byte a vessel the run no longer reads
   lumped_.set_passes(options.lumped_passes);
@@ -254,6 +223,41 @@ void PulseSolver::orient_pressure_boundaries(const std::optional<SteadyFlow>& st
       if (boundaries_.list.type(i) == BoundaryType::pressure)
         boundaries_.entering[i] = inflow[static_cast<std::size_t>(boundaries_.list.node(i))] >= 0;
   }
+}
+
+void PulseSolver::take_rank_share(const PulseRanks& ranks) {
+  const std::size_t n = net_.vessel_count();
+  // This rank's whole subtrees; the 1D vessels and every vessel above them the top's rank's.
+  const std::vector<std::int32_t> vessel_rank = ranks.vessel_ranks(zero_d_);
+  for (std::size_t v = 0; v < n; ++v)
+    if (!zero_d_[v] && vessel_rank[v] != ranks.top_rank)
+      throw std::invalid_argument("PulseSolver: 1D vessel " + std::to_string(net_.id[v]) + " on rank " +
+                                  std::to_string(vessel_rank[v]) + ", not the top's");
+  const LumpedCut cut = lumped_cut(net_, subtree_lumped_order(net_, zero_d_), vessel_rank, ranks.ranks, ranks.top_rank,
+                                   ranks.rank, lumped_sections_);
+  lumped_ = LumpedVessels(net_, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_, &cut);
+  if (ranks.cut_made) ranks.cut_made(cut);
+  lumped_.set_link(ranks.link);
+  make_whole_ = ranks.make_whole;
+  steps_vessel_.assign(n, 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    const std::int32_t i = lumped_.vessel_index(v);
+    steps_vessel_[v] = zero_d_[v] ? i >= 0 && !lumped_.ghost_vessel(i) : cut.top();
+  }
+  const RunBoundaries run(net_);
+  for (std::size_t i = 0; i < run.size(); ++i)
+    if (run.is_outlet(i)) holds_outlet_.push_back(steps_vessel_[static_cast<std::size_t>(run.outlet(i).vessel)]);
+  // A lumen closing on any rank is said on every rank as this rank would say it alone.
+  lumped_.set_failure_words([this](std::exception_ptr failure) {
+    try {
+      std::rethrow_exception(failure);
+    } catch (const LumpedVessels::CollapsedNode& collapsed) {
+      return std::make_exception_ptr(SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_));
+    } catch (...) {
+      return failure;
+    }
+  });
+  one_d_here_ = cut.top();
 }
 
 void PulseSolver::couple_lumped_ends() {

@@ -352,6 +352,9 @@ class PulseSolver {
   std::optional<SteadyFlow> solve_steady_flow();  // none where the network has none: why kept
   // A pressure boundary counts as "in" or "out" by its steady flow (without one: as built).
   void orient_pressure_boundaries(const std::optional<SteadyFlow>& steady);
+  // Over ranks: this rank's 0D vessels of the cut the caller's partition makes, its link, and
+  // which vessels and outlets it steps.
+  void take_rank_share(const PulseRanks& ranks);
   void couple_lumped_ends();  // the 1D ends at 0D nodes: their nodes, slots, held inflows
   void allocate_state();      // the state's and the point values' storage
   void choose_models(const SolverOptions& options);
