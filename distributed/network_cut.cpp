@@ -11,7 +11,7 @@
 
 namespace hemotree {
 
-TreeCut tree_cut(const Network& net, const Partition& partition) {
+void check_subtree_partition(const Partition& partition) {
   if (partition.method == Partition::Method::metis)
     throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(partition.ranks) +
                                     ": a network with loops is split by METIS, and its distributed solve is not built "
@@ -20,6 +20,10 @@ TreeCut tree_cut(const Network& net, const Partition& partition) {
     throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(partition.ranks) +
                                     ": so many ranks spread the tree's top over them, which the distributed solve does "
                                     "not take yet: fewer (at most about the square root of an eighth of the vessels)");
+}
+
+TreeCut tree_cut(const Network& net, const Partition& partition) {
+  check_subtree_partition(partition);
   std::vector<std::int32_t> owner(partition.rank_of_vessel.begin(), partition.rank_of_vessel.end());
   for (const std::int32_t v : partition.top) owner[static_cast<std::size_t>(v)] = TreeCut::top;
   try {

@@ -18,6 +18,8 @@ namespace hemotree {
 // (METIS's pieces need the distributed sparse solver) or a top spread over the ranks (more
 // ranks than about the square root of an eighth of the vessels).
 TreeCut tree_cut(const Network& net, const Partition& partition);
+// The same refusals alone, of a partition a solve over ranks takes by subtrees.
+void check_subtree_partition(const Partition& partition);
 
 // Every rank computed the partition itself: the same one where every rank runs the same
 // build. Checked (a hash of it, its least and greatest over the ranks: collective), since

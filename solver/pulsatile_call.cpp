@@ -15,9 +15,12 @@
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
 #include "formats/checkpoint_file.hpp"
+#include "mpi/session.hpp"
 #include "pulse/pulse_solver.hpp"
 #include "solver/flow_transport.hpp"
+#include "solver/decisions_over_ranks.hpp"
 #include "solver/output_folder.hpp"
+#include "solver/pulse_ranks_mpi.hpp"
 #include "solver/pulsatile_run.hpp"
 #include "solver/run_estimate.hpp"
 #include "solver/run_identity.hpp"
@@ -104,7 +107,7 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
     degree_list += (degree_list.empty() ? "" : ", ") + std::to_string(count) + " of degree " + std::to_string(p);
   }
   const int planned = config.planned_cycles(), threads = config.solver.threads;
-  const double lumped = static_cast<double>(run.lumped_count()), substeps = run.substeps() * run.coupling_passes();
+  const double lumped = static_cast<double>(run.lumped_vessels_in_run()), substeps = run.substeps() * run.coupling_passes();
   const RunEstimate per_cycle =
       estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), threads, substeps, lumped);
   const RunEstimate whole =
@@ -116,12 +119,12 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
                      "): refused, more than a day. Check that vessel's wall and length and the inlet's "
                      "flow, use fewer " + placeholder("elements") + " or a lower " + placeholder("degree") + ", or " +
                      placeholder("force") + " to run it anyway");
-  d.one_d = net.vessel_count() - run.lumped_count();
+  d.one_d = net.vessel_count() - run.lumped_vessels_in_run();
   const std::size_t sectioned = run.sectioned_count();
-  observer.note(plural(d.one_d, "vessel") + " 1D, " + std::to_string(run.lumped_count()) + " 0D (" +
+  observer.note(plural(d.one_d, "vessel") + " 1D, " + std::to_string(run.lumped_vessels_in_run()) + " 0D (" +
                 in_words(placeholder("model"), config.words) + " " + to_string(config.solver.model) +
                 (sectioned > 0 ? ", " + std::to_string(sectioned) + " of them in pi sections" : std::string()) + ")" +
-                (run.lumped_count() > 0 && d.one_d > 0
+                (run.lumped_vessels_in_run() > 0 && d.one_d > 0
                      ? "; " + std::to_string(run.substeps()) + " 1D substeps of " +
                            format_quantity(run.substep(), "s") + " per step" +
                            (run.coupling_passes() > 1 ? ", taken " + std::to_string(run.coupling_passes()) + " times"
@@ -187,7 +190,7 @@ nlohmann::json run_info(const Network& net, const PulseSolver& run, const RunCon
                          {"elements_per_vessel", options.elements}, {"scheme", to_string(options.scheme)},
                          {"model", to_string(options.model)},
                          {"vessels_1d", d.one_d},
-                         {"vessels_0d", run.lumped_count()},
+                         {"vessels_0d", run.lumped_vessels_in_run()},
                          {"vessels_0d_in_sections", run.sectioned_count()},
                          {"substeps", run.substeps()},
                          {"coupling_passes", run.coupling_passes()},
@@ -280,18 +283,51 @@ void check_pulsatile(const Network& net, const RunConfiguration& config) {
 
 namespace {
 
+// What a pulsatile run over MPI ranks does not take yet (docs/scaling.md, "The pulsatile run
+// over ranks"): each rank holds its share of the state, so a checkpoint of one rank's is not
+// the run's; the cells move in flow order across the ranks; a frame is every vessel's state at
+// once; a settling cycle is a second solver. Refused on every rank alike, before any work.
+void refuse_over_ranks(const RunConfiguration& config) {
+  auto refuse = [](const std::string& setting, const std::string& why, const std::string& value = "") {
+    throw SettingError(setting, placeholder(setting) + value + ": " + why + "; run it as one process (without mpirun)");
+  };
+  if (config.resume || config.checkpoint_every > 0)
+    refuse(config.resume ? "resume" : "checkpoint_every",
+           "a pulsatile run over MPI ranks keeps no checkpoint yet (each rank holds its share of the state)");
+  if (config.frames > 0) refuse("frames", "a pulsatile run over MPI ranks writes no frames yet");
+  if (config.red_cells == RedCells::transport || !config.tracers.empty())
+    refuse(config.tracers.empty() ? "red_cells" : "tracer",
+           "a pulsatile run over MPI ranks carries no red cells or tracers yet (they move in flow order across the ranks)",
+           config.tracers.empty() ? " transport" : "");
+  if (config.until_periodic && config.settling_step > 1)
+    refuse("settling_step", "a pulsatile run over MPI ranks takes no settling cycle yet");
+  if (config.until_periodic && config.settling_degree != SolverOptions::automatic && config.settling_degree > 0)
+    refuse("settling_degree", "a pulsatile run over MPI ranks takes no settling cycle yet");
+}
+
 // given_up: the same network where the caller gave it up (its coordinates may go), else null.
 RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObserver& observer, Network* given_up) {
-  check_configuration(config);
-  check_pulsatile(net, config);
+  // Over MPI ranks (mpirun -np P, P > 1) the tree's 0D vessels are cut into whole subtrees,
+  // the 1D vessels and every vessel above them on the top's rank (solver/pulse_ranks_mpi.hpp);
+  // every decision is agreed (solver/decisions_over_ranks.hpp) and rank 0 alone writes.
+  const bool over_ranks = world_size() > 1;
+  on_every_rank([&] {
+    check_configuration(config);
+    check_pulsatile(net, config);
+    if (over_ranks) refuse_over_ranks(config);
+  });
   // The network's identity (its coordinates included) before anything of it is freed.
   const std::uint64_t network = network_identity(net);
   if (given_up && !config.vtk && config.frames == 0)
     for (std::vector<double>* c : {&given_up->x, &given_up->y, &given_up->z}) std::vector<double>().swap(*c);
   const Waveform driving = driving_waveform(net);
   const double period = driving.period;
-  OutputFolder folder(config.out_dir);
-  Checkpoint checkpoint = checkpoint_to_resume(folder, config);
+  std::optional<OutputFolder> folder;  // rank 0's (over ranks its refusal is every rank's)
+  Checkpoint checkpoint;
+  on_lead_rank([&] {
+    folder.emplace(config.out_dir);
+    checkpoint = checkpoint_to_resume(*folder, config);
+  });
   RunResult result;
   // Interrupted where no cycle has ended (before the time loop, or in a settling cycle):
   // nothing is written, the run just stops.
@@ -302,17 +338,35 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
     result.started = false;
   };
   auto interrupted_before_start = [&] {
-    const int signal = observer.poll_interrupt();
+    const int signal = over_ranks ? interrupt_on_any_rank(observer.poll_interrupt()) : observer.poll_interrupt();
     if (signal != 0) stopped_unstarted(signal, "before the first step");
     return signal != 0;
   };
   if (interrupted_before_start()) return result;
 
   // ---- the discretisation, its step and its cost ---------------------------------------
-  PulseSolver run(net, solver_options(config));  // the steady solve: minutes on the full tree
+  SolverOptions options = solver_options(config);
+  std::optional<MpiPulseRanks> ranks;
+  if (over_ranks) {
+    on_every_rank([&] { ranks.emplace(net, std::vector<double>(net.vessel_count(), 1.0)); });  // a tree's subtrees
+    // One pi section a 0D vessel: a cut runs between vessels (pulse/lumped_cut.hpp).
+    if (options.lumped_sections > 1)
+      observer.note("over " + std::to_string(world_size()) + " MPI ranks every 0D vessel is one pi section (" +
+                    in_words(placeholder("lumped_sections"), config.words) + " 1): a vessel that would need more is 1D");
+    options.lumped_sections = 1;
+  }
+  // The steady solve: minutes on the full tree. Over ranks a refusal of the cut (a rank left
+  // without a vessel) is every rank's alike.
+  std::optional<PulseSolver> solver;
+  on_every_rank([&] { solver.emplace(net, options, ranks ? &ranks->ranks() : nullptr); });
+  PulseSolver& run = *solver;
+  if (ranks)
+    observer.note(describe(ranks->partition()) + "; the top's rank steps " + std::to_string(ranks->top_vessels()) +
+                  " vessels (the 1D ones and every vessel above them, with subtrees of its own)");
   // The settling cycle at a lower 1D degree (solver/settling_cycle.hpp) takes a solver of its
-  // own, built here while the network still has its walls.
-  std::unique_ptr<PulseSolver> settling = checkpoint.bytes.empty() ? low_degree_settling_solver(net, run, config, period) : nullptr;
+  // own, built here while the network still has its walls (not over ranks: refuse_over_ranks).
+  std::unique_ptr<PulseSolver> settling =
+      checkpoint.bytes.empty() && !over_ranks ? low_degree_settling_solver(net, run, config, period) : nullptr;
   // The walls are in the vessels' tube laws now; only a VTK file would write them again.
   if (given_up && !config.vtk && config.frames == 0)
     for (std::vector<double>* wall : {&given_up->wall_thickness, &given_up->youngs_modulus}) std::vector<double>().swap(*wall);
@@ -352,7 +406,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
   // most of the vessels are 0D: the transient it takes cheaply is theirs, and where 1D arteries
   // are the network with a few short 0D segments between them (ADAN56), a longer 0D step saves
   // nothing and broke down (the segments' nodes, tiny compliances between two 1D ends).
-  if (config.until_periodic && config.settling_step > 1 && 2 * run.lumped_count() > net.vessel_count() &&
+  if (config.until_periodic && config.settling_step > 1 && !over_ranks && 2 * run.lumped_vessels_in_run() > net.vessel_count() &&
       config.balance_compliances && run.started_from_steady())
     plan.settling_steps = std::max<std::size_t>(
         1, steps_per_cycle * static_cast<std::size_t>(run.coupling_passes()) / static_cast<std::size_t>(config.settling_step));
@@ -371,24 +425,33 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
                   plural(transport->cell_count(), "cell") + ", a transport step every " +
                   plural(plan.transport_every, "flow step"));
   }
-  PulsatileRun pulsatile(net, run, config.probes, plan, folder.staging(), transport ? &*transport : nullptr);
+  PulsatileRun pulsatile(net, run, config.probes, plan, folder ? folder->staging() : std::filesystem::path(),
+                         transport ? &*transport : nullptr);
   if (settling) pulsatile.settle_with(std::move(settling));
   if (!checkpoint.bytes.empty()) {
     pulsatile.resume(std::move(checkpoint.bytes), checkpoint.source);  // not held through the run
     observer.note("resuming from " + checkpoint.source + " after " + std::to_string(pulsatile.cycles_done()) +
                   " cycles (t = " + format_quantity(run.time(), "s") + ")");
   }
-  folder.open(pulsatile.keeps_frames());  // a resume at the run's end keeps the killed run's last frames
-  if (config.frames > 0) {
-    std::error_code ec;
-    std::filesystem::create_directories(folder.staging() / "frames", ec);
-    if (ec) throw IoError("cannot create " + (folder.staging() / "frames").string() + ": " + ec.message());
-  }
+  on_lead_rank([&] {
+    folder->open(pulsatile.keeps_frames());  // a resume at the run's end keeps the killed run's last frames
+    if (config.frames > 0) {
+      std::error_code ec;
+      std::filesystem::create_directories(folder->staging() / "frames", ec);
+      if (ec) throw IoError("cannot create " + (folder->staging() / "frames").string() + ": " + ec.message());
+    }
+  });
   const auto started = std::chrono::steady_clock::now();
   const RunStatus status = pulsatile.run(observer);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (over_ranks) {
+    // The run's end is every rank's; the results (and what comes of them) are rank 0's,
+    // which has left every collective call: a failure of its writing is its own alone.
+    if (world_rank() != 0) return result;
+    leave_collectives();
+  }
   if (pulsatile.stopped_settling()) {
-    folder.discard();
+    folder->discard();
     stopped_unstarted(pulsatile.signal(), "in the settling cycle");
     return result;
   }
@@ -400,12 +463,14 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
   nlohmann::json info = run_info(net, run, config, d, pulsatile, result.outcome, wall);
   if (!failure.empty()) info["error"] = failure;
   if (status == RunStatus::broken_down) info["error"] = in_words(pulsatile.breakdown(), config.words);
+  result.resumable = !over_ranks;
   if (status == RunStatus::interrupted)
-    info["error"] = "interrupted by " + observer.signal_name(pulsatile.signal()) + "; resume with " +
-                    in_words(placeholder("resume"), config.words) + " " + config.out_dir;
+    info["error"] = "interrupted by " + observer.signal_name(pulsatile.signal()) +
+                    (over_ranks ? "; a run over MPI ranks keeps no checkpoint to resume from yet"
+                                : "; resume with " + in_words(placeholder("resume"), config.words) + " " + config.out_dir);
 
   if (status == RunStatus::too_long) {
-    folder.discard();
+    folder->discard();
     const double cycle = pulsatile.measured_step() * static_cast<double>(steps_per_cycle);
     throw SettingError("force", "one cycle would take about " + describe_duration(cycle) + " (measured over its first steps: " +
                      format_quantity(pulsatile.measured_step(), "s") + " a step, " +
@@ -416,10 +481,10 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
   }
   // Nothing computed, nothing kept: DIR stays as it was.
   if (status == RunStatus::broken_down && last.vessels.empty()) {
-    folder.discard();
+    folder->discard();
     throw_input_error(pulsatile.breakdown());  // its placeholders worded by the catcher
   }
-  const std::filesystem::path dir = folder.staging();
+  const std::filesystem::path dir = folder->staging();
   if (status == RunStatus::interrupted || config.checkpoint_every > 0) pulsatile.write_checkpoint();
   pulsatile.discard_snapshot();
   run.release_lumped_state();  // the time loop is over: on the full tree 1.2 GB less while the report is written
@@ -434,7 +499,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
                   config.results_format);
     if (config.vtk && !last.vessels.empty()) write_results_vtk(dir / "results.vtp", net, results, config.vtk_keep);
   }
-  folder.publish();
+  folder->publish();
 
   result.error = status == RunStatus::broken_down ? in_words(pulsatile.breakdown(), config.words) : failure;
   result.cycles_done = pulsatile.cycles_done();

@@ -7,12 +7,14 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <utility>
 
 #include "core/errors.hpp"
 #include "core/free_memory.hpp"
 #include "core/setting_error.hpp"
 #include "formats/vtk_series.hpp"
+#include "solver/decisions_over_ranks.hpp"
 #include "solver/run_report.hpp"
 #include "pulse/solution_breakdown.hpp"
 
@@ -76,8 +78,16 @@ std::string coupling_advice(const Network& net, const NetworkBoundaries& boundar
 PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<Probe> probes, RunPlan plan,
                            std::filesystem::path folder, FlowTransport* transport)
     : net_(net), solver_(solver), plan_(std::move(plan)), folder_(std::move(folder)),
-      stats_(net, solver, analysis_frequency(driving_waveform(net))), probes_(std::move(probes)), transport_(transport) {
+      stats_(net, solver, analysis_frequency(driving_waveform(net))), probes_(probes), transport_(transport),
+      over_ranks_(solver.lumped().over_ranks()) {
   plan_.transport_every = std::max<std::size_t>(plan_.transport_every, 1);
+  if (over_ranks_) {
+    // What a run over ranks does not take yet (its caller refuses them in words): the
+    // checkpoint's state is a rank's, and the cells move in flow order across the ranks.
+    if (transport_ || plan_.checkpoint_every > 0 || plan_.frames > 0 || plan_.settling_steps > 0)
+      throw std::logic_error("PulsatileRun over ranks: transport, checkpoints, frames or a settling cycle");
+    probes_over_ranks_.emplace(probes, solver);
+  }
   if (!transport_) return;
   // probes.csv: the discharge hematocrit and each tracer's concentration at every probe.
   std::vector<std::string> headers;
@@ -94,6 +104,7 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
 
 void PulsatileRun::begin_snapshot() {
   snapshot_pending_ = false;
+  if (over_ranks_) return;  // a rank's state is not the run's (no checkpoint over ranks yet)
   snapshot_.emplace(pending());
   CheckpointWriter& out = *snapshot_;
   out.section("identity");
@@ -106,6 +117,7 @@ void PulsatileRun::begin_snapshot() {
 }
 
 void PulsatileRun::finish_snapshot() {
+  if (over_ranks_) return;
   CheckpointWriter& out = *snapshot_;
   out.section("run");
   out.put(static_cast<std::uint64_t>(done_));
@@ -130,7 +142,7 @@ void PulsatileRun::finish_snapshot() {
 }
 
 void PulsatileRun::set_aside_last_vessels() {
-  if (last_.vessels.empty()) return;
+  if (last_.vessels.empty() || over_ranks_) return;  // over ranks no snapshot holds them: kept
   std::vector<VesselCycle>().swap(last_.vessels);  // its waves, a few hundred, stay
   std::vector<double>().swap(last_.boundary_mean_flow);
   last_vessels_aside_ = true;
@@ -300,6 +312,7 @@ void PulsatileRun::progress(RunObserver& observer, std::size_t k, double started
 RunStatus PulsatileRun::run(RunObserver& observer) {
   const RunStatus status = run_cycles(observer);
   take_back_last_vessels();  // what the report describes, however the run stopped
+  if (over_ranks_) probes_over_ranks_->gather_into(probes_);  // rank 0's: every probe's rows
   return status;
 }
 
@@ -312,7 +325,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
   // 0D vessels the steps are few (1e-3 of the period) and a sample costs as much as a step
   // (every vessel, three points): every 2e-3 of the period, which moved no pulsatility index
   // of the 1001-vessel network by more than 0.012 % (every 4e-3: 0.13 %).
-  const double samples_per_cycle = solver_.lumped_count() > 0 ? 500 : 1e4;
+  const double samples_per_cycle = solver_.lumped_vessels_in_run() > 0 ? 500 : 1e4;
   const auto stats_every = std::max<std::size_t>(
       1, static_cast<std::size_t>(static_cast<double>(plan_.steps_per_cycle) / samples_per_cycle));
   if (!resumed_) {
@@ -349,7 +362,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
     } else if (plan_.balance_compliances) {
       solver_.balance_compliances(period);  // the first cycle's start
     }
-    probes_.sample(solver_);
+    sample_probes();
     if (transport_) transport_->take_volumes();
     snapshot();
   } else if (!resumed_bytes_.empty()) {
@@ -379,9 +392,11 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
           add_solution_frame(*series, solver_);
           ++frames_written;
         }
-        if (solver_.steps() % plan_.sample_every == 0) probes_.sample(solver_);
+        if (solver_.steps() % plan_.sample_every == 0) sample_probes();
         if (k % 256 == 0) {
-          if ((signal_ = observer.poll_interrupt()) != 0) {
+          signal_ = observer.poll_interrupt();
+          if (over_ranks_) signal_ = interrupt_on_any_rank(signal_);
+          if (signal_ != 0) {
             // Back to the last cycle end: what the summary and the checkpoint describe.
             if (live) observer.clear_live_progress();
             return RunStatus::interrupted;
@@ -389,11 +404,13 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
           if (live) progress(observer, k, started);
         }
         // The cost model's estimate, checked against this machine once the first second or
-        // thousand steps have gone by (a clock reading a step until then).
+        // thousand steps have gone by (a clock reading a step until then). Over ranks at the
+        // same step on every rank, the slowest rank's: every rank stops or none.
         if (measured_step_ == 0) {
           const double elapsed = seconds_since_epoch_start() - started;
-          if (elapsed > 1 || k + 1 >= 1024 || k + 1 == plan_.steps_per_cycle) {
-            measured_step_ = elapsed / static_cast<double>(k + 1);
+          const std::size_t first_steps = std::min<std::size_t>(1024, plan_.steps_per_cycle);
+          if (over_ranks_ ? k + 1 == first_steps : elapsed > 1 || k + 1 >= first_steps) {
+            measured_step_ = (over_ranks_ ? largest_on_ranks(elapsed) : elapsed) / static_cast<double>(k + 1);
             if (plan_.longest_cycle > 0 && measured_step_ * static_cast<double>(plan_.steps_per_cycle) > plan_.longest_cycle) {
               if (live) observer.clear_live_progress();
               return RunStatus::too_long;
@@ -401,7 +418,8 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
           }
         }
       }
-      solver_.check_solution();
+      if (over_ranks_) check_solution_on_every_rank(solver_);
+      else solver_.check_solution();
       // The cycle end (statistics, compliance balance, snapshot) takes no step: on the full
       // tree 0.26 GB of the step's arrays less at what is the run's largest moment.
       solver_.release_step_arrays();
@@ -416,6 +434,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       if (series) series->finish();
       has_previous_ = !previous_mean_pressure_.empty();
       if (has_change()) change_ = cycle_change(previous_mean_pressure_, last_.vessels);
+      if (has_change() && over_ranks_) change_ = lead_change(change_);  // rank 0 alone has the whole cycle
       // The cycle's results go to the snapshot, and from memory (but their mean pressures,
       // which the balance and the next cycle end read) before the balance; the previous
       // cycle's mean pressures have served.
@@ -423,6 +442,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       std::vector<double>().swap(previous_mean_pressure_);
       if (plan_.balance_compliances) {
         std::vector<double> mean_pressure = mean_pressures(last_.vessels);
+        if (over_ranks_) take_lead_values(mean_pressure);
         set_aside_last_vessels();
         if (solver_.balance_compliances(period, std::move(mean_pressure)) > 0) ++balances_;
       } else {

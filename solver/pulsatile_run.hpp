@@ -18,6 +18,7 @@
 #include "solver/cycle_statistics.hpp"
 #include "solver/flow_transport.hpp"
 #include "solver/probes.hpp"
+#include "solver/probes_over_ranks.hpp"
 #include "solver/run_observer.hpp"
 #include "solver/settling_cycle.hpp"
 #include "pulse/pulse_solver.hpp"
@@ -132,6 +133,10 @@ class PulsatileRun {
   void check_run_end(const std::filesystem::path& source) const;
   bool has_last_cycle_frames() const;
   void progress(RunObserver& observer, std::size_t step_in_cycle, double started);
+  void sample_probes() {
+    if (over_ranks_) probes_over_ranks_->sample(solver_);
+    else probes_.sample(solver_);
+  }
 
   const Network& net_;
   PulseSolver& solver_;
@@ -157,6 +162,11 @@ class PulsatileRun {
   FlowTransport* transport_ = nullptr;
   RedCellCycle red_cells_last_;
   double red_cell_change_ = std::numeric_limits<double>::quiet_NaN();
+  // A run over ranks (PulseSolver's PulseRanks): the decisions agreed over the ranks
+  // (solver/decisions_over_ranks.hpp), no snapshot (the last cycle's results held by rank 0),
+  // the probes sampled by their vessels' ranks and gathered into probes_ at the run's end.
+  bool over_ranks_ = false;
+  std::optional<ProbesOverRanks> probes_over_ranks_;
 };
 
 }  // namespace hemotree

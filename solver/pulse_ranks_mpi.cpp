@@ -1,5 +1,6 @@
 #include "solver/pulse_ranks_mpi.hpp"
 
+#include "distributed/network_cut.hpp"
 #include "mpi/session.hpp"
 #include "pulse/lumped_cut.hpp"
 
@@ -7,6 +8,8 @@ namespace hemotree {
 
 MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     : net_(net), cost_(std::move(cost)), partition_(partition_network(net, cost_, world_size())) {
+  check_subtree_partition(partition_);
+  check_one_partition(partition_);
   ranks_.ranks = world_size();
   ranks_.rank = world_rank();
   ranks_.top_rank = partition_.top_rank;

@@ -21,7 +21,8 @@ namespace hemotree {
 class MpiPulseRanks {
  public:
   // Over MPI_COMM_WORLD's ranks; cost: per vessel, its weight in the partition. The network
-  // must outlive this.
+  // must outlive this. SettingError "ranks" (every rank alike) for a network with loops or a
+  // top spread over the ranks (distributed/network_cut.hpp's check_subtree_partition).
   MpiPulseRanks(const Network& net, std::vector<double> cost);
   MpiPulseRanks(const MpiPulseRanks&) = delete;  // the link refers to this
   MpiPulseRanks& operator=(const MpiPulseRanks&) = delete;

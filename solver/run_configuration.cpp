@@ -193,7 +193,7 @@ TimeStepDecision decide_time_step(PulseSolver& solver, const RunConfiguration& c
   if (asked > 0 && asked > solver.stable_dt() * (1 + 1e-9))
     beyond_limit = placeholder("dt") + " " + format_quantity(asked, "s") + " is " +
                    format_rounded(asked / solver.stable_dt()) + " times the " +
-                   (solver.lumped_count() > 0 ? "0D step's accuracy limit " : "stability limit ") +
+                   (solver.lumped_vessels_in_run() > 0 ? "0D step's accuracy limit " : "stability limit ") +
                    format_quantity(solver.stable_dt(), "s") + " (" + solver.stable_dt_reason() + ")";
   if (!beyond_limit.empty() && !config.force)
     throw SettingError("dt", beyond_limit + "; the solution would blow up or be wrong: use a " + placeholder("dt") +

@@ -49,7 +49,7 @@ double estimated_cycle(const Network& net, const PulseSolver& solver, double per
   for (std::size_t v = 0; v < net.vessel_count(); ++v)
     if (!solver.is_lumped(v)) elements_of_degree[static_cast<std::size_t>(solver.degree(v))] += solver.elements_per_vessel();
   return estimate_run(elements_of_degree, std::ceil(period / solver.dt()), 1, solver.substeps() * solver.coupling_passes(),
-                      static_cast<double>(solver.lumped_count()))
+                      static_cast<double>(solver.lumped_vessels_in_run()))
       .seconds;
 }
 
@@ -65,9 +65,9 @@ std::unique_ptr<PulseSolver> low_degree_settling_solver(const Network& net, cons
   const bool automatic = config.settling_degree == SolverOptions::automatic;
   const int degree = automatic ? 2 : config.settling_degree;
   if (!(config.until_periodic && degree > 0 && config.balance_compliances && run.started_from_steady() &&
-        run.lumped_count() < net.vessel_count() && degree < run.max_degree()))
+        run.lumped_vessels_in_run() < net.vessel_count() && degree < run.max_degree()))
     return nullptr;
-  if (automatic && 2 * run.lumped_count() >= net.vessel_count()) return nullptr;
+  if (automatic && 2 * run.lumped_vessels_in_run() >= net.vessel_count()) return nullptr;
   SolverOptions options = solver_options(config);
   options.dt = 0;  // its own stable step
   if (options.degree != SolverOptions::automatic) options.degree = std::min(options.degree, degree);

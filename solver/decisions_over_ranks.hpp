@@ -1,0 +1,30 @@
+// What the ranks of a pulsatile run over ranks decide together (docs/scaling.md, "The
+// pulsatile run over ranks"): each rank meets its own interrupts, clock and failures, and the
+// whole cycle's results are rank 0's alone; every decision the time loop takes on them (stop,
+// go on, balance, break down) must be every rank's at the same step, or a rank would be left
+// waiting in the next exchange. Each call is collective over MPI_COMM_WORLD: every rank makes
+// it at the same point of the run.
+#pragma once
+
+#include <vector>
+
+#include "pulse/pulse_solver.hpp"
+#include "solver/cycle_statistics.hpp"
+
+namespace hemotree {
+
+// The largest signal any rank was asked to stop by (0: none): an interrupt on one rank stops
+// every rank.
+int interrupt_on_any_rank(int signal);
+// The largest over the ranks: the slowest rank's seconds.
+double largest_on_ranks(double value);
+// Rank 0's values (any length) on every rank: the last cycle's mean pressures, which the
+// compliance balance takes whole and only rank 0 holds.
+void take_lead_values(std::vector<double>& values);
+// Rank 0's cycle-to-cycle change (of the whole cycle's results, which it alone holds) on every rank.
+PeriodicityChange lead_change(PeriodicityChange change);
+// PulseSolver::check_solution on every rank's vessels: where any fails, SolutionBreakdown on
+// every rank, the lowest failing rank's (its first vessel in the network's order).
+void check_solution_on_every_rank(const PulseSolver& solver);
+
+}  // namespace hemotree
