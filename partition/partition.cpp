@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 #include <sstream>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
@@ -109,6 +110,15 @@ void keep_on_top(const Network& net, std::span<const double> cost, std::span<con
     }
   }
   count_ranks(net, cost, p);
+}
+
+void lead_with_the_top(Partition& p) {
+  if (p.method != Partition::Method::subtrees || p.top_spread || p.top_rank <= 0) return;
+  const std::int32_t top = p.top_rank;
+  for (std::int32_t& r : p.rank_of_vessel) r = r == top ? 0 : r == 0 ? top : r;
+  std::swap(p.cost[0], p.cost[static_cast<std::size_t>(top)]);
+  std::swap(p.vessels[0], p.vessels[static_cast<std::size_t>(top)]);
+  p.top_rank = 0;
 }
 
 std::string describe(const Partition& p) {

@@ -52,6 +52,11 @@ Partition partition_network(const Network& net, std::span<const double> cost, in
 // a spread top have no top to keep). SettingError "ranks" where a rank is left without a vessel.
 void keep_on_top(const Network& net, std::span<const double> cost, std::span<const std::uint8_t> on_top, Partition& p);
 
+// The top's rank made rank 0, the rank that gathers a run's results (ranks 0 and the top's
+// swap their vessels): what a run over ranks that writes the top's state with the results
+// (its checkpoint) takes. The same balance and cut. Nothing to do without a top on one rank.
+void lead_with_the_top(Partition& p);
+
 // Nodes whose vessels lie on more than one rank.
 std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> rank_of_vessel);
 

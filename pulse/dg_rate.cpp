@@ -271,24 +271,15 @@ void PulseSolver::outlet_end_fluxes(const PulseState& s, PulseState& rate) {
 }
 
 void PulseSolver::boundary_exchange(PulseState& rate) const {
-  // The volume fluxes the boundaries exchange, summed in a fixed order (the same bits
-  // whatever the threads); an end's flow is positive along the vessel.
+  // The volume flux in through each boundary at a 1D end; an end's flow is positive along
+  // the vessel.
   auto leaving = [&](const VesselEnd& end) {
     const double q = boundaries_.state_at(end).flow;
     return end.distal ? q : -q;
   };
-  rate.exchanged.setZero();
   for (const auto* given : {&boundaries_.flows, &boundaries_.pressures})
-    for (const auto& g : *given) {
-      const double in = -leaving(g.end);
-      rate.boundary(g.slot) = in;
-      if (boundaries_.entering[static_cast<std::size_t>(g.index)]) rate.exchanged(0) += in;
-      else rate.exchanged(1) -= in;
-    }
-  for (const auto& o : boundaries_.outlets) {
-    rate.exchanged(1) += leaving(o.end);
-    rate.boundary(o.slot) = -leaving(o.end);
-  }
+    for (const auto& g : *given) rate.boundary(g.slot) = -leaving(g.end);
+  for (const auto& o : boundaries_.outlets) rate.boundary(o.slot) = -leaving(o.end);
 }
 
 void PulseSolver::junction_fluxes(double t) {

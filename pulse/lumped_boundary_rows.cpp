@@ -48,13 +48,11 @@ void LumpedVessels::add_boundary_rows(const Network& net, std::span<const TubeLa
     if (bc.type == BoundaryType::flow) {
       inflow_node_.push_back(static_cast<std::int32_t>(at));
       inflow_boundary_.push_back(boundary);
-      inflow_entering_.push_back(bc.waveform.mean_value() >= 0);
       continue;
     }
     if (bc.type == BoundaryType::pressure) {
       held_node_.push_back(static_cast<std::int32_t>(at));
       held_boundary_.push_back(boundary);
-      held_entering_.push_back(1);
       const TubeLaw& law = laws[v];
       held_reference_conductance_.push_back(law.reference_area * law.reference_area /
                                             (friction_k_ * viscosity(law.reference_area) * net.length[v]));
@@ -108,11 +106,6 @@ std::vector<std::int32_t> LumpedVessels::boundaries() const {
   for (const OutletEdge& o : rcr_outlet_boundary_) out.push_back(o.boundary);
   std::sort(out.begin(), out.end());
   return out;
-}
-
-void LumpedVessels::set_entering(std::span<const unsigned char> entering) {
-  for (std::size_t j = 0; j < inflow_node_.size(); ++j) inflow_entering_[j] = entering[static_cast<std::size_t>(inflow_boundary_[j])];
-  for (std::size_t j = 0; j < held_node_.size(); ++j) held_entering_[j] = entering[static_cast<std::size_t>(held_boundary_[j])];
 }
 
 }  // namespace hemotree

@@ -2,6 +2,7 @@
 
 #include <numeric>
 
+#include "formats/run_boundaries.hpp"
 #include "network_flow/nodal_system.hpp"
 
 namespace hemotree {
@@ -120,6 +121,30 @@ LumpedOrder restrict_order(const LumpedOrder& order, const Network& net, const s
   for (const std::int32_t node : order.nodes)
     if (end[static_cast<std::size_t>(node)]) out.nodes.push_back(node);
   return out;
+}
+
+LumpedPlaces lumped_places(const Network& net, const std::vector<bool>& zero_d) {
+  const LumpedOrder order = network_lumped_order(net, zero_d);
+  LumpedPlaces p;
+  p.node.assign(net.node_count(), -1);
+  p.vessel.assign(net.vessel_count(), -1);
+  for (std::size_t k = 0; k < order.nodes.size(); ++k) p.node[static_cast<std::size_t>(order.nodes[k])] = static_cast<std::int32_t>(k);
+  for (std::size_t k = 0; k < order.vessels.size(); ++k) p.vessel[static_cast<std::size_t>(order.vessels[k])] = static_cast<std::int32_t>(k);
+  // LumpedVessels::add_boundary_rows' capacitors: an RCR outlet with a capacitance at a 0D
+  // vessel's node, in the run's list's order.
+  const RunBoundaries boundaries(net);
+  std::int32_t capacitors = 0;
+  for (std::size_t i = 0; i < boundaries.size(); ++i) {
+    if (!boundaries.is_outlet(i)) continue;
+    const Outlet& o = boundaries.outlet(i);
+    const bool capacitor = p.node[static_cast<std::size_t>(boundaries.node(i))] >= 0 && o.type == BoundaryType::rcr && o.c > 0;
+    p.capacitor.push_back(capacitor ? static_cast<std::int32_t>(order.nodes.size()) + capacitors : -1);
+    p.r1_edge.push_back(capacitor ? static_cast<std::int32_t>(order.vessels.size()) + capacitors : -1);
+    capacitors += capacitor ? 1 : 0;
+  }
+  p.nodes = order.nodes.size() + static_cast<std::size_t>(capacitors);
+  p.edges = order.vessels.size() + static_cast<std::size_t>(capacitors);
+  return p;
 }
 
 }  // namespace hemotree

@@ -42,4 +42,19 @@ LumpedOrder subtree_lumped_order(const Network& net, const std::vector<bool>& ze
 // in the whole's order (docs/scaling.md, the plan of the pulsatile run over ranks).
 LumpedOrder restrict_order(const LumpedOrder& order, const Network& net, const std::vector<bool>& keep);
 
+// The places of the 0D state in a checkpoint (LumpedVessels::save), of the whole run with one
+// pi section a vessel: its nodes in the network's order (network_lumped_order), then one
+// capacitor node per RCR outlet at them (in the run's outlet order); its edges, the 0D vessels
+// in the network's order, then the capacitors' R1 edges. What a rank of a run over ranks needs
+// to put its share where the whole run would (every rank computes them alike), so that a
+// checkpoint is the one-process run's, bytes and all, and any rank count resumes it.
+struct LumpedPlaces {
+  std::vector<std::int32_t> node;       // per network node: its place (-1: no 0D vessel's)
+  std::vector<std::int32_t> vessel;     // per network vessel: its edge's place (-1: 1D)
+  std::vector<std::int32_t> capacitor;  // per outlet: its capacitor node's place (-1: none)
+  std::vector<std::int32_t> r1_edge;    // per outlet: its R1 edge's place (-1: none)
+  std::size_t nodes = 0, edges = 0;     // of the whole run
+};
+LumpedPlaces lumped_places(const Network& net, const std::vector<bool>& zero_d);
+
 }  // namespace hemotree

@@ -97,8 +97,8 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   auto fit = [](auto&... arrays) { (arrays.shrink_to_fit(), ...); };
   fit(vessels_, first_edge_, a_, b_, edge_length_, edge_root_slope_, edge_root_intercept_, tapered_,
       shunt_, shunt_pressure_, volume_b_, outlet_boundary_, rcr_outlet_boundary_, outlet_of_capacitor_, capacitor_vessel_edge_,
-      capacitor_edge_sign_, edge_fixed_resistance_, inflow_node_, inflow_boundary_, inflow_entering_,
-      held_node_, held_boundary_, held_entering_, held_reference_conductance_);
+      capacitor_edge_sign_, edge_fixed_resistance_, inflow_node_, inflow_boundary_,
+      held_node_, held_boundary_, held_reference_conductance_);
   share_shunt_pressure();
 
   // Each 0D vessel's volume L A(p) = L (c + d p)^2, d = 1 / beta, half at each of its nodes
@@ -192,7 +192,6 @@ void LumpedVessels::allocate_system() {
     if (listed(e, a_[e])) incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(a_[e])]++)] = edge;
     if (listed(e, b_[e])) incident_edge_[static_cast<std::size_t>(fill[static_cast<std::size_t>(b_[e])]++)] = ~edge;
   }
-  block_outflow_.assign((nodes_ + block - 1) / block, 0.0);
 }
 
 void LumpedVessels::allocate_step_arrays() {
@@ -639,27 +638,25 @@ void LumpedVessels::hold_coupling_pressures() {
     coupling_predicted_[j] = pressure_.empty() ? 0.0 : pressure_[static_cast<std::size_t>(coupling_nodes_[j])];
 }
 
-void LumpedVessels::complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
-                             std::span<double> boundary_volume) {
+void LumpedVessels::complete(std::span<const double> coupled_volume, std::span<double> boundary_volume) {
   if (!share_.on) {
-    complete_step(coupled_volume, exchanged_in, exchanged_out, boundary_volume);
+    complete_step(coupled_volume, boundary_volume);
     return;
   }
   if (!share_.top) {
     take_answers();
-    complete_step(coupled_volume, exchanged_in, exchanged_out, boundary_volume);
+    complete_step(coupled_volume, boundary_volume);
     return;
   }
   try {
-    complete_step(coupled_volume, exchanged_in, exchanged_out, boundary_volume);
+    complete_step(coupled_volume, boundary_volume);
   } catch (...) {
     abandon_step(std::current_exception());
   }
   answer_roots();
 }
 
-void LumpedVessels::complete_step(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
-                                  std::span<double> boundary_volume) {
+void LumpedVessels::complete_step(std::span<const double> coupled_volume, std::span<double> boundary_volume) {
   if (empty()) return;
   const double dt = dt_;
   // The departure of the 1D ends' mean inflows from those held, into the forward half.
@@ -671,7 +668,7 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, double
   const std::vector<double>& p1 = rhs_;  // now the pressures at t1
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_predicted_[j] = p1[static_cast<std::size_t>(coupling_nodes_[j])];
   const auto edges = static_cast<std::int64_t>(a_.size());
-  const auto blocks = static_cast<std::int64_t>(block_outflow_.size());
+  const auto blocks = static_cast<std::int64_t>((nodes_ + block - 1) / block);
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
   {
 #pragma omp for schedule(static)
@@ -683,12 +680,10 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, double
     // it, and from it the volume: exactly what came in, (3 V - 4 V^n + V^(n-1)) / 2 =
     // dt inflow (+ the 1D ends' and the inlet's volumes, below); the pressure from the tube
     // laws. The new values go where the oldest were (the histories swap after), so a
-    // node's row is read and written once. The outlets' outflow is summed per block of
-    // nodes, in one order whatever the threads.
+    // node's row is read and written once.
 #pragma omp for schedule(static)
     for (std::int64_t b = 0; b < blocks; ++b) {
       const std::size_t first = static_cast<std::size_t>(b) * block, last = std::min(first + block, nodes_);
-      double outflow = 0;
       for (std::size_t k = first; k < last; ++k) {
         if (is_ghost_node(k)) {  // its rank's to complete (a share's nodes above it: below)
           previous_volume_[k] = volume_[k];
@@ -696,8 +691,6 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, double
           continue;
         }
         const double shunted = shunt_[k] * p1[k] - shunt_current(k);
-        // A capacitor's R2 is not the network's; a held pressure's flow is counted below.
-        if (k < network_nodes_ && (held_.empty() || !held_[k])) outflow += shunted;
         double inflow = -shunted;
         for_each_incident(k, [&](std::int32_t e) {
           inflow += e >= 0 ? -previous_flow_[static_cast<std::size_t>(e)] : previous_flow_[static_cast<std::size_t>(~e)];
@@ -717,7 +710,6 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, double
         previous_volume_[k] = next;
         previous_pressure_[k] = pressure_from_excess(k, next);
       }
-      block_outflow_[static_cast<std::size_t>(b)] = outflow;
     }
   }
   volume_.swap(previous_volume_);
@@ -736,21 +728,8 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, double
   for (std::size_t e = 0; e < passed_.size(); ++e) passed_[e] += dt * flow_[e];
   update_resistances_and_linearise(dt);
   update_dynamic_pressures();
-  // Across the network's boundary: flows, outlet shunts and the R1 of RCR outlets, held
-  // pressures' shunts; each to "in" or "out" as its boundary counts (set_entering).
-  for (std::size_t j = 0; j < inflow_node_.size(); ++j) {
-    if (inflow_entering_[j]) exchanged_in += dt * inflow_[j];
-    else exchanged_out -= dt * inflow_[j];
-  }
-  double outflow = 0;
-  for (const double b : block_outflow_) outflow += b;
-  for (std::size_t e = vessel_edges_; e < a_.size(); ++e) outflow += flow_[e];
-  exchanged_out += dt * outflow;
-  for (std::size_t j = 0; j < held_node_.size(); ++j) {
-    const double out = held_outflow(j);
-    if (held_entering_[j]) exchanged_in -= dt * out;
-    else exchanged_out += dt * out;
-  }
+  // Across the network's boundary, each boundary's volume: flows, outlet shunts and the R1
+  // of RCR outlets, held pressures' shunts.
   if (boundary_volume.empty()) return;
   for (std::size_t j = 0; j < inflow_node_.size(); ++j)
     boundary_volume[static_cast<std::size_t>(inflow_boundary_[j])] += dt * inflow_[j];
@@ -968,61 +947,6 @@ void LumpedVessels::check(double time, std::span<const std::int64_t> vessel_id) 
         throw SolutionBreakdown(vessel_id[static_cast<std::size_t>(vessels_[i])], time);
     }
   }
-}
-
-// ---- checkpoint ---------------------------------------------------------------------------------
-
-std::vector<std::int32_t> LumpedVessels::network_order_edges() const {
-  std::vector<std::int32_t> place;
-  place.reserve(a_.size());
-  for (const std::int32_t i : index_of_vessel_)
-    if (i >= 0)
-      for (std::size_t e = first_edge(static_cast<std::size_t>(i)); e < first_edge(static_cast<std::size_t>(i) + 1); ++e)
-        place.push_back(static_cast<std::int32_t>(e));
-  for (std::size_t e = vessel_edges_; e < a_.size(); ++e) place.push_back(static_cast<std::int32_t>(e));  // R1 edges
-  return place;
-}
-
-std::vector<std::int32_t> LumpedVessels::network_order_nodes() const {
-  std::vector<std::int32_t> edges = network_order_edges();
-  edges.resize(vessel_edges_);  // the vessels' ends and inner nodes, not the R1 edges'
-  std::vector<std::int32_t> place = nodes_by_first_appearance(edges, a_, b_, nodes_);
-  for (std::size_t k = network_nodes_; k < nodes_; ++k)
-    if (is_capacitor(k)) place.push_back(static_cast<std::int32_t>(k));
-  return place;
-}
-
-void LumpedVessels::save(CheckpointWriter& out) const {
-  // In the network's order (network_order_nodes): the file does not depend on the arrays'.
-  out.section("0D vessels");
-  const std::vector<std::int32_t> nodes = network_order_nodes(), edges = network_order_edges();
-  auto put = [&](const std::vector<double>& values, const std::vector<std::int32_t>& place) {
-    out.begin_vector(values.size());
-    std::vector<double> part(block);
-    for (std::size_t i = 0; i < place.size(); i += block) {
-      const std::size_t n = std::min(block, place.size() - i);
-      for (std::size_t j = 0; j < n; ++j) part[j] = values[static_cast<std::size_t>(place[i + j])];
-      out.put_part(std::span<const double>(part).first(n));
-    }
-  };
-  for (const auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) put(*v, nodes);
-  for (const auto* v : {&flow_, &previous_flow_}) put(*v, edges);
-}
-
-void LumpedVessels::restore(CheckpointReader& in) {
-  in.section("0D vessels");
-  const std::vector<std::int32_t> nodes = network_order_nodes(), edges = network_order_edges();
-  auto get = [&](std::vector<double>& values, const std::vector<std::int32_t>& place) {
-    const std::vector<double> given = in.get_vector();
-    if (given.size() != values.size()) in.fail("0D vessels of another network or model");
-    for (std::size_t i = 0; i < place.size(); ++i) values[static_cast<std::size_t>(place[i])] = given[i];
-  };
-  for (auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) get(*v, nodes);
-  for (auto* v : {&flow_, &previous_flow_}) get(*v, edges);
-  hold_coupling_pressures();
-  // The resistances are functions of the pressures: the same bits as the run had.
-  update_resistances();
-  update_dynamic_pressures();
 }
 
 }  // namespace hemotree

@@ -106,9 +106,6 @@ class LumpedVessels {
   // Every boundary of the run's list at its nodes (flows, pressures, outlets), increasing:
   // over ranks, the boundaries this rank holds.
   std::vector<std::int32_t> boundaries() const;
-  // Per boundary of the run's list: whether its flow counts as "in" (else "out") in
-  // complete()'s exchanged volumes. By default a flow by the sign of its mean, a pressure in.
-  void set_entering(std::span<const unsigned char> entering);
 
 
   // Initial states: every node at the given pressure of its network node (steady: the steady
@@ -155,11 +152,10 @@ class LumpedVessels {
   // (coupled_volume, in set_coupling_nodes' order): the pressures at t1 with the departure
   // from the predicted inflows (the same factorisation: its forward half along the coupling
   // nodes' paths, then one backward half for every node), the flows, then the node volumes
-  // from them and the pressures from the tube laws. Adds what crossed the network's boundary
-  // (flows, pressures, outlets) to exchanged (in, out) [m^3], and, where boundary_volume is
-  // given (per boundary of the run's list), what went in through each.
-  void complete(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
-                std::span<double> boundary_volume = {});
+  // from them and the pressures from the tube laws. Adds, where boundary_volume is given (per
+  // boundary of the run's list), what went in through each boundary at its nodes (flows,
+  // pressures, outlets) [m^3].
+  void complete(std::span<const double> coupled_volume, std::span<double> boundary_volume = {});
   // Frees what a step works in and leaves nothing in for the next (the edges' linearisation,
   // the system's right-hand side and factorisation: about 40 bytes a vessel) until the next
   // predict() makes it again, linearising every edge anew:
@@ -278,6 +274,21 @@ class LumpedVessels {
 
   void save(CheckpointWriter& out) const;
   void restore(CheckpointReader& in);
+  // Over ranks (one pi section a vessel): this rank's part of the checkpoint the whole run
+  // writes, at the places of the whole's order (pulse/lumped_order.hpp's lumped_places): the
+  // places of its own nodes and edges (not its ghosts'), and save()'s six arrays for them
+  // (per node: volume, previous volume, pressure, previous pressure; per edge: flow, previous
+  // flow), each in the places' order.
+  struct StateShare {
+    std::vector<std::int32_t> node_place, edge_place;
+    std::array<std::vector<double>, 6> values;
+  };
+  StateShare state_share(const LumpedPlaces& places) const;
+  // save()'s section from the six arrays whole, in the whole's order: the one-process bytes.
+  static void save_whole(CheckpointWriter& out, const std::array<std::vector<double>, 6>& whole);
+  // restore() of a rank's share: every node and edge it holds (its ghosts too) from its place
+  // in the section the whole run writes.
+  void restore_share(CheckpointReader& in, const LumpedPlaces& places);
 
  private:
   // The arrays are in pulse/lumped_order's subtree order; a checkpoint and the sums over all
@@ -285,6 +296,9 @@ class LumpedVessels {
   // the capacitors, or the R1 edges). O(nodes), built when asked (at cycle ends).
   std::vector<std::int32_t> network_order_nodes() const;
   std::vector<std::int32_t> network_order_edges() const;
+  // Per node, and per edge, of this rank's arrays: its place in the whole run's order.
+  std::vector<std::int32_t> local_node_places(const LumpedPlaces& places) const;
+  std::vector<std::int32_t> local_edge_places(const LumpedPlaces& places) const;
 
  private:
   // The batch of vessels first .. first + n - 1 (arrays' order) at their centres.
@@ -401,9 +415,8 @@ class LumpedVessels {
   std::vector<std::int32_t> first_edge_;       // per 0D vessel and one more (empty: one section each)
   std::size_t vessel_edges_ = 0;               // the 0D vessels' edges (their sections)
   // Boundary flows (currents into their nodes) and held pressures: node, place in
-  // the run's list, whether "in"; a held node's conductance scale (its vessel's at rest).
+  // the run's list; a held node's conductance scale (its vessel's at rest).
   std::vector<std::int32_t> inflow_node_, inflow_boundary_, held_node_, held_boundary_;
-  std::vector<unsigned char> inflow_entering_, held_entering_;
   std::vector<std::int32_t> held_;  // per node: 1 + its place in held_node_, or 0 (empty: none held)
   std::vector<double> inflow_, held_reference_conductance_, held_out_;
   // The outlets by their place in the run's list: a shunt at a node, or an RCR's R1 edge.
@@ -494,8 +507,7 @@ class LumpedVessels {
     }
     for (auto j = incident_offset_[k]; j < incident_offset_[k + 1]; ++j) f(incident_edge_[static_cast<std::size_t>(j)]);
   }
-  static constexpr std::size_t block = 4096;
-  std::vector<double> block_outflow_;  // per block of nodes: the outlets' outflow (a fixed-order sum)
+  static constexpr std::size_t block = 4096;  // nodes a task of the completion; values a piece of a checkpoint
   // A rank's part of a run over ranks (pulse/lumped_cut.hpp; `on` false where the run is whole).
   struct Share {
     bool on = false, top = true;
@@ -530,8 +542,7 @@ class LumpedVessels {
   // The step on this rank's vessels, between the messages (and the whole run's step).
   void predict_step(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
                     std::span<const double> held_pressure);
-  void complete_step(std::span<const double> coupled_volume, double& exchanged_in, double& exchanged_out,
-                     std::span<double> boundary_volume);
+  void complete_step(std::span<const double> coupled_volume, std::span<double> boundary_volume);
   double dt_ = 0;
   int passes_ = 1, threads_ = 1;
 };

@@ -114,6 +114,15 @@ Eigen::VectorXd PulseSolver::boundary_volumes() const {
   return volumes;
 }
 
+Eigen::Vector2d PulseSolver::exchanged_volumes() const {
+  Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();
+  for (std::size_t b = 0; b < lumped_boundary_volume_.size(); ++b) {
+    if (boundaries_.entering[b]) exchanged(0) += boundary_volume(b);
+    else exchanged(1) -= boundary_volume(b);
+  }
+  return exchanged;
+}
+
 double PulseSolver::network_volume() const {
   // The 1D vessels' volumes and what the 0D scheme conserves (lumped_vessels.hpp).
   double volume = lumped_.stored_volume();

@@ -30,7 +30,6 @@ void PulseState::set_zero_like(const PulseState& other) {
   area.setZero(other.area.rows(), other.area.cols());
   flow.setZero(other.flow.rows(), other.flow.cols());
   capacitor.setZero(other.capacitor.size());
-  exchanged.setZero();
   coupled.setZero(other.coupled.size());
   boundary.setZero(other.boundary.size());
   faces.setZero(other.faces.size());
@@ -40,7 +39,6 @@ void PulseState::add_scaled(double factor, const PulseState& other) {
   area += factor * other.area;
   flow += factor * other.flow;
   capacitor += factor * other.capacitor;
-  exchanged += factor * other.exchanged;
   coupled += factor * other.coupled;
   boundary += factor * other.boundary;
   faces += factor * other.faces;
@@ -239,6 +237,7 @@ void PulseSolver::take_rank_share(const PulseRanks& ranks) {
   if (ranks.cut_made) ranks.cut_made(cut);
   lumped_.set_link(ranks.link);
   make_whole_ = ranks.make_whole;
+  lead_whole_ = ranks.lead_whole;
   steps_vessel_.assign(n, 0);
   for (std::size_t v = 0; v < n; ++v) {
     const std::int32_t i = lumped_.vessel_index(v);
@@ -261,7 +260,6 @@ void PulseSolver::take_rank_share(const PulseRanks& ranks) {
 }
 
 void PulseSolver::couple_lumped_ends() {
-  lumped_.set_entering(boundaries_.entering);
   lumped_inflow_.assign(lumped_.inflow_boundaries().size(), 0.0);
   lumped_held_.assign(lumped_.held_boundaries().size(), 0.0);
   if (!one_d_here_) return;  // every coupled end is the top's

@@ -97,15 +97,12 @@ struct SolverOptions {
 };
 
 // The discrete state: modal coefficients of A and Q per element, the pressures of the RCR
-// outlets' capacitors, and the volumes the network has exchanged through its boundaries,
-// integrated by the same scheme as the areas, so that in - out - (change in the vessels'
-// volume) is the scheme's own mass balance (round-off and the junctions' Newton tolerance).
+// outlets' capacitors, and the volumes through the boundaries at 1D ends, integrated by the
+// same scheme as the areas, so that in - out - (change in the vessels' volume) is the scheme's
+// own mass balance (round-off and the junctions' Newton tolerance).
 struct PulseState {
   Eigen::MatrixXd area, flow;  // elements x modes
   Eigen::VectorXd capacitor;   // one per RCR outlet [Pa]
-  // In through the boundaries that count as entering (flows, pressures: NetworkBoundaries::
-  // entering), out through the others and the outlets [m^3].
-  Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();
   Eigen::VectorXd coupled;     // per 1D end at a 0D node: the volume it let into the node [m^3]
   // Per boundary at a 1D end (NetworkBoundaries::one_d_boundary): the volume in through it
   // [m^3]; PulseSolver::boundary_volume gives every boundary's.
@@ -133,6 +130,8 @@ struct PulseRanks {
   // values: one per item (vessel, outlet), this rank's right where `mine` is set (each item
   // is one rank's); after the call, every rank's values are every item's holder's. Collective.
   std::function<void(std::vector<double>& values, const std::vector<unsigned char>& mine)> make_whole;
+  // The same on the top's rank alone (the others' values left as they are): a checkpoint's.
+  std::function<void(std::vector<double>& values, const std::vector<unsigned char>& mine)> lead_whole;
 };
 
 class PulseSolver {
@@ -274,6 +273,9 @@ class PulseSolver {
     return slot >= 0 ? state_.boundary(slot) : lumped_boundary_volume_[b];
   }
   Eigen::VectorXd boundary_volumes() const;
+  // What came in through the boundaries that count as entering (boundary_entering()) and went
+  // out through the others since the start [m^3]: every boundary's volume, in the run's order.
+  Eigen::Vector2d exchanged_volumes() const;
   // The boundaries this rank holds (over ranks: its 0D vessels' and, on the top's rank, the
   // 1D ends'; alone: every one at a vessel), increasing.
   std::vector<std::int32_t> held_boundaries() const;
@@ -305,6 +307,10 @@ class PulseSolver {
   // exactly as the uninterrupted run would. The rest is rebuilt from the network and options.
   void save(CheckpointWriter& out) const;
   void restore(CheckpointReader& in);
+  // Over ranks: the whole run's checkpoint (save()'s bytes, one pi section a vessel), written to
+  // `out` on the top's rank (the lead: PulseRanks), null elsewhere. Collective. restore() reads
+  // it on every rank, for any rank count, one included.
+  void save_over_ranks(CheckpointWriter* out) const;
 
   // To be called at the start of the run and at the end of each cycle (of length period).
   // The slowest part of the approach to the periodic state is the filling of the network's
@@ -483,7 +489,9 @@ class PulseSolver {
   bool one_d_here_ = true;  // false on a share of a run over ranks (PulseRanks)
   // Over ranks: PulseRanks::make_whole, and whether this rank steps each vessel and holds each
   // run outlet's state (the compliance balance's inputs, made whole on every rank).
-  std::function<void(std::vector<double>&, const std::vector<unsigned char>&)> make_whole_;
+  std::function<void(std::vector<double>&, const std::vector<unsigned char>&)> make_whole_, lead_whole_;
+  // save()'s section "pulse solver", with each boundary's 0D volume (whole over ranks).
+  void save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume) const;
   std::vector<unsigned char> steps_vessel_, holds_outlet_;
   double time_ = 0, dt_ = 0;
   std::string dt_reason_;

@@ -1,6 +1,10 @@
 // PulseSolver's state written to a checkpoint and read back bit for bit (formats/checkpoint_file.hpp):
 // what evolves (solution, multistep history, junction guesses, compliance balance marks,
-// viscosity factors, time); the rest is rebuilt from the network and the options.
+// viscosity factors, time); the rest is rebuilt from the network and the options. Over ranks
+// the same bytes, written by the lead rank (the top's) with every rank's share of the 0D
+// vessels and boundaries, and read by each rank for its share.
+#include <array>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -9,6 +13,41 @@
 namespace hemotree {
 
 void PulseSolver::save(CheckpointWriter& out) const {
+  save_section(out, lumped_boundary_volume_);
+  lumped_.save(out);
+}
+
+void PulseSolver::save_over_ranks(CheckpointWriter* out) const {
+  if (out && !one_d_here_) throw std::logic_error("PulseSolver::save_over_ranks: written where the top is not");
+  // Each boundary's volume from the rank that holds it (the others' entries are not theirs).
+  std::vector<double> boundary_volume = lumped_boundary_volume_;
+  std::vector<unsigned char> held(boundary_volume.size(), 0);
+  for (const std::int32_t b : held_boundaries()) held[static_cast<std::size_t>(b)] = 1;
+  lead_whole_(boundary_volume, held);
+  // The 0D state: each node and edge from the rank that holds it, at its place in the whole's.
+  const LumpedPlaces places = lumped_places(net_, zero_d_);
+  LumpedVessels::StateShare share = lumped_.state_share(places);
+  std::array<std::vector<double>, 6> whole;
+  for (std::size_t a = 0; a < whole.size(); ++a) {
+    const bool per_node = a < 4;
+    const std::vector<std::int32_t>& place = per_node ? share.node_place : share.edge_place;
+    std::vector<double>& values = whole[a];
+    values.assign(per_node ? places.nodes : places.edges, 0.0);
+    std::vector<unsigned char> mine(values.size(), 0);
+    for (std::size_t i = 0; i < place.size(); ++i) {
+      values[static_cast<std::size_t>(place[i])] = share.values[a][i];
+      mine[static_cast<std::size_t>(place[i])] = 1;
+    }
+    std::vector<double>().swap(share.values[a]);
+    lead_whole_(values, mine);
+    if (!out) std::vector<double>().swap(values);
+  }
+  if (!out) return;
+  save_section(*out, boundary_volume);
+  LumpedVessels::save_whole(*out, whole);
+}
+
+void PulseSolver::save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume) const {
   out.section("pulse solver");
   out.put(time_);
   out.put(dt_);
@@ -19,14 +58,12 @@ void PulseSolver::save(CheckpointWriter& out) const {
     out.put(s->area);
     out.put(s->flow);
     out.put(s->capacitor);
-    out.put(s->exchanged(0));
-    out.put(s->exchanged(1));
     out.put(s->coupled);
     out.put(s->boundary);
     out.put(s->faces);
   }
   out.put(previous_flow_);
-  out.put(lumped_boundary_volume_);
+  out.put(lumped_boundary_volume);
   out.put(cycle_volume_);
   out.put(cycle_capacitor_);
   // The junctions' Newton iterations start from the last end states: per vessel, proximal
@@ -55,7 +92,6 @@ void PulseSolver::save(CheckpointWriter& out) const {
   }
   out.put(rest);
   out.put(viscosity_factor_);
-  lumped_.save(out);
 }
 
 void PulseSolver::restore(CheckpointReader& in) {
@@ -74,8 +110,6 @@ void PulseSolver::restore(CheckpointReader& in) {
   in.get_into(state_.area, "areas");
   in.get_into(state_.flow, "flows");
   in.get_into(state_.capacitor, "capacitors");
-  state_.exchanged(0) = in.get_double();
-  state_.exchanged(1) = in.get_double();
   in.get_into(state_.coupled, "coupled ends");
   in.get_into(state_.boundary, "boundary volumes");
   state_.faces = in.get_eigen_vector();
@@ -83,8 +117,6 @@ void PulseSolver::restore(CheckpointReader& in) {
   previous_rate_.area = in.get_matrix();
   previous_rate_.flow = in.get_matrix();
   previous_rate_.capacitor = in.get_eigen_vector();
-  previous_rate_.exchanged(0) = in.get_double();
-  previous_rate_.exchanged(1) = in.get_double();
   previous_rate_.coupled = in.get_eigen_vector();
   previous_rate_.boundary = in.get_eigen_vector();
   previous_rate_.faces = in.get_eigen_vector();
@@ -121,7 +153,8 @@ void PulseSolver::restore(CheckpointReader& in) {
   std::vector<double> factors = in.get_vector();
   if (!factors.empty() && factors.size() != net_.vessel_count()) in.fail("viscosity factors of another network");
   set_viscosity_factors(factors);  // before the 0D vessels' resistances are rebuilt
-  lumped_.restore(in);
+  if (lumped_.over_ranks()) lumped_.restore_share(in, lumped_places(net_, zero_d_));
+  else lumped_.restore(in);
 }
 
 }  // namespace hemotree

@@ -200,7 +200,6 @@ void PulseSolver::step_exponential(double h) {
     }
   state_.area += h * (1.5 * rate_.area - 0.5 * previous_rate_.area);
   state_.capacitor += h * (1.5 * rate_.capacitor - 0.5 * previous_rate_.capacitor);
-  state_.exchanged += h * (1.5 * rate_.exchanged - 0.5 * previous_rate_.exchanged);
   state_.coupled += h * (1.5 * rate_.coupled - 0.5 * previous_rate_.coupled);
   state_.boundary += h * (1.5 * rate_.boundary - 0.5 * previous_rate_.boundary);
   state_.faces += h * (1.5 * rate_.faces - 0.5 * previous_rate_.faces);
@@ -257,8 +256,7 @@ void PulseSolver::step_coupled() {
     }
   }
   // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
-  lumped_.complete(coupled_volume_, state_.exchanged(0), state_.exchanged(1),
-                   lumped_boundary_volume_);
+  lumped_.complete(coupled_volume_, lumped_boundary_volume_);
   time_ = t1;
 }
 

@@ -32,6 +32,15 @@ void take_lead_values(std::vector<double>& values) {
     MPI_Bcast(values.data() + at, static_cast<int>(std::min(piece, values.size() - at)), MPI_DOUBLE, 0, MPI_COMM_WORLD);
 }
 
+void take_lead_text(std::string& text) {
+  auto count = static_cast<std::uint64_t>(text.size());
+  MPI_Bcast(&count, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  text.resize(static_cast<std::size_t>(count));
+  constexpr std::size_t piece = std::size_t{1} << 30;
+  for (std::size_t at = 0; at < text.size(); at += piece)
+    MPI_Bcast(text.data() + at, static_cast<int>(std::min(piece, text.size() - at)), MPI_CHAR, 0, MPI_COMM_WORLD);
+}
+
 PeriodicityChange lead_change(PeriodicityChange change) {
   auto vessel = static_cast<std::uint64_t>(change.vessel);
   MPI_Bcast(&change.change, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);

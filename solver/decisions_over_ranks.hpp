@@ -6,6 +6,7 @@
 // it at the same point of the run.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "pulse/pulse_solver.hpp"
@@ -21,6 +22,8 @@ double largest_on_ranks(double value);
 // Rank 0's values (any length) on every rank: the last cycle's mean pressures, which the
 // compliance balance takes whole and only rank 0 holds.
 void take_lead_values(std::vector<double>& values);
+// Rank 0's text (any length: a checkpoint's bytes) on every rank.
+void take_lead_text(std::string& text);
 // Rank 0's cycle-to-cycle change (of the whole cycle's results, which it alone holds) on every rank.
 PeriodicityChange lead_change(PeriodicityChange change);
 // PulseSolver::check_solution on every rank's vessels: where any fails, SolutionBreakdown on

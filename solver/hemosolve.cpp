@@ -360,7 +360,9 @@ int run_command_line(CommandLine& line, int cores) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Solve 1D pulsatile blood flow in a compliant vascular network (spectral/hp "
-               "discontinuous Galerkin) and report flows, pressures and pulsatility.",
+               "discontinuous Galerkin) and report flows, pressures and pulsatility. Under mpirun -np P a "
+               "tree's run is split over P ranks by whole subtrees, its files those of one process "
+               "(docs/scaling.md).",
                "hemosolve"};
   CommandLine line;
   const int cores = omp_get_num_procs();

@@ -24,11 +24,9 @@ std::string outcome_warning(const RunResult& result, const RunConfiguration& con
   if (result.outcome == RunOutcome::interrupted)
     return "interrupted by " + signal_name + " after " + plural(static_cast<std::size_t>(result.cycles_done), "cycle") +
            ": " + out_dir +
-           (!result.resumable ? (result.cycles_done > 0 ? " holds the results of the last whole cycle" : " holds no results") +
-                                    std::string("; a run over MPI ranks keeps no checkpoint to resume from yet")
-            : result.cycles_done > 0 ? " holds the results of the last whole cycle and its checkpoint"
-                                     : " holds the checkpoint of the start (no cycle was completed)") +
-           (result.resumable ? "; " + named("resume") + " " + out_dir + " continues" : std::string());
+           (result.cycles_done > 0 ? " holds the results of the last whole cycle and its checkpoint"
+                                   : " holds the checkpoint of the start (no cycle was completed)") +
+           "; " + named("resume") + " " + out_dir + " continues";
   if (result.outcome == RunOutcome::not_periodic)
     return "not periodic within " + std::to_string(config.max_cycles) + " cycles (" + named("max_cycles") + ")" +
            (result.has_change ? ": the last cycle changed by " + format_rounded(result.change) + " (vessel " +

@@ -20,6 +20,7 @@ class ProbesOverRanks {
   // Collective over MPI_COMM_WORLD: rank 0's recorder (of the run's probes, in their order)
   // gets one row per sample; elsewhere it is left as it is.
   void gather_into(ProbeRecorder& recorder) const;
+  const std::vector<Probe>& probes() const { return probes_; }
 
  private:
   std::vector<Probe> probes_;         // the run's

@@ -284,16 +284,13 @@ void check_pulsatile(const Network& net, const RunConfiguration& config) {
 namespace {
 
 // What a pulsatile run over MPI ranks does not take yet (docs/scaling.md, "The pulsatile run
-// over ranks"): each rank holds its share of the state, so a checkpoint of one rank's is not
-// the run's; the cells move in flow order across the ranks; a frame is every vessel's state at
-// once; a settling cycle is a second solver. Refused on every rank alike, before any work.
+// over ranks"): the cells move in flow order across the ranks; a frame is every vessel's
+// state at once; a settling cycle is a second solver. Refused on every rank alike, before any
+// work.
 void refuse_over_ranks(const RunConfiguration& config) {
   auto refuse = [](const std::string& setting, const std::string& why, const std::string& value = "") {
     throw SettingError(setting, placeholder(setting) + value + ": " + why + "; run it as one process (without mpirun)");
   };
-  if (config.resume || config.checkpoint_every > 0)
-    refuse(config.resume ? "resume" : "checkpoint_every",
-           "a pulsatile run over MPI ranks keeps no checkpoint yet (each rank holds its share of the state)");
   if (config.frames > 0) refuse("frames", "a pulsatile run over MPI ranks writes no frames yet");
   if (config.red_cells == RedCells::transport || !config.tracers.empty())
     refuse(config.tracers.empty() ? "red_cells" : "tracer",
@@ -306,11 +303,16 @@ void refuse_over_ranks(const RunConfiguration& config) {
 }
 
 // given_up: the same network where the caller gave it up (its coordinates may go), else null.
-RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObserver& observer, Network* given_up) {
+RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserver& observer, Network* given_up) {
   // Over MPI ranks (mpirun -np P, P > 1) the tree's 0D vessels are cut into whole subtrees,
-  // the 1D vessels and every vessel above them on the top's rank (solver/pulse_ranks_mpi.hpp);
-  // every decision is agreed (solver/decisions_over_ranks.hpp) and rank 0 alone writes.
+  // the 1D vessels and every vessel above them on the top's rank, rank 0
+  // (solver/pulse_ranks_mpi.hpp); every decision is agreed (solver/decisions_over_ranks.hpp)
+  // and rank 0 alone writes. One pi section a 0D vessel: a cut runs between vessels
+  // (pulse/lumped_cut.hpp); the run is then, and its checkpoint says so, the one-process run
+  // with --lumped-sections 1.
   const bool over_ranks = world_size() > 1;
+  RunConfiguration config = given;
+  if (over_ranks) config.solver.lumped_sections = 1;
   on_every_rank([&] {
     check_configuration(config);
     check_pulsatile(net, config);
@@ -328,6 +330,14 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
     folder.emplace(config.out_dir);
     checkpoint = checkpoint_to_resume(*folder, config);
   });
+  // Over ranks every rank resumes from rank 0's checkpoint, and knows its folder (no rank but
+  // 0 writes there).
+  std::string staging = folder ? folder->staging().string() : std::string();
+  if (over_ranks) {
+    take_lead_text(staging);
+    take_lead_text(checkpoint.bytes);
+    take_lead_text(checkpoint.source);
+  }
   RunResult result;
   // Interrupted where no cycle has ended (before the time loop, or in a settling cycle):
   // nothing is written, the run just stops.
@@ -349,11 +359,9 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
   std::optional<MpiPulseRanks> ranks;
   if (over_ranks) {
     on_every_rank([&] { ranks.emplace(net, std::vector<double>(net.vessel_count(), 1.0)); });  // a tree's subtrees
-    // One pi section a 0D vessel: a cut runs between vessels (pulse/lumped_cut.hpp).
-    if (options.lumped_sections > 1)
+    if (given.solver.lumped_sections > 1)
       observer.note("over " + std::to_string(world_size()) + " MPI ranks every 0D vessel is one pi section (" +
                     in_words(placeholder("lumped_sections"), config.words) + " 1): a vessel that would need more is 1D");
-    options.lumped_sections = 1;
   }
   // The steady solve: minutes on the full tree. Over ranks a refusal of the cut (a rank left
   // without a vessel) is every rank's alike.
@@ -425,11 +433,11 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
                   plural(transport->cell_count(), "cell") + ", a transport step every " +
                   plural(plan.transport_every, "flow step"));
   }
-  PulsatileRun pulsatile(net, run, config.probes, plan, folder ? folder->staging() : std::filesystem::path(),
-                         transport ? &*transport : nullptr);
+  PulsatileRun pulsatile(net, run, config.probes, plan, staging, transport ? &*transport : nullptr);
   if (settling) pulsatile.settle_with(std::move(settling));
   if (!checkpoint.bytes.empty()) {
-    pulsatile.resume(std::move(checkpoint.bytes), checkpoint.source);  // not held through the run
+    // Its refusal (another run's, one at the run's end) is every rank's alike.
+    on_every_rank([&] { pulsatile.resume(std::move(checkpoint.bytes), checkpoint.source); });  // not held through the run
     observer.note("resuming from " + checkpoint.source + " after " + std::to_string(pulsatile.cycles_done()) +
                   " cycles (t = " + format_quantity(run.time(), "s") + ")");
   }
@@ -463,11 +471,9 @@ RunResult pulsatile(const Network& net, const RunConfiguration& config, RunObser
   nlohmann::json info = run_info(net, run, config, d, pulsatile, result.outcome, wall);
   if (!failure.empty()) info["error"] = failure;
   if (status == RunStatus::broken_down) info["error"] = in_words(pulsatile.breakdown(), config.words);
-  result.resumable = !over_ranks;
   if (status == RunStatus::interrupted)
-    info["error"] = "interrupted by " + observer.signal_name(pulsatile.signal()) +
-                    (over_ranks ? "; a run over MPI ranks keeps no checkpoint to resume from yet"
-                                : "; resume with " + in_words(placeholder("resume"), config.words) + " " + config.out_dir);
+    info["error"] = "interrupted by " + observer.signal_name(pulsatile.signal()) + "; resume with " +
+                    in_words(placeholder("resume"), config.words) + " " + config.out_dir;
 
   if (status == RunStatus::too_long) {
     folder->discard();

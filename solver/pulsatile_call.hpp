@@ -19,7 +19,6 @@ struct RunResult {
   RunOutcome outcome = RunOutcome::complete;
   int signal = 0;             // interrupted: the request's signal
   bool started = true;        // false: interrupted before the first step, nothing written
-  bool resumable = true;      // interrupted: a checkpoint kept to resume from (none over MPI ranks yet)
   std::string error;          // broken_down: the breakdown; failed: what is wrong with the results
   int cycles_done = 0;
   // The last cycle-to-cycle change of the mean pressures (after two cycles) and where it is largest.

@@ -14,6 +14,7 @@
 #include "core/free_memory.hpp"
 #include "core/setting_error.hpp"
 #include "formats/vtk_series.hpp"
+#include "mpi/session.hpp"
 #include "solver/decisions_over_ranks.hpp"
 #include "solver/run_report.hpp"
 #include "pulse/solution_breakdown.hpp"
@@ -79,13 +80,14 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
                            std::filesystem::path folder, FlowTransport* transport)
     : net_(net), solver_(solver), plan_(std::move(plan)), folder_(std::move(folder)),
       stats_(net, solver, analysis_frequency(driving_waveform(net))), probes_(probes), transport_(transport),
-      over_ranks_(solver.lumped().over_ranks()) {
+      over_ranks_(solver.lumped().over_ranks()), writes_(!over_ranks_ || world_rank() == 0) {
   plan_.transport_every = std::max<std::size_t>(plan_.transport_every, 1);
   if (over_ranks_) {
-    // What a run over ranks does not take yet (its caller refuses them in words): the
-    // checkpoint's state is a rank's, and the cells move in flow order across the ranks.
-    if (transport_ || plan_.checkpoint_every > 0 || plan_.frames > 0 || plan_.settling_steps > 0)
-      throw std::logic_error("PulsatileRun over ranks: transport, checkpoints, frames or a settling cycle");
+    // What a run over ranks does not take yet (its caller refuses them in words): the cells
+    // move in flow order across the ranks; a frame and a settling cycle are the whole's.
+    if (transport_ || plan_.frames > 0 || plan_.settling_steps > 0)
+      throw std::logic_error("PulsatileRun over ranks: transport, frames or a settling cycle");
+    if (writes_ && !solver.holds_one_d()) throw std::logic_error("PulsatileRun over ranks: rank 0 is not the top's");
     probes_over_ranks_.emplace(probes, solver);
   }
   if (!transport_) return;
@@ -104,7 +106,7 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
 
 void PulsatileRun::begin_snapshot() {
   snapshot_pending_ = false;
-  if (over_ranks_) return;  // a rank's state is not the run's (no checkpoint over ranks yet)
+  if (!writes_) return;  // over ranks rank 0's, which holds the whole cycle's results and the top
   snapshot_.emplace(pending());
   CheckpointWriter& out = *snapshot_;
   out.section("identity");
@@ -117,15 +119,24 @@ void PulsatileRun::begin_snapshot() {
 }
 
 void PulsatileRun::finish_snapshot() {
-  if (over_ranks_) return;
+  if (over_ranks_) {
+    // Every rank's share of the probes and of the solver's state, to rank 0's file: the
+    // bytes the one-process run writes (the probes' rows so far, after any resumed).
+    ProbeRecorder probes(probes_over_ranks_->probes());
+    probes.restore_rows(probes_.rows());
+    probes_over_ranks_->gather_into(probes);
+    if (writes_) {
+      put_run_progress(*snapshot_, probes.rows());
+      solver_.save_over_ranks(&*snapshot_);
+    } else {
+      solver_.save_over_ranks(nullptr);
+      return;
+    }
+  } else {
+    put_run_progress(*snapshot_, probes_.rows());
+    solver_.save(*snapshot_);
+  }
   CheckpointWriter& out = *snapshot_;
-  out.section("run");
-  out.put(static_cast<std::uint64_t>(done_));
-  out.put(static_cast<std::uint64_t>(balances_));
-  out.put(change_.change);
-  out.put(static_cast<std::uint64_t>(change_.vessel));
-  out.put(probes_.rows());
-  solver_.save(out);
   if (transport_) {
     transport_->save(out);
     out.put(red_cells_last_.discharge);
@@ -139,6 +150,15 @@ void PulsatileRun::finish_snapshot() {
   out.finish();
   snapshot_.reset();
   snapshot_pending_ = true;
+}
+
+void PulsatileRun::put_run_progress(CheckpointWriter& out, const std::string& probe_rows) const {
+  out.section("run");
+  out.put(static_cast<std::uint64_t>(done_));
+  out.put(static_cast<std::uint64_t>(balances_));
+  out.put(change_.change);
+  out.put(static_cast<std::uint64_t>(change_.vessel));
+  out.put(probe_rows);
 }
 
 void PulsatileRun::set_aside_last_vessels() {
@@ -225,7 +245,7 @@ void PulsatileRun::resume(std::string bytes, const std::string& source) {
   in.section("end");
   if (!in.at_end()) in.fail("unexpected bytes after the checkpoint");
   resumed_ = true;
-  resumed_bytes_ = std::move(bytes);  // the snapshot as it is until a cycle ends (written once the folder is open)
+  if (writes_) resumed_bytes_ = std::move(bytes);  // the snapshot as it is until a cycle ends (written once the folder is open)
   if (!cycles_left()) check_run_end(source);
 }
 
@@ -297,6 +317,7 @@ void PulsatileRun::write_checkpoint() {
 }
 
 void PulsatileRun::discard_snapshot() {
+  if (!writes_) return;
   std::error_code ec;
   std::filesystem::remove(pending(), ec);
   snapshot_pending_ = false;

@@ -163,10 +163,14 @@ class PulsatileRun {
   RedCellCycle red_cells_last_;
   double red_cell_change_ = std::numeric_limits<double>::quiet_NaN();
   // A run over ranks (PulseSolver's PulseRanks): the decisions agreed over the ranks
-  // (solver/decisions_over_ranks.hpp), no snapshot (the last cycle's results held by rank 0),
-  // the probes sampled by their vessels' ranks and gathered into probes_ at the run's end.
+  // (solver/decisions_over_ranks.hpp); the snapshot written by rank 0 (the top's) with every
+  // rank's share, the one-process bytes (the last cycle's results kept in memory there); the
+  // probes sampled by their vessels' ranks and gathered into probes_ at the run's end.
   bool over_ranks_ = false;
+  bool writes_ = true;  // this process writes the folder's files (over ranks rank 0 alone)
   std::optional<ProbesOverRanks> probes_over_ranks_;
+  // The snapshot's "run" section: the cycles done, the balances, the last change, the probes' rows.
+  void put_run_progress(CheckpointWriter& out, const std::string& probe_rows) const;
 };
 
 }  // namespace hemotree

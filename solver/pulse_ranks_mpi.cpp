@@ -10,6 +10,7 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     : net_(net), cost_(std::move(cost)), partition_(partition_network(net, cost_, world_size())) {
   check_subtree_partition(partition_);
   check_one_partition(partition_);
+  lead_with_the_top(partition_);  // rank 0 writes the top's state with the results (a checkpoint)
   ranks_.ranks = world_size();
   ranks_.rank = world_rank();
   ranks_.top_rank = partition_.top_rank;
@@ -30,6 +31,20 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
   };
   ranks_.link.down = [this](std::span<const double> answers, std::exception_ptr failure) {
     return exchange_->scatter(answers, failure, LumpedLink::down_per_root, "the 0D step");
+  };
+  ranks_.lead_whole = [this](std::vector<double>& values, const std::vector<unsigned char>& mine) {
+    // Every rank's (item, value) pairs to the top's rank.
+    std::vector<double> pairs;
+    for (std::size_t k = 0; k < values.size(); ++k)
+      if (mine[k]) pairs.insert(pairs.end(), {static_cast<double>(k), values[k]});
+    const int count = static_cast<int>(pairs.size()), top = ranks_.top_rank;
+    const bool here = ranks_.rank == top;
+    std::vector<int> counts(here ? static_cast<std::size_t>(world_size()) : 0), offsets(counts.size(), 0);
+    MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, top, MPI_COMM_WORLD);
+    for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+    std::vector<double> all(here ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
+    MPI_Gatherv(pairs.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, top, MPI_COMM_WORLD);
+    for (std::size_t j = 0; j < all.size(); j += 2) values[static_cast<std::size_t>(all[j])] = all[j + 1];
   };
   ranks_.make_whole = [](std::vector<double>& values, const std::vector<unsigned char>& mine) {
     // Every rank's (item, value) pairs to every rank.

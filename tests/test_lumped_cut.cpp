@@ -191,7 +191,6 @@ TEST(LumpedCut, EveryRankStepsToTheWholeRunsBits) {
     std::vector<LumpedVessels> part = t.ranks_started(c, played, pressure, flow);
     part[static_cast<std::size_t>(top)].set_coupling_nodes({part[static_cast<std::size_t>(top)].node_of(coupled)});
     const double dt = 2e-4;
-    std::vector<double> whole_exchanged(2, 0.0);
     std::size_t compared = 0, differ = 0;
     auto step_inputs = [&](int n, double& inlet, double& coupled_in, double& coupled_volume) {
       const double time = dt * (n + 1);
@@ -204,7 +203,7 @@ TEST(LumpedCut, EveryRankStepsToTheWholeRunsBits) {
       step_inputs(n, inlet, coupled_in, coupled_volume);
       whole.predict(dt, std::vector<double>{coupled_in}, std::vector<double>{inlet}, {});
       const double predicted = whole.pressure_during_step(0, 1.0), impedance = whole.impedance(0);
-      whole.complete(std::vector<double>{coupled_volume}, whole_exchanged[0], whole_exchanged[1]);
+      whole.complete(std::vector<double>{coupled_volume});
       std::vector<std::thread> threads;
       std::vector<double> top_predicted(2, 0.0);
       std::vector<std::string> failed(static_cast<std::size_t>(ranks));
@@ -212,13 +211,12 @@ TEST(LumpedCut, EveryRankStepsToTheWholeRunsBits) {
         threads.emplace_back([&, r] {
          try {
           LumpedVessels& mine = part[static_cast<std::size_t>(r)];
-          double in = 0, out = 0;
           const bool is_top = r == top;
           const std::vector<double> coupling_in = is_top ? std::vector<double>{coupled_in} : std::vector<double>{};
           const std::vector<double> inflow(mine.inflow_boundaries().size(), inlet);
           mine.predict(dt, coupling_in, inflow, {});
           if (is_top) top_predicted = {mine.pressure_during_step(0, 1.0), mine.impedance(0)};
-          mine.complete(is_top ? std::vector<double>{coupled_volume} : std::vector<double>{}, in, out);
+          mine.complete(is_top ? std::vector<double>{coupled_volume} : std::vector<double>{});
          } catch (const std::exception& e) {
           failed[static_cast<std::size_t>(r)] = e.what();
          } catch (...) {
@@ -273,10 +271,9 @@ TEST(LumpedCut, AStepAbandonedOnTheTopIsRefusedOnEveryRank) {
     threads.emplace_back([&, r] {
       LumpedVessels& mine = part[static_cast<std::size_t>(r)];
       try {
-        double in = 0, out = 0;
         mine.predict(1e-4, {}, std::vector<double>(mine.inflow_boundaries().size(), 1e-10), {});
         if (r == c.top) mine.abandon_step(std::make_exception_ptr(std::runtime_error("the 1D vessels failed")));
-        mine.complete({}, in, out);
+        mine.complete({});
       } catch (const std::runtime_error&) {
         refused[static_cast<std::size_t>(r)] = 1;
       }
@@ -315,9 +312,8 @@ TEST(LumpedCut, ALumenClosingInAShareIsSaidOnEveryRank) {
     threads.emplace_back([&, r] {
       LumpedVessels& mine = part[static_cast<std::size_t>(r)];
       try {
-        double in = 0, out = 0;
         mine.predict(1e-4, {}, std::vector<double>(mine.inflow_boundaries().size(), 1e-10), {});
-        mine.complete({}, in, out);
+        mine.complete({});
       } catch (const std::runtime_error& e) {
         said[static_cast<std::size_t>(r)] = e.what();
       }

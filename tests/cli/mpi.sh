@@ -119,18 +119,48 @@ done
 $MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --format h5 --out "$WORK/pulse-h5" >/dev/null 2>&1
 same_h5 "$WORK/pulse-one-h5/results.h5" "$WORK/pulse-h5/results.h5" \
   && pass "mpirun -np 3 hemosolve --format h5 (pulsatile): the plain run's values" || fail "pulsatile --format h5 over ranks"
+# Checkpoints over ranks are the one-process run's, byte for byte: rank 0 writes the top's
+# state with every rank's share of the 0D vessels at the whole run's places.
+six="--cycles 6 --probe 1 --probe 2000:0.3"
+"$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --checkpoint-every 1 --lumped-sections 1 --out "$WORK/kept-one" 2>/dev/null \
+  || fail "hemosolve --checkpoint-every (pulse)"
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --checkpoint-every 1 --out "$WORK/kept-3" >/dev/null 2>&1
+cmp -s "$WORK/kept-one/checkpoint.bin" "$WORK/kept-3/checkpoint.bin" && cmp -s "$WORK/kept-one/vessels.csv" "$WORK/kept-3/vessels.csv" \
+  && pass "mpirun -np 3 --checkpoint-every 1: the plain run's checkpoint.bin byte for byte" \
+  || fail "--checkpoint-every over 3 ranks: the checkpoint differs from the plain run's"
 # An interrupt of one rank stops every rank at the same step: the last whole cycle's results
-# written by rank 0, marked interrupted, said once; no rank left waiting.
-$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 500 --out "$WORK/pulse-stopped" >"$WORK/stopped" 2>&1 &
-launcher=$!
-for _ in $(seq 600); do grep -q "cycle 2/500 done" "$WORK/stopped" && break; sleep 0.1; done
-kill -TERM "$(pgrep -f -- "^$HEMOSOLVE .*--out $WORK/pulse-stopped" | tail -1)"  # a rank, not the launcher
-wait $launcher
+# and its checkpoint written by rank 0, marked interrupted, said once; no rank left waiting.
+# Resumed over 3 ranks, or as one process, the run ends as the uninterrupted one: its files.
+"$HEMOSOLVE" "$WORK/pulse.json" $six --lumped-sections 1 --out "$WORK/six-one" 2>/dev/null || fail "hemosolve --cycles 6 (pulse)"
+stop_after_two() {  # ranks, folder: started, one rank sent SIGTERM once two cycles are done
+  $MPIRUN -np "$1" "$HEMOSOLVE" "$WORK/pulse.json" $six --out "$2" >"$WORK/stopped" 2>&1 &
+  local launcher=$!
+  for _ in $(seq 600); do grep -q "cycle 2/6 done" "$WORK/stopped" && break; sleep 0.1; done
+  kill -TERM "$(pgrep -f -- "^$HEMOSOLVE .*--out $2" | tail -1)"  # a rank, not the launcher
+  wait $launcher
+}
+stop_after_two 2 "$WORK/pulse-stopped"
 status=$?
-said=$(grep -c "warning: interrupted by SIGTERM after [0-9]* cycles: .*keeps no checkpoint to resume from yet" "$WORK/stopped")
+said=$(grep -c "warning: interrupted by SIGTERM after [0-9] cycles: .* holds the results of the last whole cycle and its checkpoint" "$WORK/stopped")
 [ $status -ne 0 ] && [ $status -ne 124 ] && [ "$said" -eq 1 ] && grep -q '"status": "interrupted"' "$WORK/pulse-stopped/summary.json" \
-  && pass "one rank interrupted: every rank stopped, the last cycle's results marked interrupted, said once" \
+  && [ -f "$WORK/pulse-stopped/checkpoint.bin" ] \
+  && pass "one rank interrupted: every rank stopped, the last cycle's results and checkpoint kept, said once" \
   || fail "one rank interrupted: status $status, said $said times: $(tail -3 "$WORK/stopped")"
+cp -r "$WORK/pulse-stopped" "$WORK/pulse-stopped-copy"
+same_six() {  # the uninterrupted run's files (summary.json but its wall time)
+  cmp -s "$WORK/six-one/vessels.csv" "$1/vessels.csv" && cmp -s "$WORK/six-one/probes.csv" "$1/probes.csv" \
+    && diff <(grep -v '"wall_time"' "$WORK/six-one/summary.json") <(grep -v '"wall_time"' "$1/summary.json") >/dev/null
+}
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" $six --resume "$WORK/pulse-stopped" >"$WORK/resumed" 2>&1
+status=$?
+[ $status -eq 0 ] && grep -q "resuming from .* after [0-9] cycles" "$WORK/resumed" && same_six "$WORK/pulse-stopped" \
+  && pass "a run over 2 ranks interrupted, resumed over 3: the uninterrupted run's files" \
+  || fail "resumed over 3 ranks: status $status: $(tail -3 "$WORK/resumed")"
+"$HEMOSOLVE" "$WORK/pulse.json" $six --lumped-sections 1 --resume "$WORK/pulse-stopped-copy" >"$WORK/resumed" 2>&1
+status=$?
+[ $status -eq 0 ] && same_six "$WORK/pulse-stopped-copy" \
+  && pass "a run over 2 ranks interrupted, resumed as one process: the uninterrupted run's files" \
+  || fail "resumed as one process: status $status: $(tail -3 "$WORK/resumed")"
 # A network with loops and pressures prescribed at nodes (the rat mesentery): PETSc's
 # conjugate gradients over the ranks, within 1e-10 of the plain run (relative to each
 # column's largest value).
@@ -171,9 +201,6 @@ expect_refused() {  # name, text, command...: status 2, said once, no folder
 expect_refused "phase separation over 2 ranks" "hemosolve: error: started on 2 MPI ranks: --steady with --red-cells transport runs as one process" \
   -np 2 "$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport --out "$WORK/refused-out"
 # What a pulsatile run over ranks does not take yet: refused on every rank, said once.
-expect_refused "a pulsatile run over 2 ranks with --checkpoint-every" \
-  "hemosolve: error: --checkpoint-every: a pulsatile run over MPI ranks keeps no checkpoint yet" \
-  -np 2 "$HEMOSOLVE" "$WORK/tree.json" --checkpoint-every 1 --out "$WORK/refused-out"
 expect_refused "a pulsatile run over 2 ranks with red cells carried" \
   "hemosolve: error: --red-cells transport: a pulsatile run over MPI ranks carries no red cells or tracers yet" \
   -np 2 "$HEMOSOLVE" "$WORK/tree.json" --red-cells transport --out "$WORK/refused-out"

@@ -67,7 +67,6 @@ int main(int argc, char** argv) {
       mine.set_threads(threads);
       mine.start(pressure, flow);
       if (is_top) mine.set_coupling_nodes({mine.node_of(coupled)});
-      double whole_in = 0, whole_out = 0, in = 0, out = 0;
       std::size_t differ = 0, compared = 0;
       for (int n = 0; n < 40; ++n) {
         const double time = dt * (n + 1);
@@ -79,8 +78,8 @@ int main(int argc, char** argv) {
         if (is_top)
           differ += !same(mine.pressure_during_step(0, 1.0), whole.pressure_during_step(0, 1.0)) +
                     !same(mine.impedance(0), whole.impedance(0));
-        whole.complete(std::vector<double>{coupled_volume}, whole_in, whole_out);
-        mine.complete(is_top ? std::vector<double>{coupled_volume} : std::vector<double>{}, in, out);
+        whole.complete(std::vector<double>{coupled_volume});
+        mine.complete(is_top ? std::vector<double>{coupled_volume} : std::vector<double>{});
         compared = 0;
         for (std::size_t node = 0; node < net.node_count(); ++node) {
           const std::int32_t k = mine.node_of(static_cast<std::int64_t>(node));
@@ -116,10 +115,9 @@ int main(int argc, char** argv) {
     mine.start(pressure, flow);
     std::string words;
     try {
-      double in = 0, out = 0;
       mine.predict(dt, {}, std::vector<double>(mine.inflow_boundaries().size(), 1e-10), {});
       if (is_top) mine.abandon_step(std::make_exception_ptr(std::runtime_error("the 1D vessels failed")));
-      mine.complete({}, in, out);
+      mine.complete({});
     } catch (const std::invalid_argument& e) {
       words = e.what();
     }
