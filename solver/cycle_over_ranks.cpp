@@ -63,6 +63,20 @@ Eigen::VectorXd boundary_volumes_over_ranks(const PulseSolver& solver) {
   return all;
 }
 
+void gather_vessel_values(const Network& net, const PulseSolver& solver, std::span<std::vector<double>* const> values) {
+  const std::size_t width = values.size();
+  std::vector<std::int32_t> mine;
+  std::vector<double> rows;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+    if (!solver.steps_vessel(v)) continue;
+    mine.push_back(static_cast<std::int32_t>(v));
+    for (const std::vector<double>* column : values) rows.push_back((*column)[v]);
+  }
+  gather_rows(mine, rows, width, net.vessel_count(), [&](std::int32_t v, const double* row) {
+    for (std::size_t j = 0; j < width; ++j) (*values[j])[static_cast<std::size_t>(v)] = row[j];
+  });
+}
+
 void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary) {
   constexpr std::size_t width = 10;  // VesselCycle's eight numbers, the two wave speeds
   std::vector<std::int32_t> mine;

@@ -4,6 +4,9 @@
 // MPI_COMM_WORLD: every rank calls each at the same point of the run.
 #pragma once
 
+#include <span>
+#include <vector>
+
 #include <Eigen/Dense>
 
 #include "formats/network.hpp"
@@ -20,6 +23,10 @@ double network_volume_over_ranks(const Network& net, const PulseSolver& solver);
 // PulseSolver::boundary_volumes of the whole run on rank 0 (each boundary from the rank that
 // holds it); elsewhere empty.
 Eigen::VectorXd boundary_volumes_over_ranks(const PulseSolver& solver);
+
+// Per vessel, numbers each rank holds right for the vessels it steps (PulseSolver::sample_all's,
+// a frame's), made every vessel's on rank 0 from the rank that steps it; elsewhere left.
+void gather_vessel_values(const Network& net, const PulseSolver& solver, std::span<std::vector<double>* const> values);
 
 // Every vessel's cycle results, and the wave speeds of the 1D vessels, from the rank that steps
 // the vessel, into rank 0's `summary` (which holds this rank's own before the call: the ghosts'

@@ -284,22 +284,19 @@ void check_pulsatile(const Network& net, const RunConfiguration& config) {
 namespace {
 
 // What a pulsatile run over MPI ranks does not take yet (docs/scaling.md, "The pulsatile run
-// over ranks"): the cells move in flow order across the ranks; a frame is every vessel's
-// state at once; a settling cycle is a second solver. Refused on every rank alike, before any
-// work.
+// over ranks"): the cells move in flow order across the ranks; a settling cycle at a lower
+// degree is a second solver (taken by default only where most vessels are 1D: not a tree
+// that ranks split). Refused on every rank alike, before any work.
 void refuse_over_ranks(const RunConfiguration& config) {
   auto refuse = [](const std::string& setting, const std::string& why, const std::string& value = "") {
     throw SettingError(setting, placeholder(setting) + value + ": " + why + "; run it as one process (without mpirun)");
   };
-  if (config.frames > 0) refuse("frames", "a pulsatile run over MPI ranks writes no frames yet");
   if (config.red_cells == RedCells::transport || !config.tracers.empty())
     refuse(config.tracers.empty() ? "red_cells" : "tracer",
            "a pulsatile run over MPI ranks carries no red cells or tracers yet (they move in flow order across the ranks)",
            config.tracers.empty() ? " transport" : "");
-  if (config.until_periodic && config.settling_step > 1)
-    refuse("settling_step", "a pulsatile run over MPI ranks takes no settling cycle yet");
   if (config.until_periodic && config.settling_degree != SolverOptions::automatic && config.settling_degree > 0)
-    refuse("settling_degree", "a pulsatile run over MPI ranks takes no settling cycle yet");
+    refuse("settling_degree", "a pulsatile run over MPI ranks takes no settling cycle at a lower degree yet (a second solver)");
 }
 
 // given_up: the same network where the caller gave it up (its coordinates may go), else null.
@@ -414,7 +411,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   // most of the vessels are 0D: the transient it takes cheaply is theirs, and where 1D arteries
   // are the network with a few short 0D segments between them (ADAN56), a longer 0D step saves
   // nothing and broke down (the segments' nodes, tiny compliances between two 1D ends).
-  if (config.until_periodic && config.settling_step > 1 && !over_ranks && 2 * run.lumped_vessels_in_run() > net.vessel_count() &&
+  if (config.until_periodic && config.settling_step > 1 && 2 * run.lumped_vessels_in_run() > net.vessel_count() &&
       config.balance_compliances && run.started_from_steady())
     plan.settling_steps = std::max<std::size_t>(
         1, steps_per_cycle * static_cast<std::size_t>(run.coupling_passes()) / static_cast<std::size_t>(config.settling_step));
@@ -457,6 +454,12 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     // which has left every collective call: a failure of its writing is its own alone.
     if (world_rank() != 0) return result;
     leave_collectives();
+    if (const RootExchange* exchange = ranks->exchange()) {
+      const RootExchange::Traffic& t = exchange->traffic();
+      observer.note("the 0D steps' exchanges on rank 0, the top's: " + std::to_string(t.calls) + " collective calls, " +
+                    std::to_string(t.bytes) + " bytes, " + format_quantity(t.seconds, "s") +
+                    " inside them (waiting for the shares included)");
+    }
   }
   if (pulsatile.stopped_settling()) {
     folder->discard();

@@ -15,6 +15,7 @@
 #include "core/setting_error.hpp"
 #include "formats/vtk_series.hpp"
 #include "mpi/session.hpp"
+#include "solver/cycle_over_ranks.hpp"
 #include "solver/decisions_over_ranks.hpp"
 #include "solver/run_report.hpp"
 #include "pulse/solution_breakdown.hpp"
@@ -83,10 +84,9 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
       over_ranks_(solver.lumped().over_ranks()), writes_(!over_ranks_ || world_rank() == 0) {
   plan_.transport_every = std::max<std::size_t>(plan_.transport_every, 1);
   if (over_ranks_) {
-    // What a run over ranks does not take yet (its caller refuses them in words): the cells
-    // move in flow order across the ranks; a frame and a settling cycle are the whole's.
-    if (transport_ || plan_.frames > 0 || plan_.settling_steps > 0)
-      throw std::logic_error("PulsatileRun over ranks: transport, frames or a settling cycle");
+    // What a run over ranks does not take yet (its caller refuses it in words): the cells
+    // move in flow order across the ranks.
+    if (transport_) throw std::logic_error("PulsatileRun over ranks: transport");
     if (writes_ && !solver.holds_one_d()) throw std::logic_error("PulsatileRun over ranks: rank 0 is not the top's");
     probes_over_ranks_.emplace(probes, solver);
   }
@@ -323,6 +323,19 @@ void PulsatileRun::discard_snapshot() {
   snapshot_pending_ = false;
 }
 
+void PulsatileRun::add_frame(std::optional<VtkTimeSeries>& series) const {
+  if (!over_ranks_) {
+    add_solution_frame(*series, solver_);
+    return;
+  }
+  // Every vessel's centre from the rank that steps it, written by rank 0.
+  std::vector<double> area, flow, pressure;
+  solver_.sample_all(0.5, area, flow, &pressure);
+  std::vector<double>* columns[] = {&area, &flow, &pressure};
+  gather_vessel_values(net_, solver_, columns);
+  if (series) add_solution_frame(*series, solver_.time(), std::move(area), std::move(flow), std::move(pressure));
+}
+
 void PulsatileRun::progress(RunObserver& observer, std::size_t k, double started) {
   const double elapsed = seconds_since_epoch_start() - started;
   const double rate = static_cast<double>(k + 1) / std::max(elapsed, 1e-9);
@@ -395,7 +408,7 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
   try {
     while (cycles_left()) {
       std::optional<VtkTimeSeries> series;  // each cycle could be the last: its frames replace the previous
-      if (plan_.frames > 0) series.emplace(net_, folder_ / "frames", "frames", plan_.vtk_keep);
+      if (plan_.frames > 0 && writes_) series.emplace(net_, folder_ / "frames", "frames", plan_.vtk_keep);
       std::size_t frames_written = 0;
       return_free_memory();  // what the set-up or the last cycle end freed, before the loop's arrays
       stats_.begin(solver_);
@@ -409,8 +422,8 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
           stats_.sample(solver_, solver_.time(), solver_.time() - sampled_until);
           sampled_until = solver_.time();
         }
-        if (series && (k + 1) * static_cast<std::size_t>(plan_.frames) >= (frames_written + 1) * plan_.steps_per_cycle) {
-          add_solution_frame(*series, solver_);
+        if (plan_.frames > 0 && (k + 1) * static_cast<std::size_t>(plan_.frames) >= (frames_written + 1) * plan_.steps_per_cycle) {
+          add_frame(series);
           ++frames_written;
         }
         if (solver_.steps() % plan_.sample_every == 0) sample_probes();

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "formats/checkpoint_file.hpp"
+#include "formats/vtk_series.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/flow_transport.hpp"
 #include "solver/probes.hpp"
@@ -133,6 +134,8 @@ class PulsatileRun {
   void check_run_end(const std::filesystem::path& source) const;
   bool has_last_cycle_frames() const;
   void progress(RunObserver& observer, std::size_t step_in_cycle, double started);
+  // A frame of every vessel's centre now (over ranks gathered on rank 0, which alone has a series).
+  void add_frame(std::optional<VtkTimeSeries>& series) const;
   void sample_probes() {
     if (over_ranks_) probes_over_ranks_->sample(solver_);
     else probes_.sample(solver_);

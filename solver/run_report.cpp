@@ -303,9 +303,14 @@ void write_results_vtk(const std::filesystem::path& file, const Network& net, co
 void add_solution_frame(VtkTimeSeries& series, const PulseSolver& solver) {
   std::vector<double> area, flow, pressure;
   solver.sample_all(0.5, area, flow, &pressure);
+  add_solution_frame(series, solver.time(), std::move(area), std::move(flow), std::move(pressure));
+}
+
+void add_solution_frame(VtkTimeSeries& series, double t, std::vector<double> area, std::vector<double> flow,
+                        std::vector<double> pressure) {
   std::vector<double> velocity(area.size());
   for (std::size_t v = 0; v < area.size(); ++v) velocity[v] = flow[v] / area[v];
-  series.add_frame(solver.time(), {{"p", pressure}, {"Q", flow}, {"A", area}, {"u", velocity}});
+  series.add_frame(t, {{"p", pressure}, {"Q", flow}, {"A", area}, {"u", velocity}});
 }
 
 }  // namespace hemotree

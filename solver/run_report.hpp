@@ -91,5 +91,8 @@ void write_results_vtk(const std::filesystem::path& file, const Network& net, co
 
 // Appends the solution now, at every vessel's centre (p, Q, A, u), as a frame at the solver's time.
 void add_solution_frame(VtkTimeSeries& series, const PulseSolver& solver);
+// The same from every vessel's centre values given (a run over ranks gathers them), at time t.
+void add_solution_frame(VtkTimeSeries& series, double t, std::vector<double> area, std::vector<double> flow,
+                        std::vector<double> pressure);
 
 }  // namespace hemotree

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "solver/cycle_statistics.hpp"
+#include "solver/decisions_over_ranks.hpp"
 #include "solver/run_estimate.hpp"
 
 namespace hemotree {
@@ -24,15 +25,22 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   CycleStatistics stats(net, solver, 1 / period);
   stats.begin(solver);
   double sampled_until = solver.time();
+  // Over ranks every decision is every rank's (solver/decisions_over_ranks.hpp).
+  const bool over_ranks = solver.lumped().over_ranks();
   for (std::size_t k = 0; k < steps; ++k) {
     solver.step();
     stats.sample(solver, solver.time(), solver.time() - sampled_until);
     sampled_until = solver.time();
-    if (k % 256 == 0 && (s.signal = observer.poll_interrupt()) != 0) return s;
+    if (k % 256 == 0) {
+      s.signal = over_ranks ? interrupt_on_any_rank(observer.poll_interrupt()) : observer.poll_interrupt();
+      if (s.signal != 0) return s;
+    }
   }
-  solver.check_solution();
+  if (over_ranks) check_solution_on_every_rank(solver);
+  else solver.check_solution();
   solver.release_step_arrays();
   std::vector<double> mean_pressure = mean_pressures(stats.close(solver).vessels);  // the rest freed here
+  if (over_ranks) take_lead_values(mean_pressure);  // rank 0 alone has the whole cycle
   solver.balance_compliances(period, std::move(mean_pressure));
   solver.set_time_step(run_step);
   solver.set_coupling_passes(run_passes);

@@ -2,7 +2,8 @@
 # plain command's outputs byte for byte (but the wall time), text or HDF5, and so do the linear
 # periodic state over 2 and 3 and a pulsatile run over 2 to 4; a looped network (PETSc) the
 # plain run's to 1e-10; the partition is said in one line; an interrupt of one rank stops all;
-# what does not run over ranks yet is refused in one line, said once, nothing written.
+# what does not run over ranks yet is refused in one line, said once, nothing written;
+# checkpoints and frames over ranks are the plain run's bytes; the Slurm script runs.
 source "$(dirname "$0")/lib.sh"
 HEMOSOLVE=$BUILD/solver/hemosolve
 if ! command -v mpirun >/dev/null; then
@@ -119,6 +120,26 @@ done
 $MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --format h5 --out "$WORK/pulse-h5" >/dev/null 2>&1
 same_h5 "$WORK/pulse-one-h5/results.h5" "$WORK/pulse-h5/results.h5" \
   && pass "mpirun -np 3 hemosolve --format h5 (pulsatile): the plain run's values" || fail "pulsatile --format h5 over ranks"
+# The settling cycle (a 0D step four times the run's) over ranks: the plain run's files (but
+# the wall times, the run's and the settling cycle's seconds).
+"$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-step 4 --lumped-sections 1 --out "$WORK/settled-one" >"$WORK/settled-log" 2>&1 \
+  || fail "hemosolve --settling-step 4 (pulse)"
+grep -q "settling cycle done" "$WORK/settled-log" || fail "the plain run took no settling cycle"
+$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-step 4 --out "$WORK/settled-2" >/dev/null 2>&1
+cmp -s "$WORK/settled-one/vessels.csv" "$WORK/settled-2/vessels.csv" && cmp -s "$WORK/settled-one/probes.csv" "$WORK/settled-2/probes.csv" \
+  && diff <(grep -v '"wall_time"\|"seconds"' "$WORK/settled-one/summary.json") \
+          <(grep -v '"wall_time"\|"seconds"' "$WORK/settled-2/summary.json") >/dev/null \
+  && pass "mpirun -np 2 --settling-step 4: the plain run's files (the settling cycle over ranks)" \
+  || fail "--settling-step over 2 ranks: the files differ from the plain run's"
+# Frames over ranks: every vessel's centre gathered on rank 0 at each frame, the plain run's
+# files (ParaView's time series and results.vtp) byte for byte.
+"$HEMOSOLVE" "$WORK/pulse.json" --cycles 1 --frames 4 --vtk --lumped-sections 1 --out "$WORK/frames-one" 2>/dev/null \
+  || fail "hemosolve --frames (pulse)"
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 1 --frames 4 --vtk --out "$WORK/frames-3" >/dev/null 2>&1
+[ "$(ls "$WORK/frames-one/frames" | wc -l)" -eq 5 ] && diff -r "$WORK/frames-one/frames" "$WORK/frames-3/frames" >/dev/null \
+  && cmp -s "$WORK/frames-one/results.vtp" "$WORK/frames-3/results.vtp" \
+  && pass "mpirun -np 3 --frames 4 --vtk: the plain run's frames and results.vtp byte for byte" \
+  || fail "--frames over 3 ranks: the frames differ from the plain run's"
 # Checkpoints over ranks are the one-process run's, byte for byte: rank 0 writes the top's
 # state with every rank's share of the 0D vessels at the whole run's places.
 six="--cycles 6 --probe 1 --probe 2000:0.3"
@@ -161,6 +182,17 @@ status=$?
 [ $status -eq 0 ] && same_six "$WORK/pulse-stopped-copy" \
   && pass "a run over 2 ranks interrupted, resumed as one process: the uninterrupted run's files" \
   || fail "resumed as one process: status $status: $(tail -3 "$WORK/resumed")"
+# The Slurm batch script (examples/slurm/over-ranks.sbatch), its srun played by mpirun over 2
+# ranks: a pulsatile run's results.h5, the plain run's values.
+mkdir -p "$WORK/fake-slurm"
+printf '#!/bin/bash\nshift  # --mpi=pmix\nexec %s -np 2 "$@"\n' "$MPIRUN" >"$WORK/fake-slurm/srun"
+chmod +x "$WORK/fake-slurm/srun"
+"$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --probe 1 --lumped-sections 1 --format h5 --out "$WORK/slurm-one" 2>/dev/null
+PATH="$WORK/fake-slurm:$PATH" HEMOSOLVE="$HEMOSOLVE" bash "$(dirname "$0")/../../examples/slurm/over-ranks.sbatch" \
+  "$WORK/pulse.json" "$WORK/slurm-run" --cycles 2 --probe 1 >"$WORK/slurm-log" 2>&1
+same_h5 "$WORK/slurm-one/results.h5" "$WORK/slurm-run/results.h5" \
+  && pass "examples/slurm/over-ranks.sbatch, a pulsatile run (srun played by mpirun -np 2): the plain run's values" \
+  || fail "the Slurm script's pulsatile run: $(tail -3 "$WORK/slurm-log")"
 # A network with loops and pressures prescribed at nodes (the rat mesentery): PETSc's
 # conjugate gradients over the ranks, within 1e-10 of the plain run (relative to each
 # column's largest value).
