@@ -193,6 +193,20 @@ PATH="$WORK/fake-slurm:$PATH" HEMOSOLVE="$HEMOSOLVE" bash "$(dirname "$0")/../..
 same_h5 "$WORK/slurm-one/results.h5" "$WORK/slurm-run/results.h5" \
   && pass "examples/slurm/over-ranks.sbatch, a pulsatile run (srun played by mpirun -np 2): the plain run's values" \
   || fail "the Slurm script's pulsatile run: $(tail -3 "$WORK/slurm-log")"
+# A rank killed (SIGKILL: nothing of it answers): mpirun ends every rank, the folder stays
+# OUT.partial with the last cycle end's checkpoint, and a resume over 3 ranks ends with the
+# uninterrupted run's files.
+$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" $six --checkpoint-every 1 --out "$WORK/pulse-killed" >"$WORK/killed" 2>&1 &
+launcher=$!
+for _ in $(seq 600); do grep -q "cycle 3/6 done" "$WORK/killed" && break; sleep 0.1; done
+kill -KILL "$(pgrep -f -- "^$HEMOSOLVE .*--out $WORK/pulse-killed" | tail -1)"
+wait $launcher
+status=$?
+[ $status -ne 0 ] && [ $status -ne 124 ] && [ ! -e "$WORK/pulse-killed" ] && [ -f "$WORK/pulse-killed.partial/checkpoint.bin" ] \
+  && $MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" $six --checkpoint-every 1 --resume "$WORK/pulse-killed" >"$WORK/resumed" 2>&1 \
+  && cmp -s "$WORK/six-one/vessels.csv" "$WORK/pulse-killed/vessels.csv" && cmp -s "$WORK/six-one/probes.csv" "$WORK/pulse-killed/probes.csv" \
+  && pass "a rank killed: the run ends on every rank, OUT.partial keeps its checkpoint, resumed over 3 ranks to the uninterrupted files" \
+  || fail "a rank killed: status $status: $(tail -3 "$WORK/killed") / $(tail -2 "$WORK/resumed" 2>/dev/null)"
 # A network with loops and pressures prescribed at nodes (the rat mesentery): PETSc's
 # conjugate gradients over the ranks, within 1e-10 of the plain run (relative to each
 # column's largest value).
