@@ -56,11 +56,15 @@ struct LumpedLink {
   // returns on the top's rank every other rank's, rank after rank, or sets `failed` where some
   // rank failed (the top then goes straight to `down`); elsewhere nothing.
   std::function<std::vector<double>(std::span<const double> numbers, std::exception_ptr failure, bool& failed)> up;
-  // The top's answers, rank after rank (or, on any rank, its failure), out; returns this
-  // rank's. Where any rank failed, throws its refusal on every rank alike.
-  std::function<std::vector<double>(std::span<const double> answers, std::exception_ptr failure)> down;
-  static constexpr std::size_t up_per_root = 4;    // g, S_r, y_r, h
-  static constexpr std::size_t down_per_root = 3;  // x_r, x_u, u's pressure after the step
+  // The top's answers, rank after rank, per_root numbers a root (or, on any rank, its
+  // failure), out; returns this rank's. Where any rank failed, throws its refusal on every
+  // rank alike.
+  std::function<std::vector<double>(std::span<const double> answers, std::exception_ptr failure, std::size_t per_root)> down;
+  static constexpr std::size_t up_per_root = 4;  // g, S_r, y_r, h
+  // Down twice a step: the potentials at the root vessel's ends (x_r, x_u) as soon as the
+  // top's backward half has them, then u's pressure after the step once the top has
+  // completed its nodes: a share completes its own in the meantime.
+  static constexpr std::size_t potentials_per_root = 2, pressures_per_root = 1;
 };
 
 }  // namespace hemotree

@@ -1,5 +1,6 @@
 // The 0D vessels of a run over ranks (pulse/lumped_cut.hpp): what a rank holds of the cut, and
-// the two messages of every step, as LumpedVessels' predict() and complete() send them.
+// the messages of every step, as LumpedVessels' predict() and complete() send them: the roots
+// up, the potentials at their ends down, u's pressures down.
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -42,10 +43,14 @@ void LumpedVessels::abandon_step(std::exception_ptr failure) {
     bool failed = false;
     share_.link.up({}, failure, failed);
   }
-  // Once: a failure after the step's answers went down (or its refusal) is this rank's alone.
-  if (!share_.answered) {
-    share_.answered = true;
-    share_.link.down({}, failure);
+  // In the step's next message down (a refusal ends the step on every rank: none follows); a
+  // failure after both went down is this rank's alone.
+  if (!share_.potentials_down) {
+    share_.potentials_down = share_.pressures_down = true;
+    share_.link.down({}, failure, LumpedLink::potentials_per_root);
+  } else if (!share_.pressures_down) {
+    share_.pressures_down = true;
+    share_.link.down({}, failure, LumpedLink::pressures_per_root);
   }
   std::rethrow_exception(failure);  // a link that did not throw it: this rank's own
 }
@@ -80,32 +85,53 @@ void LumpedVessels::take_roots() {
   share_.root_row = message;
 }
 
-void LumpedVessels::answer_roots() {
-  // Per root vessel (u, r): the potentials at its ends, and u's pressure after the step.
-  std::vector<double> answers;
-  answers.reserve(LumpedLink::down_per_root * share_.root_edge.size());
-  for (const std::int32_t edge : share_.root_edge) {
-    const auto e = static_cast<std::size_t>(edge);
-    const std::size_t r = root_lower(e), u = root_upper(e);
-    answers.insert(answers.end(), {rhs_[r], rhs_[u], pressure_[u]});
+std::vector<double> LumpedVessels::exchange_down(std::span<const double> answers, std::size_t per_root, bool& sent) {
+  sent = true;
+  std::vector<double> mine;
+  try {
+    mine = share_.link.down(answers, nullptr, per_root);
+  } catch (...) {
+    share_.potentials_down = share_.pressures_down = true;  // a refusal: the step ends on every rank
+    throw;
   }
-  share_.answered = true;
-  share_.link.down(answers, nullptr);
+  if (!share_.top && mine.size() != per_root * share_.root_edge.size())
+    throw std::logic_error("LumpedVessels: " + std::to_string(mine.size()) + " numbers from the top, " +
+                           std::to_string(per_root * share_.root_edge.size()) + " expected");
+  return mine;
 }
 
-void LumpedVessels::take_answers() {
-  const std::vector<double> answer = share_.link.down({}, nullptr);
-  if (answer.size() != LumpedLink::down_per_root * share_.root_edge.size())
-    throw std::logic_error("LumpedVessels: " + std::to_string(answer.size()) + " numbers from the top, " +
-                           std::to_string(LumpedLink::down_per_root * share_.root_edge.size()) + " expected");
+void LumpedVessels::answer_potentials() {
+  // Per root vessel (u, r): the potentials at its ends.
+  std::vector<double> answers;
+  answers.reserve(LumpedLink::potentials_per_root * share_.root_edge.size());
+  for (const std::int32_t edge : share_.root_edge) {
+    const auto e = static_cast<std::size_t>(edge);
+    answers.insert(answers.end(), {rhs_[root_lower(e)], rhs_[root_upper(e)]});
+  }
+  exchange_down(answers, LumpedLink::potentials_per_root, share_.potentials_down);
+}
+
+void LumpedVessels::take_potentials() {
+  const std::vector<double> answer = exchange_down({}, LumpedLink::potentials_per_root, share_.potentials_down);
   if (empty()) return;
   for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
     const auto e = static_cast<std::size_t>(share_.root_edge[j]);
-    const std::size_t u = root_upper(e), r = root_lower(e);
-    rhs_[r] = answer[LumpedLink::down_per_root * j];
-    rhs_[u] = answer[LumpedLink::down_per_root * j + 1];
-    share_.root_row[j] = answer[LumpedLink::down_per_root * j + 2];
+    rhs_[root_lower(e)] = answer[LumpedLink::potentials_per_root * j];
+    rhs_[root_upper(e)] = answer[LumpedLink::potentials_per_root * j + 1];
   }
+}
+
+void LumpedVessels::answer_pressures() {
+  // Per root vessel (u, r): u's pressure after the step.
+  std::vector<double> answers;
+  answers.reserve(share_.root_edge.size());
+  for (const std::int32_t edge : share_.root_edge) answers.push_back(pressure_[root_upper(static_cast<std::size_t>(edge))]);
+  exchange_down(answers, LumpedLink::pressures_per_root, share_.pressures_down);
+}
+
+void LumpedVessels::take_pressures() {
+  const std::vector<double> answer = exchange_down({}, LumpedLink::pressures_per_root, share_.pressures_down);
+  std::copy(answer.begin(), answer.end(), share_.root_row.begin());
 }
 
 }  // namespace hemotree

@@ -564,7 +564,7 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, s
     predict_step(dt, coupled_inflow, inflow, held_pressure);
     return;
   }
-  share_.answered = false;
+  share_.potentials_down = share_.pressures_down = false;
   if (!share_.top) {
     std::exception_ptr failure;
     try {
@@ -643,17 +643,16 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, std::span<d
     complete_step(coupled_volume, boundary_volume);
     return;
   }
-  if (!share_.top) {
-    take_answers();
-    complete_step(coupled_volume, boundary_volume);
-    return;
-  }
+  // The messages down are sent and taken within the step (complete_step); a failure before
+  // both went down is every rank's.
   try {
+    if (!share_.top) take_potentials();
     complete_step(coupled_volume, boundary_volume);
+    if (!share_.potentials_down) answer_potentials();  // a top with no 0D vessel of its own
+    if (!share_.pressures_down) share_.top ? answer_pressures() : take_pressures();
   } catch (...) {
-    abandon_step(std::current_exception());
+    abandon_step(in_words(std::current_exception()));
   }
-  answer_roots();
 }
 
 void LumpedVessels::complete_step(std::span<const double> coupled_volume, std::span<double> boundary_volume) {
@@ -665,6 +664,7 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, std::s
     system_.add_forward(coupling_nodes_, coupling_scratch_, rhs_);
   }
   system_.backward(rhs_, rhs_);
+  if (share_.on && share_.top) answer_potentials();  // the shares' backward halves go on meanwhile
   const std::vector<double>& p1 = rhs_;  // now the pressures at t1
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_predicted_[j] = p1[static_cast<std::size_t>(coupling_nodes_[j])];
   const auto edges = static_cast<std::int64_t>(a_.size());
@@ -719,6 +719,7 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, std::s
     pressure_[k] = pressure_from_excess(k, volume_[k]);
   });
   previous_flow_.swap(flow_);  // the new flows went where the oldest were
+  if (share_.on) share_.top ? answer_pressures() : take_pressures();
   if (share_.on && !share_.top)  // the top's nodes above the roots: their pressures as the top completed them
     for (std::size_t j = 0; j < share_.root_edge.size(); ++j) {
       const std::size_t u = root_upper(static_cast<std::size_t>(share_.root_edge[j]));

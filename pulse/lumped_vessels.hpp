@@ -516,7 +516,9 @@ class LumpedVessels {
     std::vector<unsigned char> ghost_edge;  // per edge: the top's ghosts (empty: none)
     std::vector<double> root_row;           // the top's: per ghost edge, its message; a share's: per root, u's pressure
     std::vector<std::int32_t> waiting_node;  // the top's nodes above the shares' roots (their rows need the messages)
-    bool awaiting_roots = false, answered = false;  // the top's step: its messages not yet in, its answers out
+    // The step's messages: the top's still to take in; the potentials and the pressures gone
+    // down (a share: taken in).
+    bool awaiting_roots = false, potentials_down = false, pressures_down = false;
     LumpedLink link;
     std::function<std::exception_ptr(std::exception_ptr)> failure_words;
   } share_;
@@ -531,11 +533,17 @@ class LumpedVessels {
   std::size_t root_lower(std::size_t e) const { return static_cast<std::size_t>(std::max(a_[e], b_[e])); }
   // A step's messages (pulse/lumped_exchange.cpp): a share's roots up after its forward half
   // (or its failure); the top's taken in before its linearisation (false: a rank failed);
-  // the top's answers down after its step; a share's taken in before its backward half.
+  // the potentials at the roots' ends down after the top's backward half, a share's taken in
+  // before its own; u's pressures down once the top has completed its nodes, a share's taken
+  // in after completing its own (before its linearisation, which reads them).
   void send_roots(std::exception_ptr failure);
   void take_roots();
-  void answer_roots();
-  void take_answers();
+  void answer_potentials();
+  void take_potentials();
+  void answer_pressures();
+  void take_pressures();
+  // One message down (`sent` marks it), the refusal of a failed rank thrown on every rank.
+  std::vector<double> exchange_down(std::span<const double> answers, std::size_t per_root, bool& sent);
   std::exception_ptr in_words(std::exception_ptr failure) const {
     return share_.failure_words ? share_.failure_words(failure) : failure;
   }

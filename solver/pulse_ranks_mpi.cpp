@@ -29,8 +29,8 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     if (!exchange_) exchange_ = std::make_unique<RootExchange>(MPI_COMM_WORLD, ranks_.top_rank, roots_);
     return exchange_->gather(numbers, failure, LumpedLink::up_per_root, failed);
   };
-  ranks_.link.down = [this](std::span<const double> answers, std::exception_ptr failure) {
-    return exchange_->scatter(answers, failure, LumpedLink::down_per_root, "the 0D step");
+  ranks_.link.down = [this](std::span<const double> answers, std::exception_ptr failure, std::size_t per_root) {
+    return exchange_->scatter(answers, failure, per_root, "the 0D step");
   };
   ranks_.lead_whole = [this](std::vector<double>& values, const std::vector<unsigned char>& mine) {
     // Every rank's (item, value) pairs to the top's rank.

@@ -61,7 +61,7 @@ class PlayedLink {
       }
       return all;
     };
-    link.down = [this, rank](std::span<const double> answers, std::exception_ptr failure) {
+    link.down = [this, rank](std::span<const double> answers, std::exception_ptr failure, std::size_t per_root) {
       if (failure) failure_[static_cast<std::size_t>(rank)] = failure;
       if (rank == top_) answers_.assign(answers.begin(), answers.end());
       meet_.arrive_and_wait();
@@ -70,8 +70,8 @@ class PlayedLink {
         if (failure_[r]) refusal += "rank " + std::to_string(r) + ": " + words(failure_[r]) + "; ";
       if (!refusal.empty()) throw std::runtime_error(refusal);
       std::size_t first = 0;
-      for (int r = 0; r < rank; ++r) first += LumpedLink::down_per_root * static_cast<std::size_t>(roots_[static_cast<std::size_t>(r)]);
-      const std::size_t count = LumpedLink::down_per_root * static_cast<std::size_t>(roots_[static_cast<std::size_t>(rank)]);
+      for (int r = 0; r < rank; ++r) first += per_root * static_cast<std::size_t>(roots_[static_cast<std::size_t>(r)]);
+      const std::size_t count = per_root * static_cast<std::size_t>(roots_[static_cast<std::size_t>(rank)]);
       std::vector<double> mine(answers_.begin() + static_cast<std::ptrdiff_t>(first),
                                answers_.begin() + static_cast<std::ptrdiff_t>(first + count));
       meet_.arrive_and_wait();  // every rank has read its answers before the next step's

@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
       MPI_Allreduce(&held, &total, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
       check(total == net.node_count() + net.vessel_count() + net.outlets.size(),
             std::to_string(total) + " numbers held over the ranks");
-      check(exchange.traffic().calls == 80, std::to_string(exchange.traffic().calls) + " collective calls for 40 steps");
+      check(exchange.traffic().calls == 120, std::to_string(exchange.traffic().calls) + " collective calls for 40 steps (the roots up, the potentials and the pressures down)");
     }
 
     // The top's rank abandons a step between its halves: every rank refuses it, in its words.
