@@ -107,7 +107,9 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
     degree_list += (degree_list.empty() ? "" : ", ") + std::to_string(count) + " of degree " + std::to_string(p);
   }
   const int planned = config.planned_cycles(), threads = config.solver.threads;
-  const double lumped = static_cast<double>(run.lumped_vessels_in_run()), substeps = run.substeps() * run.coupling_passes();
+  // Over P ranks each steps about a P-th of the 0D vessels; the 1D vessels are the top's.
+  const int ranks = world_size();
+  const double lumped = static_cast<double>(run.lumped_vessels_in_run()) / ranks, substeps = run.substeps() * run.coupling_passes();
   const RunEstimate per_cycle =
       estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), threads, substeps, lumped);
   const RunEstimate whole =
@@ -135,7 +137,7 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
                 (degree_list.empty() ? "" : ": ") + degree_list + "; estimated " +
                 describe_duration(per_cycle.seconds) + " per cycle, " + describe_duration(whole.seconds) +
                 (config.until_periodic ? " for at most " : " for ") + plural(planned, "cycle") + " on " +
-                plural(threads, "thread"));
+                (ranks > 1 ? std::to_string(ranks) + " ranks of " : std::string()) + plural(threads, "thread"));
   if (whole.seconds > one_day && observer.hears_notes())
     observer.warn("the whole run may take " + describe_duration(whole.seconds) + " (use " +
                   in_words(placeholder("checkpoint_every"), config.words) + " N to be able to resume it)");
