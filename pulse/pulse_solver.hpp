@@ -142,6 +142,10 @@ class PulseSolver {
   PulseSolver(const Network& net, const SolverOptions& options, const PulseRanks* ranks = nullptr);
 
   void step();  // advances one time step (one 0D step, with its 1D substeps, where there are 0D vessels)
+  // The same; on a share of a run over ranks, while_waiting is called once its roots are sent,
+  // while the top's rank takes its 1D substeps: the share's state is still the step's start
+  // (t = time()), so that work reading it (the last step's statistics) fills the wait.
+  void step(const std::function<void()>& while_waiting);
   double time() const { return time_; }
   double dt() const { return dt_; }
   // Replaces the chosen step (e.g. by one that divides the period); the reason stays.
@@ -346,7 +350,7 @@ class PulseSolver {
   void choose_stable_step(const SolverOptions& options);  // the 1D vessels' stability limit
   void step_exponential(double h);  // ETD2 in the friction, AB2 in the rest
   void step_1d(double h);  // one step of the 1D vessels, time_ from t to t + h
-  void step_coupled();     // a 0D step around its 1D substeps
+  void step_coupled(const std::function<void()>& while_waiting);  // a 0D step around its 1D substeps
   void take_coupled_substeps();  // its 1D substeps, in every coupling pass; coupled_volume_ from them
   void take_substeps();    // the 1D substeps of the 0D step being taken, from its start
   void keep_pass_start();       // pass_start_ from the 1D vessels now (the step's start)

@@ -206,18 +206,20 @@ void PulseSolver::step_exponential(double h) {
   std::swap(previous_rate_, rate_);
 }
 
-void PulseSolver::step() {
+void PulseSolver::step() { step({}); }
+
+void PulseSolver::step(const std::function<void()>& while_waiting) {
   if (lumped_count_after_release_) throw std::logic_error("PulseSolver::step after release_lumped_state");
   if (lumped_.empty() && !lumped_.over_ranks()) {
     step_1d(dt_);
     time_ += dt_;
   } else {
-    step_coupled();
+    step_coupled(while_waiting);
   }
   ++steps_;
 }
 
-void PulseSolver::step_coupled() {
+void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
   // The 0D vessels step first with the coupled ends' inflows held at their last values; the
   // 1D ends then see each node's pressure move to the prediction, plus the node's own
   // response to their departure from the held inflow: a Robin condition. Without it the
@@ -245,6 +247,7 @@ void PulseSolver::step_coupled() {
   } catch (const LumpedVessels::CollapsedNode& collapsed) {
     throw SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_);
   }
+  if (while_waiting && !one_d_here_) while_waiting();  // a share: the top's rank takes its substeps
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
   if (element_count() > 0 && one_d_here_) {
     try {

@@ -22,24 +22,23 @@ double largest_on_ranks(double value) {
   return largest;
 }
 
-void take_lead_values(std::vector<double>& values) {
-  auto count = static_cast<std::uint64_t>(values.size());
+namespace {
+// Rank 0's items (a vector's, a string's) on every rank, its length first; in pieces below
+// 2^31 items, MPI's count.
+template <class Items>
+void take_lead_items(Items& items, MPI_Datatype type) {
+  auto count = static_cast<std::uint64_t>(items.size());
   MPI_Bcast(&count, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
-  values.resize(static_cast<std::size_t>(count));
-  // In pieces below 2^31 numbers, MPI's count.
+  items.resize(static_cast<std::size_t>(count));
   constexpr std::size_t piece = std::size_t{1} << 30;
-  for (std::size_t at = 0; at < values.size(); at += piece)
-    MPI_Bcast(values.data() + at, static_cast<int>(std::min(piece, values.size() - at)), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  for (std::size_t at = 0; at < items.size(); at += piece)
+    MPI_Bcast(items.data() + at, static_cast<int>(std::min(piece, items.size() - at)), type, 0, MPI_COMM_WORLD);
 }
+}  // namespace
 
-void take_lead_text(std::string& text) {
-  auto count = static_cast<std::uint64_t>(text.size());
-  MPI_Bcast(&count, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
-  text.resize(static_cast<std::size_t>(count));
-  constexpr std::size_t piece = std::size_t{1} << 30;
-  for (std::size_t at = 0; at < text.size(); at += piece)
-    MPI_Bcast(text.data() + at, static_cast<int>(std::min(piece, text.size() - at)), MPI_CHAR, 0, MPI_COMM_WORLD);
-}
+void take_lead_values(std::vector<double>& values) { take_lead_items(values, MPI_DOUBLE); }
+
+void take_lead_text(std::string& text) { take_lead_items(text, MPI_CHAR); }
 
 PeriodicityChange lead_change(PeriodicityChange change) {
   auto vessel = static_cast<std::uint64_t>(change.vessel);

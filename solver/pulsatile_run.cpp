@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
+#include <functional>
 #include <utility>
 
 #include "core/errors.hpp"
@@ -415,11 +416,23 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       if (transport_) transport_->begin_cycle();
       double sampled_until = solver_.time();
       const double started = seconds_since_epoch_start();
+      // A share of a run over ranks takes a step's statistics in the next step, while the
+      // top's rank takes its 1D substeps and the share would wait (its state is still that
+      // step's end then): the same sums, off the share's part of the step. The cycle's last
+      // step's at once.
+      const bool sample_while_waiting = over_ranks_ && !solver_.holds_one_d();
+      std::optional<std::pair<double, double>> waiting_sample;  // (t, weight)
+      const std::function<void()> take_waiting_sample = [&] {
+        if (!waiting_sample) return;
+        stats_.sample(solver_, waiting_sample->first, waiting_sample->second);
+        waiting_sample.reset();
+      };
       for (std::size_t k = 0; k < plan_.steps_per_cycle; ++k) {
-        solver_.step();
+        solver_.step(take_waiting_sample);
         if (transport_ && ((k + 1) % plan_.transport_every == 0 || k + 1 == plan_.steps_per_cycle)) transport_->advance();
         if ((k + 1) % stats_every == 0 || k + 1 == plan_.steps_per_cycle) {
-          stats_.sample(solver_, solver_.time(), solver_.time() - sampled_until);
+          if (sample_while_waiting && k + 1 < plan_.steps_per_cycle) waiting_sample.emplace(solver_.time(), solver_.time() - sampled_until);
+          else stats_.sample(solver_, solver_.time(), solver_.time() - sampled_until);
           sampled_until = solver_.time();
         }
         if (plan_.frames > 0 && (k + 1) * static_cast<std::size_t>(plan_.frames) >= (frames_written + 1) * plan_.steps_per_cycle) {

@@ -16,10 +16,13 @@ MPIRUN="timeout 120 mpirun --oversubscribe"
   -o "$WORK/tree.json" 2>/dev/null || fail "vgen | vprune"
 "$HEMOSOLVE" "$WORK/tree.json" --steady --out "$WORK/one" 2>/dev/null || fail "hemosolve --steady"
 "$HEMOSOLVE" "$WORK/tree.json" --steady --format h5 --out "$WORK/one-h5" 2>/dev/null || fail "hemosolve --steady --format h5"
-same_run() {  # the plain run's files, summary.json but its wall time
-  cmp -s "$WORK/one/vessels.csv" "$1/vessels.csv" \
-    && diff <(grep -v '"wall_time"' "$WORK/one/summary.json") <(grep -v '"wall_time"' "$1/summary.json") >/dev/null
+same_files() {  # REFERENCE RUN [PATTERN]: vessels.csv and probes.csv byte for byte, summary.json but
+  # its wall time (and the lines PATTERN matches)
+  local skip='"wall_time"'${3:+"\\|$3"}
+  cmp -s "$1/vessels.csv" "$2/vessels.csv" && { [ ! -e "$1/probes.csv" ] || cmp -s "$1/probes.csv" "$2/probes.csv"; } \
+    && diff <(grep -v "$skip" "$1/summary.json") <(grep -v "$skip" "$2/summary.json") >/dev/null
 }
+same_run() { same_files "$WORK/one" "$1"; }  # the plain steady run's files
 for ranks in 1 2 3 4; do
   $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/tree.json" --steady --out "$WORK/ranks$ranks" >"$WORK/out$ranks" 2>&1
   status=$?
@@ -49,9 +52,7 @@ for ranks in 2 3; do
     >"$WORK/lout$ranks" 2>&1
   status=$?
   said=$(grep -c "^hemosolve: $ranks ranks by subtrees: .*; the harmonics' exchanges on rank 0: " "$WORK/lout$ranks")
-  [ $status -eq 0 ] && [ "$said" -eq 1 ] && cmp -s "$WORK/linear-one/vessels.csv" "$WORK/linear$ranks/vessels.csv" \
-    && cmp -s "$WORK/linear-one/probes.csv" "$WORK/linear$ranks/probes.csv" \
-    && diff <(grep -v '"wall_time"' "$WORK/linear-one/summary.json") <(grep -v '"wall_time"' "$WORK/linear$ranks/summary.json") >/dev/null \
+  [ $status -eq 0 ] && [ "$said" -eq 1 ] && same_files "$WORK/linear-one" "$WORK/linear$ranks" \
     && pass "mpirun -np $ranks hemosolve --linear: the plain run's bytes, probes too, the partition said once" \
     || fail "mpirun -np $ranks --linear: status $status, partition said $said times: $(head -3 "$WORK/lout$ranks")"
 done
@@ -67,10 +68,7 @@ probes="--probe 870:0.2 --probe 3 --probe 431:0.9"
 for ranks in 2 3 4; do
   $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/waves.json" --linear $probes --out "$WORK/waves$ranks" >"$WORK/wout$ranks" 2>&1
   status=$?
-  [ $status -eq 0 ] && grep -q "the top's 855 vessels" "$WORK/wout$ranks" \
-    && cmp -s "$WORK/waves-one/vessels.csv" "$WORK/waves$ranks/vessels.csv" \
-    && cmp -s "$WORK/waves-one/probes.csv" "$WORK/waves$ranks/probes.csv" \
-    && diff <(grep -v '"wall_time"' "$WORK/waves-one/summary.json") <(grep -v '"wall_time"' "$WORK/waves$ranks/summary.json") >/dev/null \
+  [ $status -eq 0 ] && grep -q "the top's 855 vessels" "$WORK/wout$ranks" && same_files "$WORK/waves-one" "$WORK/waves$ranks" \
     && pass "mpirun -np $ranks --linear, a tree with waves (its 1D vessels moved to the top): the plain run's bytes" \
     || fail "mpirun -np $ranks --linear (waves): status $status: $(head -3 "$WORK/wout$ranks")"
 done
@@ -111,9 +109,7 @@ for ranks in 2 3 4; do
   status=$?
   said=$(grep -c "^hemosolve: $ranks ranks by subtrees: .*; the top's rank steps [0-9]* vessels" "$WORK/pout$ranks")
   [ $status -eq 0 ] && [ "$said" -eq 1 ] && [ "$(grep -c "cycle 1/50 done" "$WORK/pout$ranks")" -eq 1 ] \
-    && cmp -s "$WORK/pulse-one/vessels.csv" "$WORK/pulse$ranks/vessels.csv" \
-    && cmp -s "$WORK/pulse-one/probes.csv" "$WORK/pulse$ranks/probes.csv" \
-    && diff <(grep -v '"wall_time"' "$WORK/pulse-one/summary.json") <(grep -v '"wall_time"' "$WORK/pulse$ranks/summary.json") >/dev/null \
+    && same_files "$WORK/pulse-one" "$WORK/pulse$ranks" \
     && pass "mpirun -np $ranks hemosolve (pulsatile, until periodic): the plain run's bytes, probes too, said once" \
     || fail "mpirun -np $ranks (pulsatile): status $status, partition said $said times: $(head -3 "$WORK/pout$ranks")"
 done
@@ -126,9 +122,7 @@ same_h5 "$WORK/pulse-one-h5/results.h5" "$WORK/pulse-h5/results.h5" \
   || fail "hemosolve --settling-step 4 (pulse)"
 grep -q "settling cycle done" "$WORK/settled-log" || fail "the plain run took no settling cycle"
 $MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-step 4 --out "$WORK/settled-2" >/dev/null 2>&1
-cmp -s "$WORK/settled-one/vessels.csv" "$WORK/settled-2/vessels.csv" && cmp -s "$WORK/settled-one/probes.csv" "$WORK/settled-2/probes.csv" \
-  && diff <(grep -v '"wall_time"\|"seconds"' "$WORK/settled-one/summary.json") \
-          <(grep -v '"wall_time"\|"seconds"' "$WORK/settled-2/summary.json") >/dev/null \
+same_files "$WORK/settled-one" "$WORK/settled-2" '"seconds"' \
   && pass "mpirun -np 2 --settling-step 4: the plain run's files (the settling cycle over ranks)" \
   || fail "--settling-step over 2 ranks: the files differ from the plain run's"
 # Frames over ranks: every vessel's centre gathered on rank 0 at each frame, the plain run's
@@ -168,10 +162,7 @@ said=$(grep -c "warning: interrupted by SIGTERM after [0-9] cycles: .* holds the
   && pass "one rank interrupted: every rank stopped, the last cycle's results and checkpoint kept, said once" \
   || fail "one rank interrupted: status $status, said $said times: $(tail -3 "$WORK/stopped")"
 cp -r "$WORK/pulse-stopped" "$WORK/pulse-stopped-copy"
-same_six() {  # the uninterrupted run's files (summary.json but its wall time)
-  cmp -s "$WORK/six-one/vessels.csv" "$1/vessels.csv" && cmp -s "$WORK/six-one/probes.csv" "$1/probes.csv" \
-    && diff <(grep -v '"wall_time"' "$WORK/six-one/summary.json") <(grep -v '"wall_time"' "$1/summary.json") >/dev/null
-}
+same_six() { same_files "$WORK/six-one" "$1"; }  # the uninterrupted run's files
 $MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" $six --resume "$WORK/pulse-stopped" >"$WORK/resumed" 2>&1
 status=$?
 [ $status -eq 0 ] && grep -q "resuming from .* after [0-9] cycles" "$WORK/resumed" && same_six "$WORK/pulse-stopped" \
