@@ -49,17 +49,28 @@ PeriodicityChange lead_change(PeriodicityChange change) {
 }
 
 void check_solution_on_every_rank(const PulseSolver& solver) {
+  std::exception_ptr failure;
+  try {
+    solver.check_solution();
+  } catch (const SolutionBreakdown&) {
+    failure = std::current_exception();
+  }
+  breakdown_on_every_rank(failure);
+}
+
+void breakdown_on_every_rank(std::exception_ptr failure) {
   const int none = world_size();
   int failed = none;
   std::int64_t vessel = 0;
   double at = 0;
-  try {
-    solver.check_solution();
-  } catch (const SolutionBreakdown& e) {
-    failed = world_rank();
-    vessel = e.vessel;
-    at = e.at;
-  }
+  if (failure) try {
+      std::rethrow_exception(failure);
+    } catch (const SolutionBreakdown& e) {
+      failed = world_rank();
+      vessel = e.vessel;
+      at = e.at;
+    } catch (...) {
+    }
   int first = failed;
   MPI_Allreduce(&failed, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   if (first == none) return;

@@ -6,6 +6,7 @@
 // it at the same point of the run.
 #pragma once
 
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -29,5 +30,9 @@ PeriodicityChange lead_change(PeriodicityChange change);
 // PulseSolver::check_solution on every rank's vessels: where any fails, SolutionBreakdown on
 // every rank, the lowest failing rank's (its first vessel in the network's order).
 void check_solution_on_every_rank(const PulseSolver& solver);
+// Where any rank's failure (null: none) is a SolutionBreakdown, throws the lowest such rank's
+// on every rank, as the solver says it alone (a breakdown a step's messages refused carries
+// words only); else returns. Every rank calls it after the same refusal.
+void breakdown_on_every_rank(std::exception_ptr failure);
 
 }  // namespace hemotree

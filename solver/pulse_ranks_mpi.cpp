@@ -2,6 +2,7 @@
 
 #include "distributed/network_cut.hpp"
 #include "mpi/session.hpp"
+#include "solver/decisions_over_ranks.hpp"
 #include "pulse/lumped_cut.hpp"
 
 namespace hemotree {
@@ -30,7 +31,12 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     return exchange_->gather(numbers, failure, LumpedLink::up_per_root, failed);
   };
   ranks_.link.down = [this](std::span<const double> answers, std::exception_ptr failure, std::size_t per_root) {
-    return exchange_->scatter(answers, failure, per_root, "the 0D step");
+    try {
+      return exchange_->scatter(answers, failure, per_root, "the 0D step");
+    } catch (const CollectiveFailure&) {
+      breakdown_on_every_rank(failure);  // the solution's breakdown as the run reports it alone
+      throw;
+    }
   };
   ranks_.lead_whole = [this](std::vector<double>& values, const std::vector<unsigned char>& mine) {
     // Every rank's (item, value) pairs to the top's rank.

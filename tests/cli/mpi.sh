@@ -237,6 +237,13 @@ expect_refused() {  # name, text, command...: status 2, said once, no folder
 }
 expect_refused "phase separation over 2 ranks" "hemosolve: error: started on 2 MPI ranks: --steady with --red-cells transport runs as one process" \
   -np 2 "$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport --out "$WORK/refused-out"
+# A breakdown over ranks (a 1D vessel on the top's rank, a step beyond its limit, forced) is
+# every rank's and said as the plain run says it, once; nothing computed, nothing kept.
+"$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --cfl 3 --force --lumped-sections 1 --out "$WORK/broken-one" 2>"$WORK/broken-one.err"
+expect_refused "a breakdown over 2 ranks" "$(grep -o "hemosolve: error: the solution broke down in vessel [0-9]* at t = [0-9.e-]* s" "$WORK/broken-one.err")" \
+  -np 2 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --cfl 3 --force --out "$WORK/refused-out"
+grep -q "broke down" "$WORK/broken-one.err" || fail "the plain run did not break down at --cfl 3"
+[ ! -e "$WORK/refused-out.partial" ] || fail "a breakdown over ranks left $WORK/refused-out.partial"
 # What a pulsatile run over ranks does not take yet: refused on every rank, said once.
 expect_refused "a pulsatile run over 2 ranks with red cells carried" \
   "hemosolve: error: --red-cells transport: a pulsatile run over MPI ranks carries no red cells or tracers yet" \
