@@ -117,7 +117,7 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
   if (per_cycle.seconds > one_day && !config.force)
     throw SettingError("force", "one cycle would take about " + describe_duration(per_cycle.seconds) + " (" +
                      format_rounded(static_cast<double>(steps_per_cycle)) + " steps of " + format_quantity(dt, "s") +
-                     ", set by the " + d.step.reason + "; " + plural(run.element_count(), "element") +
+                     (d.step.reason.starts_with("given") ? ", " : ", set by the ") + d.step.reason + "; " + plural(run.element_count(), "element") +
                      "): refused, more than a day. Check that vessel's wall and length and the inlet's "
                      "flow, use fewer " + placeholder("elements") + " or a lower " + placeholder("degree") + ", or " +
                      placeholder("force") + " to run it anyway");
@@ -378,7 +378,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   if (given_up && !config.vtk && config.frames == 0)
     for (std::vector<double>* wall : {&given_up->wall_thickness, &given_up->youngs_modulus}) std::vector<double>().swap(*wall);
   if (interrupted_before_start()) return result;
-  const Discretisation d = decide_discretisation(net, run, config, period, observer);
+  Discretisation d;  // its refusal (a cycle above a day, too many frames) every rank's alike
+  on_every_rank([&] { d = decide_discretisation(net, run, config, period, observer); });
   const std::size_t steps_per_cycle = d.step.cycle.steps_per_cycle;
   const double dt = d.step.cycle.dt;
 

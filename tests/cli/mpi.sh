@@ -244,6 +244,9 @@ expect_refused "a breakdown over 2 ranks" "$(grep -o "hemosolve: error: the solu
   -np 2 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --cfl 3 --force --out "$WORK/refused-out"
 grep -q "broke down" "$WORK/broken-one.err" || fail "the plain run did not break down at --cfl 3"
 [ ! -e "$WORK/refused-out.partial" ] || fail "a breakdown over ranks left $WORK/refused-out.partial"
+# A cycle estimated above a day: the one-process refusal, said once.
+expect_refused "a pulsatile run over 2 ranks estimated above a day" "hemosolve: error: one cycle would take about" \
+  -np 2 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --dt 1e-9 --out "$WORK/refused-out"
 # What a pulsatile run over ranks does not take yet: refused on every rank, said once.
 expect_refused "a pulsatile run over 2 ranks with red cells carried" \
   "hemosolve: error: --red-cells transport: a pulsatile run over MPI ranks carries no red cells or tracers yet" \
