@@ -113,6 +113,15 @@ for ranks in 2 3 4; do
     && pass "mpirun -np $ranks hemosolve (pulsatile, until periodic): the plain run's bytes, probes too, said once" \
     || fail "mpirun -np $ranks (pulsatile): status $status, partition said $said times: $(head -3 "$WORK/pout$ranks")"
 done
+# A pruned tree (vprune --budget 3000: 174 RCR outlets, 350 R, 976 capillaries), its RCR
+# capacitors balanced: over 3 ranks the plain run's files.
+"$VGEN" --seed 3 --root-diameter 1mm --min-diameter 40um 2>/dev/null | "$BUILD/pruner/vprune" --budget 3000 \
+  -o "$WORK/pruned.json" 2>/dev/null || fail "vgen | vprune --budget 3000"
+"$HEMOSOLVE" "$WORK/pruned.json" $pulse --lumped-sections 1 --out "$WORK/pruned-one" 2>/dev/null || fail "hemosolve (pruned)"
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pruned.json" $pulse --out "$WORK/pruned-3" >/dev/null 2>&1
+grep -q '"type":"RCR"' "$WORK/pruned.json" && same_files "$WORK/pruned-one" "$WORK/pruned-3" \
+  && pass "mpirun -np 3, a pruned tree with RCR and R outlets until periodic: the plain run's files" \
+  || fail "a pruned tree with RCR outlets over 3 ranks: the files differ from the plain run's"
 $MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --format h5 --out "$WORK/pulse-h5" >/dev/null 2>&1
 same_h5 "$WORK/pulse-one-h5/results.h5" "$WORK/pulse-h5/results.h5" \
   && pass "mpirun -np 3 hemosolve --format h5 (pulsatile): the plain run's values" || fail "pulsatile --format h5 over ranks"
