@@ -5,6 +5,7 @@
 // the refusals.
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -126,6 +127,28 @@ TEST(Partition, VesselsKeptOnTheTopMoveThereWithThoseAboveThem) {
   // Every vessel on the top leaves the other ranks without one.
   Partition all = plain;
   EXPECT_THROW(keep_on_top(net, cost, std::vector<std::uint8_t>(net.vessel_count(), 1), all), SettingError);
+}
+
+// The top made rank 0 (a run over ranks writes the top's state with the results): ranks 0
+// and the top's swap their vessels, their costs and counts; every other rank and the cut stay.
+TEST(Partition, TheTopLedByRankZero) {
+  const Network net = grown_tree();
+  const std::vector<double> cost(net.vessel_count(), 1.0);
+  for (const int ranks : {2, 3, 4}) {
+    const Partition plain = partition_network(net, cost, ranks);
+    ASSERT_FALSE(plain.top_spread);
+    Partition p = plain;
+    lead_with_the_top(p);
+    EXPECT_EQ(p.top_rank, 0);
+    expect_consistent(net, cost, p);
+    const int top = plain.top_rank;
+    auto was = [&](std::int32_t r) { return r == 0 ? top : r == top ? 0 : r; };
+    for (std::size_t v = 0; v < net.vessel_count(); ++v) EXPECT_EQ(p.rank_of_vessel[v], was(plain.rank_of_vessel[v])) << "vessel " << v;
+    for (const std::int32_t v : p.top) EXPECT_EQ(p.rank_of_vessel[static_cast<std::size_t>(v)], 0);
+    EXPECT_EQ(p.imbalance(), plain.imbalance());
+    EXPECT_EQ(p.cut_nodes, plain.cut_nodes);
+    std::printf("%d ranks: the top was on rank %d\n", ranks, top);
+  }
 }
 
 TEST(Partition, BalancesCostNotCount) {
