@@ -369,7 +369,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   PulseSolver& run = *solver;
   if (ranks)
     observer.note(describe(ranks->partition()) + "; the top's rank steps " + std::to_string(ranks->top_vessels()) +
-                  " vessels (the 1D ones and every vessel above them, with subtrees of its own)");
+                  " vessels (the 1D ones and every vessel above them, with subtrees of its own; weighed for its "
+                  "statistics as " + std::to_string(std::llround(ranks->top_weight())) + " vessels more)");
   // The settling cycle at a lower 1D degree (solver/settling_cycle.hpp) takes a solver of its
   // own, built here while the network still has its walls (not over ranks: refuse_over_ranks).
   std::unique_ptr<PulseSolver> settling =

@@ -7,6 +7,14 @@
 
 namespace hemotree {
 
+std::int32_t MpiPulseRanks::tree_root() const {
+  std::vector<std::int32_t> entering(net_.node_count(), -1);
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) entering[static_cast<std::size_t>(net_.to[v])] = static_cast<std::int32_t>(v);
+  std::int32_t root = 0;
+  for (std::int32_t up = 0; up >= 0; up = entering[static_cast<std::size_t>(net_.from[static_cast<std::size_t>(up)])]) root = up;
+  return root;
+}
+
 MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     : net_(net), cost_(std::move(cost)), partition_(partition_network(net, cost_, world_size())) {
   check_subtree_partition(partition_);
@@ -18,7 +26,23 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
   ranks_.vessel_ranks = [this](const std::vector<bool>& zero_d) {
     std::vector<std::uint8_t> on_top(zero_d.size());
     for (std::size_t v = 0; v < zero_d.size(); ++v) on_top[v] = zero_d[v] ? 0 : 1;
-    keep_on_top(net_, cost_, on_top, partition_);
+    // The top's rank takes its statistics on the step's path, a share in its wait for the
+    // top's 1D substeps (docs/scaling.md, item 7): the top should hold x = N / ((P - 1)(1 + r)
+    // + 1) of the N 0D vessels, r a sample's cost over a vessel's step. An extra weight W on
+    // the tree's root (always the top's) deals it so: x + W = (N + W) / P.
+    const int ranks = world_size();
+    const auto n = static_cast<double>(std::count(zero_d.begin(), zero_d.end(), true));
+    const double x = n / ((ranks - 1) * (1 + statistics_per_vessel_step) + 1);
+    top_weight_ = ranks > 1 ? (n - ranks * x) / (ranks - 1) : 0;
+    std::vector<double> cost = cost_;
+    if (top_weight_ > 0) {
+      cost[static_cast<std::size_t>(tree_root())] += top_weight_;
+      partition_ = partition_network(net_, cost, ranks);
+      check_subtree_partition(partition_);
+      check_one_partition(partition_);
+      lead_with_the_top(partition_);
+    }
+    keep_on_top(net_, cost, on_top, partition_);
     std::vector<std::int32_t> rank(partition_.rank_of_vessel.begin(), partition_.rank_of_vessel.end());
     for (const std::int32_t v : partition_.top) rank[static_cast<std::size_t>(v)] = partition_.top_rank;
     top_vessels_ = 0;
