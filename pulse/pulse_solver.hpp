@@ -131,6 +131,7 @@ struct PulseRanks {
   // is one rank's); after the call, every rank's values are every item's holder's. Collective.
   std::function<void(std::vector<double>& values, const std::vector<unsigned char>& mine)> make_whole;
   // The same on the top's rank alone (the others' values left as they are): a checkpoint's.
+  // (Over MPI the top is rank 0, which writes the results: solver/pulse_ranks_mpi.hpp.)
   std::function<void(std::vector<double>& values, const std::vector<unsigned char>& mine)> lead_whole;
 };
 

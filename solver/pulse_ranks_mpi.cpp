@@ -1,5 +1,6 @@
 #include "solver/pulse_ranks_mpi.hpp"
 
+#include "distributed/gather_rows.hpp"
 #include "distributed/network_cut.hpp"
 #include "mpi/session.hpp"
 #include "solver/decisions_over_ranks.hpp"
@@ -62,19 +63,16 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
       throw;
     }
   };
-  ranks_.lead_whole = [this](std::vector<double>& values, const std::vector<unsigned char>& mine) {
-    // Every rank's (item, value) pairs to the top's rank.
-    std::vector<double> pairs;
+  ranks_.lead_whole = [](std::vector<double>& values, const std::vector<unsigned char>& mine) {
+    // Every rank's own items to rank 0, the top's (lead_with_the_top above).
+    std::vector<std::int32_t> items;
+    std::vector<double> rows;
     for (std::size_t k = 0; k < values.size(); ++k)
-      if (mine[k]) pairs.insert(pairs.end(), {static_cast<double>(k), values[k]});
-    const int count = static_cast<int>(pairs.size()), top = ranks_.top_rank;
-    const bool here = ranks_.rank == top;
-    std::vector<int> counts(here ? static_cast<std::size_t>(world_size()) : 0), offsets(counts.size(), 0);
-    MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, top, MPI_COMM_WORLD);
-    for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-    std::vector<double> all(here ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
-    MPI_Gatherv(pairs.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, top, MPI_COMM_WORLD);
-    for (std::size_t j = 0; j < all.size(); j += 2) values[static_cast<std::size_t>(all[j])] = all[j + 1];
+      if (mine[k]) {
+        items.push_back(static_cast<std::int32_t>(k));
+        rows.push_back(values[k]);
+      }
+    gather_rows(items, rows, 1, values.size(), [&](std::int32_t item, const double* row) { values[static_cast<std::size_t>(item)] = row[0]; });
   };
   ranks_.make_whole = [](std::vector<double>& values, const std::vector<unsigned char>& mine) {
     // Every rank's (item, value) pairs to every rank.

@@ -16,12 +16,16 @@
 
 namespace hemotree::test_networks {
 
-inline Network grown_tree() {
+// vgen --root-diameter ROOT --min-diameter MIN --seed SEED, in code.
+inline Network grown_tree(double root_diameter, double min_diameter, std::uint64_t seed = GrowthParameters{}.seed) {
   GrowthParameters p;
-  p.root_diameter = 150e-6;
-  p.min_diameter = 7e-6;
+  p.root_diameter = root_diameter;
+  p.min_diameter = min_diameter;
+  p.seed = seed;
   return grow_tree(default_rules(), p);
 }
+
+inline Network grown_tree() { return grown_tree(150e-6, 7e-6); }
 
 // A network's vessels (from, to) with its nodes labelled in a shuffled order (seed), and every
 // `reversed`-th vessel the other way round (0: none): a forest whose labels no longer hang

@@ -11,6 +11,7 @@
 #include "physics/wall_law.hpp"
 #include "pruner/outlet_calibration.hpp"
 #include "pruner/pruning_strategies.hpp"
+#include "tests/grown_trees.hpp"
 #include "steady/steady_flow.hpp"
 
 using namespace hemotree;
@@ -18,11 +19,7 @@ using namespace hemotree;
 namespace {
 
 Network full_tree() {
-  GrowthParameters p;
-  p.root_diameter = 400e-6;
-  p.min_diameter = 8.5e-6;
-  p.seed = 11;
-  Network net = grow_tree(default_rules(), p);
+  Network net = test_networks::grown_tree(400e-6, 8.5e-6, 11);
   net.blood = Blood{};
   Inlet inlet;
   inlet.vessel = 0;

@@ -8,8 +8,7 @@
 #include <bit>
 #include <cstdint>
 
-#include "generator/growth_rules.hpp"
-#include "generator/tree_growth.hpp"
+#include "../grown_trees.hpp"
 #include "pruner/outlet_calibration.hpp"
 #include "pruner/pruning_strategies.hpp"
 #include "pulse/pulse_solver.hpp"
@@ -17,11 +16,7 @@
 namespace hemotree::test_networks {
 
 inline Network tree_with_waves() {
-  GrowthParameters p;
-  p.root_diameter = 1e-3;
-  p.min_diameter = 50e-6;
-  p.seed = 3;
-  Network full = grow_tree(default_rules(), p);
+  Network full = grown_tree(1e-3, 50e-6, 3);
   full.blood = Blood{};
   Inlet inlet;
   inlet.vessel = full.id[0];
