@@ -2,20 +2,16 @@
 
 #include "distributed/gather_rows.hpp"
 #include "distributed/network_cut.hpp"
+#include "formats/topology.hpp"
 #include "mpi/session.hpp"
 #include "solver/decisions_over_ranks.hpp"
 #include "pulse/lumped_cut.hpp"
 
 namespace hemotree {
 
-std::int32_t MpiPulseRanks::tree_root() const {
-  std::vector<std::int32_t> entering(net_.node_count(), -1);
-  for (std::size_t v = 0; v < net_.vessel_count(); ++v) entering[static_cast<std::size_t>(net_.to[v])] = static_cast<std::int32_t>(v);
-  std::int32_t root = 0;
-  for (std::int32_t up = 0; up >= 0; up = entering[static_cast<std::size_t>(net_.from[static_cast<std::size_t>(up)])]) root = up;
-  return root;
-}
-
+// The partition by the given costs first: a network with loops or too many ranks is refused
+// here, before the solver's steady solve; the top's weight needs the models, and the vessels
+// are dealt again with it once the solver has chosen them (vessel_ranks).
 MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     : net_(net), cost_(std::move(cost)), partition_(partition_network(net, cost_, world_size())) {
   check_subtree_partition(partition_);
@@ -37,7 +33,7 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     top_weight_ = ranks > 1 ? (n - ranks * x) / (ranks - 1) : 0;
     std::vector<double> cost = cost_;
     if (top_weight_ > 0) {
-      cost[static_cast<std::size_t>(tree_root())] += top_weight_;
+      cost[static_cast<std::size_t>(inlet_vessels(net_).front())] += top_weight_;  // a root: the top's
       partition_ = partition_network(net_, cost, ranks);
       check_subtree_partition(partition_);
       check_one_partition(partition_);

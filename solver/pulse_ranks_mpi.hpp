@@ -48,7 +48,6 @@ class MpiPulseRanks {
   std::vector<int> roots_;
   std::size_t top_vessels_ = 0;
   double top_weight_ = 0;
-  std::int32_t tree_root() const;  // the root of vessel 0's tree
   std::unique_ptr<RootExchange> exchange_;
 };
 
