@@ -23,7 +23,8 @@ constexpr std::string_view magic = "hemotree checkpoint\n";
 // 8: the last two cycles' results in sections of their own (a writer holds one section at a time).
 // 9: of the cycle before the last, its mean pressures alone (what the periodicity test reads).
 // 10: no volumes in and out summed over the boundaries (each boundary's volume gives them).
-constexpr std::uint64_t format_version = 10;
+// 11: the red cells in and out per boundary (ranks hold a few each), the faces before the step count.
+constexpr std::uint64_t format_version = 11;
 constexpr std::size_t word = sizeof(std::uint64_t);
 constexpr std::size_t header = magic.size() + word;  // the magic line and the format
 

@@ -180,6 +180,10 @@ class LumpedVessels {
   // rank's): the top's rank's ghosts, a share's nodes above its roots.
   bool ghost_node(std::int32_t node) const { return is_ghost_node(static_cast<std::size_t>(node)); }
   bool ghost_vessel(std::int32_t index) const { return is_ghost_edge(first_edge(static_cast<std::size_t>(index))); }
+  // The root vessels (their indices here) in the messages' order: on the top's rank its ghosts,
+  // every other rank's roots rank after rank; on a share its own (pulse/lumped_cut.hpp). Over
+  // ranks a vessel is one section, so its edge is its index.
+  const std::vector<std::int32_t>& root_vessels() const { return share_.root_edge; }
 
   // The state a vessel's samples come from.
   double node_pressure(std::int32_t node) const { return pressure_[static_cast<std::size_t>(node)]; }

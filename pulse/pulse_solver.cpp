@@ -238,6 +238,8 @@ void PulseSolver::take_rank_share(const PulseRanks& ranks) {
   lumped_.set_link(ranks.link);
   make_whole_ = ranks.make_whole;
   lead_whole_ = ranks.lead_whole;
+  rank_ = ranks.rank;
+  rank_count_ = ranks.ranks;
   steps_vessel_.assign(n, 0);
   for (std::size_t v = 0; v < n; ++v) {
     const std::int32_t i = lumped_.vessel_index(v);

@@ -492,11 +492,14 @@ class PulseSolver {
   TimeScheme scheme_;
   int threads_ = 1;
   bool one_d_here_ = true;  // false on a share of a run over ranks (PulseRanks)
+  int rank_ = 0, rank_count_ = 1;  // over ranks: this rank's, of how many
   // Over ranks: PulseRanks::make_whole, and whether this rank steps each vessel and holds each
   // run outlet's state (the compliance balance's inputs, made whole on every rank).
   std::function<void(std::vector<double>&, const std::vector<unsigned char>&)> make_whole_, lead_whole_;
-  // save()'s section "pulse solver", with each boundary's 0D volume (whole over ranks).
-  void save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume) const;
+  // save()'s section "pulse solver", with each boundary's 0D volume and the viscosity factors
+  // (whole over ranks).
+  void save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume,
+                    const std::vector<double>& viscosity_factor) const;
   std::vector<unsigned char> steps_vessel_, holds_outlet_;
   double time_ = 0, dt_ = 0;
   std::string dt_reason_;

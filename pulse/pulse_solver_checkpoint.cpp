@@ -3,6 +3,7 @@
 // viscosity factors, time); the rest is rebuilt from the network and the options. Over ranks
 // the same bytes, written by the lead rank (the top's) with every rank's share of the 0D
 // vessels and boundaries, and read by each rank for its share.
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 #include <string>
@@ -13,7 +14,7 @@
 namespace hemotree {
 
 void PulseSolver::save(CheckpointWriter& out) const {
-  save_section(out, lumped_boundary_volume_);
+  save_section(out, lumped_boundary_volume_, viscosity_factor_);
   lumped_.save(out);
 }
 
@@ -24,6 +25,18 @@ void PulseSolver::save_over_ranks(CheckpointWriter* out) const {
   std::vector<unsigned char> held(boundary_volume.size(), 0);
   for (const std::int32_t b : held_boundaries()) held[static_cast<std::size_t>(b)] = 1;
   lead_whole_(boundary_volume, held);
+  // The viscosity factors (a red-cell transport's): each vessel's from the rank that steps it,
+  // none where no rank has set any (as the one-process run has none until a vessel's is set).
+  std::vector<double> set_on(static_cast<std::size_t>(rank_count_), 0.0);
+  std::vector<unsigned char> own(set_on.size(), 0);
+  set_on[static_cast<std::size_t>(rank_)] = viscosity_factor_.empty() ? 0.0 : 1.0;
+  own[static_cast<std::size_t>(rank_)] = 1;
+  make_whole_(set_on, own);  // every rank decides alike: the gather below is collective
+  std::vector<double> factors;
+  if (std::count(set_on.begin(), set_on.end(), 1.0) > 0) {
+    factors = viscosity_factor_.empty() ? std::vector<double>(net_.vessel_count(), 1.0) : viscosity_factor_;
+    lead_whole_(factors, steps_vessel_);
+  }
   // The 0D state: each node and edge from the rank that holds it, at its place in the whole's.
   const LumpedPlaces places = lumped_places(net_, zero_d_);
   LumpedVessels::StateShare share = lumped_.state_share(places);
@@ -43,11 +56,12 @@ void PulseSolver::save_over_ranks(CheckpointWriter* out) const {
     if (!out) std::vector<double>().swap(values);
   }
   if (!out) return;
-  save_section(*out, boundary_volume);
+  save_section(*out, boundary_volume, factors);
   LumpedVessels::save_whole(*out, whole);
 }
 
-void PulseSolver::save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume) const {
+void PulseSolver::save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume,
+                               const std::vector<double>& viscosity_factor) const {
   out.section("pulse solver");
   out.put(time_);
   out.put(dt_);
@@ -91,7 +105,7 @@ void PulseSolver::save_section(CheckpointWriter& out, const std::vector<double>&
     rest.push_back(o.rest_flow);
   }
   out.put(rest);
-  out.put(viscosity_factor_);
+  out.put(viscosity_factor);
 }
 
 void PulseSolver::restore(CheckpointReader& in) {

@@ -35,10 +35,12 @@ FlowTransportOptions red_cells_fixed(FlowTransportOptions options) {
   return options;
 }
 
-FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options)
+FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options,
+                             const TransportRanks* ranks)
     : net_(net), solver_(solver), options_(options) {
   if (solver.steps() != 0)
     throw InputError("red-cell transport: set up before the solver's first step (its face volumes start then)");
+  if (ranks && !options_.tracers.empty()) throw std::logic_error("FlowTransport over ranks: tracers");
   const LumpedVessels& lumped = solver.lumped();
   // Its cells at 0D nodes are the network's nodes: the inner nodes of a vessel in sections
   // would hold volume no cell does (solver_options() keeps every 0D vessel one section).
@@ -52,7 +54,23 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   auto fahraeus = [&](double diameter) { return options_.fahraeus ? fahraeus_parameter(diameter, scale) : 1.0; };
 
   TransportGrid grid;
-  grid.boundaries = boundaries.size();
+  // Over ranks a cut per root vessel: on a share its own roots, on the top's rank its ghosts.
+  const std::vector<std::int32_t> no_roots;
+  const std::vector<std::int32_t>& roots = ranks ? lumped.root_vessels() : no_roots;
+  grid.cuts = roots.size();
+  grid.boundaries = boundaries.size() + grid.cuts;
+  std::vector<std::int32_t> root_of;  // per 0D vessel here: its root's place in `roots`, or -1
+  if (ranks) {
+    cut_.emplace();
+    cut_->run_boundaries = boundaries.size();
+    cut_->face.assign(roots.size(), -1);
+    cut_->cell.assign(roots.size(), -1);
+    cut_->across.assign(roots.size(), -1);
+    cut_->far.assign(roots.size(), blood.hematocrit);
+    cut_->ghost.assign(lumped.empty() ? 0 : lumped.network_node_count(), -1);
+    root_of.assign(lumped.vessel_count(), -1);
+    for (std::size_t j = 0; j < roots.size(); ++j) root_of[static_cast<std::size_t>(roots[j])] = static_cast<std::int32_t>(j);
+  }
   std::vector<double> volume;
 
   // Nodes of 0D vessels: k weighted by the half-vessels they hold.
@@ -65,6 +83,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
     if (!solver.is_lumped(v)) continue;
     const std::int32_t i = lumped.vessel_index(v);
+    if (i < 0) continue;  // another rank's (over ranks)
     const double d = mean_diameter(net, v), half = 0.125 * std::numbers::pi * d * d * net.length[v];
     for (const std::int32_t k : {lumped.from_node(i), lumped.to_node(i)}) {
       k_sum[static_cast<std::size_t>(k)] += half * fahraeus(d);
@@ -77,7 +96,10 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   }
 
   // Slices of the 1D elements.
-  const std::vector<std::int32_t>& one_d = solver.one_d_vessels();
+  // The 1D vessels: every one, or over ranks the top's rank's (a share's solver has their
+  // laws and start, but never steps them).
+  if (solver.holds_one_d()) one_d_ = solver.one_d_vessels();
+  const std::vector<std::int32_t>& one_d = one_d_;
   slices_ = options_.slices > 0 ? options_.slices : solver.max_degree() + 1;
   const int modes = solver.max_degree() + 1, per_vessel = solver.elements_per_vessel();
   slice_integral_.resize(slices_, std::max(modes, 1));
@@ -100,7 +122,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
 
   // Junctions of 1D vessels, and what meets each 1D end: (vessel, distal) -> cell or boundary.
   std::map<std::pair<std::int32_t, bool>, std::int32_t> end_side;
-  for (std::size_t j = 0; j + 1 < ends.junction_offset.size(); ++j) {
+  for (std::size_t j = 0; j + 1 < ends.junction_offset.size() && solver.holds_one_d(); ++j) {
     const auto cell = static_cast<std::int32_t>(grid.cell_count());
     const VesselEnd& first = ends.junction_ends[static_cast<std::size_t>(ends.junction_offset[j])];
     const auto v = static_cast<std::size_t>(first.vessel);
@@ -124,17 +146,36 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     return found->second;
   };
 
-  // Faces: the 0D vessels, the boundaries at 0D nodes, then each 1D vessel's.
+  // Faces: the 0D vessels, the boundaries at 0D nodes, then each 1D vessel's. Over ranks a
+  // root vessel's joins the node on this side to its cut (turned round where that node is its
+  // `to` node); the node across, held for the flow's sums alone, is an empty cell of no face.
   lumped_face_.assign(lumped.vessel_count(), -1);
+  std::vector<std::int32_t> turned;
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
     if (!solver.is_lumped(v)) continue;
     const std::int32_t i = lumped.vessel_index(v);
-    lumped_face_[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(grid.face_count());
-    grid.add_face(lumped.from_node(i), lumped.to_node(i), static_cast<std::int32_t>(v), mean_diameter(net, v));
+    if (i < 0) continue;  // another rank's
+    const auto face = static_cast<std::int32_t>(grid.face_count());
+    lumped_face_[static_cast<std::size_t>(i)] = face;
+    const std::int32_t a = lumped.from_node(i), b = lumped.to_node(i);
+    const std::int32_t root = ranks ? root_of[static_cast<std::size_t>(i)] : -1;
+    if (root < 0) {
+      grid.add_face(a, b, static_cast<std::int32_t>(v), mean_diameter(net, v));
+      continue;
+    }
+    const bool a_across = lumped.ghost_node(a);
+    const std::int32_t here = a_across ? b : a, across = a_across ? a : b;
+    grid.add_face(here, TransportGrid::boundary_side(boundaries.size() + static_cast<std::size_t>(root)),
+                  static_cast<std::int32_t>(v), mean_diameter(net, v));
+    cut_->face[static_cast<std::size_t>(root)] = face;
+    cut_->cell[static_cast<std::size_t>(root)] = here;
+    cut_->across[static_cast<std::size_t>(root)] = across;
+    cut_->ghost[static_cast<std::size_t>(across)] = root;
+    if (a_across) turned.push_back(face);
   }
   for (std::size_t b = 0; b < boundaries.size(); ++b) {
     const std::int32_t k = lumped.empty() ? -1 : lumped.node_of(boundaries.node(b));
-    if (k < 0) continue;
+    if (k < 0 || lumped.ghost_node(k)) continue;  // another rank's
     node_boundary_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
     node_boundary_.push_back(static_cast<std::int32_t>(b));
     grid.add_face(k, TransportGrid::boundary_side(b), -1, 0.0);
@@ -152,14 +193,19 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     grid.add_face(last, distal, v, d1);
   }
 
-  inflow_hematocrit_.resize(boundaries.size());
+  inflow_hematocrit_.assign(grid.boundaries, blood.hematocrit);  // a cut's: given every step
   for (std::size_t b = 0; b < boundaries.size(); ++b) inflow_hematocrit_[b] = boundaries[b].entering_hematocrit(blood);
+  if (cut_) {
+    cut_->face_sign.assign(grid.face_count(), 1);
+    for (const std::int32_t f : turned) cut_->face_sign[static_cast<std::size_t>(f)] = -1;
+  }
 
   solver_volumes(volume);
   red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
                      RedCellOptions{options_.phase_separation, blood.phase_separation_diameter_scale(),
                                     !options_.tracers.empty()});
   face_volume_.assign(red_cells_->grid().face_count(), 0.0);
+  if (ranks) place_cut(*ranks);
   const std::size_t vessels = net.vessel_count();
   cycle_cells_.assign(vessels, 0.0);
   cycle_blood_.assign(vessels, 0.0);
@@ -244,12 +290,18 @@ std::size_t FlowTransport::cell_at(std::size_t v, double x) const {
   }
   const LumpedVessels& lumped = solver_.lumped();
   const std::int32_t i = lumped.vessel_index(v);
-  const double q = face_volume_[static_cast<std::size_t>(lumped_face_[static_cast<std::size_t>(i)])];
+  const auto face = static_cast<std::size_t>(lumped_face_[static_cast<std::size_t>(i)]);
+  const double q = cut_ ? cut_->face_sign[face] * face_volume_[face] : face_volume_[face];
   const bool from = q != 0 ? q > 0 : x < 0.5;
   return static_cast<std::size_t>(from ? lumped.from_node(i) : lumped.to_node(i));
 }
 
-double FlowTransport::hematocrit_at(std::size_t v, double x) const { return red_cells_->discharge_hematocrit()[cell_at(v, x)]; }
+double FlowTransport::hematocrit_at(std::size_t v, double x) const {
+  const std::size_t c = cell_at(v, x);
+  // Over ranks a root vessel's node across the cut: its hematocrit as the last step sent it.
+  if (cut_ && c < cut_->ghost.size() && cut_->ghost[c] >= 0) return cut_->far[static_cast<std::size_t>(cut_->ghost[c])];
+  return red_cells_->discharge_hematocrit()[c];
+}
 
 double FlowTransport::tracer_at(std::size_t k, std::size_t v, double x) const {
   return tracers_[k].concentration()[cell_at(v, x)];
@@ -258,9 +310,10 @@ double FlowTransport::tracer_at(std::size_t k, std::size_t v, double x) const {
 void FlowTransport::solver_volumes(std::vector<double>& volume) const {
   const LumpedVessels& lumped = solver_.lumped();
   if (!lumped.empty())
-    for (std::size_t k = 0; k < lumped.network_node_count(); ++k) volume[k] = lumped.stored_volume(static_cast<std::int32_t>(k));
+    for (std::size_t k = 0; k < lumped.network_node_count(); ++k)  // a node across a cut holds none here
+      volume[k] = cut_ && cut_->ghost[k] >= 0 ? 0.0 : lumped.stored_volume(static_cast<std::int32_t>(k));
   const Eigen::MatrixXd& area = solver_.state().area;
-  const std::vector<std::int32_t>& one_d = solver_.one_d_vessels();
+  const std::vector<std::int32_t>& one_d = one_d_;
   for (std::size_t i = 0; i < one_d.size(); ++i) {
     auto cell = static_cast<std::size_t>(vessel_first_cell_[i]);
     const auto first = solver_.first_element(static_cast<std::size_t>(one_d[i]));
@@ -285,15 +338,34 @@ void FlowTransport::restart() {
 void FlowTransport::take_volumes() {
   now_.assign(red_cells_->volume().begin(), red_cells_->volume().end());
   solver_volumes(now_);
+  if (cut_) {  // what it adds, cell by cell in the one-process order (RedCellTransport::set_volumes)
+    std::vector<double> added(now_.size());
+    for (std::size_t c = 0; c < added.size(); ++c)
+      added[c] = (now_[c] - red_cells_->volume()[c]) * red_cells_->tube_hematocrit(c);
+    cut_->adjusted = lead_sum(added, own_cell_places(), cut_->cells, cut_->adjusted);
+  }
   red_cells_->set_volumes(now_);
 }
 
-void FlowTransport::advance() {
+FlowTransport::Totals FlowTransport::totals() const {
+  const RedCellTransport& t = *red_cells_;
+  if (!cut_) return {t.red_cells(), t.entered(), t.left(), t.adjusted()};
+  std::vector<double> content(t.grid().cell_count());
+  for (std::size_t c = 0; c < content.size(); ++c) content[c] = t.content(c);
+  const std::vector<std::int32_t> held = boundary_places();
+  return {lead_sum(content, own_cell_places(), cut_->cells, 0.0),
+          lead_sum(t.entered_by_boundary(), held, cut_->run_boundaries, 0.0),
+          lead_sum(t.left_by_boundary(), held, cut_->run_boundaries, 0.0), cut_->adjusted};
+}
+
+void FlowTransport::face_volumes() {
   const PulseState& s = solver_.state();
   const LumpedVessels& lumped = solver_.lumped();
-  for (std::size_t i = 0; i < lumped_face_.size(); ++i)
-    face_volume_[static_cast<std::size_t>(lumped_face_[i])] =
-        lumped.passed_volume(static_cast<std::int32_t>(i));
+  for (std::size_t i = 0; i < lumped_face_.size(); ++i) {
+    const auto face = static_cast<std::size_t>(lumped_face_[i]);
+    const double passed = lumped.passed_volume(static_cast<std::int32_t>(i));
+    face_volume_[face] = cut_ ? cut_->face_sign[face] * passed : passed;
+  }
   for (std::size_t j = 0; j < node_boundary_face_.size(); ++j) {
     const auto b = static_cast<Eigen::Index>(node_boundary_[j]);
     face_volume_[static_cast<std::size_t>(node_boundary_face_[j])] =
@@ -303,7 +375,7 @@ void FlowTransport::advance() {
   now_.resize(cell_count());  // only its 0D nodes and slices are read below
   solver_volumes(now_);
   const std::span<const double> held = red_cells_->volume();
-  const std::vector<std::int32_t>& one_d = solver_.one_d_vessels();
+  const std::vector<std::int32_t>& one_d = one_d_;
   const int cells_per_vessel = solver_.elements_per_vessel() * slices_;
   for (std::size_t i = 0; i < one_d.size(); ++i) {
     const auto el = solver_.first_element(static_cast<std::size_t>(one_d[i]));
@@ -316,12 +388,23 @@ void FlowTransport::advance() {
       face_volume_[face++] = passed;
     }
   }
-  red_cells_->step(face_volume_, inflow_hematocrit_);
-  ++advances_;
-  mark();
-  step_tracers(last_time_, solver_.time());
-  last_time_ = solver_.time();
+}
 
+void FlowTransport::advance() {
+  face_volumes();
+  if (cut_) {
+    advance_over_ranks();
+  } else {
+    red_cells_->step(face_volume_, inflow_hematocrit_);
+    ++advances_;
+    mark();
+    step_tracers(last_time_, solver_.time());
+    last_time_ = solver_.time();
+  }
+  close_step();
+}
+
+void FlowTransport::close_step() {
   // The cycle's sums per vessel: red cells and blood through its faces, and the step's
   // discharge hematocrit (the faces' mean) for its extremes.
   const TransportGrid& grid = red_cells_->grid();
@@ -352,10 +435,11 @@ void FlowTransport::begin_cycle() {
   std::fill(cycle_blood_.begin(), cycle_blood_.end(), 0.0);
   std::fill(cycle_low_.begin(), cycle_low_.end(), std::numeric_limits<double>::infinity());
   std::fill(cycle_high_.begin(), cycle_high_.end(), -std::numeric_limits<double>::infinity());
-  cycle_content_ = red_cells_->red_cells();
-  cycle_entered_ = red_cells_->entered();
-  cycle_left_ = red_cells_->left();
-  cycle_adjusted_ = red_cells_->adjusted();
+  const Totals now = totals();
+  cycle_content_ = now.red_cells;
+  cycle_entered_ = now.entered;
+  cycle_left_ = now.left;
+  cycle_adjusted_ = now.adjusted;
 }
 
 RedCellCycle FlowTransport::close_cycle() const {
@@ -370,13 +454,15 @@ RedCellCycle FlowTransport::close_cycle() const {
     c.lowest[v] = std::isfinite(cycle_low_[v]) ? cycle_low_[v] : 0.0;
     c.highest[v] = std::isfinite(cycle_high_[v]) ? cycle_high_[v] : 0.0;
   }
-  c.red_cells = red_cells_->red_cells();
-  c.entered = red_cells_->entered() - cycle_entered_;
-  c.left = red_cells_->left() - cycle_left_;
-  const double adjusted = red_cells_->adjusted() - cycle_adjusted_;
+  const Totals now = totals();
+  c.red_cells = now.red_cells;
+  c.entered = now.entered - cycle_entered_;
+  c.left = now.left - cycle_left_;
+  const double adjusted = now.adjusted - cycle_adjusted_;
   c.balance_error = (c.red_cells - cycle_content_ - (c.entered - c.left) - adjusted) /
                     std::max(cycle_content_ + c.entered, std::numeric_limits<double>::min());
   c.separating_nodes = red_cells_->separating_nodes();
+  if (cut_) close_cycle_over_ranks(c);
   return c;
 }
 
@@ -387,17 +473,54 @@ void FlowTransport::follow_viscosities(std::size_t v, double hematocrit) {
   applied_hematocrit_[v] = hematocrit;
 }
 
-void FlowTransport::save(CheckpointWriter& out) const {
+void FlowTransport::put_red_cells(CheckpointWriter& out, const RedCellState& state) {
   out.section("red cells");
+  out.put(state.discharge);
+  out.put(state.volume);
+  out.put(state.entered);
+  out.put(state.left);
+  out.put(state.adjusted);
+  out.put(state.last_outflow);
+  out.put(state.applied);  // the factors themselves are the solver's (its checkpoint)
+  out.put(state.faces);    // the last step's flow directions: which node a 0D probe reads (cell_at)
+}
+
+FlowTransport::RedCellState FlowTransport::get_red_cells(CheckpointReader& in) const {
+  in.section("red cells");
+  RedCellState s;
+  s.discharge = in.get_vector();
+  s.volume = in.get_vector();
+  s.entered = in.get_vector();
+  s.left = in.get_vector();
+  s.adjusted = in.get_double();
+  s.last_outflow = in.get_vector();
+  const std::size_t boundaries = solver_.boundary_list().size();
+  if (s.discharge.size() != cell_count() || s.volume.size() != cell_count() || s.entered.size() != boundaries ||
+      s.left.size() != boundaries || s.last_outflow.size() != boundaries)
+    in.fail("red cells of another network or another transport grid");
+  s.applied = in.get_vector();
+  if (s.applied.size() != (options_.viscosity_feedback ? net_.vessel_count() : 0))
+    in.fail("red-cell viscosities of another network");
+  // Without them a probe in a 0D vessel read the other node until the next transport step
+  // (4 samples after a resume differed from the uninterrupted run's).
+  s.faces = in.get_vector();
+  if (s.faces.size() != (cut_ ? cut_->faces : face_volume_.size()))
+    in.fail("red-cell faces of another network or another transport grid");
+  return s;
+}
+
+void FlowTransport::save(CheckpointWriter& out) const {
   const RedCellTransport& t = *red_cells_;
-  out.put(std::vector<double>(t.discharge_hematocrit().begin(), t.discharge_hematocrit().end()));
-  out.put(std::vector<double>(t.volume().begin(), t.volume().end()));
-  out.put(std::vector<double>{t.entered(), t.left(), t.adjusted()});
-  out.put(t.last_outflow());
-  out.put(applied_hematocrit_);  // the factors themselves are the solver's (its checkpoint)
+  put_red_cells(out, {{t.discharge_hematocrit().begin(), t.discharge_hematocrit().end()},
+                      {t.volume().begin(), t.volume().end()},
+                      t.entered_by_boundary(),
+                      t.left_by_boundary(),
+                      t.adjusted(),
+                      t.last_outflow(),
+                      applied_hematocrit_,
+                      face_volume_});
   out.put(static_cast<std::uint64_t>(advances_));
   out.put(last_time_);
-  out.put(face_volume_);  // the last step's flow directions: which node a 0D probe reads (cell_at)
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const TracerTransport& t = tracers_[k];
     out.put(std::vector<double>(t.concentration().begin(), t.concentration().end()));
@@ -408,23 +531,16 @@ void FlowTransport::save(CheckpointWriter& out) const {
 }
 
 void FlowTransport::restore(CheckpointReader& in) {
-  in.section("red cells");
-  const std::vector<double> discharge = in.get_vector(), volume = in.get_vector(), totals = in.get_vector(),
-                            last_outflow = in.get_vector();
-  if (discharge.size() != cell_count() || volume.size() != cell_count() || totals.size() != 3 ||
-      last_outflow.size() != red_cells_->grid().boundaries)
-    in.fail("red cells of another network or another transport grid");
-  red_cells_->restore(discharge, volume, totals[0], totals[1], totals[2], last_outflow);
-  applied_hematocrit_ = in.get_vector();
-  if (applied_hematocrit_.size() != (options_.viscosity_feedback ? net_.vessel_count() : 0))
-    in.fail("red-cell viscosities of another network");
+  RedCellState s = get_red_cells(in);
+  applied_hematocrit_ = std::move(s.applied);
+  if (cut_) {
+    restore_share(s);
+  } else {
+    red_cells_->restore(s.discharge, s.volume, s.entered, s.left, s.adjusted, s.last_outflow);
+    face_volume_ = std::move(s.faces);
+  }
   advances_ = static_cast<std::size_t>(in.get_u64());
   last_time_ = in.get_double();
-  // Without them a probe in a 0D vessel read the other node until the next transport step
-  // (4 samples after a resume differed from the uninterrupted run's).
-  std::vector<double> faces = in.get_vector();
-  if (faces.size() != face_volume_.size()) in.fail("red-cell faces of another network or another transport grid");
-  face_volume_ = std::move(faces);
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const std::vector<double> c = in.get_vector(), last = in.get_vector(), totals = in.get_vector(),
                               curve = in.get_vector();

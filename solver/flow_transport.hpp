@@ -12,10 +12,20 @@
 // less the change of the slices before it, so that every slice ends the step holding the
 // solver's own volume. Everything the 0D nodes hold is theirs exactly too (BDF2's stored
 // volume), so the transport's volumes never drift from the flow's.
+//
+// Over MPI ranks (docs/transport.md, "Over MPI ranks") each rank carries the cells of the 0D
+// nodes it holds, the top's rank also the 1D vessels'; a root vessel between a share's node r
+// and the top's node u is a face on both sides, to a cut (transport/transport_grid.hpp). A
+// step solves first the cells no cut's inflow reaches; the shares send r's hematocrit and
+// phase separation share up, the top solves the rest and sends u's down, the shares finish
+// (flow_transport_ranks.cpp). Every cell's value is the one-process run's, bit for bit; every
+// sum of the cycle and the checkpoint is taken on rank 0 in the one-process order.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -59,21 +69,31 @@ struct RedCellCycle {
   std::size_t separating_nodes = 0;  // where the law split red cells at the cycle's last step
 };
 
+// A run over ranks: the top's rank and each rank's root vessels (LumpedCut::roots).
+struct TransportRanks {
+  int top_rank = 0;
+  std::vector<int> roots;
+};
+
+class RootExchange;
+
 class FlowTransport {
  public:
-  // Call before the solver's first step (it starts the solver's face accumulators).
-  FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options = {});
+  // Call before the solver's first step (it starts the solver's face accumulators). ranks:
+  // where the solver is a rank's part of a run over ranks (tracers are not carried then).
+  FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options = {},
+                const TransportRanks* ranks = nullptr);
 
-  // Moves the red cells by what the solver passed since the last call.
+  // Moves the red cells by what the solver passed since the last call (over ranks: collective).
   void advance();
   // After the solver's compliance balance moved its volumes: the cells take them.
   void take_volumes();
   // After the solver stepped without it (a settling cycle, solver/settling_cycle.hpp, whose
   // clock restarts at 0): the next advance counts from the solver's state and time now.
   void restart();
+  // Over ranks these two are collective, and the cycle's numbers rank 0's (elsewhere partial).
   void begin_cycle();
   RedCellCycle close_cycle() const;
-
 
   const RedCellTransport& red_cells() const { return *red_cells_; }
   const std::vector<TracerSpec>& tracer_specs() const { return options_.tracers; }
@@ -86,10 +106,14 @@ class FlowTransport {
   // concentration, of the cell there (a 0D vessel: the node its blood came from last).
   double hematocrit_at(std::size_t vessel, double x) const;
   double tracer_at(std::size_t k, std::size_t vessel, double x) const;
-  std::size_t cell_count() const { return red_cells_->grid().cell_count(); }
+  // The whole run's cells (over ranks: every rank's).
+  std::size_t cell_count() const { return cut_ ? cut_->cells : red_cells_->grid().cell_count(); }
   std::size_t advances() const { return advances_; }
 
   void save(CheckpointWriter& out) const;
+  // Over ranks: the one-process run's bytes, written to `out` on rank 0, null elsewhere. Collective.
+  void save_over_ranks(CheckpointWriter* out) const;
+  // Over ranks every rank reads the whole run's checkpoint and takes its share.
   void restore(CheckpointReader& in);
 
  private:
@@ -98,11 +122,62 @@ class FlowTransport {
   void mark();  // the next advance counts from the solver's state now
   std::size_t cell_at(std::size_t vessel, double x) const;
   void step_tracers(double t0, double t1);
+  void face_volumes();  // face_volume_ from what the solver passed since the last advance
+  // The red cells in the network, through the boundaries (in, out) and added by the volumes'
+  // changes since the start (over ranks: rank 0's, collective).
+  struct Totals {
+    double red_cells, entered, left, adjusted;
+  };
+  Totals totals() const;
+  void close_step();    // the cycle's sums and the viscosities after a step
+
+  // Over ranks (flow_transport_ranks.cpp): the cut's faces and where every cell, face and
+  // boundary of this rank lies in the whole run's grid (the one-process order).
+  struct Cut {
+    bool top = false;
+    std::shared_ptr<RootExchange> exchange;
+    std::size_t run_boundaries = 0;   // the network's (the grid's first ones)
+    std::vector<std::int32_t> face;   // per root (the messages' order): its face here
+    std::vector<std::int32_t> cell;   // the cell on this side of it
+    std::vector<std::int32_t> across; // the empty cell of the node across it
+    std::vector<double> far;          // the hematocrit of the cell across it (a share's probes)
+    std::vector<std::int32_t> ghost;  // per cell: the root it is the node across (-1: a cell of its own)
+    std::vector<std::int32_t> cell_place, face_place;  // in the whole run's grid
+    std::vector<signed char> face_sign;  // per face: +1, or -1 where a cut turned it round
+    std::size_t cells = 0, faces = 0;    // the whole run's
+    double adjusted = 0;                 // the whole run's (rank 0)
+  };
+  // The cut's faces were made with the grid; the rest of the Cut from them.
+  void place_cut(const TransportRanks& ranks);
+  void advance_over_ranks();
+  // On rank 0 `start` plus each of the whole run's items in turn (per cell or boundary: each
+  // rank's values at `place`, -1 none), in the one-process order; elsewhere `start`. Collective.
+  double lead_sum(std::span<const double> values, std::span<const std::int32_t> place, std::size_t whole,
+                  double start) const;
+  // The same items whole on rank 0 (elsewhere empty).
+  std::vector<double> lead_whole(std::span<const double> values, std::span<const std::int32_t> place,
+                                 std::size_t whole) const;
+  // The places of what this rank holds for its own (-1: what another rank holds, the cells
+  // and faces across a cut): per cell, per face, per boundary of the grid.
+  std::vector<std::int32_t> own_cell_places() const;
+  std::vector<std::int32_t> own_face_places() const;
+  std::vector<std::int32_t> boundary_places() const;
+  void close_cycle_over_ranks(RedCellCycle& c) const;
+  // The red cells' state as a checkpoint holds it, in the one-process grid's order: per cell,
+  // per boundary of the network, per vessel, per face.
+  struct RedCellState {
+    std::vector<double> discharge, volume, entered, left;
+    double adjusted = 0;
+    std::vector<double> last_outflow, applied, faces;
+  };
+  static void put_red_cells(CheckpointWriter& out, const RedCellState& state);
+  RedCellState get_red_cells(CheckpointReader& in) const;  // its sizes checked
+  void restore_share(const RedCellState& whole);
 
   const Network& net_;
   PulseSolver& solver_;
   FlowTransportOptions options_;
-  // 1D vessels: per 1D vessel (one_d_vessels' order) its first slice cell and its faces, the
+  // 1D vessels: per 1D vessel (one_d_'s order) its first slice cell and its faces, the
   // proximal face first; per slice the element and its row of the slice integrals.
   std::vector<std::int32_t> vessel_first_cell_, vessel_first_face_;
   std::vector<signed char> proximal_sign_;  // +1: the proximal face runs along the vessel
@@ -110,7 +185,8 @@ class FlowTransport {
   Eigen::MatrixXd slice_integral_;  // slices x modes: int of P_j over each slice of [-1, 1]
   // 0D vessels: their faces (in LumpedVessels' order); boundaries at 0D nodes: face and boundary.
   std::vector<std::int32_t> lumped_face_;
-  std::vector<std::int32_t> one_d_place_;  // per vessel: its place in one_d_vessels, or -1
+  std::vector<std::int32_t> one_d_;        // the 1D vessels it carries (over ranks the top's rank's)
+  std::vector<std::int32_t> one_d_place_;  // per vessel: its place in one_d_, or -1
   std::vector<std::int32_t> node_boundary_face_, node_boundary_;
   std::vector<double> inflow_hematocrit_;  // per boundary (NaN: what last left there)
   // The boundaries' volumes at the last advance (the solver's own sums, never cleared).
@@ -135,6 +211,7 @@ class FlowTransport {
   std::vector<std::int32_t> tracer_face_;
   std::vector<double> tracer_inflow_, tracer_injected_;  // scratch
   double last_time_ = 0;  // the solver's time at the last advance
+  std::optional<Cut> cut_;
 };
 
 }  // namespace hemotree

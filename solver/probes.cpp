@@ -46,12 +46,15 @@ void ProbeRecorder::sample(const PulseSolver& solver) {
   });
 }
 
-void ProbeRecorder::add_row(double t, const std::function<Values(const Probe&)>& at) {
+void ProbeRecorder::add_row(double t, const std::function<Values(const Probe&)>& at) { add_row(t, at, column_); }
+
+void ProbeRecorder::add_row(double t, const std::function<Values(const Probe&)>& at,
+                            const std::function<double(std::size_t, const Probe&)>& column) {
   rows_ << number(t);
   for (const Probe& p : probes_) {
     const Values v = at(p);
     rows_ << ',' << number(v.pressure) << ',' << number(v.flow) << ',' << number(v.area) << ',' << number(v.flow / v.area);
-    for (std::size_t j = 0; j < headers_.size(); ++j) rows_ << ',' << number(column_(j, p));
+    for (std::size_t j = 0; j < headers_.size(); ++j) rows_ << ',' << number(column(j, p));
   }
   rows_ << '\n';
 }

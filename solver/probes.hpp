@@ -32,12 +32,16 @@ class ProbeRecorder {
     double pressure, flow, area;
   };
   void add_row(double t, const std::function<Values(const Probe&)>& at);
+  // The same with the further columns' values given too (column(j, probe), add_columns').
+  void add_row(double t, const std::function<Values(const Probe&)>& at,
+               const std::function<double(std::size_t, const Probe&)>& column);
   // Further columns at every probe (the transported red cells and tracers): their headers'
   // names and units, and the value of column j at a probe now.
   void add_columns(std::vector<std::string> headers, std::function<double(std::size_t, const Probe&)> value) {
     headers_ = std::move(headers);
     column_ = std::move(value);
   }
+  const std::vector<std::string>& column_headers() const { return headers_; }
   // probes.csv: a header with units, then one row per sample; nothing without probes.
   void write(const std::filesystem::path& file) const;
   bool empty() const { return probes_.empty(); }

@@ -286,17 +286,16 @@ void check_pulsatile(const Network& net, const RunConfiguration& config) {
 namespace {
 
 // What a pulsatile run over MPI ranks does not take yet (docs/scaling.md, "The pulsatile run
-// over ranks"): the cells move in flow order across the ranks; a settling cycle at a lower
+// over ranks"): tracers (they move in flow order across the ranks, as the red cells do, on
+// carriers of their own); a settling cycle at a lower
 // degree is a second solver (taken by default only where most vessels are 1D: not a tree
 // that ranks split). Refused on every rank alike, before any work.
 void refuse_over_ranks(const RunConfiguration& config) {
   auto refuse = [](const std::string& setting, const std::string& why, const std::string& value = "") {
     throw SettingError(setting, placeholder(setting) + value + ": " + why + "; run it as one process (without mpirun)");
   };
-  if (config.red_cells == RedCells::transport || !config.tracers.empty())
-    refuse(config.tracers.empty() ? "red_cells" : "tracer",
-           "a pulsatile run over MPI ranks carries no red cells or tracers yet (they move in flow order across the ranks)",
-           config.tracers.empty() ? " transport" : "");
+  if (!config.tracers.empty())
+    refuse("tracer", "a pulsatile run over MPI ranks carries no tracers yet (red cells it carries)");
   if (config.until_periodic && config.settling_degree != SolverOptions::automatic && config.settling_degree > 0)
     refuse("settling_degree", "a pulsatile run over MPI ranks takes no settling cycle at a lower degree yet (a second solver)");
 }
@@ -426,7 +425,9 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     const std::vector<TracerSpec>& tracers = config.tracers;
     FlowTransportOptions carried;
     carried.tracers = tracers;
-    transport.emplace(net, run, red ? carried : red_cells_fixed(carried));
+    std::optional<TransportRanks> over;
+    if (ranks) over = TransportRanks{ranks->ranks().top_rank, ranks->roots()};
+    transport.emplace(net, run, red ? carried : red_cells_fixed(carried), over ? &*over : nullptr);
     plan.transport_every = std::max<std::size_t>(
         1, static_cast<std::size_t>(std::llround(config.transport_step * static_cast<double>(steps_per_cycle))));
     observer.note(std::string(red ? "red cells" : "") + (red && !tracers.empty() ? " and " : "") +

@@ -85,9 +85,6 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
       over_ranks_(solver.lumped().over_ranks()), writes_(!over_ranks_ || world_rank() == 0) {
   plan_.transport_every = std::max<std::size_t>(plan_.transport_every, 1);
   if (over_ranks_) {
-    // What a run over ranks does not take yet (its caller refuses it in words): the cells
-    // move in flow order across the ranks.
-    if (transport_) throw std::logic_error("PulsatileRun over ranks: transport");
     if (writes_ && !solver.holds_one_d()) throw std::logic_error("PulsatileRun over ranks: rank 0 is not the top's");
     probes_over_ranks_.emplace(probes, solver);
   }
@@ -99,10 +96,12 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
     headers.push_back("c_" + t.name + " [per " + (t.carrier == TracerCarrier::cells ? "red-cell" : to_string(t.carrier)) +
                       " volume]");
   const bool red = transport_->reports_red_cells();
-  probes_.add_columns(std::move(headers), [this, red](std::size_t j, const Probe& p) {
+  auto column = [this, red](std::size_t j, const Probe& p) {
     if (red && j == 0) return transport_->hematocrit_at(p.vessel, p.x);
     return transport_->tracer_at(j - (red ? 1 : 0), p.vessel, p.x);
-  });
+  };
+  if (probes_over_ranks_) probes_over_ranks_->add_columns(headers.size(), column);
+  probes_.add_columns(std::move(headers), column);
 }
 
 void PulsatileRun::begin_snapshot() {
@@ -124,13 +123,16 @@ void PulsatileRun::finish_snapshot() {
     // Every rank's share of the probes and of the solver's state, to rank 0's file: the
     // bytes the one-process run writes (the probes' rows so far, after any resumed).
     ProbeRecorder probes(probes_over_ranks_->probes());
+    probes.add_columns(probes_.column_headers(), {});
     probes.restore_rows(probes_.rows());
     probes_over_ranks_->gather_into(probes);
     if (writes_) {
       put_run_progress(*snapshot_, probes.rows());
       solver_.save_over_ranks(&*snapshot_);
+      if (transport_) transport_->save_over_ranks(&*snapshot_);
     } else {
       solver_.save_over_ranks(nullptr);
+      if (transport_) transport_->save_over_ranks(nullptr);
       return;
     }
   } else {
@@ -139,7 +141,7 @@ void PulsatileRun::finish_snapshot() {
   }
   CheckpointWriter& out = *snapshot_;
   if (transport_) {
-    transport_->save(out);
+    if (!over_ranks_) transport_->save(out);
     out.put(red_cells_last_.discharge);
     out.put(red_cells_last_.lowest);
     out.put(red_cells_last_.highest);
@@ -501,6 +503,11 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
           red_cell_change_ = 0;
           for (std::size_t v = 0; v < cycle.discharge.size(); ++v)
             red_cell_change_ = std::max(red_cell_change_, std::abs(cycle.discharge[v] - red_cells_last_.discharge[v]));
+          if (over_ranks_) {  // rank 0 alone has the whole cycle
+            std::vector<double> change{red_cell_change_};
+            take_lead_values(change);
+            red_cell_change_ = change[0];
+          }
         }
         red_cells_last_ = std::move(cycle);
         transport_->take_volumes();  // the balance's shifts, and the 0D nodes' round-off

@@ -33,6 +33,8 @@ class MpiPulseRanks {
   const Partition& partition() const { return partition_; }
   std::size_t top_vessels() const { return top_vessels_; }
   const RootExchange* exchange() const { return exchange_.get(); }  // null before the first step
+  // Per rank, its root vessels (LumpedCut::roots): the messages' sizes. Known once the solver is built.
+  const std::vector<int>& roots() const { return roots_; }
   // What the top's rank was weighed by besides its vessels, in 0D vessels: its statistics.
   double top_weight() const { return top_weight_; }
   // A statistics sample's cost over a 0D vessel's step, taken every step (up to 500 steps a

@@ -37,13 +37,17 @@ RedCellTransport::RedCellTransport(TransportGrid grid, std::vector<double> volum
   next_volume_.assign(cells, 0.0);
   share_.assign(grid_.face_count(), 1.0);
   last_outflow_.assign(grid_.boundaries, hematocrit);
-  // Where the law can apply: a node's cell with three faces, each in a vessel between cells.
+  entered_.assign(grid_.boundaries, 0.0);
+  left_.assign(grid_.boundaries, 0.0);
+  // Where the law can apply: a node's cell with three faces, each in a vessel between cells
+  // (a cut's face is one: the cell across it is another rank's).
   for (std::size_t c = 0; c < cells; ++c) {
     if (grid_.node[c] < 0 || faces_.start[c + 1] - faces_.start[c] != 3) continue;
     bool inner = true;
     for (auto i = faces_.start[c]; i < faces_.start[c + 1]; ++i) {
       const auto f = static_cast<std::size_t>(faces_.face[static_cast<std::size_t>(i)]);
-      inner = inner && grid_.b[f] >= 0 && grid_.vessel[f] >= 0;
+      const std::int32_t b = grid_.b[f];
+      inner = inner && (b >= 0 || grid_.is_cut(static_cast<std::size_t>(-1 - b))) && grid_.vessel[f] >= 0;
     }
     if (inner) candidates_.push_back(static_cast<std::int32_t>(c));
   }
@@ -70,13 +74,14 @@ void RedCellTransport::set_hematocrit(std::span<const double> discharge) {
   }
 }
 
-void RedCellTransport::restore(std::span<const double> discharge, std::span<const double> volume, double entered,
-                               double left, double adjusted, std::span<const double> last_outflow) {
+void RedCellTransport::restore(std::span<const double> discharge, std::span<const double> volume,
+                               std::span<const double> entered, std::span<const double> left, double adjusted,
+                               std::span<const double> last_outflow) {
   discharge_.assign(discharge.begin(), discharge.end());
   volume_.assign(volume.begin(), volume.end());
   last_outflow_.assign(last_outflow.begin(), last_outflow.end());
-  entered_ = entered;
-  left_ = left;
+  entered_.assign(entered.begin(), entered.end());
+  left_.assign(left.begin(), left.end());
   adjusted_ = adjusted;
 }
 
@@ -90,7 +95,19 @@ void RedCellTransport::set_volumes(std::span<const double> volume) {
 
 double RedCellTransport::red_cells() const {
   double sum = 0;
-  for (std::size_t c = 0; c < volume_.size(); ++c) sum += volume_[c] * tube(c, discharge_[c]);
+  for (std::size_t c = 0; c < volume_.size(); ++c) sum += content(c);
+  return sum;
+}
+
+double RedCellTransport::entered() const {
+  double sum = 0;
+  for (const double e : entered_) sum += e;
+  return sum;
+}
+
+double RedCellTransport::left() const {
+  double sum = 0;
+  for (const double l : left_) sum += l;
   return sum;
 }
 
@@ -174,8 +191,14 @@ double RedCellTransport::solve_cell(std::size_t c, std::span<const double> face_
 }
 
 void RedCellTransport::step(std::span<const double> face_volume, std::span<const double> inflow_hematocrit) {
+  begin_step(face_volume);
+  solve(face_volume, inflow_hematocrit, Cells::all);
+  end_step(face_volume, inflow_hematocrit);
+}
+
+void RedCellTransport::begin_step(std::span<const double> face_volume) {
   const std::size_t cells = grid_.cell_count(), faces = grid_.face_count();
-  if (face_volume.size() != faces || inflow_hematocrit.size() != grid_.boundaries)
+  if (face_volume.size() != faces)
     throw InputError("red-cell transport: a step needs " + std::to_string(faces) + " face volumes and " +
                      std::to_string(grid_.boundaries) + " boundary hematocrits");
   // The blood: each cell's volume after the step from what its faces passed.
@@ -187,13 +210,36 @@ void RedCellTransport::step(std::span<const double> face_volume, std::span<const
   for (std::size_t c = 0; c < cells; ++c) cells_.before[c] = volume_[c] * tube(c, discharge_[c]);
   split_at_nodes(face_volume);
   order_.update(grid_, faces_, face_volume);
+  if (grid_.cuts == 0) return;
+  // Which cells a cut's inflow reaches: in flow order, from the cuts and the cells it reached.
+  after_cut_.assign(cells, 0);
+  for (const std::int32_t cell : order_.cells) {
+    const auto c = static_cast<std::size_t>(cell);
+    for (auto i = faces_.start[c]; i < faces_.start[c + 1] && !after_cut_[c]; ++i) {
+      const auto f = static_cast<std::size_t>(faces_.face[static_cast<std::size_t>(i)]);
+      const double q = face_volume[f];
+      if (q == 0 || (static_cast<std::size_t>(grid_.a[f]) == c) == (q > 0)) continue;  // none in through f
+      const std::int32_t from = static_cast<std::size_t>(grid_.a[f]) == c ? grid_.b[f] : grid_.a[f];
+      after_cut_[c] = from >= 0 ? after_cut_[static_cast<std::size_t>(from)]
+                                : static_cast<unsigned char>(grid_.is_cut(static_cast<std::size_t>(-1 - from)));
+    }
+  }
+}
 
+void RedCellTransport::solve(std::span<const double> face_volume, std::span<const double> inflow_hematocrit, Cells which) {
+  const std::size_t cells = grid_.cell_count();
+  if (inflow_hematocrit.size() != grid_.boundaries)
+    throw InputError("red-cell transport: a step needs " + std::to_string(grid_.face_count()) + " face volumes and " +
+                     std::to_string(grid_.boundaries) + " boundary hematocrits");
+  auto taken = [&](std::size_t c) {
+    return which == Cells::all || after_cut_.empty() || (after_cut_[c] != 0) == (which == Cells::after_cuts);
+  };
   const std::size_t ordered = cells - order_.cyclic;
   for (std::size_t k = 0; k < ordered; ++k) {
     const auto c = static_cast<std::size_t>(order_.cells[k]);
-    discharge_[c] = solve_cell(c, face_volume, inflow_hematocrit);
+    if (taken(c)) discharge_[c] = solve_cell(c, face_volume, inflow_hematocrit);
   }
-  if (order_.cyclic > 0) {
+  if (order_.cyclic > 0 && which != Cells::before_cuts) {
     double change = std::numeric_limits<double>::infinity();
     int sweep = 0;
     for (; sweep < max_cycle_sweeps && change > cycle_tolerance; ++sweep) {
@@ -210,7 +256,10 @@ void RedCellTransport::step(std::span<const double> face_volume, std::span<const
                        std::to_string(grid_.node[static_cast<std::size_t>(order_.cells[ordered])]) +
                        " did not settle in " + std::to_string(max_cycle_sweeps) + " sweeps");
   }
+}
 
+void RedCellTransport::end_step(std::span<const double> face_volume, std::span<const double> inflow_hematocrit) {
+  const std::size_t cells = grid_.cell_count(), faces = grid_.face_count();
   // What moved: red cells per face at the new upwind values, and the boundaries' balance.
   for (std::size_t f = 0; f < faces; ++f) {
     const double q = face_volume[f];
@@ -220,11 +269,12 @@ void RedCellTransport::step(std::span<const double> face_volume, std::span<const
     if (options_.all_carriers) plasma_.face[f] = q - cells_through;
     if (grid_.b[f] >= 0 || q == 0) continue;
     const auto boundary = static_cast<std::size_t>(-1 - grid_.b[f]);
+    if (grid_.is_cut(boundary)) continue;  // the other side's cells, not the network's
     if (q > 0) {
-      left_ += cells_through;
+      left_[boundary] += cells_through;
       last_outflow_[boundary] = cells_through / q;
     } else {
-      entered_ -= cells_through;
+      entered_[boundary] -= cells_through;
     }
   }
   for (std::size_t c = 0; c < cells; ++c) cells_.after[c] = next_volume_[c] * tube(c, discharge_[c]);

@@ -17,6 +17,7 @@
 // through one vessel and leaves through two (the law's own case, with the feed's hematocrit
 // of the step before); blood is mixed by flux everywhere else, and at a node of more than
 // three vessels too (NetFlow's dishem.cpp rule; steady/steady_hematocrit.hpp does the same).
+// A cut of the grid (transport/transport_grid.hpp) counts as the vessel it stands in for there.
 #pragma once
 
 #include <cstdint>
@@ -54,13 +55,29 @@ class RedCellTransport {
   // the starting hematocrit until something has).
   void step(std::span<const double> face_volume, std::span<const double> inflow_hematocrit);
 
+  // The same step in parts, for a grid with cuts (a run over ranks): begin, solve the cells
+  // that no cut's inflow reaches (`before_cuts`: what the other side's cells wait for), give
+  // each cut its inflow, solve the rest (`after_cuts`), end. Each cell's new value is the one
+  // step() gives: its upwind cells are solved before it either way. face_volume and
+  // inflow_hematocrit as step()'s, the same in every part (the cuts' inflows read in
+  // after_cuts only).
+  enum class Cells { all, before_cuts, after_cuts };
+  void begin_step(std::span<const double> face_volume);
+  void solve(std::span<const double> face_volume, std::span<const double> inflow_hematocrit, Cells cells);
+  void end_step(std::span<const double> face_volume, std::span<const double> inflow_hematocrit);
+  // Of this step (after begin_step): the phase separation's share s_f of a face, the red
+  // cells' over the blood's there (1 but where a node divides its blood): blood leaving a cell
+  // c through f carries s_f H_D(c).
+  double separation_share(std::size_t face) const { return share_[face]; }
+
   // Replaces the cells' volumes (the flow solver's moved them: its compliance balance),
   // keeping their hematocrits; the red cells that adds or removes are kept in adjusted().
   void set_volumes(std::span<const double> volume);
   void set_hematocrit(std::span<const double> discharge);
-  // The whole state, as a checkpoint holds it (sizes checked by the caller).
-  void restore(std::span<const double> discharge, std::span<const double> volume, double entered, double left,
-               double adjusted, std::span<const double> last_outflow);
+  // The whole state, as a checkpoint holds it (sizes checked by the caller): entered and left
+  // per boundary.
+  void restore(std::span<const double> discharge, std::span<const double> volume, std::span<const double> entered,
+               std::span<const double> left, double adjusted, std::span<const double> last_outflow);
   // Per boundary: the discharge hematocrit that last left through it.
   const std::vector<double>& last_outflow() const { return last_outflow_; }
 
@@ -70,11 +87,15 @@ class RedCellTransport {
   std::span<const double> discharge_hematocrit() const { return discharge_; }
   std::span<const double> volume() const { return volume_; }
   double tube_hematocrit(std::size_t cell) const { return tube(cell, discharge_[cell]); }
-  // Red cells in the network now, sum V H_T [m^3]; through the boundaries since the start
-  // (in, out) [m^3]; added by set_volumes.
+  // Red cells in the network now, sum V H_T [m^3] (a cell's: content()); through the
+  // boundaries since the start (in, out) [m^3], each boundary's summed in their order (cuts
+  // are no boundary of the network: none through them); added by set_volumes.
   double red_cells() const;
-  double entered() const { return entered_; }
-  double left() const { return left_; }
+  double content(std::size_t cell) const { return volume_[cell] * tube(cell, discharge_[cell]); }
+  double entered() const;
+  double left() const;
+  const std::vector<double>& entered_by_boundary() const { return entered_; }
+  const std::vector<double>& left_by_boundary() const { return left_; }
   double adjusted() const { return adjusted_; }
   // The last step's red cells per face (signed as the blood's) [m^3], and the carriers.
   const CarrierStep& cells_step() const { return cells_; }
@@ -103,8 +124,13 @@ class RedCellTransport {
   std::vector<double> share_;            // per face: s_f of this step
   std::vector<std::int32_t> candidates_;  // node cells of three vessels and no boundary
   std::vector<double> last_outflow_;     // per boundary: the hematocrit that last left there
+  // Per cell, with cuts: whether a cut's inflow reaches it this step (solved after_cuts).
+  std::vector<unsigned char> after_cut_;
   CarrierStep cells_, plasma_, blood_;
-  double entered_ = 0, left_ = 0, adjusted_ = 0;
+  // Per boundary, red cells in and out through it since the start: summed at the end in the
+  // boundaries' order, so that ranks holding a few each give the one-process sum.
+  std::vector<double> entered_, left_;
+  double adjusted_ = 0;
   std::size_t separating_ = 0;
 };
 

@@ -12,6 +12,11 @@
 // values upstream, so cells are visited in flow order, found each step by Kahn's algorithm on
 // the faces' signs. Cells on a directed cycle of the flow (an instant of circulation in a
 // loop) are left for a Gauss-Seidel iteration.
+//
+// A run over ranks (docs/transport.md, "Over MPI ranks") cuts the grid where a rank's subtrees
+// hang from the top's: each side holds the face between them, to a cut of its own, a
+// boundary whose inflow is the other side's (its cell's hematocrit and the phase separation's
+// share there), exchanged once a step in flow order.
 #pragma once
 
 #include <cstdint>
@@ -33,7 +38,11 @@ struct TransportGrid {
   std::vector<std::int32_t> vessel;
   std::vector<double> diameter;
   std::size_t boundaries = 0;
+  // The last `cuts` of the boundaries are cuts (a run over ranks): the network's boundaries
+  // are the first boundaries - cuts.
+  std::size_t cuts = 0;
 
+  bool is_cut(std::size_t boundary) const { return boundary + cuts >= boundaries; }
   std::size_t cell_count() const { return node.size(); }
   std::size_t face_count() const { return a.size(); }
   void add_cell(std::int64_t network_node, double fahraeus_k) {

@@ -1,0 +1,232 @@
+// Red cells over MPI ranks (docs/transport.md, "Over MPI ranks"): where each rank's cells,
+// faces and boundaries lie in the one-process run's grid, a step's two messages across the
+// cuts, and the cycle's sums and the checkpoint taken on rank 0 in the one-process order.
+#include <mpi.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "distributed/gather_rows.hpp"
+#include "distributed/root_exchange.hpp"
+#include "mpi/session.hpp"
+#include "pulse/lumped_order.hpp"
+#include "solver/cycle_over_ranks.hpp"
+#include "solver/flow_transport.hpp"
+
+namespace hemotree {
+
+namespace {
+constexpr std::size_t per_root = 2;  // a side's hematocrit H_D and its phase separation share s_f
+}  // namespace
+
+void FlowTransport::place_cut(const TransportRanks& ranks) {
+  Cut& cut = *cut_;
+  cut.top = solver_.holds_one_d();
+  cut.exchange = std::make_shared<RootExchange>(MPI_COMM_WORLD, ranks.top_rank, ranks.roots);
+  const TransportGrid& grid = red_cells_->grid();
+  const LumpedVessels& lumped = solver_.lumped();
+  const std::size_t n = net_.vessel_count();
+  std::vector<bool> zero_d(n);
+  for (std::size_t v = 0; v < n; ++v) zero_d[v] = solver_.is_lumped(v);
+  // The one-process grid: the 0D nodes in the 0D vessels' order (pulse/lumped_order), the 1D
+  // vessels' slices and junctions after them, all the top's. Its faces: the 0D vessels in the
+  // network's order, the boundaries at 0D nodes, the 1D vessels'.
+  const LumpedOrder whole = subtree_lumped_order(net_, zero_d);
+  std::vector<std::int32_t> node_place(net_.node_count(), -1);
+  for (std::size_t k = 0; k < whole.nodes.size(); ++k) node_place[static_cast<std::size_t>(whole.nodes[k])] = static_cast<std::int32_t>(k);
+  const std::size_t here_nodes = lumped.empty() ? 0 : lumped.network_node_count();
+  cut.cell_place.resize(grid.cell_count());
+  for (std::size_t c = 0; c < grid.cell_count(); ++c)
+    cut.cell_place[c] = c < here_nodes ? node_place[static_cast<std::size_t>(grid.node[c])]
+                                       : static_cast<std::int32_t>(whole.nodes.size() + (c - here_nodes));
+  const std::size_t one_d_cells = grid.cell_count() - here_nodes;
+  std::vector<std::int32_t> zero_d_before(n + 1, 0);  // the 0D vessels before each
+  for (std::size_t v = 0; v < n; ++v) zero_d_before[v + 1] = zero_d_before[v] + (zero_d[v] ? 1 : 0);
+  std::vector<bool> zero_d_node(net_.node_count(), false);
+  for (const std::int32_t node : whole.nodes) zero_d_node[static_cast<std::size_t>(node)] = true;
+  const RunBoundaries& boundaries = solver_.boundary_list();
+  std::vector<std::int32_t> boundary_face_place(boundaries.size(), -1);
+  std::int32_t at_zero_d_nodes = 0;
+  for (std::size_t b = 0; b < boundaries.size(); ++b)
+    if (zero_d_node[static_cast<std::size_t>(boundaries.node(b))]) boundary_face_place[b] = at_zero_d_nodes++;
+  const std::int32_t zero_d_faces = zero_d_before[n];
+  // The top's 1D faces follow its 0D vessels' and boundaries' in the order the whole grid has.
+  std::int32_t first_one_d_face = -1;
+  cut.face_place.assign(grid.face_count(), -1);
+  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+    const std::int32_t v = grid.vessel[f];
+    if (v >= 0 && zero_d[static_cast<std::size_t>(v)]) {
+      cut.face_place[f] = zero_d_before[static_cast<std::size_t>(v)];
+    } else if (v < 0) {
+      const auto b = static_cast<std::size_t>(-1 - grid.b[f]);
+      cut.face_place[f] = zero_d_faces + boundary_face_place[b];
+    } else {
+      if (first_one_d_face < 0) first_one_d_face = static_cast<std::int32_t>(f);
+      cut.face_place[f] = zero_d_faces + at_zero_d_nodes + (static_cast<std::int32_t>(f) - first_one_d_face);
+    }
+  }
+  // The whole run's counts: every rank knows its 0D part; the top's 1D cells and faces are
+  // the top's alone (rank 0's, and said to every rank).
+  double one_d[2] = {static_cast<double>(one_d_cells),
+                     static_cast<double>(first_one_d_face < 0 ? 0 : grid.face_count() - static_cast<std::size_t>(first_one_d_face))};
+  if (!cut.top) one_d[0] = one_d[1] = 0;
+  MPI_Allreduce(MPI_IN_PLACE, one_d, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  cut.cells = whole.nodes.size() + static_cast<std::size_t>(one_d[0]);
+  cut.faces = static_cast<std::size_t>(zero_d_faces + at_zero_d_nodes) + static_cast<std::size_t>(one_d[1]);
+}
+
+std::vector<std::int32_t> FlowTransport::own_cell_places() const {
+  std::vector<std::int32_t> place = cut_->cell_place;
+  for (const std::int32_t c : cut_->across) place[static_cast<std::size_t>(c)] = -1;
+  return place;
+}
+
+std::vector<std::int32_t> FlowTransport::own_face_places() const {
+  std::vector<std::int32_t> place = cut_->face_place;
+  if (cut_->top)  // its cuts' faces are the shares' root vessels
+    for (const std::int32_t f : cut_->face) place[static_cast<std::size_t>(f)] = -1;
+  return place;
+}
+
+std::vector<std::int32_t> FlowTransport::boundary_places() const {
+  const TransportGrid& grid = red_cells_->grid();
+  std::vector<std::int32_t> place(grid.boundaries, -1);
+  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+    if (grid.b[f] >= 0) continue;
+    const auto b = static_cast<std::size_t>(-1 - grid.b[f]);
+    if (!grid.is_cut(b)) place[b] = static_cast<std::int32_t>(b);
+  }
+  return place;
+}
+
+std::vector<double> FlowTransport::lead_whole(std::span<const double> values, std::span<const std::int32_t> place,
+                                              std::size_t whole) const {
+  std::vector<std::int32_t> items;
+  std::vector<double> rows;
+  for (std::size_t i = 0; i < place.size(); ++i)
+    if (place[i] >= 0) {
+      items.push_back(place[i]);
+      rows.push_back(values[i]);
+    }
+  std::vector<double> all(world_rank() == 0 ? whole : 0);
+  gather_rows(items, rows, 1, whole, [&](std::int32_t item, const double* row) { all[static_cast<std::size_t>(item)] = row[0]; });
+  return all;
+}
+
+double FlowTransport::lead_sum(std::span<const double> values, std::span<const std::int32_t> place, std::size_t whole,
+                               double start) const {
+  double sum = start;
+  for (const double v : lead_whole(values, place, whole)) sum += v;
+  return sum;
+}
+
+void FlowTransport::advance_over_ranks() {
+  Cut& cut = *cut_;
+  RedCellTransport& cells = *red_cells_;
+  const std::span<const double> hematocrit = cells.discharge_hematocrit();
+  const std::size_t roots = cut.face.size();
+  // Blood leaving through a cut carries s_f H_D of the cell it leaves; entering, what the
+  // other side's cell sends (the product taken as the one-process run takes it).
+  auto from_across = [&](std::span<const double> numbers) {
+    for (std::size_t j = 0; j < roots; ++j) {
+      cut.far[j] = numbers[per_root * j];
+      inflow_hematocrit_[cut.run_boundaries + j] = numbers[per_root * j + 1] * numbers[per_root * j];
+    }
+  };
+  auto from_here = [&] {
+    std::vector<double> numbers(per_root * roots);
+    for (std::size_t j = 0; j < roots; ++j) {
+      numbers[per_root * j] = hematocrit[static_cast<std::size_t>(cut.cell[j])];
+      numbers[per_root * j + 1] = cells.separation_share(static_cast<std::size_t>(cut.face[j]));
+    }
+    return numbers;
+  };
+  cells.begin_step(face_volume_);
+  std::exception_ptr failure;
+  try {
+    cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::before_cuts);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  // Up: the shares' root nodes (what the top's nodes above take where blood flows up).
+  bool failed = false;
+  const std::vector<double> up = cut.exchange->gather(cut.top ? std::vector<double>() : from_here(), failure, per_root, failed);
+  std::vector<double> down;
+  if (cut.top && !failed && !failure) {
+    from_across(up);
+    try {
+      cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::after_cuts);
+      down = from_here();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  // Down: the top's nodes above the roots; then a share finishes its subtrees below them.
+  const std::vector<double> mine = cut.exchange->scatter(down, failure, per_root, "the red cells' step");
+  if (!cut.top) {
+    from_across(mine);
+    cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::after_cuts);
+  }
+  cells.end_step(face_volume_, inflow_hematocrit_);
+  ++advances_;
+  mark();
+  last_time_ = solver_.time();
+}
+
+void FlowTransport::close_cycle_over_ranks(RedCellCycle& c) const {
+  std::vector<double>* columns[] = {&c.discharge, &c.lowest, &c.highest};
+  gather_vessel_values(net_, solver_, columns);
+  unsigned long long separating = c.separating_nodes;
+  MPI_Reduce(world_rank() == 0 ? MPI_IN_PLACE : &separating, &separating, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0,
+             MPI_COMM_WORLD);
+  c.separating_nodes = static_cast<std::size_t>(separating);
+}
+
+void FlowTransport::save_over_ranks(CheckpointWriter* out) const {
+  const RedCellTransport& t = *red_cells_;
+  const std::vector<std::int32_t> cells = own_cell_places(), faces = own_face_places(), held = boundary_places();
+  const std::size_t boundaries = cut_->run_boundaries;
+  std::vector<double> turned(face_volume_.size());  // each face as the whole grid has it
+  for (std::size_t f = 0; f < turned.size(); ++f) turned[f] = cut_->face_sign[f] * face_volume_[f];
+  std::vector<double> applied(applied_hematocrit_);
+  std::vector<std::int32_t> stepped(applied.size(), -1);
+  for (std::size_t v = 0; v < stepped.size(); ++v)
+    if (solver_.steps_vessel(v)) stepped[v] = static_cast<std::int32_t>(v);
+  const RedCellState whole{lead_whole(t.discharge_hematocrit(), cells, cut_->cells),
+                           lead_whole(t.volume(), cells, cut_->cells),
+                           lead_whole(t.entered_by_boundary(), held, boundaries),
+                           lead_whole(t.left_by_boundary(), held, boundaries),
+                           cut_->adjusted,
+                           lead_whole(t.last_outflow(), held, boundaries),
+                           lead_whole(applied, stepped, applied.size()),
+                           lead_whole(turned, faces, cut_->faces)};
+  if (!out) return;
+  put_red_cells(*out, whole);
+  out->put(static_cast<std::uint64_t>(advances_));
+  out->put(last_time_);
+}
+
+void FlowTransport::restore_share(const RedCellState& whole) {
+  RedCellTransport& t = *red_cells_;
+  const TransportGrid& grid = t.grid();
+  std::vector<double> discharge(grid.cell_count()), volume(grid.cell_count(), 0.0);
+  for (std::size_t c = 0; c < discharge.size(); ++c) {
+    discharge[c] = whole.discharge[static_cast<std::size_t>(cut_->cell_place[c])];
+    volume[c] = c >= cut_->ghost.size() || cut_->ghost[c] < 0 ? whole.volume[static_cast<std::size_t>(cut_->cell_place[c])] : 0.0;
+  }
+  for (std::size_t j = 0; j < cut_->across.size(); ++j) cut_->far[j] = discharge[static_cast<std::size_t>(cut_->across[j])];
+  std::vector<double> entered(grid.boundaries, 0.0), left(grid.boundaries, 0.0), last(grid.boundaries, solver_.blood().hematocrit);
+  for (const std::int32_t b : boundary_places())
+    if (b >= 0) {
+      const auto i = static_cast<std::size_t>(b);
+      entered[i] = whole.entered[i];
+      left[i] = whole.left[i];
+      last[i] = whole.last_outflow[i];
+    }
+  t.restore(discharge, volume, entered, left, 0.0, last);
+  cut_->adjusted = whole.adjusted;
+  for (std::size_t f = 0; f < face_volume_.size(); ++f)
+    face_volume_[f] = cut_->face_sign[f] * whole.faces[static_cast<std::size_t>(cut_->face_place[f])];
+}
+
+}  // namespace hemotree
