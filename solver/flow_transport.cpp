@@ -40,7 +40,6 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     : net_(net), solver_(solver), options_(options) {
   if (solver.steps() != 0)
     throw InputError("red-cell transport: set up before the solver's first step (its face volumes start then)");
-  if (ranks && !options_.tracers.empty()) throw std::logic_error("FlowTransport over ranks: tracers");
   const LumpedVessels& lumped = solver.lumped();
   // Its cells at 0D nodes are the network's nodes: the inner nodes of a vessel in sections
   // would hold volume no cell does (solver_options() keeps every 0D vessel one section).
@@ -219,15 +218,19 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     for (std::size_t v = 0; v < vessels; ++v) viscosity_scaling_.emplace_back(blood, mean_diameter(net, v));
   }
   // Tracers: clean blood at every boundary that lets blood in, what left at the others.
+  const TransportGrid& carried = red_cells_->grid();
   for (const TracerSpec& spec : options_.tracers) {
-    tracers_.emplace_back(cell_count(), boundaries.size(), spec.carrier);
+    tracers_.emplace_back(carried.cell_count(), carried.boundaries, spec.carrier);
     curves_.emplace_back(vessels, spec.concentration, spec.centre(), spec.shape == TracerSpec::Shape::step);
     std::vector<std::int32_t> given;
     std::int32_t face = -1;
     if (spec.place == TracerSpec::Place::vessel) {
+      // Over ranks the rank that steps the vessel injects (the top's ghost of a share's root
+      // vessel does not: what crosses the cut carries the injection already, or takes it there).
       const auto v = static_cast<std::size_t>(spec.at);
-      face = one_d_place_[v] >= 0 ? vessel_first_face_[static_cast<std::size_t>(one_d_place_[v])]
-                                  : lumped_face_[static_cast<std::size_t>(lumped.vessel_index(v))];
+      if (one_d_place_[v] >= 0) face = vessel_first_face_[static_cast<std::size_t>(one_d_place_[v])];
+      else if (solver.is_lumped(v) && solver.steps_vessel(v))
+        face = lumped_face_[static_cast<std::size_t>(lumped.vessel_index(v))];
     } else {
       for (std::size_t b = 0; b < boundaries.size(); ++b) {
         if (!boundaries.is_outlet(b) && (spec.place == TracerSpec::Place::inlet || boundaries.node(b) == spec.at))
@@ -243,43 +246,61 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     tracer_boundaries_.push_back(std::move(given));
     tracer_face_.push_back(face);
   }
+  tracer_inflow_.resize(tracers_.size());
+  tracer_injected_.resize(tracers_.size());
+  if (cut_) cut_->tracer_far.assign(tracers_.size() * cut_->face.size(), 0.0);
   last_time_ = solver.time();
   mark();
   begin_cycle();
 }
 
-void FlowTransport::step_tracers(double t0, double t1) {
+void FlowTransport::tracer_given(std::size_t k, double t0, double t1) {
   const RunBoundaries& boundaries = solver_.boundary_list();
   const TransportGrid& grid = red_cells_->grid();
-  for (std::size_t k = 0; k < tracers_.size(); ++k) {
-    const TracerSpec& spec = options_.tracers[k];
-    const double given = spec.mean_over(t0, t1);
-    tracer_inflow_.assign(boundaries.size(), 0.0);
-    for (std::size_t b = 0; b < boundaries.size(); ++b)
-      if (boundaries.is_outlet(b))
-        tracer_inflow_[b] = std::numeric_limits<double>::quiet_NaN();  // an outlet returns what it took
-    for (const std::int32_t b : tracer_boundaries_[k]) tracer_inflow_[static_cast<std::size_t>(b)] = given;
-    tracer_injected_.clear();
-    if (tracer_face_[k] >= 0) {
-      tracer_injected_.assign(grid.face_count(), 0.0);
-      tracer_injected_[static_cast<std::size_t>(tracer_face_[k])] = given;
-    }
-    tracers_[k].step(*red_cells_, tracer_inflow_, tracer_injected_);
-    // Each vessel's curve: the mean over its faces that passed blood of what crossed them.
-    const std::span<const double> c = tracers_[k].face_concentration();
-    std::fill(step_sum_.begin(), step_sum_.end(), 0.0);
-    std::fill(step_count_.begin(), step_count_.end(), 0);
-    for (std::size_t f = 0; f < grid.face_count(); ++f) {
-      const std::int32_t v = grid.vessel[f];
-      if (v < 0 || face_volume_[f] == 0) continue;
-      step_sum_[static_cast<std::size_t>(v)] += c[f];
-      ++step_count_[static_cast<std::size_t>(v)];
-    }
-    for (std::size_t v = 0; v < step_sum_.size(); ++v)
-      if (step_count_[v] > 0) curves_[k].add(v, t0, t1, step_sum_[v] / step_count_[v]);
+  const double given = options_.tracers[k].mean_over(t0, t1);
+  std::vector<double>& inflow = tracer_inflow_[k];
+  inflow.assign(grid.boundaries, 0.0);  // a cut's from the messages (over ranks)
+  for (std::size_t b = 0; b < boundaries.size(); ++b)
+    if (boundaries.is_outlet(b)) inflow[b] = std::numeric_limits<double>::quiet_NaN();  // an outlet returns what it took
+  for (const std::int32_t b : tracer_boundaries_[k]) inflow[static_cast<std::size_t>(b)] = given;
+  std::vector<double>& injected = tracer_injected_[k];
+  injected.clear();
+  if (tracer_face_[k] >= 0) {
+    injected.assign(grid.face_count(), 0.0);
+    injected[static_cast<std::size_t>(tracer_face_[k])] = given;
   }
+}
+
+void FlowTransport::follow_curve(std::size_t k, double t0, double t1) {
+  // Each vessel's curve: the mean over its faces that passed blood of what crossed them.
+  const TransportGrid& grid = red_cells_->grid();
+  const std::span<const double> c = tracers_[k].face_concentration();
   std::fill(step_sum_.begin(), step_sum_.end(), 0.0);
   std::fill(step_count_.begin(), step_count_.end(), 0);
+  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+    const std::int32_t v = grid.vessel[f];
+    if (v < 0 || face_volume_[f] == 0) continue;
+    step_sum_[static_cast<std::size_t>(v)] += c[f];
+    ++step_count_[static_cast<std::size_t>(v)];
+  }
+  for (std::size_t v = 0; v < step_sum_.size(); ++v)
+    if (step_count_[v] > 0) curves_[k].add(v, t0, t1, step_sum_[v] / step_count_[v]);
+  std::fill(step_sum_.begin(), step_sum_.end(), 0.0);
+  std::fill(step_count_.begin(), step_count_.end(), 0);
+}
+
+void FlowTransport::step_tracers(double t0, double t1) {
+  for (std::size_t k = 0; k < tracers_.size(); ++k) {
+    tracer_given(k, t0, t1);
+    tracers_[k].step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+    follow_curve(k, t0, t1);
+  }
+}
+
+FlowTransport::TracerReport FlowTransport::tracer_report(std::size_t k) const {
+  if (cut_) return reports_.at(k);
+  const TracerTransport& t = tracers_[k];
+  return {curves_[k].landmarks(solver_.time()), t.amount(*red_cells_), t.entered(), t.left(), t.injected(), t.adjusted()};
 }
 
 std::size_t FlowTransport::cell_at(std::size_t v, double x) const {
@@ -304,7 +325,10 @@ double FlowTransport::hematocrit_at(std::size_t v, double x) const {
 }
 
 double FlowTransport::tracer_at(std::size_t k, std::size_t v, double x) const {
-  return tracers_[k].concentration()[cell_at(v, x)];
+  const std::size_t c = cell_at(v, x);
+  if (cut_ && c < cut_->ghost.size() && cut_->ghost[c] >= 0)
+    return cut_->tracer_far[k * cut_->face.size() + static_cast<std::size_t>(cut_->ghost[c])];
+  return tracers_[k].concentration()[c];
 }
 
 void FlowTransport::solver_volumes(std::vector<double>& volume) const {
@@ -338,6 +362,11 @@ void FlowTransport::restart() {
 void FlowTransport::take_volumes() {
   now_.assign(red_cells_->volume().begin(), red_cells_->volume().end());
   solver_volumes(now_);
+  // Each tracer's carrier moves with the volumes: what that adds, cell by cell.
+  const std::size_t cells = now_.size();
+  std::vector<std::vector<double>> carried_before(tracers_.size(), std::vector<double>(cells));
+  for (std::size_t k = 0; k < tracers_.size(); ++k)
+    for (std::size_t c = 0; c < cells; ++c) carried_before[k][c] = tracers_[k].carried(*red_cells_, c);
   if (cut_) {  // what it adds, cell by cell in the one-process order (RedCellTransport::set_volumes)
     std::vector<double> added(now_.size());
     for (std::size_t c = 0; c < added.size(); ++c)
@@ -345,6 +374,18 @@ void FlowTransport::take_volumes() {
     cut_->adjusted = lead_sum(added, own_cell_places(), cut_->cells, cut_->adjusted);
   }
   red_cells_->set_volumes(now_);
+  for (std::size_t k = 0; k < tracers_.size(); ++k) {
+    TracerTransport& t = tracers_[k];
+    std::vector<double>& added = carried_before[k];
+    for (std::size_t c = 0; c < cells; ++c) added[c] = (t.carried(*red_cells_, c) - added[c]) * t.concentration()[c];
+    if (cut_) {
+      t.set_adjusted(lead_sum(added, own_cell_places(), cut_->cells, t.adjusted()));  // rank 0's the whole's
+    } else {
+      double sum = t.adjusted();
+      for (const double a : added) sum += a;
+      t.set_adjusted(sum);
+    }
+  }
 }
 
 FlowTransport::Totals FlowTransport::totals() const {
@@ -523,11 +564,40 @@ void FlowTransport::save(CheckpointWriter& out) const {
   out.put(last_time_);
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const TracerTransport& t = tracers_[k];
-    out.put(std::vector<double>(t.concentration().begin(), t.concentration().end()));
-    out.put(t.last_outflow());
-    out.put(t.totals());
-    out.put(curves_[k].state());
+    put_tracer(out, {{t.concentration().begin(), t.concentration().end()},
+                     t.last_outflow(),
+                     t.entered_by_boundary(),
+                     t.left_by_boundary(),
+                     t.injected(),
+                     t.adjusted(),
+                     curves_[k].state()});
   }
+}
+
+void FlowTransport::put_tracer(CheckpointWriter& out, const TracerState& state) {
+  out.put(state.concentration);
+  out.put(state.last_outflow);
+  out.put(state.entered);
+  out.put(state.left);
+  out.put(std::vector<double>{state.injected, state.adjusted});
+  out.put(state.curve);
+}
+
+FlowTransport::TracerState FlowTransport::get_tracer(CheckpointReader& in, std::size_t k) const {
+  TracerState s;
+  s.concentration = in.get_vector();
+  s.last_outflow = in.get_vector();
+  s.entered = in.get_vector();
+  s.left = in.get_vector();
+  const std::vector<double> totals = in.get_vector();
+  s.curve = in.get_vector();
+  const std::size_t boundaries = solver_.boundary_list().size();
+  if (s.concentration.size() != cell_count() || s.last_outflow.size() != boundaries || s.entered.size() != boundaries ||
+      s.left.size() != boundaries || totals.size() != 2 || s.curve.size() != 6 * net_.vessel_count())
+    in.fail("tracer " + options_.tracers[k].name + " of another network or transport grid");
+  s.injected = totals[0];
+  s.adjusted = totals[1];
+  return s;
 }
 
 void FlowTransport::restore(CheckpointReader& in) {
@@ -542,12 +612,10 @@ void FlowTransport::restore(CheckpointReader& in) {
   advances_ = static_cast<std::size_t>(in.get_u64());
   last_time_ = in.get_double();
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
-    const std::vector<double> c = in.get_vector(), last = in.get_vector(), totals = in.get_vector(),
-                              curve = in.get_vector();
-    if (c.size() != cell_count() || last.size() != red_cells_->grid().boundaries || totals.size() != 5 ||
-        !curves_[k].restore(curve))
-      in.fail("tracer " + options_.tracers[k].name + " of another network or transport grid");
-    tracers_[k].restore(c, last, totals);
+    const TracerState t = get_tracer(in, k);
+    curves_[k].restore(t.curve);
+    if (cut_) restore_tracer_share(k, t);
+    else tracers_[k].restore(t.concentration, t.last_outflow, t.entered, t.left, t.injected, t.adjusted);
   }
   mark();
   begin_cycle();

@@ -80,7 +80,7 @@ class RootExchange;
 class FlowTransport {
  public:
   // Call before the solver's first step (it starts the solver's face accumulators). ranks:
-  // where the solver is a rank's part of a run over ranks (tracers are not carried then).
+  // where the solver is a rank's part of a run over ranks.
   FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options = {},
                 const TransportRanks* ranks = nullptr);
 
@@ -99,9 +99,14 @@ class FlowTransport {
   const std::vector<TracerSpec>& tracer_specs() const { return options_.tracers; }
   bool reports_red_cells() const { return options_.red_cells; }
   const Blood& red_cells_blood() const { return solver_.blood(); }
-  const TracerTransport& tracer(std::size_t k) const { return tracers_[k]; }
-  // Per vessel, tracer k's curve landmarks over the run so far.
-  IndicatorCurves::Landmarks tracer_landmarks(std::size_t k) const { return curves_[k].landmarks(solver_.time()); }
+  // Tracer k's numbers for the report: per vessel its curve's landmarks over the run so far,
+  // and its balance (over ranks rank 0's, taken by take_reports before the ranks part).
+  struct TracerReport {
+    IndicatorCurves::Landmarks landmarks;
+    double amount = 0, entered = 0, left = 0, injected = 0, adjusted = 0;
+  };
+  TracerReport tracer_report(std::size_t k) const;
+  void take_reports();  // over ranks, collective: every rank at the run's end; alone nothing
   // At fraction x along a vessel (probes): the discharge hematocrit, and tracer k's
   // concentration, of the cell there (a 0D vessel: the node its blood came from last).
   double hematocrit_at(std::size_t vessel, double x) const;
@@ -109,6 +114,8 @@ class FlowTransport {
   // The whole run's cells (over ranks: every rank's).
   std::size_t cell_count() const { return cut_ ? cut_->cells : red_cells_->grid().cell_count(); }
   std::size_t advances() const { return advances_; }
+  // Over ranks: the exchange of its steps' messages (its traffic); else null.
+  const RootExchange* exchange() const { return cut_ ? cut_->exchange.get() : nullptr; }
 
   void save(CheckpointWriter& out) const;
   // Over ranks: the one-process run's bytes, written to `out` on rank 0, null elsewhere. Collective.
@@ -123,6 +130,9 @@ class FlowTransport {
   std::size_t cell_at(std::size_t vessel, double x) const;
   void step_tracers(double t0, double t1);
   void face_volumes();  // face_volume_ from what the solver passed since the last advance
+  // Tracer k's inflow per boundary and injection per face over [t0, t1], into its arrays.
+  void tracer_given(std::size_t k, double t0, double t1);
+  void follow_curve(std::size_t k, double t0, double t1);  // each vessel's curve after a step
   // The red cells in the network, through the boundaries (in, out) and added by the volumes'
   // changes since the start (over ranks: rank 0's, collective).
   struct Totals {
@@ -141,6 +151,7 @@ class FlowTransport {
     std::vector<std::int32_t> cell;   // the cell on this side of it
     std::vector<std::int32_t> across; // the empty cell of the node across it
     std::vector<double> far;          // the hematocrit of the cell across it (a share's probes)
+    std::vector<double> tracer_far;   // per tracer, per root: its concentration there
     std::vector<std::int32_t> ghost;  // per cell: the root it is the node across (-1: a cell of its own)
     std::vector<std::int32_t> cell_place, face_place;  // in the whole run's grid
     std::vector<signed char> face_sign;  // per face: +1, or -1 where a cut turned it round
@@ -150,6 +161,8 @@ class FlowTransport {
   // The cut's faces were made with the grid; the rest of the Cut from them.
   void place_cut(const TransportRanks& ranks);
   void advance_over_ranks();
+  void step_tracers_over_ranks(double t0, double t1);
+  std::vector<TracerReport> reports_;  // over ranks, rank 0's (take_reports)
   // On rank 0 `start` plus each of the whole run's items in turn (per cell or boundary: each
   // rank's values at `place`, -1 none), in the one-process order; elsewhere `start`. Collective.
   double lead_sum(std::span<const double> values, std::span<const std::int32_t> place, std::size_t whole,
@@ -162,6 +175,8 @@ class FlowTransport {
   std::vector<std::int32_t> own_cell_places() const;
   std::vector<std::int32_t> own_face_places() const;
   std::vector<std::int32_t> boundary_places() const;
+  std::vector<std::int32_t> own_curve_places() const;  // a tracer's curves: the vessels it steps
+  double rank_sum(double value) const;  // on rank 0 every rank's value, summed in rank order
   void close_cycle_over_ranks(RedCellCycle& c) const;
   // The red cells' state as a checkpoint holds it, in the one-process grid's order: per cell,
   // per boundary of the network, per vessel, per face.
@@ -173,6 +188,16 @@ class FlowTransport {
   static void put_red_cells(CheckpointWriter& out, const RedCellState& state);
   RedCellState get_red_cells(CheckpointReader& in) const;  // its sizes checked
   void restore_share(const RedCellState& whole);
+  // A tracer's state as a checkpoint holds it (the same order; its curves per vessel, six
+  // arrays one after the other).
+  struct TracerState {
+    std::vector<double> concentration, last_outflow, entered, left;
+    double injected = 0, adjusted = 0;
+    std::vector<double> curve;
+  };
+  static void put_tracer(CheckpointWriter& out, const TracerState& state);
+  TracerState get_tracer(CheckpointReader& in, std::size_t k) const;  // its sizes checked
+  void restore_tracer_share(std::size_t k, const TracerState& whole);
 
   const Network& net_;
   PulseSolver& solver_;
@@ -208,8 +233,8 @@ class FlowTransport {
   std::vector<TracerTransport> tracers_;
   std::vector<IndicatorCurves> curves_;
   std::vector<std::vector<std::int32_t>> tracer_boundaries_;
-  std::vector<std::int32_t> tracer_face_;
-  std::vector<double> tracer_inflow_, tracer_injected_;  // scratch
+  std::vector<std::int32_t> tracer_face_;  // -1: none here (over ranks: another rank's vessel)
+  std::vector<std::vector<double>> tracer_inflow_, tracer_injected_;  // per tracer, of a step
   double last_time_ = 0;  // the solver's time at the last advance
   std::optional<Cut> cut_;
 };

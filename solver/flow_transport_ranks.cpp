@@ -170,7 +170,57 @@ void FlowTransport::advance_over_ranks() {
   cells.end_step(face_volume_, inflow_hematocrit_);
   ++advances_;
   mark();
+  if (!tracers_.empty()) step_tracers_over_ranks(last_time_, solver_.time());
   last_time_ = solver_.time();
+}
+
+void FlowTransport::step_tracers_over_ranks(double t0, double t1) {
+  // The red cells' step is whole: every tracer rides on its carriers, in its split, with two
+  // messages of its own (each root's concentration of every tracer up, then down).
+  Cut& cut = *cut_;
+  const std::size_t roots = cut.face.size(), count = tracers_.size();
+  using Cells = RedCellTransport::Cells;
+  for (std::size_t k = 0; k < count; ++k) {
+    tracer_given(k, t0, t1);
+    tracers_[k].begin_step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+    tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], Cells::before_cuts);
+  }
+  // What crosses each cut from this side (with an injection there, which its rank adds), and
+  // what the other side sent as the cuts' inflows (and the far side's concentration).
+  auto from_here = [&] {
+    std::vector<double> numbers(count * roots);
+    for (std::size_t j = 0; j < roots; ++j)
+      for (std::size_t k = 0; k < count; ++k)
+        numbers[count * j + k] =
+            tracers_[k].inflowing(static_cast<std::size_t>(cut.face[j]), *red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+    return numbers;
+  };
+  auto from_across = [&](std::span<const double> numbers) {
+    for (std::size_t j = 0; j < roots; ++j)
+      for (std::size_t k = 0; k < count; ++k) {
+        tracer_inflow_[k][cut.run_boundaries + j] = numbers[count * j + k];
+        cut.tracer_far[k * roots + j] = numbers[count * j + k];
+      }
+  };
+  bool failed = false;
+  const std::vector<double> up = cut.exchange->gather(cut.top ? std::vector<double>() : from_here(), nullptr, count, failed);
+  std::vector<double> down;
+  if (cut.top) {
+    from_across(up);
+    for (std::size_t k = 0; k < count; ++k)
+      tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], Cells::after_cuts);
+    down = from_here();
+  }
+  const std::vector<double> mine = cut.exchange->scatter(down, nullptr, count, "the tracers' step");
+  if (!cut.top) {
+    from_across(mine);
+    for (std::size_t k = 0; k < count; ++k)
+      tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], Cells::after_cuts);
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    tracers_[k].end_step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+    follow_curve(k, t0, t1);
+  }
 }
 
 void FlowTransport::close_cycle_over_ranks(RedCellCycle& c) const {
@@ -200,10 +250,78 @@ void FlowTransport::save_over_ranks(CheckpointWriter* out) const {
                            lead_whole(t.last_outflow(), held, boundaries),
                            lead_whole(applied, stepped, applied.size()),
                            lead_whole(turned, faces, cut_->faces)};
-  if (!out) return;
-  put_red_cells(*out, whole);
-  out->put(static_cast<std::uint64_t>(advances_));
-  out->put(last_time_);
+  if (out) {
+    put_red_cells(*out, whole);
+    out->put(static_cast<std::uint64_t>(advances_));
+    out->put(last_time_);
+  }
+  const std::vector<std::int32_t> curves = own_curve_places();
+  for (std::size_t k = 0; k < tracers_.size(); ++k) {
+    const TracerTransport& tracer = tracers_[k];
+    const TracerState state{lead_whole(tracer.concentration(), cells, cut_->cells),
+                            lead_whole(tracer.last_outflow(), held, boundaries),
+                            lead_whole(tracer.entered_by_boundary(), held, boundaries),
+                            lead_whole(tracer.left_by_boundary(), held, boundaries),
+                            rank_sum(tracer.injected()),
+                            tracer.adjusted(),
+                            lead_whole(curves_[k].state(), curves, curves.size())};
+    if (out) put_tracer(*out, state);
+  }
+}
+
+std::vector<std::int32_t> FlowTransport::own_curve_places() const {
+  const std::size_t n = net_.vessel_count();
+  std::vector<std::int32_t> place(6 * n, -1);
+  for (std::size_t a = 0; a < 6; ++a)
+    for (std::size_t v = 0; v < n; ++v)
+      if (solver_.steps_vessel(v)) place[a * n + v] = static_cast<std::int32_t>(a * n + v);
+  return place;
+}
+
+double FlowTransport::rank_sum(double value) const {
+  const std::vector<std::int32_t> place{world_rank()};
+  return lead_sum(std::span<const double>(&value, 1), place, static_cast<std::size_t>(world_size()), 0.0);
+}
+
+void FlowTransport::restore_tracer_share(std::size_t k, const TracerState& whole) {
+  const TransportGrid& grid = red_cells_->grid();
+  std::vector<double> concentration(grid.cell_count());
+  for (std::size_t c = 0; c < concentration.size(); ++c) concentration[c] = whole.concentration[static_cast<std::size_t>(cut_->cell_place[c])];
+  const std::size_t roots = cut_->across.size();
+  for (std::size_t j = 0; j < roots; ++j) cut_->tracer_far[k * roots + j] = concentration[static_cast<std::size_t>(cut_->across[j])];
+  std::vector<double> entered(grid.boundaries, 0.0), left(grid.boundaries, 0.0), last(grid.boundaries, 0.0);
+  for (const std::int32_t b : boundary_places())
+    if (b >= 0) {
+      const auto i = static_cast<std::size_t>(b);
+      entered[i] = whole.entered[i];
+      left[i] = whole.left[i];
+      last[i] = whole.last_outflow[i];
+    }
+  // The injection's and the balance's totals are rank 0's (the whole run's), and what the
+  // injecting rank adds from here on: the same sums, in the same order, there.
+  const bool injects = tracer_face_[k] >= 0;
+  tracers_[k].restore(concentration, last, entered, left, injects ? whole.injected : 0.0, world_rank() == 0 ? whole.adjusted : 0.0);
+}
+
+void FlowTransport::take_reports() {
+  if (!cut_) return;
+  reports_.clear();
+  const std::vector<std::int32_t> cells = own_cell_places(), held = boundary_places();
+  for (std::size_t k = 0; k < tracers_.size(); ++k) {
+    const TracerTransport& t = tracers_[k];
+    TracerReport r;
+    r.landmarks = curves_[k].landmarks(solver_.time());
+    std::vector<double>* columns[] = {&r.landmarks.arrival, &r.landmarks.peak_time, &r.landmarks.peak, &r.landmarks.mean_transit};
+    gather_vessel_values(net_, solver_, columns);
+    std::vector<double> carried(red_cells_->grid().cell_count());
+    for (std::size_t c = 0; c < carried.size(); ++c) carried[c] = t.carried(*red_cells_, c) * t.concentration()[c];
+    r.amount = lead_sum(carried, cells, cut_->cells, 0.0);
+    r.entered = lead_sum(t.entered_by_boundary(), held, cut_->run_boundaries, 0.0);
+    r.left = lead_sum(t.left_by_boundary(), held, cut_->run_boundaries, 0.0);
+    r.injected = rank_sum(t.injected());
+    r.adjusted = t.adjusted();
+    reports_.push_back(std::move(r));
+  }
 }
 
 void FlowTransport::restore_share(const RedCellState& whole) {

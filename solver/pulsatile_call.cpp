@@ -264,7 +264,7 @@ void say_results(const Network& net, const PulseSolver& run, const RunConfigurat
   warn_unphysiological(low, high, net.id[highest], net, "mean pressures", config.words, observer);
   // A tracer whose injection the run never reached has no curves: said, not left to be found.
   for (std::size_t k = 0; transport && k < config.tracers.size(); ++k)
-    if (const TracerTransport& moved = transport->tracer(k); moved.entered() + moved.injected() == 0)
+    if (const FlowTransport::TracerReport moved = transport->tracer_report(k); moved.entered + moved.injected == 0)
       observer.warn("tracer " + config.tracers[k].name + " never entered the network (its injection starts at t = " +
                     format_quantity(config.tracers[k].start, "s") + ", the run ended at t = " +
                     format_quantity(run.time(), "s") + "): its arrival, peak and transit times are null");
@@ -286,16 +286,13 @@ void check_pulsatile(const Network& net, const RunConfiguration& config) {
 namespace {
 
 // What a pulsatile run over MPI ranks does not take yet (docs/scaling.md, "The pulsatile run
-// over ranks"): tracers (they move in flow order across the ranks, as the red cells do, on
-// carriers of their own); a settling cycle at a lower
+// over ranks"): a settling cycle at a lower
 // degree is a second solver (taken by default only where most vessels are 1D: not a tree
 // that ranks split). Refused on every rank alike, before any work.
 void refuse_over_ranks(const RunConfiguration& config) {
   auto refuse = [](const std::string& setting, const std::string& why, const std::string& value = "") {
     throw SettingError(setting, placeholder(setting) + value + ": " + why + "; run it as one process (without mpirun)");
   };
-  if (!config.tracers.empty())
-    refuse("tracer", "a pulsatile run over MPI ranks carries no tracers yet (red cells it carries)");
   if (config.until_periodic && config.settling_degree != SolverOptions::automatic && config.settling_degree > 0)
     refuse("settling_degree", "a pulsatile run over MPI ranks takes no settling cycle at a lower degree yet (a second solver)");
 }
@@ -464,6 +461,11 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
       observer.note("the 0D steps' exchanges on rank 0, the top's: " + std::to_string(t.calls) + " collective calls, " +
                     std::to_string(t.bytes) + " bytes, " + format_quantity(t.seconds, "s") +
                     " inside them (waiting for the shares included)");
+    }
+    if (const RootExchange* exchange = transport ? transport->exchange() : nullptr) {
+      const RootExchange::Traffic& t = exchange->traffic();
+ observer.note("the transport steps' exchanges on rank 0: " + std::to_string(t.calls) + " collective calls, " +
+                    std::to_string(t.bytes) + " bytes, " + format_quantity(t.seconds, "s") + " inside them");
     }
   }
   if (pulsatile.stopped_settling()) {

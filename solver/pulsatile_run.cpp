@@ -350,6 +350,7 @@ RunStatus PulsatileRun::run(RunObserver& observer) {
   const RunStatus status = run_cycles(observer);
   take_back_last_vessels();  // what the report describes, however the run stopped
   if (over_ranks_) probes_over_ranks_->gather_into(probes_);  // rank 0's: every probe's rows
+  if (over_ranks_ && transport_) transport_->take_reports();  // rank 0's: the tracers' curves and balances
   return status;
 }
 

@@ -13,11 +13,9 @@ namespace hemotree {
 
 namespace {
 
-nlohmann::json tracer_block(const FlowTransport& transport, std::size_t k) {
-  const TracerSpec& t = transport.tracer_specs()[k];
-  const TracerTransport& moved = transport.tracer(k);
-  const double amount = moved.amount(transport.red_cells());
-  const double scale = std::max({moved.injected() + moved.entered(), amount, 1e-300});
+nlohmann::json tracer_block(const TracerSpec& t, const FlowTransport::TracerReport& moved) {
+  const double amount = moved.amount;
+  const double scale = std::max({moved.injected + moved.entered, amount, 1e-300});
   const bool bolus = t.shape == TracerSpec::Shape::bolus;
   return {{"name", t.name},
           {"carrier", to_string(t.carrier)},
@@ -25,11 +23,11 @@ nlohmann::json tracer_block(const FlowTransport& transport, std::size_t k) {
           {"start", t.start},
           {"duration", bolus ? nlohmann::json(t.duration) : nlohmann::json(nullptr)},
           {"concentration", t.concentration},
-          {"entered", moved.entered()},
-          {"injected", moved.injected()},
-          {"left", moved.left()},
+          {"entered", moved.entered},
+          {"injected", moved.injected},
+          {"left", moved.left},
           {"in_network", amount},
-          {"balance_error", (amount - (moved.entered() + moved.injected() - moved.left() + moved.adjusted())) / scale}};
+          {"balance_error", (amount - (moved.entered + moved.injected - moved.left + moved.adjusted)) / scale}};
 }
 
 }  // namespace
@@ -44,12 +42,13 @@ void report_transport(const Network& net, const FlowTransport& transport, const 
     nlohmann::json list = nlohmann::json::array();
     for (std::size_t k = 0; k < tracers; ++k) {
       const std::string& name = transport.tracer_specs()[k].name;
-      IndicatorCurves::Landmarks l = transport.tracer_landmarks(k);
+      FlowTransport::TracerReport report = transport.tracer_report(k);
+      list.push_back(tracer_block(transport.tracer_specs()[k], report));
+      IndicatorCurves::Landmarks& l = report.landmarks;
       results.add_number(name + "_arrival_time", std::move(l.arrival));
       results.add_number(name + "_peak_time", std::move(l.peak_time));
       results.add_number(name + "_peak", std::move(l.peak));
       results.add_number(name + "_mean_transit_time", std::move(l.mean_transit));
-      list.push_back(tracer_block(transport, k));
     }
     run_info["tracers"] = list;
   }

@@ -3,7 +3,8 @@
 // two roots, stepped in parts with the two messages between them played here, against the
 // whole grid stepped at once. Flows that turn round, daughters of opposite signs (a root node
 // that feeds its parent and a daughter: phase separation sent up), every cell's hematocrit
-// and every boundary's red cells equal to the bit.
+// and every boundary's red cells equal to the bit; a tracer on the plasma the same, injected
+// into a root vessel (which the share, the vessel's rank, injects).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "transport/red_cell_transport.hpp"
+#include "transport/tracer_transport.hpp"
 
 namespace hemotree {
 namespace {
@@ -124,6 +126,77 @@ TEST(RedCellCut, TwoSidesStepInPartsToTheWholeGridsBits) {
   EXPECT_NEAR(top.red_cells() + share.red_cells(), whole.red_cells(), 1e-15 * whole.red_cells());
   const double initial = 6 * v * h0 * (0.8 + 0.2 * h0);
   EXPECT_NEAR(whole.red_cells() - initial, whole.entered() - whole.left(), 1e-13 * initial);
+}
+
+TEST(RedCellCut, ATracerInjectedIntoARootVesselStepsInPartsToTheWholeGridsBits) {
+  const double v = 1e-13, h0 = 0.45;
+  RedCellTransport whole(whole_tree(), std::vector<double>(6, v), h0);
+  RedCellTransport top(top_side(), std::vector<double>(2, v), h0);
+  RedCellTransport share(share_side(), std::vector<double>(4, v), h0);
+  TracerTransport whole_dye(6, 4, TracerCarrier::plasma), top_dye(2, 6, TracerCarrier::plasma),
+      share_dye(4, 6, TracerCarrier::plasma);
+  std::vector<double> inflow(4, nan), cut_inflow(6, nan);
+  inflow[0] = cut_inflow[0] = 0.4;
+  using Cells = RedCellTransport::Cells;
+  int up_through_root = 0;
+  for (int s = 0; s < 300; ++s) {
+    const double t = 2 * std::numbers::pi * s / 100;
+    const double q3 = 0.2 * v * (0.2 + std::sin(t)), q4 = 0.15 * v * (0.5 + std::cos(1.3 * t));
+    const double q8 = 0.1 * v * (0.4 + std::sin(0.7 * t + 1)), q1 = q3 + q4, q2 = q8, q0 = q1 + q2;
+    const std::vector<double> whole_q{q0, q1, q2, q3, q4, -q0, q3, q4, q8};
+    const std::vector<double> top_q{q0, q1, q2, -q0}, share_q{-q1, -q2, q3, q4, q3, q4, q8};
+    up_through_root += q1 < 0;
+    // The dye: at the inlet, and injected into vessel 1 (whole face 1, the share's face 0).
+    const double given = 1 + 0.5 * std::sin(0.3 * t);
+    std::vector<double> dye_in(4, nan), dye_cut_in(6, nan);
+    dye_in[0] = dye_cut_in[0] = given;
+    std::vector<double> whole_injected(9, 0.0), share_injected(7, 0.0);
+    whole_injected[1] = share_injected[0] = 0.5 * given;
+
+    whole.step(whole_q, inflow);
+    whole_dye.step(whole, dye_in, whole_injected);
+
+    // The red cells as the first test steps them (their two messages).
+    top.begin_step(top_q);
+    share.begin_step(share_q);
+    top.solve(top_q, cut_inflow, Cells::before_cuts);
+    share.solve(share_q, cut_inflow, Cells::before_cuts);
+    std::vector<double> top_inflow = cut_inflow, share_inflow = cut_inflow;
+    for (int j = 0; j < 2; ++j) top_inflow[4 + j] = share.separation_share(j) * share.discharge_hematocrit()[j];
+    top.solve(top_q, top_inflow, Cells::after_cuts);
+    for (int j = 0; j < 2; ++j) share_inflow[4 + j] = top.separation_share(1 + j) * top.discharge_hematocrit()[1];
+    share.solve(share_q, share_inflow, Cells::after_cuts);
+    top.end_step(top_q, top_inflow);
+    share.end_step(share_q, share_inflow);
+
+    // The dye's two messages: what crosses each cut from either side.
+    const std::vector<double> top_injected;
+    top_dye.begin_step(top, dye_cut_in, top_injected);
+    share_dye.begin_step(share, dye_cut_in, share_injected);
+    top_dye.solve(top, dye_cut_in, top_injected, Cells::before_cuts);
+    share_dye.solve(share, dye_cut_in, share_injected, Cells::before_cuts);
+    std::vector<double> top_dye_in = dye_cut_in, share_dye_in = dye_cut_in;
+    for (int j = 0; j < 2; ++j) top_dye_in[4 + j] = share_dye.inflowing(j, share, dye_cut_in, share_injected);
+    top_dye.solve(top, top_dye_in, top_injected, Cells::after_cuts);
+    for (int j = 0; j < 2; ++j) share_dye_in[4 + j] = top_dye.inflowing(1 + j, top, top_dye_in, top_injected);
+    share_dye.solve(share, share_dye_in, share_injected, Cells::after_cuts);
+    top_dye.end_step(top, top_dye_in, top_injected);
+    share_dye.end_step(share, share_dye_in, share_injected);
+
+    for (int c = 0; c < 2; ++c) ASSERT_EQ(top_dye.concentration()[c], whole_dye.concentration()[c]) << "step " << s;
+    for (int c = 0; c < 4; ++c)
+      ASSERT_EQ(share_dye.concentration()[c], whole_dye.concentration()[2 + c]) << "step " << s << " cell S" << 2 + c;
+  }
+  EXPECT_GT(up_through_root, 50);
+  // The injection counted once, by the share; the inlet's and the outlets' dye the whole's.
+  EXPECT_EQ(share_dye.injected(), whole_dye.injected());
+  EXPECT_EQ(top_dye.injected(), 0.0);
+  EXPECT_GT(whole_dye.injected(), 0.0);
+  EXPECT_EQ(top_dye.entered_by_boundary()[0], whole_dye.entered_by_boundary()[0]);
+  for (int b = 1; b < 4; ++b) EXPECT_EQ(share_dye.left_by_boundary()[b], whole_dye.left_by_boundary()[b]);
+  // The whole grid's dye balance closes (no volume moved between steps: nothing adjusted).
+  EXPECT_NEAR(whole_dye.amount(whole), whole_dye.entered() + whole_dye.injected() - whole_dye.left(),
+              1e-13 * (whole_dye.entered() + whole_dye.injected()));
 }
 
 TEST(RedCellCut, ACellBelowACutWaitsForItsInflow) {

@@ -231,13 +231,10 @@ void RedCellTransport::solve(std::span<const double> face_volume, std::span<cons
   if (inflow_hematocrit.size() != grid_.boundaries)
     throw InputError("red-cell transport: a step needs " + std::to_string(grid_.face_count()) + " face volumes and " +
                      std::to_string(grid_.boundaries) + " boundary hematocrits");
-  auto taken = [&](std::size_t c) {
-    return which == Cells::all || after_cut_.empty() || (after_cut_[c] != 0) == (which == Cells::after_cuts);
-  };
   const std::size_t ordered = cells - order_.cyclic;
   for (std::size_t k = 0; k < ordered; ++k) {
     const auto c = static_cast<std::size_t>(order_.cells[k]);
-    if (taken(c)) discharge_[c] = solve_cell(c, face_volume, inflow_hematocrit);
+    if (solves(c, which)) discharge_[c] = solve_cell(c, face_volume, inflow_hematocrit);
   }
   if (order_.cyclic > 0 && which != Cells::before_cuts) {
     double change = std::numeric_limits<double>::infinity();

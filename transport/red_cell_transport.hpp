@@ -69,6 +69,12 @@ class RedCellTransport {
   // cells' over the blood's there (1 but where a node divides its blood): blood leaving a cell
   // c through f carries s_f H_D(c).
   double separation_share(std::size_t face) const { return share_[face]; }
+  // Of this step: whether a cut's inflow reaches a cell (solved after_cuts; never without cuts).
+  bool after_cut(std::size_t cell) const { return !after_cut_.empty() && after_cut_[cell] != 0; }
+  // Which of a step's parts solves a cell.
+  bool solves(std::size_t cell, Cells cells) const {
+    return cells == Cells::all || after_cut(cell) == (cells == Cells::after_cuts);
+  }
 
   // Replaces the cells' volumes (the flow solver's moved them: its compliance balance),
   // keeping their hematocrits; the red cells that adds or removes are kept in adjusted().

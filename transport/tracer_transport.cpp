@@ -15,7 +15,8 @@ constexpr double cycle_tolerance = 1e-15;
 }  // namespace
 
 TracerTransport::TracerTransport(std::size_t cells, std::size_t boundaries, TracerCarrier carrier)
-    : carrier_(carrier), concentration_(cells, 0.0), last_outflow_(boundaries, 0.0) {}
+    : carrier_(carrier), concentration_(cells, 0.0), last_outflow_(boundaries, 0.0), entered_(boundaries, 0.0),
+      left_(boundaries, 0.0) {}
 
 const CarrierStep& TracerTransport::carrier_step(const RedCellTransport& red_cells) const {
   switch (carrier_) {
@@ -29,10 +30,33 @@ const CarrierStep& TracerTransport::carrier_step(const RedCellTransport& red_cel
   return red_cells.blood_step();
 }
 
+double TracerTransport::carried(const RedCellTransport& red_cells, std::size_t c) const {
+  switch (carrier_) {
+    case TracerCarrier::plasma:
+      return red_cells.volume()[c] - red_cells.content(c);
+    case TracerCarrier::cells:
+      return red_cells.content(c);
+    case TracerCarrier::blood:
+      break;
+  }
+  return red_cells.volume()[c];
+}
+
 double TracerTransport::amount(const RedCellTransport& red_cells) const {
-  const CarrierStep& m = carrier_step(red_cells);
   double sum = 0;
-  for (std::size_t c = 0; c < concentration_.size(); ++c) sum += m.after[c] * concentration_[c];
+  for (std::size_t c = 0; c < concentration_.size(); ++c) sum += carried(red_cells, c) * concentration_[c];
+  return sum;
+}
+
+double TracerTransport::entered() const {
+  double sum = 0;
+  for (const double e : entered_) sum += e;
+  return sum;
+}
+
+double TracerTransport::left() const {
+  double sum = 0;
+  for (const double l : left_) sum += l;
   return sum;
 }
 
@@ -71,23 +95,32 @@ double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_ce
 
 void TracerTransport::step(const RedCellTransport& red_cells, std::span<const double> inflow,
                            std::span<const double> injected) {
+  begin_step(red_cells, inflow, injected);
+  solve(red_cells, inflow, injected, RedCellTransport::Cells::all);
+  end_step(red_cells, inflow, injected);
+}
+
+void TracerTransport::begin_step(const RedCellTransport& red_cells, std::span<const double> inflow,
+                                 std::span<const double> injected) {
   const TransportGrid& grid = red_cells.grid();
-  const FlowOrder& order = red_cells.order();
-  const CarrierStep& m = carrier_step(red_cells);
   if (inflow.size() != grid.boundaries || (!injected.empty() && injected.size() != grid.face_count()))
     throw InputError("tracer transport: a step needs " + std::to_string(grid.boundaries) +
                      " boundary concentrations and none or one injection per face");
-  const std::size_t cells = concentration_.size(), ordered = cells - order.cyclic;
-  double before = 0;
-  for (std::size_t c = 0; c < cells; ++c) before += m.before[c] * concentration_[c];
-  adjusted_ += before - last_amount_;
   // What the injections add, at the concentrations upstream before they move.
+  const CarrierStep& m = carrier_step(red_cells);
   for (std::size_t f = 0; f < injected.size(); ++f) injected_ += std::abs(m.face[f]) * injected[f];
+}
+
+void TracerTransport::solve(const RedCellTransport& red_cells, std::span<const double> inflow,
+                            std::span<const double> injected, RedCellTransport::Cells which) {
+  const FlowOrder& order = red_cells.order();
+  const CarrierStep& m = carrier_step(red_cells);
+  const std::size_t cells = concentration_.size(), ordered = cells - order.cyclic;
   for (std::size_t k = 0; k < ordered; ++k) {
     const auto c = static_cast<std::size_t>(order.cells[k]);
-    concentration_[c] = solve_cell(c, red_cells, m, inflow, injected);
+    if (red_cells.solves(c, which)) concentration_[c] = solve_cell(c, red_cells, m, inflow, injected);
   }
-  if (order.cyclic > 0) {
+  if (order.cyclic > 0 && which != RedCellTransport::Cells::before_cuts) {
     double change = std::numeric_limits<double>::infinity();
     for (int sweep = 0; sweep < max_cycle_sweeps && change > cycle_tolerance; ++sweep) {
       change = 0;
@@ -99,6 +132,12 @@ void TracerTransport::step(const RedCellTransport& red_cells, std::span<const do
       }
     }
   }
+}
+
+void TracerTransport::end_step(const RedCellTransport& red_cells, std::span<const double> inflow,
+                               std::span<const double> injected) {
+  const TransportGrid& grid = red_cells.grid();
+  const CarrierStep& m = carrier_step(red_cells);
   face_concentration_.assign(grid.face_count(), 0.0);
   const std::span<const double> blood = red_cells.blood_step().face;
   for (std::size_t f = 0; f < grid.face_count(); ++f) {
@@ -107,26 +146,25 @@ void TracerTransport::step(const RedCellTransport& red_cells, std::span<const do
     face_concentration_[f] = c;
     if (grid.b[f] >= 0) continue;
     const auto boundary = static_cast<std::size_t>(-1 - grid.b[f]);
+    if (grid.is_cut(boundary)) continue;  // the other side's cells, not the network's
     if (blood[f] > 0) {
-      left_ += std::abs(m.face[f]) * c;
+      left_[boundary] += std::abs(m.face[f]) * c;
       last_outflow_[boundary] = c;
     } else {
-      entered_ += std::abs(m.face[f]) * (injected.empty() ? c : c - injected[f]);  // an injection there is counted apart
+      entered_[boundary] += std::abs(m.face[f]) * (injected.empty() ? c : c - injected[f]);  // an injection there is counted apart
     }
   }
-  last_amount_ = 0;
-  for (std::size_t c = 0; c < cells; ++c) last_amount_ += m.after[c] * concentration_[c];
 }
 
 void TracerTransport::restore(std::span<const double> concentration, std::span<const double> last_outflow,
-                              std::span<const double> totals) {
+                              std::span<const double> entered, std::span<const double> left, double injected,
+                              double adjusted) {
   concentration_.assign(concentration.begin(), concentration.end());
   last_outflow_.assign(last_outflow.begin(), last_outflow.end());
-  entered_ = totals[0];
-  left_ = totals[1];
-  injected_ = totals[2];
-  adjusted_ = totals[3];
-  last_amount_ = totals[4];
+  entered_.assign(entered.begin(), entered.end());
+  left_.assign(left.begin(), left.end());
+  injected_ = injected;
+  adjusted_ = adjusted;
 }
 
 }  // namespace hemotree

@@ -8,6 +8,7 @@
 // each face (CarrierStep). The carrier's own balance closes per cell (M+ + m_out = M + m_in),
 // so C+ is a convex combination of C and the inflows: 0 <= C, no new extrema, and the
 // tracer in the network changes by what the boundaries let in and out plus what is injected.
+// On a grid with cuts (a run over ranks) a step runs in the red cells' parts, on their split.
 #pragma once
 
 #include <cstdint>
@@ -29,6 +30,16 @@ class TracerTransport {
   // there). injected: per face, a concentration added to the carrier crossing it in this step
   // (empty: none), the injection's amount counted in injected().
   void step(const RedCellTransport& red_cells, std::span<const double> inflow, std::span<const double> injected);
+  // The same step in parts (RedCellTransport's, after its whole step): the cells no cut's
+  // inflow reaches, then the rest once the cuts' inflows are given.
+  void begin_step(const RedCellTransport& red_cells, std::span<const double> inflow, std::span<const double> injected);
+  void solve(const RedCellTransport& red_cells, std::span<const double> inflow, std::span<const double> injected,
+             RedCellTransport::Cells cells);
+  void end_step(const RedCellTransport& red_cells, std::span<const double> inflow, std::span<const double> injected);
+  // The concentration of the carrier crossing face f in the last step (or, between begin_step
+  // and end_step, now): its upwind cell's, or its boundary's, and any injection there.
+  double inflowing(std::size_t face, const RedCellTransport& red_cells, std::span<const double> inflow,
+                   std::span<const double> injected) const;
 
   TracerCarrier carrier() const { return carrier_; }
   std::span<const double> concentration() const { return concentration_; }
@@ -36,30 +47,35 @@ class TracerTransport {
   std::span<const double> face_concentration() const { return face_concentration_; }
   // The carrier of a step (red cells' CarrierStep for this tracer's carrier).
   const CarrierStep& carrier_step(const RedCellTransport& red_cells) const;
-  // Tracer in the network now, and through the boundaries and injected since the start
-  // (concentration x carrier volume).
+  // Its carrier in a cell now (after the last step, or the volumes set since).
+  double carried(const RedCellTransport& red_cells, std::size_t cell) const;
+  // Tracer in the network now (concentration x carrier volume), and through the boundaries
+  // (each boundary's summed in their order) and injected since the start.
   double amount(const RedCellTransport& red_cells) const;
-  double entered() const { return entered_; }
-  double left() const { return left_; }
+  double entered() const;
+  double left() const;
+  const std::vector<double>& entered_by_boundary() const { return entered_; }
+  const std::vector<double>& left_by_boundary() const { return left_; }
   double injected() const { return injected_; }
-  // What the carrier's volumes moved between steps (the flow's compliance balance) added.
+  // What the carrier's volumes moved between steps (the flow's compliance balance) added:
+  // the caller adds, term by term, (carried after - before) x C of each cell as the volumes
+  // move, and sets the total.
   double adjusted() const { return adjusted_; }
+  void set_adjusted(double total) { adjusted_ = total; }
 
-  // The totals as a checkpoint keeps them: entered, left, injected, adjusted, amount.
-  std::vector<double> totals() const { return {entered_, left_, injected_, adjusted_, last_amount_}; }
+  // The state as a checkpoint keeps it (entered and left per boundary).
   void restore(std::span<const double> concentration, std::span<const double> last_outflow,
-               std::span<const double> totals);
+               std::span<const double> entered, std::span<const double> left, double injected, double adjusted);
   const std::vector<double>& last_outflow() const { return last_outflow_; }
 
  private:
-  double inflowing(std::size_t face, const RedCellTransport& red_cells, std::span<const double> inflow,
-                   std::span<const double> injected) const;
   double solve_cell(std::size_t cell, const RedCellTransport& red_cells, const CarrierStep& m,
                     std::span<const double> inflow, std::span<const double> injected) const;
 
   TracerCarrier carrier_;
   std::vector<double> concentration_, face_concentration_, last_outflow_;
-  double entered_ = 0, left_ = 0, injected_ = 0, adjusted_ = 0, last_amount_ = 0;
+  std::vector<double> entered_, left_;  // per boundary
+  double injected_ = 0, adjusted_ = 0;
 };
 
 }  // namespace hemotree

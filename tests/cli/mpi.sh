@@ -143,27 +143,32 @@ $MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 1 --frames 4 --vtk --out 
   && cmp -s "$WORK/frames-one/results.vtp" "$WORK/frames-3/results.vtp" \
   && pass "mpirun -np 3 --frames 4 --vtk: the plain run's frames and results.vtp byte for byte" \
   || fail "--frames over 3 ranks: the frames differ from the plain run's"
-# Red cells over ranks (docs/transport.md, "Over MPI ranks"): every step the shares solve the
-# cells no root's inflow reaches, send each root's hematocrit and phase separation share up,
-# the top answers with its nodes above the roots; the plain run's files byte for byte (the
-# hematocrit per vessel and at the probes, the red cells' balance), its checkpoint too, and a
-# checkpoint resumed at another rank count, or as one process, ends as the uninterrupted run.
-cells="--red-cells transport --cycles 2 --probe 1 --probe 2000:0.3 --probe 40 --checkpoint-every 1"
+# Red cells and tracers over ranks (docs/transport.md, "Over MPI ranks"): every step the
+# shares solve the cells no root's inflow reaches, send each root's hematocrit and phase
+# separation share up, the top answers with its nodes above the roots (then the same for the
+# tracers); the plain run's files byte for byte (the hematocrit and the tracers' curves per
+# vessel and at the probes, the balances), its checkpoint too, and a checkpoint resumed at
+# another rank count, or as one process, ends as the uninterrupted run. One tracer enters at
+# the inlet, one is injected into a deep 0D vessel.
+cells="--red-cells transport --cycles 2 --probe 1 --probe 2000:0.3 --probe 40 --checkpoint-every 1
+  --tracer name=dye,carrier=plasma,at=inlet,shape=bolus,start=0.1,duration=0.2
+  --tracer name=mark,carrier=cells,at=vessel:2000,shape=step,start=0.05"
 "$HEMOSOLVE" "$WORK/pulse.json" $cells --lumped-sections 1 --out "$WORK/cells-one" 2>/dev/null || fail "hemosolve --red-cells transport (pulse)"
-grep -q '"separating_nodes": [1-9]' "$WORK/cells-one/summary.json" || fail "the pulse tree: no node separates red cells"
+grep -q '"separating_nodes": [1-9]' "$WORK/cells-one/summary.json" && grep -q '"injected": [1-9]' "$WORK/cells-one/summary.json" \
+  || fail "the pulse tree: no node separates red cells, or no tracer injected"
 for ranks in 2 3; do
   $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/pulse.json" $cells --out "$WORK/cells$ranks" >/dev/null 2>&1
   same_files "$WORK/cells-one" "$WORK/cells$ranks" && cmp -s "$WORK/cells-one/checkpoint.bin" "$WORK/cells$ranks/checkpoint.bin" \
-    && pass "mpirun -np $ranks --red-cells transport: the plain run's files and checkpoint byte for byte" \
-    || fail "--red-cells transport over $ranks ranks: the files differ from the plain run's"
+    && pass "mpirun -np $ranks --red-cells transport, two tracers: the plain run's files and checkpoint byte for byte" \
+    || fail "--red-cells transport and tracers over $ranks ranks: the files differ from the plain run's"
 done
 "$HEMOSOLVE" "$WORK/pulse.json" ${cells/--cycles 2/--cycles 1} --lumped-sections 1 --out "$WORK/cells-half" 2>/dev/null
 $MPIRUN -np 4 "$HEMOSOLVE" "$WORK/pulse.json" $cells --resume "$WORK/cells-half" --out "$WORK/cells-half" >/dev/null 2>&1
 $MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" ${cells/--cycles 2/--cycles 1} --out "$WORK/cells-half2" >/dev/null 2>&1
 "$HEMOSOLVE" "$WORK/pulse.json" $cells --lumped-sections 1 --resume "$WORK/cells-half2" --out "$WORK/cells-half2" >/dev/null 2>&1
 same_files "$WORK/cells-one" "$WORK/cells-half" && same_files "$WORK/cells-one" "$WORK/cells-half2" \
-  && pass "red cells resumed: the plain run's checkpoint over 4 ranks, 2 ranks' as one process, the uninterrupted files" \
-  || fail "red cells resumed at another rank count: the files differ from the uninterrupted run's"
+  && pass "red cells and tracers resumed: the plain run's checkpoint over 4 ranks, 2 ranks' as one process, the uninterrupted files" \
+  || fail "red cells and tracers resumed at another rank count: the files differ from the uninterrupted run's"
 # The pruned tree (R and RCR outlets on the shares' nodes) until periodic, red cells settled
 # too, with the settling cycle: over 3 ranks the plain run's files.
 periodic="--red-cells transport --until-periodic 1e-3 --probe 1 --probe 40 --settling-step 4"
@@ -286,9 +291,6 @@ grep -q "broke down" "$WORK/broken-one.err" || fail "the plain run did not break
 expect_refused "a pulsatile run over 2 ranks estimated above a day" "hemosolve: error: one cycle would take about" \
   -np 2 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --dt 1e-9 --out "$WORK/refused-out"
 # What a pulsatile run over ranks does not take yet: refused on every rank, said once.
-expect_refused "a pulsatile run over 2 ranks with a tracer carried" \
-  "hemosolve: error: --tracer: a pulsatile run over MPI ranks carries no tracers yet" \
-  -np 2 "$HEMOSOLVE" "$WORK/tree.json" --tracer name=dye --out "$WORK/refused-out"
 # Started by Slurm's srun (its step's task count and this task's rank, no Open MPI variables):
 # the same refusal, said by rank 0 alone, nothing written.
 for procid in 0 1; do
