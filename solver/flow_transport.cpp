@@ -46,11 +46,8 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   if (lumped.sectioned())
     throw InputError("red-cell and tracer transport: the 0D vessels must be one pi section each (--lumped-sections 1)");
   solver_.track_face_volumes();
-  const NetworkBoundaries& ends = solver.network_boundaries();
   const RunBoundaries& boundaries = solver.boundary_list();
   const Blood blood = solver.blood();
-  const double scale = blood.pries_diameter_scale();
-  auto fahraeus = [&](double diameter) { return options_.fahraeus ? fahraeus_parameter(diameter, scale) : 1.0; };
 
   TransportGrid grid;
   // Over ranks a cut per root vessel: on a share its own roots, on the top's rank its ghosts.
@@ -58,7 +55,6 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   const std::vector<std::int32_t>& roots = ranks ? lumped.root_vessels() : no_roots;
   grid.cuts = roots.size();
   grid.boundaries = boundaries.size() + grid.cuts;
-  std::vector<std::int32_t> root_of;  // per 0D vessel here: its root's place in `roots`, or -1
   if (ranks) {
     cut_.emplace();
     cut_->run_boundaries = boundaries.size();
@@ -67,138 +63,14 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     cut_->across.assign(roots.size(), -1);
     cut_->far.assign(roots.size(), blood.hematocrit);
     cut_->ghost.assign(lumped.empty() ? 0 : lumped.network_node_count(), -1);
-    root_of.assign(lumped.vessel_count(), -1);
-    for (std::size_t j = 0; j < roots.size(); ++j) root_of[static_cast<std::size_t>(roots[j])] = static_cast<std::int32_t>(j);
   }
   std::vector<double> volume;
-
-  // Nodes of 0D vessels: k weighted by the half-vessels they hold.
-  const std::size_t lumped_nodes = lumped.empty() ? 0 : lumped.network_node_count();
-  std::vector<std::int64_t> network_node(lumped_nodes, -1);
-  for (std::size_t n = 0; n < net.node_count(); ++n)
-    if (!lumped.empty() && lumped.node_of(static_cast<std::int64_t>(n)) >= 0)
-      network_node[static_cast<std::size_t>(lumped.node_of(static_cast<std::int64_t>(n)))] = static_cast<std::int64_t>(n);
-  std::vector<double> k_sum(lumped_nodes, 0.0), weight(lumped_nodes, 0.0);
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    if (!solver.is_lumped(v)) continue;
-    const std::int32_t i = lumped.vessel_index(v);
-    if (i < 0) continue;  // another rank's (over ranks)
-    const double d = mean_diameter(net, v), half = 0.125 * std::numbers::pi * d * d * net.length[v];
-    for (const std::int32_t k : {lumped.from_node(i), lumped.to_node(i)}) {
-      k_sum[static_cast<std::size_t>(k)] += half * fahraeus(d);
-      weight[static_cast<std::size_t>(k)] += half;
-    }
-  }
-  for (std::size_t k = 0; k < lumped_nodes; ++k) {
-    grid.add_cell(network_node[k], weight[k] > 0 ? k_sum[k] / weight[k] : 1.0);
-    volume.push_back(lumped.stored_volume(static_cast<std::int32_t>(k)));
-  }
-
-  // Slices of the 1D elements.
-  // The 1D vessels: every one, or over ranks the top's rank's (a share's solver has their
-  // laws and start, but never steps them).
-  if (solver.holds_one_d()) one_d_ = solver.one_d_vessels();
-  const std::vector<std::int32_t>& one_d = one_d_;
-  slices_ = options_.slices > 0 ? options_.slices : solver.max_degree() + 1;
-  const int modes = solver.max_degree() + 1, per_vessel = solver.elements_per_vessel();
-  slice_integral_.resize(slices_, std::max(modes, 1));
-  for (int s = 0; s < slices_; ++s)
-    for (int j = 0; j < slice_integral_.cols(); ++j)
-      slice_integral_(s, j) = legendre_integral(j, -1 + 2.0 * s / slices_, -1 + 2.0 * (s + 1) / slices_);
-  one_d_place_.assign(net.vessel_count(), -1);
-  for (const std::int32_t vi : one_d) {
-    const auto v = static_cast<std::size_t>(vi);
-    one_d_place_[v] = static_cast<std::int32_t>(vessel_first_cell_.size());
-    vessel_first_cell_.push_back(static_cast<std::int32_t>(grid.cell_count()));
-    const int count = per_vessel * slices_;
-    for (int s = 0; s < count; ++s) {
-      const double x = (s + 0.5) / count;
-      const double d = net.diameter[v] + x * (net.diameter_at_to(v) - net.diameter[v]);
-      grid.add_cell(-1, fahraeus(d));
-      volume.push_back(0.0);  // set below from the solver's areas
-    }
-  }
-
-  // Junctions of 1D vessels, and what meets each 1D end: (vessel, distal) -> cell or boundary.
-  std::map<std::pair<std::int32_t, bool>, std::int32_t> end_side;
-  for (std::size_t j = 0; j + 1 < ends.junction_offset.size() && solver.holds_one_d(); ++j) {
-    const auto cell = static_cast<std::int32_t>(grid.cell_count());
-    const VesselEnd& first = ends.junction_ends[static_cast<std::size_t>(ends.junction_offset[j])];
-    const auto v = static_cast<std::size_t>(first.vessel);
-    grid.add_cell(first.distal ? net.to[v] : net.from[v], 1.0);
-    volume.push_back(0.0);
-    for (auto e = ends.junction_offset[j]; e < ends.junction_offset[j + 1]; ++e) {
-      const VesselEnd& end = ends.junction_ends[static_cast<std::size_t>(e)];
-      end_side[{end.vessel, end.distal}] = cell;
-    }
-  }
-  for (const auto& c : ends.coupled) end_side[{c.end.vessel, c.end.distal}] = lumped.node_of(c.node);
-  for (const auto* given : {&ends.flows, &ends.pressures})
-    for (const auto& g : *given) end_side[{g.end.vessel, g.end.distal}] = TransportGrid::boundary_side(static_cast<std::size_t>(g.index));
-  for (const auto& o : ends.outlets)
-    end_side[{o.end.vessel, o.end.distal}] = TransportGrid::boundary_side(static_cast<std::size_t>(o.boundary));
-  auto side_of = [&](std::int32_t v, bool distal) {
-    const auto found = end_side.find({v, distal});
-    if (found == end_side.end())
-      throw InputError("red-cell transport: vessel " + std::to_string(net.id[static_cast<std::size_t>(v)]) + ": its " +
-                       (distal ? "distal" : "proximal") + " end meets neither a vessel nor a boundary");
-    return found->second;
-  };
-
-  // Faces: the 0D vessels, the boundaries at 0D nodes, then each 1D vessel's. Over ranks a
-  // root vessel's joins the node on this side to its cut (turned round where that node is its
-  // `to` node); the node across, held for the flow's sums alone, is an empty cell of no face.
-  lumped_face_.assign(lumped.vessel_count(), -1);
-  std::vector<std::int32_t> turned;
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    if (!solver.is_lumped(v)) continue;
-    const std::int32_t i = lumped.vessel_index(v);
-    if (i < 0) continue;  // another rank's
-    const auto face = static_cast<std::int32_t>(grid.face_count());
-    lumped_face_[static_cast<std::size_t>(i)] = face;
-    const std::int32_t a = lumped.from_node(i), b = lumped.to_node(i);
-    const std::int32_t root = ranks ? root_of[static_cast<std::size_t>(i)] : -1;
-    if (root < 0) {
-      grid.add_face(a, b, static_cast<std::int32_t>(v), mean_diameter(net, v));
-      continue;
-    }
-    const bool a_across = lumped.ghost_node(a);
-    const std::int32_t here = a_across ? b : a, across = a_across ? a : b;
-    grid.add_face(here, TransportGrid::boundary_side(boundaries.size() + static_cast<std::size_t>(root)),
-                  static_cast<std::int32_t>(v), mean_diameter(net, v));
-    cut_->face[static_cast<std::size_t>(root)] = face;
-    cut_->cell[static_cast<std::size_t>(root)] = here;
-    cut_->across[static_cast<std::size_t>(root)] = across;
-    cut_->ghost[static_cast<std::size_t>(across)] = root;
-    if (a_across) turned.push_back(face);
-  }
-  for (std::size_t b = 0; b < boundaries.size(); ++b) {
-    const std::int32_t k = lumped.empty() ? -1 : lumped.node_of(boundaries.node(b));
-    if (k < 0 || lumped.ghost_node(k)) continue;  // another rank's
-    node_boundary_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
-    node_boundary_.push_back(static_cast<std::int32_t>(b));
-    grid.add_face(k, TransportGrid::boundary_side(b), -1, 0.0);
-  }
-  for (std::size_t i = 0; i < one_d.size(); ++i) {
-    const std::int32_t v = one_d[i];
-    const double d0 = net.diameter[static_cast<std::size_t>(v)], d1 = net.diameter_at_to(static_cast<std::size_t>(v));
-    const std::int32_t first = vessel_first_cell_[i], last = first + per_vessel * slices_ - 1;
-    vessel_first_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
-    const std::int32_t proximal = side_of(v, false), distal = side_of(v, true);
-    if (proximal >= 0) grid.add_face(proximal, first, v, d0);
-    else grid.add_face(first, proximal, v, d0);
-    proximal_sign_.push_back(proximal >= 0 ? 1 : -1);
-    for (std::int32_t c = first; c < last; ++c) grid.add_face(c, c + 1, v, d0 + (d1 - d0) * (c + 1 - first) / (last - first + 1.0));
-    grid.add_face(last, distal, v, d1);
-  }
+  add_node_cells(grid, volume);
+  const EndSides sides = add_one_d_cells(grid, volume);
+  add_faces(grid, roots, sides);
 
   inflow_hematocrit_.assign(grid.boundaries, blood.hematocrit);  // a cut's: given every step
   for (std::size_t b = 0; b < boundaries.size(); ++b) inflow_hematocrit_[b] = boundaries[b].entering_hematocrit(blood);
-  if (cut_) {
-    cut_->face_sign.assign(grid.face_count(), 1);
-    for (const std::int32_t f : turned) cut_->face_sign[static_cast<std::size_t>(f)] = -1;
-  }
-
   solver_volumes(volume);
   red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
                      RedCellOptions{options_.phase_separation, blood.phase_separation_diameter_scale(),
@@ -217,11 +89,164 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     viscosity_scaling_.reserve(vessels);
     for (std::size_t v = 0; v < vessels; ++v) viscosity_scaling_.emplace_back(blood, mean_diameter(net, v));
   }
+  set_up_tracers();
+  last_time_ = solver.time();
+  mark();
+  begin_cycle();
+}
+
+double FlowTransport::fahraeus(double diameter) const {
+  return options_.fahraeus ? fahraeus_parameter(diameter, solver_.blood().pries_diameter_scale()) : 1.0;
+}
+
+void FlowTransport::add_node_cells(TransportGrid& grid, std::vector<double>& volume) const {
+  // Nodes of 0D vessels: k weighted by the half-vessels they hold.
+  const LumpedVessels& lumped = solver_.lumped();
+  const std::size_t lumped_nodes = lumped.empty() ? 0 : lumped.network_node_count();
+  std::vector<std::int64_t> network_node(lumped_nodes, -1);
+  for (std::size_t n = 0; n < net_.node_count(); ++n)
+    if (!lumped.empty() && lumped.node_of(static_cast<std::int64_t>(n)) >= 0)
+      network_node[static_cast<std::size_t>(lumped.node_of(static_cast<std::int64_t>(n)))] = static_cast<std::int64_t>(n);
+  std::vector<double> k_sum(lumped_nodes, 0.0), weight(lumped_nodes, 0.0);
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    if (!solver_.is_lumped(v)) continue;
+    const std::int32_t i = lumped.vessel_index(v);
+    if (i < 0) continue;  // another rank's (over ranks)
+    const double d = mean_diameter(net_, v), half = 0.125 * std::numbers::pi * d * d * net_.length[v];
+    for (const std::int32_t k : {lumped.from_node(i), lumped.to_node(i)}) {
+      k_sum[static_cast<std::size_t>(k)] += half * fahraeus(d);
+      weight[static_cast<std::size_t>(k)] += half;
+    }
+  }
+  for (std::size_t k = 0; k < lumped_nodes; ++k) {
+    grid.add_cell(network_node[k], weight[k] > 0 ? k_sum[k] / weight[k] : 1.0);
+    volume.push_back(lumped.stored_volume(static_cast<std::int32_t>(k)));
+  }
+}
+
+FlowTransport::EndSides FlowTransport::add_one_d_cells(TransportGrid& grid, std::vector<double>& volume) {
+  // Slices of the 1D elements. The 1D vessels: every one, or over ranks the top's rank's (a
+  // share's solver has their laws and start, but never steps them).
+  const PulseSolver& solver = solver_;
+  if (solver.holds_one_d()) one_d_ = solver.one_d_vessels();
+  slices_ = options_.slices > 0 ? options_.slices : solver.max_degree() + 1;
+  const int modes = solver.max_degree() + 1, per_vessel = solver.elements_per_vessel();
+  slice_integral_.resize(slices_, std::max(modes, 1));
+  for (int s = 0; s < slices_; ++s)
+    for (int j = 0; j < slice_integral_.cols(); ++j)
+      slice_integral_(s, j) = legendre_integral(j, -1 + 2.0 * s / slices_, -1 + 2.0 * (s + 1) / slices_);
+  one_d_place_.assign(net_.vessel_count(), -1);
+  for (const std::int32_t vi : one_d_) {
+    const auto v = static_cast<std::size_t>(vi);
+    one_d_place_[v] = static_cast<std::int32_t>(vessel_first_cell_.size());
+    vessel_first_cell_.push_back(static_cast<std::int32_t>(grid.cell_count()));
+    const int count = per_vessel * slices_;
+    for (int s = 0; s < count; ++s) {
+      const double x = (s + 0.5) / count;
+      const double d = net_.diameter[v] + x * (net_.diameter_at_to(v) - net_.diameter[v]);
+      grid.add_cell(-1, fahraeus(d));
+      volume.push_back(0.0);  // set from the solver's areas (solver_volumes)
+    }
+  }
+  // Junctions of 1D vessels, and what meets each 1D end: (vessel, distal) -> cell or boundary.
+  const NetworkBoundaries& ends = solver.network_boundaries();
+  EndSides end_side;
+  for (std::size_t j = 0; j + 1 < ends.junction_offset.size() && solver.holds_one_d(); ++j) {
+    const auto cell = static_cast<std::int32_t>(grid.cell_count());
+    const VesselEnd& first = ends.junction_ends[static_cast<std::size_t>(ends.junction_offset[j])];
+    const auto v = static_cast<std::size_t>(first.vessel);
+    grid.add_cell(first.distal ? net_.to[v] : net_.from[v], 1.0);
+    volume.push_back(0.0);
+    for (auto e = ends.junction_offset[j]; e < ends.junction_offset[j + 1]; ++e) {
+      const VesselEnd& end = ends.junction_ends[static_cast<std::size_t>(e)];
+      end_side[{end.vessel, end.distal}] = cell;
+    }
+  }
+  for (const auto& c : ends.coupled) end_side[{c.end.vessel, c.end.distal}] = solver.lumped().node_of(c.node);
+  for (const auto* given : {&ends.flows, &ends.pressures})
+    for (const auto& g : *given) end_side[{g.end.vessel, g.end.distal}] = TransportGrid::boundary_side(static_cast<std::size_t>(g.index));
+  for (const auto& o : ends.outlets)
+    end_side[{o.end.vessel, o.end.distal}] = TransportGrid::boundary_side(static_cast<std::size_t>(o.boundary));
+  return end_side;
+}
+
+void FlowTransport::add_faces(TransportGrid& grid, const std::vector<std::int32_t>& roots, const EndSides& end_side) {
+  const LumpedVessels& lumped = solver_.lumped();
+  const RunBoundaries& boundaries = solver_.boundary_list();
+  auto side_of = [&](std::int32_t v, bool distal) {
+    const auto found = end_side.find({v, distal});
+    if (found == end_side.end())
+      throw InputError("red-cell transport: vessel " + std::to_string(net_.id[static_cast<std::size_t>(v)]) + ": its " +
+                       (distal ? "distal" : "proximal") + " end meets neither a vessel nor a boundary");
+    return found->second;
+  };
+  std::vector<std::int32_t> root_of;  // per 0D vessel here: its root's place in `roots`, or -1
+  if (cut_) {
+    root_of.assign(lumped.vessel_count(), -1);
+    for (std::size_t j = 0; j < roots.size(); ++j) root_of[static_cast<std::size_t>(roots[j])] = static_cast<std::int32_t>(j);
+    cut_->face_sign.clear();
+  }
+  // Faces: the 0D vessels, the boundaries at 0D nodes, then each 1D vessel's. Over ranks a
+  // root vessel's joins the node on this side to its cut (turned round where that node is its
+  // `to` node); the node across, held for the flow's sums alone, is an empty cell of no face.
+  lumped_face_.assign(lumped.vessel_count(), -1);
+  std::vector<std::int32_t> turned;
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    if (!solver_.is_lumped(v)) continue;
+    const std::int32_t i = lumped.vessel_index(v);
+    if (i < 0) continue;  // another rank's
+    const auto face = static_cast<std::int32_t>(grid.face_count());
+    lumped_face_[static_cast<std::size_t>(i)] = face;
+    const std::int32_t a = lumped.from_node(i), b = lumped.to_node(i);
+    const std::int32_t root = cut_ ? root_of[static_cast<std::size_t>(i)] : -1;
+    if (root < 0) {
+      grid.add_face(a, b, static_cast<std::int32_t>(v), mean_diameter(net_, v));
+      continue;
+    }
+    const bool a_across = lumped.ghost_node(a);
+    const std::int32_t here = a_across ? b : a, across = a_across ? a : b;
+    grid.add_face(here, TransportGrid::boundary_side(boundaries.size() + static_cast<std::size_t>(root)),
+                  static_cast<std::int32_t>(v), mean_diameter(net_, v));
+    cut_->face[static_cast<std::size_t>(root)] = face;
+    cut_->cell[static_cast<std::size_t>(root)] = here;
+    cut_->across[static_cast<std::size_t>(root)] = across;
+    cut_->ghost[static_cast<std::size_t>(across)] = root;
+    if (a_across) turned.push_back(face);
+  }
+  for (std::size_t b = 0; b < boundaries.size(); ++b) {
+    const std::int32_t k = lumped.empty() ? -1 : lumped.node_of(boundaries.node(b));
+    if (k < 0 || lumped.ghost_node(k)) continue;  // another rank's
+    node_boundary_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
+    node_boundary_.push_back(static_cast<std::int32_t>(b));
+    grid.add_face(k, TransportGrid::boundary_side(b), -1, 0.0);
+  }
+  const int per_vessel = solver_.elements_per_vessel();
+  for (std::size_t i = 0; i < one_d_.size(); ++i) {
+    const std::int32_t v = one_d_[i];
+    const double d0 = net_.diameter[static_cast<std::size_t>(v)], d1 = net_.diameter_at_to(static_cast<std::size_t>(v));
+    const std::int32_t first = vessel_first_cell_[i], last = first + per_vessel * slices_ - 1;
+    vessel_first_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
+    const std::int32_t proximal = side_of(v, false), distal = side_of(v, true);
+    if (proximal >= 0) grid.add_face(proximal, first, v, d0);
+    else grid.add_face(first, proximal, v, d0);
+    proximal_sign_.push_back(proximal >= 0 ? 1 : -1);
+    for (std::int32_t c = first; c < last; ++c) grid.add_face(c, c + 1, v, d0 + (d1 - d0) * (c + 1 - first) / (last - first + 1.0));
+    grid.add_face(last, distal, v, d1);
+  }
+  if (cut_) {
+    cut_->face_sign.assign(grid.face_count(), 1);
+    for (const std::int32_t f : turned) cut_->face_sign[static_cast<std::size_t>(f)] = -1;
+  }
+}
+
+void FlowTransport::set_up_tracers() {
   // Tracers: clean blood at every boundary that lets blood in, what left at the others.
+  const RunBoundaries& boundaries = solver_.boundary_list();
+  const LumpedVessels& lumped = solver_.lumped();
   const TransportGrid& carried = red_cells_->grid();
   for (const TracerSpec& spec : options_.tracers) {
     tracers_.emplace_back(carried.cell_count(), carried.boundaries, spec.carrier);
-    curves_.emplace_back(vessels, spec.concentration, spec.centre(), spec.shape == TracerSpec::Shape::step);
+    curves_.emplace_back(net_.vessel_count(), spec.concentration, spec.centre(), spec.shape == TracerSpec::Shape::step);
     std::vector<std::int32_t> given;
     std::int32_t face = -1;
     if (spec.place == TracerSpec::Place::vessel) {
@@ -229,7 +254,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
       // vessel does not: what crosses the cut carries the injection already, or takes it there).
       const auto v = static_cast<std::size_t>(spec.at);
       if (one_d_place_[v] >= 0) face = vessel_first_face_[static_cast<std::size_t>(one_d_place_[v])];
-      else if (solver.is_lumped(v) && solver.steps_vessel(v))
+      else if (solver_.is_lumped(v) && solver_.steps_vessel(v))
         face = lumped_face_[static_cast<std::size_t>(lumped.vessel_index(v))];
     } else {
       for (std::size_t b = 0; b < boundaries.size(); ++b) {
@@ -240,7 +265,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
         throw SettingError("tracer", placeholder("tracer") + " " + spec.name + ": " +
                            (spec.place == TracerSpec::Place::inlet
                                 ? std::string("the network has no flow or pressure boundary to give it through")
-                                : "node " + std::to_string(net.node_id[static_cast<std::size_t>(spec.at)]) +
+                                : "node " + std::to_string(net_.node_id[static_cast<std::size_t>(spec.at)]) +
                                       " has no flow or pressure boundary (at=vessel:ID gives it inside the network)"));
     }
     tracer_boundaries_.push_back(std::move(given));
@@ -249,9 +274,6 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   tracer_inflow_.resize(tracers_.size());
   tracer_injected_.resize(tracers_.size());
   if (cut_) cut_->tracer_far.assign(tracers_.size() * cut_->face.size(), 0.0);
-  last_time_ = solver.time();
-  mark();
-  begin_cycle();
 }
 
 void FlowTransport::tracer_given(std::size_t k, double t0, double t1) {

@@ -23,7 +23,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <utility>
 #include <optional>
 #include <span>
 #include <vector>
@@ -124,6 +126,15 @@ class FlowTransport {
   void restore(CheckpointReader& in);
 
  private:
+  // The grid, as the constructor makes it: the 0D nodes' cells, the 1D vessels' slices and
+  // junctions (and what meets each 1D end: (vessel, distal) -> cell or boundary side), the
+  // faces; then the tracers where they are given.
+  using EndSides = std::map<std::pair<std::int32_t, bool>, std::int32_t>;
+  void add_node_cells(TransportGrid& grid, std::vector<double>& volume) const;
+  EndSides add_one_d_cells(TransportGrid& grid, std::vector<double>& volume);
+  void add_faces(TransportGrid& grid, const std::vector<std::int32_t>& roots, const EndSides& sides);
+  void set_up_tracers();
+  double fahraeus(double diameter) const;  // the Fahraeus parameter k of a lumen (1: the effect off)
   // Each 0D node's and 1D slice's volume in the solver now, into its cell's place.
   void solver_volumes(std::vector<double>& volume) const;
   void mark();  // the next advance counts from the solver's state now
