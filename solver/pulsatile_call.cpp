@@ -285,18 +285,6 @@ void check_pulsatile(const Network& net, const RunConfiguration& config) {
 
 namespace {
 
-// What a pulsatile run over MPI ranks does not take yet (docs/scaling.md, "The pulsatile run
-// over ranks"): a settling cycle at a lower
-// degree is a second solver (taken by default only where most vessels are 1D: not a tree
-// that ranks split). Refused on every rank alike, before any work.
-void refuse_over_ranks(const RunConfiguration& config) {
-  auto refuse = [](const std::string& setting, const std::string& why, const std::string& value = "") {
-    throw SettingError(setting, placeholder(setting) + value + ": " + why + "; run it as one process (without mpirun)");
-  };
-  if (config.until_periodic && config.settling_degree != SolverOptions::automatic && config.settling_degree > 0)
-    refuse("settling_degree", "a pulsatile run over MPI ranks takes no settling cycle at a lower degree yet (a second solver)");
-}
-
 // given_up: the same network where the caller gave it up (its coordinates may go), else null.
 RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserver& observer, Network* given_up) {
   // Over MPI ranks (mpirun -np P, P > 1) the tree's 0D vessels are cut into whole subtrees,
@@ -311,7 +299,6 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   on_every_rank([&] {
     check_configuration(config);
     check_pulsatile(net, config);
-    if (over_ranks) refuse_over_ranks(config);
   });
   // The network's identity (its coordinates included) before anything of it is freed.
   const std::uint64_t network = network_identity(net);
@@ -368,9 +355,10 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
                   " vessels (the 1D ones and every vessel above them, with subtrees of its own; weighed for its "
                   "statistics as " + std::to_string(std::llround(ranks->top_weight())) + " vessels more)");
   // The settling cycle at a lower 1D degree (solver/settling_cycle.hpp) takes a solver of its
-  // own, built here while the network still has its walls (not over ranks: refuse_over_ranks).
-  std::unique_ptr<PulseSolver> settling =
-      checkpoint.bytes.empty() && !over_ranks ? low_degree_settling_solver(net, run, config, period) : nullptr;
+  // own, built here while the network still has its walls (over ranks on the run's cut).
+  std::unique_ptr<PulseSolver> settling;
+  if (checkpoint.bytes.empty())
+    on_every_rank([&] { settling = low_degree_settling_solver(net, run, config, period, ranks ? &ranks->ranks() : nullptr); });
   // The walls are in the vessels' tube laws now; only a VTK file would write them again.
   if (given_up && !config.vtk && config.frames == 0)
     for (std::vector<double>* wall : {&given_up->wall_thickness, &given_up->youngs_modulus}) std::vector<double>().swap(*wall);

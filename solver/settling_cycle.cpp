@@ -69,7 +69,8 @@ double estimated_cycle(const Network& net, const PulseSolver& solver, double per
 // (docs/solver.md §6a): ADAN56 and the circle of Willis periodic to 1e-3 in two cycles after
 // it, three without; the trees, mostly 0D, in two without it.
 std::unique_ptr<PulseSolver> low_degree_settling_solver(const Network& net, const PulseSolver& run,
-                                                       const RunConfiguration& config, double period) {
+                                                       const RunConfiguration& config, double period,
+                                                       const PulseRanks* ranks) {
   const bool automatic = config.settling_degree == SolverOptions::automatic;
   const int degree = automatic ? 2 : config.settling_degree;
   if (!(config.until_periodic && degree > 0 && config.balance_compliances && run.started_from_steady() &&
@@ -82,7 +83,7 @@ std::unique_ptr<PulseSolver> low_degree_settling_solver(const Network& net, cons
   options.degree_rule.low = std::min(options.degree_rule.low, degree);
   options.degree_rule.high = std::min(options.degree_rule.high, degree);
   options.degree_rule.raise_to = std::min(options.degree_rule.raise_to, degree);
-  auto settling = std::make_unique<PulseSolver>(net, options);
+  auto settling = std::make_unique<PulseSolver>(net, options, ranks);
   if (automatic && estimated_cycle(net, *settling, period) > estimated_cycle(net, run, period) / 3) return nullptr;
   return settling;
 }

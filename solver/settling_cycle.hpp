@@ -43,9 +43,12 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
 // The solver of the settling cycle at a lower 1D degree (RunConfiguration::settling_degree:
 // the run's options with the 1D vessels' degrees capped and the step its own), or null where
 // the run takes none: only where it seeks the periodic state from the steady network with the
-// compliance balance and has 1D vessels above that degree. period: the pulse's [s].
+// compliance balance and has 1D vessels above that degree. period: the pulse's [s]. ranks:
+// the run's over MPI ranks, whose cut the second solver takes too (the same models, so the
+// same partition: each rank starts its run's share from its settling share).
 std::unique_ptr<PulseSolver> low_degree_settling_solver(const Network& net, const PulseSolver& run,
-                                                       const RunConfiguration& config, double period);
+                                                       const RunConfiguration& config, double period,
+                                                       const PulseRanks* ranks = nullptr);
 // The steps of its cycle: its own stable step, taken in one coupling pass (a 0D step as long as
 // the run's takes the run's passes' 1D substeps in one), and settling_step times longer where
 // that is asked too (RunConfiguration::settling_step).

@@ -134,6 +134,15 @@ $MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-step 4 --out "$W
 same_files "$WORK/settled-one" "$WORK/settled-2" '"seconds"' \
   && pass "mpirun -np 2 --settling-step 4: the plain run's files (the settling cycle over ranks)" \
   || fail "--settling-step over 2 ranks: the files differ from the plain run's"
+# The settling cycle at a lower degree (a second solver, on the run's cut) over 2 ranks: the
+# plain run's files.
+"$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-degree 1 --lumped-sections 1 --out "$WORK/coarse-one" >"$WORK/coarse-log" 2>&1 \
+  || fail "hemosolve --settling-degree 1 (pulse)"
+grep -q "settling cycle: .* at degree 1 at most" "$WORK/coarse-log" || fail "the plain run took no settling cycle at degree 1"
+$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-degree 1 --out "$WORK/coarse-2" >/dev/null 2>&1
+same_files "$WORK/coarse-one" "$WORK/coarse-2" '"seconds"' \
+  && pass "mpirun -np 2 --settling-degree 1: the plain run's files (a settling solver at a lower degree over ranks)" \
+  || fail "--settling-degree 1 over 2 ranks: the files differ from the plain run's"
 # Frames over ranks: every vessel's centre gathered on rank 0 at each frame, the plain run's
 # files (ParaView's time series and results.vtp) byte for byte.
 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 1 --frames 4 --vtk --lumped-sections 1 --out "$WORK/frames-one" 2>/dev/null \
