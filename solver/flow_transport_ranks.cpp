@@ -17,6 +17,26 @@ namespace hemotree {
 
 namespace {
 constexpr std::size_t per_root = 2;  // a side's hematocrit H_D and its phase separation share s_f
+
+// A rank's per-boundary arrays (the grid's boundaries, cuts last) from the whole run's: the
+// boundaries it holds (held: the boundary, or -1) take their values, the rest nothing in or
+// out and `last` as what last left.
+struct BoundaryShare {
+  std::vector<double> entered, left, last_outflow;
+};
+BoundaryShare boundary_share(std::span<const std::int32_t> held, std::span<const double> entered,
+                             std::span<const double> left, std::span<const double> last_outflow, double last) {
+  BoundaryShare share{std::vector<double>(held.size(), 0.0), std::vector<double>(held.size(), 0.0),
+                      std::vector<double>(held.size(), last)};
+  for (const std::int32_t b : held)
+    if (b >= 0) {
+      const auto i = static_cast<std::size_t>(b);
+      share.entered[i] = entered[i];
+      share.left[i] = left[i];
+      share.last_outflow[i] = last_outflow[i];
+    }
+  return share;
+}
 }  // namespace
 
 void FlowTransport::place_cut(const TransportRanks& ranks) {
@@ -289,18 +309,12 @@ void FlowTransport::restore_tracer_share(std::size_t k, const TracerState& whole
   for (std::size_t c = 0; c < concentration.size(); ++c) concentration[c] = whole.concentration[static_cast<std::size_t>(cut_->cell_place[c])];
   const std::size_t roots = cut_->across.size();
   for (std::size_t j = 0; j < roots; ++j) cut_->tracer_far[k * roots + j] = concentration[static_cast<std::size_t>(cut_->across[j])];
-  std::vector<double> entered(grid.boundaries, 0.0), left(grid.boundaries, 0.0), last(grid.boundaries, 0.0);
-  for (const std::int32_t b : boundary_places())
-    if (b >= 0) {
-      const auto i = static_cast<std::size_t>(b);
-      entered[i] = whole.entered[i];
-      left[i] = whole.left[i];
-      last[i] = whole.last_outflow[i];
-    }
+  const BoundaryShare held = boundary_share(boundary_places(), whole.entered, whole.left, whole.last_outflow, 0.0);
   // The injection's and the balance's totals are rank 0's (the whole run's), and what the
   // injecting rank adds from here on: the same sums, in the same order, there.
   const bool injects = tracer_face_[k] >= 0;
-  tracers_[k].restore(concentration, last, entered, left, injects ? whole.injected : 0.0, world_rank() == 0 ? whole.adjusted : 0.0);
+  tracers_[k].restore(concentration, held.last_outflow, held.entered, held.left, injects ? whole.injected : 0.0,
+                      world_rank() == 0 ? whole.adjusted : 0.0);
 }
 
 void FlowTransport::take_reports() {
@@ -333,15 +347,9 @@ void FlowTransport::restore_share(const RedCellState& whole) {
     volume[c] = c >= cut_->ghost.size() || cut_->ghost[c] < 0 ? whole.volume[static_cast<std::size_t>(cut_->cell_place[c])] : 0.0;
   }
   for (std::size_t j = 0; j < cut_->across.size(); ++j) cut_->far[j] = discharge[static_cast<std::size_t>(cut_->across[j])];
-  std::vector<double> entered(grid.boundaries, 0.0), left(grid.boundaries, 0.0), last(grid.boundaries, solver_.blood().hematocrit);
-  for (const std::int32_t b : boundary_places())
-    if (b >= 0) {
-      const auto i = static_cast<std::size_t>(b);
-      entered[i] = whole.entered[i];
-      left[i] = whole.left[i];
-      last[i] = whole.last_outflow[i];
-    }
-  t.restore(discharge, volume, entered, left, 0.0, last);
+  const BoundaryShare held = boundary_share(boundary_places(), whole.entered, whole.left, whole.last_outflow,
+                                           solver_.blood().hematocrit);
+  t.restore(discharge, volume, held.entered, held.left, 0.0, held.last_outflow);
   cut_->adjusted = whole.adjusted;
   for (std::size_t f = 0; f < face_volume_.size(); ++f)
     face_volume_[f] = cut_->face_sign[f] * whole.faces[static_cast<std::size_t>(cut_->face_place[f])];

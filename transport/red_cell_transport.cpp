@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
 
 #include "core/errors.hpp"
@@ -99,17 +100,8 @@ double RedCellTransport::red_cells() const {
   return sum;
 }
 
-double RedCellTransport::entered() const {
-  double sum = 0;
-  for (const double e : entered_) sum += e;
-  return sum;
-}
-
-double RedCellTransport::left() const {
-  double sum = 0;
-  for (const double l : left_) sum += l;
-  return sum;
-}
+double RedCellTransport::entered() const { return std::accumulate(entered_.begin(), entered_.end(), 0.0); }
+double RedCellTransport::left() const { return std::accumulate(left_.begin(), left_.end(), 0.0); }
 
 void RedCellTransport::split_at_nodes(std::span<const double> face_volume) {
   std::fill(share_.begin(), share_.end(), 1.0);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
 
 #include "core/errors.hpp"
@@ -48,17 +49,8 @@ double TracerTransport::amount(const RedCellTransport& red_cells) const {
   return sum;
 }
 
-double TracerTransport::entered() const {
-  double sum = 0;
-  for (const double e : entered_) sum += e;
-  return sum;
-}
-
-double TracerTransport::left() const {
-  double sum = 0;
-  for (const double l : left_) sum += l;
-  return sum;
-}
+double TracerTransport::entered() const { return std::accumulate(entered_.begin(), entered_.end(), 0.0); }
+double TracerTransport::left() const { return std::accumulate(left_.begin(), left_.end(), 0.0); }
 
 // The concentration of the carrier entering through face f into its downstream cell.
 double TracerTransport::inflowing(std::size_t f, const RedCellTransport& red_cells, std::span<const double> inflow,
