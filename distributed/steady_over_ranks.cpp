@@ -19,12 +19,20 @@ namespace hemotree {
 
 namespace {
 
+// A vessel's resistance at its own hematocrit (none given: the blood's), as vessel_resistances.
+double resistance_at(const Network& net, const Blood& blood, std::span<const double> hematocrit, std::size_t v) {
+  if (hematocrit.empty()) return vessel_resistance(net, blood, v);
+  Blood own = blood;
+  own.hematocrit = hematocrit[v];
+  return vessel_resistance(net, own, v);
+}
+
 // Any other network (loops, pressures prescribed at nodes): PETSc's solve of the nodal system
 // over the ranks, each node on the rank of a vessel leaving it (METIS's pieces go with their
 // `from` nodes), else of one entering it; the pressures on every rank, the flows on rank 0
 // as the one-process solve forms them.
-SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, double inlet_flow, const SteadyRows& rows,
-                               const Partition& partition) {
+SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, std::span<const double> hematocrit,
+                               double inlet_flow, const SteadyRows& rows, const Partition& partition) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
   std::vector<std::int32_t> owner(nodes, -1);
   std::vector<double> resistance(n), conductance(n), inflow;
@@ -34,7 +42,7 @@ SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, double in
       if (std::int32_t& o = owner[static_cast<std::size_t>(net.to[v])]; o < 0) o = partition.rank_of_vessel[v];
     for (std::int32_t& o : owner) o = std::max(o, 0);  // a node no vessel touches: a unit shunt, rank 0's
     for (std::size_t v = 0; v < n; ++v) {
-      resistance[v] = vessel_resistance(net, blood, v);
+      resistance[v] = resistance_at(net, blood, hematocrit, v);
       conductance[v] = 1 / resistance[v];
     }
     inflow = rows.inflow;
@@ -59,7 +67,8 @@ SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, double in
 
 }  // namespace
 
-SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& blood, double inlet_flow) {
+SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& blood, double inlet_flow,
+                                             std::span<const double> hematocrit) {
   const int ranks = world_size(), rank = world_rank();
   // What each rank sets up alone, its failure every rank's before any of them solves.
   SteadyRows rows;
@@ -91,7 +100,7 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
     }
   });
   check_one_partition(partition);
-  if (iterative) return solve_by_petsc(net, blood, inlet_flow, rows, partition);
+  if (iterative) return solve_by_petsc(net, blood, hematocrit, inlet_flow, rows, partition);
 
   // This rank's share and its vessels' resistances (rigid), one solve.
   std::optional<SteadyShare> share;
@@ -99,7 +108,7 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
   on_every_rank([&] {
     share.emplace(net, *cut, rows, inlet_flow);
     for (const std::int32_t v : share->vessels())
-      resistance[static_cast<std::size_t>(v)] = vessel_resistance(net, blood, static_cast<std::size_t>(v));
+      resistance[static_cast<std::size_t>(v)] = resistance_at(net, blood, hematocrit, static_cast<std::size_t>(v));
   });
   SteadyFlow held_here;
   share->solve(resistance, held_here);

@@ -11,6 +11,7 @@
 //     1e-12 relative.
 #pragma once
 
+#include <span>
 #include <string>
 
 #include "formats/network.hpp"
@@ -25,7 +26,10 @@ struct SteadyOverRanks {
 };
 
 // InputError as solve_steady_flow's, or where the iterative solve does not converge;
-// SettingError "ranks" where a tree's partition spreads its top over the ranks.
-SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& blood, double inlet_flow);
+// SettingError "ranks" where a tree's partition spreads its top over the ranks. hematocrit:
+// per vessel its own discharge hematocrit, its resistance's (steady/steady_flow.hpp's
+// vessel_resistances; empty: the blood's everywhere), alike on every rank.
+SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& blood, double inlet_flow,
+                                             std::span<const double> hematocrit = {});
 
 }  // namespace hemotree

@@ -367,11 +367,9 @@ int main(int argc, char** argv) {
   CommandLine line;
   const int cores = omp_get_num_procs();
   bind_options(app, line, cores);
-  // Over MPI ranks: the steady flow with red cells fixed, the linear periodic state and a
-  // pulsatile run on a tree (what it does not take yet it refuses: solver/pulsatile_call.cpp).
-  auto over_ranks = [&]() -> std::string {
-    if (line.steady && line.red_cells != "fixed") return "--steady with --red-cells " + line.red_cells + " runs as one process";
-    return "";
-  };
+  // Over MPI ranks every run (the steady state, with or without phase separation, the linear
+  // periodic state, a pulsatile run on a tree); what a run cannot take over ranks it refuses
+  // itself (solver/pulsatile_call.cpp, solver/linear_run.cpp).
+  auto over_ranks = []() -> std::string { return ""; };
   return run_tool(app, argc, argv, hemosolve_words(), [&] { return run_command_line(line, cores); }, over_ranks);
 }

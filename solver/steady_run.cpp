@@ -13,6 +13,7 @@
 
 #include "core/errors.hpp"
 #include "core/units.hpp"
+#include "distributed/steady_hematocrit_over_ranks.hpp"
 #include "distributed/steady_over_ranks.hpp"
 #include "formats/run_boundaries.hpp"
 #include "physics/rheology.hpp"
@@ -129,9 +130,16 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
   const auto started = std::chrono::steady_clock::now();
   SteadyFlow steady;
   SteadyHematocritResult separated;
-  if (world_size() > 1) {
-    if (request.phase_separation)
-      throw std::logic_error("run_steady: phase separation over MPI ranks (hemosolve refuses it before)");
+  if (world_size() > 1 && request.phase_separation) {
+    // Each pass's flows over the ranks, the hematocrits on rank 0 (as below, relaxed by half).
+    SteadyHematocritOverRanks over =
+        solve_steady_with_phase_separation_over_ranks(net, blood, red_cell_iterations, red_cell_tolerance, 0.5);
+    if (world_rank() != 0) return;
+    leave_collectives();
+    observer.note(over.partition);
+    separated = std::move(over.result);
+    steady = separated.flow;
+  } else if (world_size() > 1) {
     SteadyOverRanks over = solve_steady_flow_over_ranks(net, blood, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
     if (world_rank() != 0) return;
     leave_collectives();  // the others have finished: a failure of the writing is rank 0's alone

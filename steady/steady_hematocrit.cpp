@@ -187,14 +187,35 @@ void settle_round_off_flows(const Network& net, SteadyFlow& s) {
 
 }  // namespace
 
-SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, const Blood& blood,
-                                                          int max_iterations, double tolerance,
-                                                          double relaxation) {
+void check_phase_separation_settings(int max_iterations, double tolerance, double relaxation) {
   if (max_iterations < 1)
     throw InputError("max_iterations " + std::to_string(max_iterations) + ": must be at least 1");
   if (!(tolerance > 0)) throw InputError("tolerance " + std::to_string(tolerance) + ": must be positive");
   if (!(relaxation > 0 && relaxation <= 1))
     throw InputError("relaxation " + std::to_string(relaxation) + ": accepted range (0, 1]");
+}
+
+HematocritPass hematocrit_pass(const Network& net, const Blood& blood, SteadyFlow& s, std::span<const double> h,
+                               std::span<const double> previous_flow) {
+  settle_round_off_flows(net, s);
+  HematocritPass pass;
+  pass.target = distribute_hematocrit(net, s.flow, blood.hematocrit, blood.phase_separation_diameter_scale());
+  double q_scale = 0;
+  for (const double q : s.flow) q_scale = std::max(q_scale, std::abs(q));
+  // No previous flow to compare with on the first pass: not converged yet.
+  pass.change = previous_flow.empty() ? std::numeric_limits<double>::infinity() : 0.0;
+  for (std::size_t v = 0; v < h.size(); ++v) {
+    pass.change = std::max(pass.change, std::abs(pass.target[v] - h[v]));
+    if (!previous_flow.empty() && q_scale > 0)
+      pass.change = std::max(pass.change, std::abs(s.flow[v] - previous_flow[v]) / q_scale);
+  }
+  return pass;
+}
+
+SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, const Blood& blood,
+                                                          int max_iterations, double tolerance,
+                                                          double relaxation) {
+  check_phase_separation_settings(max_iterations, tolerance, relaxation);
   const double inlet_flow = net.inlet ? net.inlet->waveform.mean_value() : 0.0;
 
   std::vector<double> h(net.vessel_count(), blood.hematocrit);
@@ -202,26 +223,15 @@ SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, co
   SteadyHematocritResult result;
   for (int it = 1; it <= max_iterations; ++it) {
     SteadyFlow s = solve_steady_flow(net, vessel_resistances(net, blood, h), inlet_flow);
-    settle_round_off_flows(net, s);
-    std::vector<double> target =
-        distribute_hematocrit(net, s.flow, blood.hematocrit, blood.phase_separation_diameter_scale());
-    double q_scale = 0;
-    for (const double q : s.flow) q_scale = std::max(q_scale, std::abs(q));
-    // No previous flow to compare with on the first pass: not converged yet.
-    double change = previous_flow.empty() ? std::numeric_limits<double>::infinity() : 0.0;
-    for (std::size_t v = 0; v < h.size(); ++v) {
-      change = std::max(change, std::abs(target[v] - h[v]));
-      if (!previous_flow.empty() && q_scale > 0)
-        change = std::max(change, std::abs(s.flow[v] - previous_flow[v]) / q_scale);
-    }
+    HematocritPass pass = hematocrit_pass(net, blood, s, h, previous_flow);
     result.iterations = it;
-    result.change = change;
-    result.converged = change < tolerance;
+    result.change = pass.change;
+    result.converged = pass.change < tolerance;
     previous_flow = s.flow;
     result.flow = std::move(s);
-    result.hematocrit = target;
+    result.hematocrit = std::move(pass.target);
     if (result.converged) break;
-    for (std::size_t v = 0; v < h.size(); ++v) h[v] += relaxation * (target[v] - h[v]);
+    for (std::size_t v = 0; v < h.size(); ++v) h[v] += relaxation * (result.hematocrit[v] - h[v]);
   }
   return result;
 }

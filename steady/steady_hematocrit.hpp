@@ -65,4 +65,18 @@ SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, co
                                                           int max_iterations, double tolerance,
                                                           double relaxation);
 
+// The iteration's checks of its settings (InputError, as above).
+void check_phase_separation_settings(int max_iterations, double tolerance, double relaxation);
+
+// One pass of that iteration after its flow solve s (of the resistances at hematocrits h):
+// the round-off flows set to zero in s, the target hematocrits from the flows and the change
+// against h and the previous pass's flows (empty: the first pass, the change infinite). What a
+// run over ranks takes on rank 0 (distributed/steady_hematocrit_over_ranks.hpp).
+struct HematocritPass {
+  std::vector<double> target;
+  double change = 0;
+};
+HematocritPass hematocrit_pass(const Network& net, const Blood& blood, SteadyFlow& s, std::span<const double> h,
+                               std::span<const double> previous_flow);
+
 }  // namespace hemotree

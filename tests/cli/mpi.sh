@@ -273,6 +273,21 @@ for c in ("mean_flow", "mean_pressure", "mean_wss", "reynolds"):
 assert (a["id"] == b["id"]).all()
 PY
   done
+  # Its red cells separated at the bifurcations (121 passes of flows over the ranks): within
+  # 1e-10 too, the hematocrits with them.
+  "$HEMOSOLVE" "$WORK/mesentery.json" --steady --red-cells transport --out "$WORK/mesentery-rbc-one" 2>/dev/null \
+    || fail "the mesentery with phase separation, plain"
+  $MPIRUN -np 2 "$HEMOSOLVE" "$WORK/mesentery.json" --steady --red-cells transport --out "$WORK/mesentery-rbc-2" >/dev/null 2>&1
+  /usr/bin/python3 - "$WORK/mesentery-rbc-one/vessels.csv" "$WORK/mesentery-rbc-2/vessels.csv" <<'PY' \
+    && pass "the mesentery with phase separation over 2 ranks: the plain run's within 1e-10" \
+    || fail "the mesentery with phase separation over 2 ranks: not the plain run's"
+import sys, pandas as pd, numpy as np
+a, b = pd.read_csv(sys.argv[1]), pd.read_csv(sys.argv[2])
+assert list(a.columns) == list(b.columns) and len(a) == len(b)
+for c in ("mean_flow", "mean_pressure", "discharge_hematocrit"):
+    x, y = a[c].to_numpy(), b[c].to_numpy()
+    assert np.abs(x - y).max() <= 1e-10 * np.abs(x).max(), c
+PY
 else
   echo "skip: the mesentery over ranks (no shared networks)"
 fi
@@ -287,8 +302,17 @@ expect_refused() {  # name, text, command...: status 2, said once, no folder
     && pass "$name: refused, said once, nothing written" \
     || fail "$name: status $status, said $count times: $(head -3 "$WORK/refused")"
 }
-expect_refused "phase separation over 2 ranks" "hemosolve: error: started on 2 MPI ranks: --steady with --red-cells transport runs as one process" \
-  -np 2 "$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport --out "$WORK/refused-out"
+# The steady state with phase separation over ranks (distributed/steady_hematocrit_over_ranks):
+# each pass's flows solved over the ranks, the hematocrits on rank 0: the plain run's files.
+"$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport --out "$WORK/separated-one" 2>/dev/null \
+  || fail "hemosolve --steady --red-cells transport"
+grep -q '"passes": [2-9]' "$WORK/separated-one/summary.json" || fail "the plain phase separation took fewer than 2 passes"
+for ranks in 2 3; do
+  $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport --out "$WORK/separated-$ranks" >/dev/null 2>&1
+  same_files "$WORK/separated-one" "$WORK/separated-$ranks" \
+    && pass "mpirun -np $ranks --steady --red-cells transport: the plain run's files (every pass over the ranks)" \
+    || fail "--steady --red-cells transport over $ranks ranks: the files differ from the plain run's"
+done
 # A breakdown over ranks (a 1D vessel on the top's rank, a step beyond its limit, forced) is
 # every rank's and said as the plain run says it, once; nothing computed, nothing kept.
 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --cfl 3 --force --lumped-sections 1 --out "$WORK/broken-one" 2>"$WORK/broken-one.err"
@@ -299,16 +323,14 @@ grep -q "broke down" "$WORK/broken-one.err" || fail "the plain run did not break
 # A cycle estimated above a day: the one-process refusal, said once.
 expect_refused "a pulsatile run over 2 ranks estimated above a day" "hemosolve: error: one cycle would take about" \
   -np 2 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 2 --dt 1e-9 --out "$WORK/refused-out"
-# What a pulsatile run over ranks does not take yet: refused on every rank, said once.
-# Started by Slurm's srun (its step's task count and this task's rank, no Open MPI variables):
-# the same refusal, said by rank 0 alone, nothing written.
+# A tool that runs as one process, started by Slurm's srun (its step's task count and this
+# task's rank, no Open MPI variables): refused, said by rank 0 alone, nothing written.
 for procid in 0 1; do
-  SLURM_STEP_NUM_TASKS=2 SLURM_PROCID=$procid "$HEMOSOLVE" "$WORK/tree.json" --steady --red-cells transport \
-    --out "$WORK/refused-out" >"$WORK/slurm" 2>&1
+  SLURM_STEP_NUM_TASKS=2 SLURM_PROCID=$procid "$BUILD/stats/vstats" "$WORK/tree.json" >"$WORK/slurm" 2>&1
   status=$?
-  said=$(grep -c "hemosolve: error: started on 2 MPI ranks: " "$WORK/slurm")
-  [ $status -eq 2 ] && [ "$said" -eq $((1 - procid)) ] && [ ! -e "$WORK/refused-out" ] \
-    && pass "phase separation under srun's variables, task $procid: refused, said by task 0 alone" \
+  said=$(grep -c "vstats: error: started on 2 MPI ranks: vstats runs as one process" "$WORK/slurm")
+  [ $status -eq 2 ] && [ "$said" -eq $((1 - procid)) ] \
+    && pass "vstats under srun's variables, task $procid: refused, said by task 0 alone" \
     || fail "srun's variables, task $procid: status $status, said $said times"
 done
 if [ -f "$WORK/mesentery.json" ]; then
