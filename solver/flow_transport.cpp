@@ -92,7 +92,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   set_up_tracers();
   last_time_ = solver.time();
   mark();
-  begin_cycle();
+  if (!cut_) begin_cycle();  // over ranks in join_ranks, the constructor taking no collective call
 }
 
 double FlowTransport::fahraeus(double diameter) const {

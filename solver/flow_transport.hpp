@@ -82,9 +82,12 @@ class RootExchange;
 class FlowTransport {
  public:
   // Call before the solver's first step (it starts the solver's face accumulators). ranks:
-  // where the solver is a rank's part of a run over ranks.
+  // where the solver is a rank's part of a run over ranks; the constructor then takes no
+  // collective call (so that a refusal on one rank can be made every rank's:
+  // mpi/session.hpp's on_every_rank), and join_ranks, collective, completes it.
   FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options = {},
                 const TransportRanks* ranks = nullptr);
+  void join_ranks();
 
   // Moves the red cells by what the solver passed since the last call (over ranks: collective).
   void advance();

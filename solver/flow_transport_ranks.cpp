@@ -86,13 +86,20 @@ void FlowTransport::place_cut(const TransportRanks& ranks) {
     }
   }
   // The whole run's counts: every rank knows its 0D part; the top's 1D cells and faces are
-  // the top's alone (rank 0's, and said to every rank).
-  double one_d[2] = {static_cast<double>(one_d_cells),
-                     static_cast<double>(first_one_d_face < 0 ? 0 : grid.face_count() - static_cast<std::size_t>(first_one_d_face))};
-  if (!cut.top) one_d[0] = one_d[1] = 0;
-  MPI_Allreduce(MPI_IN_PLACE, one_d, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  cut.cells = whole.nodes.size() + static_cast<std::size_t>(one_d[0]);
-  cut.faces = static_cast<std::size_t>(zero_d_faces + at_zero_d_nodes) + static_cast<std::size_t>(one_d[1]);
+  // the top's alone (said to every rank by join_ranks).
+  cut.cells = whole.nodes.size() + (cut.top ? one_d_cells : 0);
+  cut.faces = static_cast<std::size_t>(zero_d_faces + at_zero_d_nodes) +
+              (cut.top && first_one_d_face >= 0 ? grid.face_count() - static_cast<std::size_t>(first_one_d_face) : 0);
+}
+
+void FlowTransport::join_ranks() {
+  // The top's counts (the others hold their 0D part's, which is every rank's), then the first
+  // cycle's sums.
+  unsigned long long counts[2] = {cut_->cells, cut_->faces};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 2, MPI_UNSIGNED_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+  cut_->cells = static_cast<std::size_t>(counts[0]);
+  cut_->faces = static_cast<std::size_t>(counts[1]);
+  begin_cycle();
 }
 
 std::vector<std::int32_t> FlowTransport::own_cell_places() const {

@@ -412,7 +412,9 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     carried.tracers = tracers;
     std::optional<TransportRanks> over;
     if (ranks) over = TransportRanks{ranks->ranks().top_rank, ranks->roots()};
-    transport.emplace(net, run, red ? carried : red_cells_fixed(carried), over ? &*over : nullptr);
+    // A refusal (a tracer given where the network has no boundary) is every rank's alike.
+    on_every_rank([&] { transport.emplace(net, run, red ? carried : red_cells_fixed(carried), over ? &*over : nullptr); });
+    if (over) transport->join_ranks();
     plan.transport_every = std::max<std::size_t>(
         1, static_cast<std::size_t>(std::llround(config.transport_step * static_cast<double>(steps_per_cycle))));
     observer.note(std::string(red ? "red cells" : "") + (red && !tracers.empty() ? " and " : "") +
