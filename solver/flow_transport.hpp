@@ -18,8 +18,9 @@
 // and the top's node u is a face on both sides, to a cut (transport/transport_grid.hpp). A
 // step solves first the cells no cut's inflow reaches; the shares send r's hematocrit and
 // phase separation share up, the top solves the rest and sends u's down, the shares finish
-// (flow_transport_ranks.cpp). Every cell's value is the one-process run's, bit for bit; every
-// sum of the cycle and the checkpoint is taken on rank 0 in the one-process order.
+// (flow_transport_ranks.cpp); the tracers then ride on that step with two messages of their
+// own. Every cell's value is the one-process run's, bit for bit; every sum of the cycle, the
+// report and the checkpoint is taken on rank 0 in the one-process order.
 #pragma once
 
 #include <cstdint>

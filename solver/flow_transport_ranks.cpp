@@ -1,10 +1,8 @@
-// Red cells over MPI ranks (docs/transport.md, "Over MPI ranks"): where each rank's cells,
-// faces and boundaries lie in the one-process run's grid, a step's two messages across the
-// cuts, and the cycle's sums and the checkpoint taken on rank 0 in the one-process order.
+// Red cells and tracers over MPI ranks (docs/transport.md, "Over MPI ranks"): where each
+// rank's cells, faces and boundaries lie in the one-process run's grid, a step's messages
+// across the cuts (two for the red cells, two for the tracers), and the cycle's sums, the
+// report's and the checkpoint taken on rank 0 in the one-process order.
 #include <mpi.h>
-
-#include <stdexcept>
-#include <string>
 
 #include "distributed/gather_rows.hpp"
 #include "distributed/root_exchange.hpp"
