@@ -110,10 +110,20 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
   // Over P ranks each steps about a P-th of the 0D vessels; the 1D vessels are the top's.
   const int ranks = world_size();
   const double lumped = static_cast<double>(run.lumped_vessels_in_run()) / ranks, substeps = run.substeps() * run.coupling_passes();
-  const RunEstimate per_cycle =
-      estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), threads, substeps, lumped);
-  const RunEstimate whole =
+  RunEstimate per_cycle = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), threads, substeps, lumped);
+  RunEstimate whole =
       estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned, threads, substeps, lumped);
+  if (config.carries_transport()) {
+    // Its cells: a node's of the 0D vessels (about one a vessel), the 1D elements' slices (a
+    // degree's modes each); a rank carries its own. Its steps: as the run takes them below.
+    const double cells = (static_cast<double>(run.lumped_vessels_in_run()) +
+                          static_cast<double>(run.element_count()) * (run.max_degree() + 1)) / ranks;
+    const auto every = std::max<std::size_t>(
+        1, static_cast<std::size_t>(std::llround(config.transport_step * static_cast<double>(steps_per_cycle))));
+    const double transport = cells * static_cast<double>(steps_per_cycle / every) * per_transport_cell;
+    per_cycle.seconds += transport;
+    whole.seconds += transport * planned;
+  }
   if (per_cycle.seconds > one_day && !config.force)
     throw SettingError("force", "one cycle would take about " + describe_duration(per_cycle.seconds) + " (" +
                      format_rounded(static_cast<double>(steps_per_cycle)) + " steps of " + format_quantity(dt, "s") +

@@ -20,6 +20,13 @@ struct RunEstimate {
 RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads,
                          double substeps = 1, double lumped_vessels = 0);
 
+// A red-cell or tracer transport step, per cell: measured 85 ns of wall time a cell and
+// transport step on two threads, on the 421,047-vessel tree and on the full tree alike
+// (bench/README.md, "Red cells and tracers over ranks"), most of it serial (the sweep in flow
+// order) or the viscosity feedback's; 100 ns on any number of threads, so that the estimate
+// errs long.
+inline constexpr double per_transport_cell = 100e-9;  // [s per cell and transport step]
+
 // "3.2 s", "4.1 min", "2.5 h", "3.1 days", "2e+06 years".
 std::string describe_duration(double seconds);
 
