@@ -19,14 +19,6 @@ namespace hemotree {
 
 namespace {
 
-// A vessel's resistance at its own hematocrit (none given: the blood's), as vessel_resistances.
-double resistance_at(const Network& net, const Blood& blood, std::span<const double> hematocrit, std::size_t v) {
-  if (hematocrit.empty()) return vessel_resistance(net, blood, v);
-  Blood own = blood;
-  own.hematocrit = hematocrit[v];
-  return vessel_resistance(net, own, v);
-}
-
 // Any other network (loops, pressures prescribed at nodes): PETSc's solve of the nodal system
 // over the ranks, each node on the rank of a vessel leaving it (METIS's pieces go with their
 // `from` nodes), else of one entering it; the pressures on every rank, the flows on rank 0
@@ -42,7 +34,7 @@ SteadyOverRanks solve_by_petsc(const Network& net, const Blood& blood, std::span
       if (std::int32_t& o = owner[static_cast<std::size_t>(net.to[v])]; o < 0) o = partition.rank_of_vessel[v];
     for (std::int32_t& o : owner) o = std::max(o, 0);  // a node no vessel touches: a unit shunt, rank 0's
     for (std::size_t v = 0; v < n; ++v) {
-      resistance[v] = resistance_at(net, blood, hematocrit, v);
+      resistance[v] = vessel_resistance(net, blood, v, hematocrit);
       conductance[v] = 1 / resistance[v];
     }
     inflow = rows.inflow;
@@ -108,7 +100,7 @@ SteadyOverRanks solve_steady_flow_over_ranks(const Network& net, const Blood& bl
   on_every_rank([&] {
     share.emplace(net, *cut, rows, inlet_flow);
     for (const std::int32_t v : share->vessels())
-      resistance[static_cast<std::size_t>(v)] = resistance_at(net, blood, hematocrit, static_cast<std::size_t>(v));
+      resistance[static_cast<std::size_t>(v)] = vessel_resistance(net, blood, static_cast<std::size_t>(v), hematocrit);
   });
   SteadyFlow held_here;
   share->solve(resistance, held_here);

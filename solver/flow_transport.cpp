@@ -615,7 +615,7 @@ FlowTransport::TracerState FlowTransport::get_tracer(CheckpointReader& in, std::
   s.curve = in.get_vector();
   const std::size_t boundaries = solver_.boundary_list().size();
   if (s.concentration.size() != cell_count() || s.last_outflow.size() != boundaries || s.entered.size() != boundaries ||
-      s.left.size() != boundaries || totals.size() != 2 || s.curve.size() != 6 * net_.vessel_count())
+      s.left.size() != boundaries || totals.size() != 2 || s.curve.size() != IndicatorCurves::state_arrays * net_.vessel_count())
     in.fail("tracer " + options_.tracers[k].name + " of another network or transport grid");
   s.injected = totals[0];
   s.adjusted = totals[1];

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <utility>
@@ -176,6 +177,13 @@ class FlowTransport {
   // The cut's faces were made with the grid; the rest of the Cut from them.
   void place_cut(const TransportRanks& ranks);
   void advance_over_ranks();
+  // A step's two messages across the cuts, per_root numbers a root each way: `here` gives this
+  // side's (the shares' up, then the top's down), `across` takes the other side's as the cuts'
+  // inflows, `rest` solves what waited for them. failure: this rank's before the messages;
+  // it, or the top's in `rest`, is thrown on every rank. Collective.
+  void across_cuts(std::size_t per_root, std::exception_ptr failure, const char* what,
+                   const std::function<std::vector<double>()>& here,
+                   const std::function<void(std::span<const double>)>& across, const std::function<void()>& rest);
   void step_tracers_over_ranks(double t0, double t1);
   std::vector<TracerReport> reports_;  // over ranks, rank 0's (take_reports)
   // On rank 0 `start` plus each of the whole run's items in turn (per cell or boundary: each
@@ -190,7 +198,8 @@ class FlowTransport {
   std::vector<std::int32_t> own_cell_places() const;
   std::vector<std::int32_t> own_face_places() const;
   std::vector<std::int32_t> boundary_places() const;
-  std::vector<std::int32_t> own_curve_places() const;  // a tracer's curves: the vessels it steps
+  // Per vessel, `arrays` arrays one after the other (a tracer's curves): those of the vessels it steps.
+  std::vector<std::int32_t> own_vessel_places(std::size_t arrays) const;
   double rank_sum(double value) const;  // on rank 0 every rank's value, summed in rank order
   void close_cycle_over_ranks(RedCellCycle& c) const;
   // The red cells' state as a checkpoint holds it, in the one-process grid's order: per cell,

@@ -4,6 +4,8 @@
 // report's and the checkpoint taken on rank 0 in the one-process order.
 #include <mpi.h>
 
+#include <functional>
+
 #include "distributed/gather_rows.hpp"
 #include "distributed/root_exchange.hpp"
 #include "mpi/session.hpp"
@@ -15,6 +17,16 @@ namespace hemotree {
 
 namespace {
 constexpr std::size_t per_root = 2;  // a side's hematocrit H_D and its phase separation share s_f
+
+// A part of a step that may fail on this rank: its failure, to be made every rank's.
+std::exception_ptr attempt(const std::function<void()>& part) {
+  try {
+    part();
+  } catch (...) {
+    return std::current_exception();
+  }
+  return nullptr;
+}
 
 // A rank's per-boundary arrays (the grid's boundaries, cuts last) from the whole run's: the
 // boundaries it holds (held: the boundary, or -1) take their values, the rest nothing in or
@@ -145,6 +157,31 @@ double FlowTransport::lead_sum(std::span<const double> values, std::span<const s
   return sum;
 }
 
+void FlowTransport::across_cuts(std::size_t per_root, std::exception_ptr failure, const char* what,
+                                const std::function<std::vector<double>()>& here,
+                                const std::function<void(std::span<const double>)>& across,
+                                const std::function<void()>& rest) {
+  Cut& cut = *cut_;
+  // Up: the shares' root nodes (what the top's nodes above take where blood flows up).
+  bool failed = false;
+  const std::vector<double> up = cut.exchange->gather(cut.top ? std::vector<double>() : here(), failure, per_root, failed);
+  std::vector<double> down;
+  if (cut.top && !failed && !failure) {
+    try {
+      across(up);
+      rest();
+      down = here();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  // Down: the top's nodes above the roots; then a share finishes its subtrees below them.
+  const std::vector<double> mine = cut.exchange->scatter(down, failure, per_root, what);
+  if (cut.top) return;
+  across(mine);
+  rest();
+}
+
 void FlowTransport::advance_over_ranks() {
   Cut& cut = *cut_;
   RedCellTransport& cells = *red_cells_;
@@ -167,31 +204,9 @@ void FlowTransport::advance_over_ranks() {
     return numbers;
   };
   cells.begin_step(face_volume_);
-  std::exception_ptr failure;
-  try {
-    cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::before_cuts);
-  } catch (...) {
-    failure = std::current_exception();
-  }
-  // Up: the shares' root nodes (what the top's nodes above take where blood flows up).
-  bool failed = false;
-  const std::vector<double> up = cut.exchange->gather(cut.top ? std::vector<double>() : from_here(), failure, per_root, failed);
-  std::vector<double> down;
-  if (cut.top && !failed && !failure) {
-    from_across(up);
-    try {
-      cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::after_cuts);
-      down = from_here();
-    } catch (...) {
-      failure = std::current_exception();
-    }
-  }
-  // Down: the top's nodes above the roots; then a share finishes its subtrees below them.
-  const std::vector<double> mine = cut.exchange->scatter(down, failure, per_root, "the red cells' step");
-  if (!cut.top) {
-    from_across(mine);
-    cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::after_cuts);
-  }
+  across_cuts(per_root, attempt([&] { cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::before_cuts); }),
+              "the red cells' step", from_here, from_across,
+              [&] { cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::after_cuts); });
   cells.end_step(face_volume_, inflow_hematocrit_);
   ++advances_;
   mark();
@@ -205,11 +220,14 @@ void FlowTransport::step_tracers_over_ranks(double t0, double t1) {
   Cut& cut = *cut_;
   const std::size_t roots = cut.face.size(), count = tracers_.size();
   using Cells = RedCellTransport::Cells;
+  auto solve = [&](Cells cells) {
+    for (std::size_t k = 0; k < count; ++k) tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], cells);
+  };
   for (std::size_t k = 0; k < count; ++k) {
     tracer_given(k, t0, t1);
     tracers_[k].begin_step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
-    tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], Cells::before_cuts);
   }
+  const std::exception_ptr failure = attempt([&] { solve(Cells::before_cuts); });
   // What crosses each cut from this side (with an injection there, which its rank adds), and
   // what the other side sent as the cuts' inflows (and the far side's concentration).
   auto from_here = [&] {
@@ -227,21 +245,7 @@ void FlowTransport::step_tracers_over_ranks(double t0, double t1) {
         cut.tracer_far[k * roots + j] = numbers[count * j + k];
       }
   };
-  bool failed = false;
-  const std::vector<double> up = cut.exchange->gather(cut.top ? std::vector<double>() : from_here(), nullptr, count, failed);
-  std::vector<double> down;
-  if (cut.top) {
-    from_across(up);
-    for (std::size_t k = 0; k < count; ++k)
-      tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], Cells::after_cuts);
-    down = from_here();
-  }
-  const std::vector<double> mine = cut.exchange->scatter(down, nullptr, count, "the tracers' step");
-  if (!cut.top) {
-    from_across(mine);
-    for (std::size_t k = 0; k < count; ++k)
-      tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], Cells::after_cuts);
-  }
+  across_cuts(count, failure, "the tracers' step", from_here, from_across, [&] { solve(Cells::after_cuts); });
   for (std::size_t k = 0; k < count; ++k) {
     tracers_[k].end_step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
     follow_curve(k, t0, t1);
@@ -263,24 +267,21 @@ void FlowTransport::save_over_ranks(CheckpointWriter* out) const {
   const std::size_t boundaries = cut_->run_boundaries;
   std::vector<double> turned(face_volume_.size());  // each face as the whole grid has it
   for (std::size_t f = 0; f < turned.size(); ++f) turned[f] = cut_->face_sign[f] * face_volume_[f];
-  std::vector<double> applied(applied_hematocrit_);
-  std::vector<std::int32_t> stepped(applied.size(), -1);
-  for (std::size_t v = 0; v < stepped.size(); ++v)
-    if (solver_.steps_vessel(v)) stepped[v] = static_cast<std::int32_t>(v);
   const RedCellState whole{lead_whole(t.discharge_hematocrit(), cells, cut_->cells),
                            lead_whole(t.volume(), cells, cut_->cells),
                            lead_whole(t.entered_by_boundary(), held, boundaries),
                            lead_whole(t.left_by_boundary(), held, boundaries),
                            cut_->adjusted,
                            lead_whole(t.last_outflow(), held, boundaries),
-                           lead_whole(applied, stepped, applied.size()),
+                           lead_whole(applied_hematocrit_, own_vessel_places(applied_hematocrit_.empty() ? 0 : 1),
+                                      applied_hematocrit_.size()),
                            lead_whole(turned, faces, cut_->faces)};
   if (out) {
     put_red_cells(*out, whole);
     out->put(static_cast<std::uint64_t>(advances_));
     out->put(last_time_);
   }
-  const std::vector<std::int32_t> curves = own_curve_places();
+  const std::vector<std::int32_t> curves = own_vessel_places(IndicatorCurves::state_arrays);
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const TracerTransport& tracer = tracers_[k];
     const TracerState state{lead_whole(tracer.concentration(), cells, cut_->cells),
@@ -294,10 +295,10 @@ void FlowTransport::save_over_ranks(CheckpointWriter* out) const {
   }
 }
 
-std::vector<std::int32_t> FlowTransport::own_curve_places() const {
+std::vector<std::int32_t> FlowTransport::own_vessel_places(std::size_t arrays) const {
   const std::size_t n = net_.vessel_count();
-  std::vector<std::int32_t> place(6 * n, -1);
-  for (std::size_t a = 0; a < 6; ++a)
+  std::vector<std::int32_t> place(arrays * n, -1);
+  for (std::size_t a = 0; a < arrays; ++a)
     for (std::size_t v = 0; v < n; ++v)
       if (solver_.steps_vessel(v)) place[a * n + v] = static_cast<std::int32_t>(a * n + v);
   return place;

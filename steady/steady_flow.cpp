@@ -40,15 +40,19 @@ double vessel_resistance(const Network& net, const Blood& blood, std::size_t v) 
                                      blood.alpha);
 }
 
+double vessel_resistance(const Network& net, const Blood& blood, std::size_t v, std::span<const double> hematocrit) {
+  if (hematocrit.empty()) return vessel_resistance(net, blood, v);
+  Blood own = blood;
+  own.hematocrit = hematocrit[v];
+  return vessel_resistance(net, own, v);
+}
+
 std::vector<double> vessel_resistances(const Network& net, const Blood& blood, std::span<const double> hematocrit,
                                        int threads) {
   std::vector<double> r(net.vessel_count());
   parallel_blocks(static_cast<std::int64_t>(r.size()), threads, [&](std::int64_t first, std::int64_t last) {
-    Blood own = blood;
-    for (auto v = static_cast<std::size_t>(first); v < static_cast<std::size_t>(last); ++v) {
-      if (!hematocrit.empty()) own.hematocrit = hematocrit[v];
-      r[v] = vessel_resistance(net, own, v);
-    }
+    for (auto v = static_cast<std::size_t>(first); v < static_cast<std::size_t>(last); ++v)
+      r[v] = vessel_resistance(net, blood, v, hematocrit);
   });
   return r;
 }

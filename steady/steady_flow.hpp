@@ -29,8 +29,10 @@ std::vector<double> vessel_resistances(const Network& net, const Blood& blood);
 std::vector<double> vessel_resistances(const Network& net, const Blood& blood, std::span<const double> hematocrit,
                                        int threads = 1);
 
-// One vessel's (the function of every vessel of vessel_resistances, the blood's hematocrit).
+// One vessel's (the function of every vessel of vessel_resistances, the blood's hematocrit),
+// and at the vessel's own hematocrit (hematocrit: per vessel; empty: the blood's).
 double vessel_resistance(const Network& net, const Blood& blood, std::size_t v);
+double vessel_resistance(const Network& net, const Blood& blood, std::size_t v, std::span<const double> hematocrit);
 
 // The steady flow's boundary rows, after its checks (InputError, SettingError "pressure_at",
 // as solve_steady_flow's below): per node the outlets' 1/R to ground (shunt; a unit shunt at a

@@ -48,14 +48,14 @@ IndicatorCurves::Landmarks IndicatorCurves::landmarks(double now) const {
 
 std::vector<double> IndicatorCurves::state() const {
   std::vector<double> s;
-  s.reserve(6 * mass_.size());
+  s.reserve(state_arrays * mass_.size());
   for (const auto* a : {&arrival_, &peak_time_, &peak_, &previous_, &mass_, &moment_}) s.insert(s.end(), a->begin(), a->end());
   return s;
 }
 
 bool IndicatorCurves::restore(std::span<const double> s) {
   const std::size_t n = mass_.size();
-  if (s.size() != 6 * n) return false;
+  if (s.size() != state_arrays * n) return false;
   std::size_t k = 0;
   for (auto* a : {&arrival_, &peak_time_, &peak_, &previous_, &mass_, &moment_}) {
     a->assign(s.begin() + static_cast<std::ptrdiff_t>(k), s.begin() + static_cast<std::ptrdiff_t>(k + n));

@@ -31,7 +31,9 @@ class IndicatorCurves {
   // now: the time the run has reached (a step's area above the curve runs to it).
   Landmarks landmarks(double now) const;
 
-  // The running sums, as a checkpoint keeps them (six per vessel).
+  // The running sums, as a checkpoint keeps them: state_arrays arrays of one number a vessel,
+  // one after the other.
+  static constexpr std::size_t state_arrays = 6;
   std::vector<double> state() const;
   bool restore(std::span<const double> state);  // false for one of another size
 
