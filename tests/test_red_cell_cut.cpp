@@ -71,6 +71,39 @@ TransportGrid share_side() {
   return g;
 }
 
+// Step s's volumes (cells of volume v), which keep every cell's: S2's daughters of their own
+// phases (at times S4 feeds S2, which sends to T1 and S5), S3's outflow, the parents' sums;
+// each side's faces as it has them.
+struct StepVolumes {
+  std::vector<double> whole, top, share;
+  bool up_through_root = false, up_through_cut = false;  // vessel 1 up; vessel 1 or 2 up
+};
+StepVolumes step_volumes(int s, double v) {
+  const double t = 2 * std::numbers::pi * s / 100;
+  const double q3 = 0.2 * v * (0.2 + std::sin(t)), q4 = 0.15 * v * (0.5 + std::cos(1.3 * t));
+  const double q8 = 0.1 * v * (0.4 + std::sin(0.7 * t + 1)), q1 = q3 + q4, q2 = q8, q0 = q1 + q2;
+  return {{q0, q1, q2, q3, q4, -q0, q3, q4, q8}, {q0, q1, q2, -q0}, {-q1, -q2, q3, q4, q3, q4, q8}, q1 < 0, q1 < 0 || q2 < 0};
+}
+
+// The red cells' step on both sides, their two messages played here: each root node's H_D and
+// its face's share up (the top takes s H_D as its cuts' inflow), T1's through each of its cut
+// faces down.
+void step_both_sides(RedCellTransport& top, RedCellTransport& share, const StepVolumes& q,
+                     const std::vector<double>& inflow) {
+  using Cells = RedCellTransport::Cells;
+  top.begin_step(q.top);
+  share.begin_step(q.share);
+  top.solve(q.top, inflow, Cells::before_cuts);
+  share.solve(q.share, inflow, Cells::before_cuts);
+  std::vector<double> top_inflow = inflow, share_inflow = inflow;
+  for (int j = 0; j < 2; ++j) top_inflow[4 + j] = share.separation_share(j) * share.discharge_hematocrit()[j];
+  top.solve(q.top, top_inflow, Cells::after_cuts);
+  for (int j = 0; j < 2; ++j) share_inflow[4 + j] = top.separation_share(1 + j) * top.discharge_hematocrit()[1];
+  share.solve(q.share, share_inflow, Cells::after_cuts);
+  top.end_step(q.top, top_inflow);
+  share.end_step(q.share, share_inflow);
+}
+
 TEST(RedCellCut, TwoSidesStepInPartsToTheWholeGridsBits) {
   const double v = 1e-13, h0 = 0.45;
   RedCellTransport whole(whole_tree(), std::vector<double>(6, v), h0);
@@ -80,32 +113,10 @@ TEST(RedCellCut, TwoSidesStepInPartsToTheWholeGridsBits) {
   inflow[0] = cut_inflow[0] = 0.4;  // the inlet's; the outlets return what left them
   int separated = 0, up_through_cut = 0;
   for (int s = 0; s < 400; ++s) {
-    // Per step, volumes that keep every cell's: S2's daughters of their own phases (at times
-    // S4 feeds S2, which sends to T1 and S5), S3's outflow, the parents' sums.
-    const double t = 2 * std::numbers::pi * s / 100;
-    const double q3 = 0.2 * v * (0.2 + std::sin(t)), q4 = 0.15 * v * (0.5 + std::cos(1.3 * t));
-    const double q8 = 0.1 * v * (0.4 + std::sin(0.7 * t + 1)), q1 = q3 + q4, q2 = q8, q0 = q1 + q2;
-    const std::vector<double> whole_q{q0, q1, q2, q3, q4, -q0, q3, q4, q8};
-    const std::vector<double> top_q{q0, q1, q2, -q0}, share_q{-q1, -q2, q3, q4, q3, q4, q8};
-    up_through_cut += q1 < 0 || q2 < 0;
-
-    whole.step(whole_q, inflow);
-
-    using Cells = RedCellTransport::Cells;
-    top.begin_step(top_q);
-    share.begin_step(share_q);
-    top.solve(top_q, cut_inflow, Cells::before_cuts);
-    share.solve(share_q, cut_inflow, Cells::before_cuts);
-    // Up: each root node's H_D and its face's share; the top takes s H_D as its cuts' inflow.
-    std::vector<double> top_inflow = cut_inflow, share_inflow = cut_inflow;
-    for (int j = 0; j < 2; ++j)
-      top_inflow[4 + j] = share.separation_share(j) * share.discharge_hematocrit()[j];
-    top.solve(top_q, top_inflow, Cells::after_cuts);
-    // Down: T1's, through each of its cut faces.
-    for (int j = 0; j < 2; ++j) share_inflow[4 + j] = top.separation_share(1 + j) * top.discharge_hematocrit()[1];
-    share.solve(share_q, share_inflow, Cells::after_cuts);
-    top.end_step(top_q, top_inflow);
-    share.end_step(share_q, share_inflow);
+    const StepVolumes q = step_volumes(s, v);
+    up_through_cut += q.up_through_cut;
+    whole.step(q.whole, inflow);
+    step_both_sides(top, share, q, cut_inflow);
 
     separated += whole.separating_nodes() > 0;
     for (int c = 0; c < 2; ++c) ASSERT_EQ(top.discharge_hematocrit()[c], whole.discharge_hematocrit()[c]) << "step " << s;
@@ -140,34 +151,18 @@ TEST(RedCellCut, ATracerInjectedIntoARootVesselStepsInPartsToTheWholeGridsBits) 
   using Cells = RedCellTransport::Cells;
   int up_through_root = 0;
   for (int s = 0; s < 300; ++s) {
-    const double t = 2 * std::numbers::pi * s / 100;
-    const double q3 = 0.2 * v * (0.2 + std::sin(t)), q4 = 0.15 * v * (0.5 + std::cos(1.3 * t));
-    const double q8 = 0.1 * v * (0.4 + std::sin(0.7 * t + 1)), q1 = q3 + q4, q2 = q8, q0 = q1 + q2;
-    const std::vector<double> whole_q{q0, q1, q2, q3, q4, -q0, q3, q4, q8};
-    const std::vector<double> top_q{q0, q1, q2, -q0}, share_q{-q1, -q2, q3, q4, q3, q4, q8};
-    up_through_root += q1 < 0;
+    const StepVolumes q = step_volumes(s, v);
+    up_through_root += q.up_through_root;
     // The dye: at the inlet, and injected into vessel 1 (whole face 1, the share's face 0).
-    const double given = 1 + 0.5 * std::sin(0.3 * t);
+    const double given = 1 + 0.5 * std::sin(0.3 * 2 * std::numbers::pi * s / 100);
     std::vector<double> dye_in(4, nan), dye_cut_in(6, nan);
     dye_in[0] = dye_cut_in[0] = given;
     std::vector<double> whole_injected(9, 0.0), share_injected(7, 0.0);
     whole_injected[1] = share_injected[0] = 0.5 * given;
 
-    whole.step(whole_q, inflow);
+    whole.step(q.whole, inflow);
     whole_dye.step(whole, dye_in, whole_injected);
-
-    // The red cells as the first test steps them (their two messages).
-    top.begin_step(top_q);
-    share.begin_step(share_q);
-    top.solve(top_q, cut_inflow, Cells::before_cuts);
-    share.solve(share_q, cut_inflow, Cells::before_cuts);
-    std::vector<double> top_inflow = cut_inflow, share_inflow = cut_inflow;
-    for (int j = 0; j < 2; ++j) top_inflow[4 + j] = share.separation_share(j) * share.discharge_hematocrit()[j];
-    top.solve(top_q, top_inflow, Cells::after_cuts);
-    for (int j = 0; j < 2; ++j) share_inflow[4 + j] = top.separation_share(1 + j) * top.discharge_hematocrit()[1];
-    share.solve(share_q, share_inflow, Cells::after_cuts);
-    top.end_step(top_q, top_inflow);
-    share.end_step(share_q, share_inflow);
+    step_both_sides(top, share, q, cut_inflow);
 
     // The dye's two messages: what crosses each cut from either side.
     const std::vector<double> top_injected;
