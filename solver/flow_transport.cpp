@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <numbers>
 #include <utility>
 
@@ -393,21 +394,20 @@ void FlowTransport::take_volumes() {
     std::vector<double> added(now_.size());
     for (std::size_t c = 0; c < added.size(); ++c)
       added[c] = (now_[c] - red_cells_->volume()[c]) * red_cells_->tube_hematocrit(c);
-    cut_->adjusted = lead_sum(added, own_cell_places(), cut_->cells, cut_->adjusted);
+    cut_->adjusted = cell_sum(added, cut_->adjusted);
   }
   red_cells_->set_volumes(now_);
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     TracerTransport& t = tracers_[k];
     std::vector<double>& added = carried_before[k];
     for (std::size_t c = 0; c < cells; ++c) added[c] = (t.carried(*red_cells_, c) - added[c]) * t.concentration()[c];
-    if (cut_) {
-      t.set_adjusted(lead_sum(added, own_cell_places(), cut_->cells, t.adjusted()));  // rank 0's the whole's
-    } else {
-      double sum = t.adjusted();
-      for (const double a : added) sum += a;
-      t.set_adjusted(sum);
-    }
+    t.set_adjusted(cell_sum(added, t.adjusted()));  // over ranks rank 0's the whole's
   }
+}
+
+double FlowTransport::cell_sum(std::span<const double> per_cell, double start) const {
+  if (cut_) return lead_sum(per_cell, own_cell_places(), cut_->cells, start);
+  return std::accumulate(per_cell.begin(), per_cell.end(), start);
 }
 
 FlowTransport::Totals FlowTransport::totals() const {
@@ -416,7 +416,7 @@ FlowTransport::Totals FlowTransport::totals() const {
   std::vector<double> content(t.grid().cell_count());
   for (std::size_t c = 0; c < content.size(); ++c) content[c] = t.content(c);
   const std::vector<std::int32_t> held = boundary_places();
-  return {lead_sum(content, own_cell_places(), cut_->cells, 0.0),
+  return {cell_sum(content, 0.0),
           lead_sum(t.entered_by_boundary(), held, cut_->run_boundaries, 0.0),
           lead_sum(t.left_by_boundary(), held, cut_->run_boundaries, 0.0), cut_->adjusted};
 }

@@ -190,6 +190,9 @@ class FlowTransport {
   // rank's values at `place`, -1 none), in the one-process order; elsewhere `start`. Collective.
   double lead_sum(std::span<const double> values, std::span<const std::int32_t> place, std::size_t whole,
                   double start) const;
+  // The sum over the whole run's cells of per_cell (this rank's), from start, in the
+  // one-process order: alone in turn, over ranks on rank 0 (elsewhere start).
+  double cell_sum(std::span<const double> per_cell, double start) const;
   // The same items whole on rank 0 (elsewhere empty).
   std::vector<double> lead_whole(std::span<const double> values, std::span<const std::int32_t> place,
                                  std::size_t whole) const;

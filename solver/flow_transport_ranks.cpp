@@ -326,7 +326,7 @@ void FlowTransport::restore_tracer_share(std::size_t k, const TracerState& whole
 void FlowTransport::take_reports() {
   if (!cut_) return;
   reports_.clear();
-  const std::vector<std::int32_t> cells = own_cell_places(), held = boundary_places();
+  const std::vector<std::int32_t> held = boundary_places();
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const TracerTransport& t = tracers_[k];
     TracerReport r;
@@ -335,7 +335,7 @@ void FlowTransport::take_reports() {
     gather_vessel_values(net_, solver_, columns);
     std::vector<double> carried(red_cells_->grid().cell_count());
     for (std::size_t c = 0; c < carried.size(); ++c) carried[c] = t.carried(*red_cells_, c) * t.concentration()[c];
-    r.amount = lead_sum(carried, cells, cut_->cells, 0.0);
+    r.amount = cell_sum(carried, 0.0);
     r.entered = lead_sum(t.entered_by_boundary(), held, cut_->run_boundaries, 0.0);
     r.left = lead_sum(t.left_by_boundary(), held, cut_->run_boundaries, 0.0);
     r.injected = rank_sum(t.injected());
