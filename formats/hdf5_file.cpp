@@ -471,10 +471,64 @@ std::vector<std::int64_t> File::read_integers(const std::string& path, std::opti
   return values;
 }
 
-std::vector<std::uint8_t> File::read_enum(const std::string& path, const EnumNames& names,
-                                          std::optional<std::size_t> rows) const {
+void File::read_picked(const Handle& dataset, const std::string& path, hid_t memory_type, std::size_t element,
+                       std::span<const std::int32_t> pick, void* data) const {
+  // Blocks of whole chunks: each chunk read is decompressed once, and one that holds none of
+  // the rows not at all.
+  constexpr std::size_t block = 16 * chunk_rows;
+  std::vector<unsigned char> buffer;
+  Handle file_space(H5Dget_space(dataset.id()), H5Sclose);
+  auto* out = static_cast<unsigned char*>(data);
+  for (std::size_t k = 0; k < pick.size();) {
+    const std::size_t first = static_cast<std::size_t>(pick[k]) / block * block;
+    std::size_t end = k;
+    while (end < pick.size() && static_cast<std::size_t>(pick[end]) < first + block) ++end;
+    // The block's span of rows from its first picked row's chunk to its last's.
+    const std::size_t lo = static_cast<std::size_t>(pick[k]) / chunk_rows * chunk_rows;
+    const std::size_t hi = static_cast<std::size_t>(pick[end - 1]) + 1;
+    const hsize_t start = lo, count = hi - lo;
+    buffer.resize(count * element);
+    Handle memory_space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+    if (H5Sselect_hyperslab(file_space.id(), H5S_SELECT_SET, &start, nullptr, &count, nullptr) < 0 ||
+        H5Dread(dataset.id(), memory_type, memory_space.id(), file_space.id(), H5P_DEFAULT, buffer.data()) < 0)
+      throw InputError(with_reason(name_ + ": " + path + ": cannot be read (damaged or of values out of range)"));
+    for (; k < end; ++k) std::memcpy(out + k * element, buffer.data() + (static_cast<std::size_t>(pick[k]) - lo) * element, element);
+  }
+}
+
+std::vector<double> File::read_reals(const std::string& path, std::size_t rows,
+                                     std::span<const std::int32_t> pick) const {
   Handle dataset = open_dataset(path);
-  const std::size_t n = checked_rows(dataset, path, H5T_ENUM, "an enumeration", rows);
+  checked_rows(dataset, path, H5T_FLOAT, "floating-point numbers", rows);
+  std::vector<double> values(pick.size());
+  read_picked(dataset, path, H5T_NATIVE_DOUBLE, sizeof(double), pick, values.data());
+  return values;
+}
+
+std::vector<std::int64_t> File::read_integers(const std::string& path, std::size_t rows,
+                                              std::span<const std::int32_t> pick) const {
+  Handle dataset = open_dataset(path);
+  checked_rows(dataset, path, H5T_INTEGER, "integers", rows);
+  std::vector<std::int64_t> values(pick.size());
+  read_picked(dataset, path, H5T_NATIVE_INT64, sizeof(std::int64_t), pick, values.data());
+  return values;
+}
+
+std::vector<std::uint8_t> File::read_enum(const std::string& path, const EnumNames& names, std::size_t rows,
+                                          std::span<const std::int32_t> pick) const {
+  Handle dataset = open_dataset(path);
+  checked_rows(dataset, path, H5T_ENUM, "an enumeration", rows);
+  check_enum_names(dataset, path, names);
+  std::vector<std::uint8_t> values(pick.size());
+  Handle memory_type = enum_type(names);
+  read_picked(dataset, path, memory_type.id(), 1, pick, values.data());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (values[i] >= names.names.size())
+      fail(path, "row " + std::to_string(pick[i]) + ": a value that names none of the enumeration's");
+  return values;
+}
+
+void File::check_enum_names(const Handle& dataset, const std::string& path, const EnumNames& names) const {
   // The file's names, each one of ours (its values may differ: the library converts by name).
   Handle file_type(H5Dget_type(dataset.id()), H5Tclose);
   const int members = H5Tget_nmembers(file_type.id());
@@ -488,6 +542,13 @@ std::vector<std::uint8_t> File::read_enum(const std::string& path, const EnumNam
       fail(path, "unknown value \"" + found + "\" (expected one of " + known + ")");
     }
   }
+}
+
+std::vector<std::uint8_t> File::read_enum(const std::string& path, const EnumNames& names,
+                                          std::optional<std::size_t> rows) const {
+  Handle dataset = open_dataset(path);
+  const std::size_t n = checked_rows(dataset, path, H5T_ENUM, "an enumeration", rows);
+  check_enum_names(dataset, path, names);
   std::vector<std::uint8_t> values(n);
   Handle memory_type = enum_type(names);
   read_column(dataset, path, memory_type.id(), values.data(), n);

@@ -115,6 +115,15 @@ class File {
   // value it maps to another name, is refused).
   std::vector<std::uint8_t> read_enum(const std::string& path, const EnumNames& names,
                                       std::optional<std::size_t> rows = {}) const;
+  // The same, of the rows `pick` alone (increasing) of a column of `rows` rows: a process
+  // that holds part of a network (a rank of a run over MPI) reads only the chunks that hold
+  // its rows, a block of chunks at a time, so that neither the time nor the room is the
+  // whole column's.
+  std::vector<double> read_reals(const std::string& path, std::size_t rows, std::span<const std::int32_t> pick) const;
+  std::vector<std::int64_t> read_integers(const std::string& path, std::size_t rows,
+                                          std::span<const std::int32_t> pick) const;
+  std::vector<std::uint8_t> read_enum(const std::string& path, const EnumNames& names, std::size_t rows,
+                                      std::span<const std::int32_t> pick) const;
 
   // Text (UTF-8, JSON for the small members) as a scalar dataset, and attributes of the root.
   void write_text(const std::string& path, std::string_view text);
@@ -144,6 +153,9 @@ class File {
                     std::size_t rows);
   void read_column(const Handle& dataset, const std::string& path, hid_t memory_type, void* data,
                    std::size_t rows) const;
+  void read_picked(const Handle& dataset, const std::string& path, hid_t memory_type, std::size_t element,
+                   std::span<const std::int32_t> pick, void* data) const;
+  void check_enum_names(const Handle& dataset, const std::string& path, const EnumNames& names) const;
   std::size_t checked_rows(const Handle& dataset, const std::string& path, int type_class,
                            const char* kind, std::optional<std::size_t> rows) const;
 

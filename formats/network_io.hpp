@@ -21,6 +21,7 @@ int format_version_needed(const Network& net);
 namespace hdf5 {
 class File;
 }
+struct NetworkSlice;
 
 // path "-" reads standard input; either form (an HDF5 file by its signature). Throws InputError naming the position or the vessel at
 // fault, IoError when the file cannot be read.
@@ -40,5 +41,9 @@ void write_network(const Network& net, OutputStream& out);
 void write_network_hdf5(const Network& net, OutputStream& out);
 // Throws InputError naming the file, the dataset and the row at fault.
 Network read_network_hdf5(const hdf5::File& file);
+// Its topology and a slice of it (formats/network_slice.hpp, which reads them from a path).
+Network read_network_topology_hdf5(const hdf5::File& file);
+NetworkSlice read_network_slice_hdf5(const hdf5::File& file, const Network& topology,
+                                     std::span<const std::int32_t> vessels);
 
 }  // namespace hemotree
