@@ -9,22 +9,38 @@
 
 namespace hemotree {
 
-SteadyShare::SteadyShare(const Network& net, const TreeCut& cut, const SteadyRows& rows, double inlet_flow)
-    : net_(net), cut_(cut), inlet_node_(rows.inlet_node), system_(MPI_COMM_WORLD, cut) {
+SteadyShare::SteadyShare(const Network& net, const TreeCut& cut, const std::function<Row(std::int32_t node)>& row)
+    : net_(net), cut_(cut), system_(MPI_COMM_WORLD, cut) {
   for (const std::int32_t node : system_.nodes()) {
-    const auto i = static_cast<std::size_t>(node);
-    shunt_.push_back(rows.shunt[i]);
-    inflow_.push_back(rows.inflow[i]);
-    if (static_cast<std::int64_t>(node) == rows.inlet_node) inflow_.back() += inlet_flow;
-    if (const std::int32_t v = cut.parent_edge[i]; v >= 0) vessels_.push_back(v);  // the forest's roots have none
+    const Row r = row(node);
+    shunt_.push_back(r.shunt);
+    inflow_.push_back(r.inflow);
+    if (const std::int32_t v = cut.parent_edge[static_cast<std::size_t>(node)]; v >= 0) vessels_.push_back(v);  // the forest's roots have none
   }
   conductance_.assign(shunt_.size(), 0.0);
   sorted_nodes_.assign(system_.nodes().begin(), system_.nodes().end());
   std::sort(sorted_nodes_.begin(), sorted_nodes_.end());
 }
 
+SteadyShare::SteadyShare(const Network& net, const TreeCut& cut, const SteadyRows& rows, double inlet_flow)
+    : SteadyShare(net, cut, [&](std::int32_t node) {
+        const auto i = static_cast<std::size_t>(node);
+        Row r{rows.shunt[i], rows.inflow[i]};
+        if (static_cast<std::int64_t>(node) == rows.inlet_node) r.inflow += inlet_flow;
+        return r;
+      }) {
+  inlet_node_ = rows.inlet_node;
+}
+
 bool SteadyShare::holds(std::int32_t node) const {
   return std::binary_search(sorted_nodes_.begin(), sorted_nodes_.end(), node);
+}
+
+std::span<const double> SteadyShare::solve_nodes(std::span<const double> conductance) {
+  x_.assign(inflow_.begin(), inflow_.end());
+  if (const std::int64_t floating = system_.factorize_solve(conductance, shunt_, x_); floating >= 0)
+    refuse_floating_part_everywhere(net_, floating);
+  return x_;
 }
 
 void SteadyShare::solve(const std::vector<double>& resistance, SteadyFlow& s) {
@@ -34,9 +50,7 @@ void SteadyShare::solve(const std::vector<double>& resistance, SteadyFlow& s) {
     const std::int32_t v = cut_.parent_edge[static_cast<std::size_t>(nodes[k])];
     conductance_[k] = v >= 0 ? 1 / resistance[static_cast<std::size_t>(v)] : 0.0;
   }
-  x_.assign(inflow_.begin(), inflow_.end());
-  if (const std::int64_t floating = system_.factorize_solve(conductance_, shunt_, x_); floating >= 0)
-    refuse_floating_part_everywhere(net_, floating);
+  solve_nodes(conductance_);
   // Whole-network arrays, sized once: a solve writes this rank's entries alone, so that its
   // work is its share's.
   if (s.node_pressure.size() != net_.node_count()) s.node_pressure.assign(net_.node_count(), 0.0);

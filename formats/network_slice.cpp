@@ -27,6 +27,20 @@ NetworkSlice read_network_slice(const std::string& path, const Network& topology
   return read_network_slice_hdf5(hdf5::File::open(path), topology, vessels);
 }
 
+Network topology_of(const Network& whole) {
+  Network t;
+  t.node_id = whole.node_id;
+  t.id = whole.id;
+  t.from = whole.from;
+  t.to = whole.to;
+  t.blood = whole.blood;
+  t.inlet = whole.inlet;
+  t.boundaries = whole.boundaries;
+  t.provenance = whole.provenance;
+  t.extra = whole.extra;
+  return t;
+}
+
 NetworkSlice slice_of(const Network& whole, std::span<const std::int32_t> vessels) {
   NetworkSlice out;
   out.vessel_row.assign(vessels.begin(), vessels.end());

@@ -36,6 +36,9 @@ bool is_hdf5_network_file(const std::string& path);
 // reader on what it reads (unique ids, ends among the nodes, an inlet's vessel), in its words.
 Network read_network_topology(const std::string& path);
 
+// The same topology of a network held whole (what read_network_topology reads of its file).
+Network topology_of(const Network& whole);
+
 // The vessels at rows `vessels` (increasing) of topology's, read from the same file: every
 // value checked as the whole reader checks it, named by the row of the file.
 NetworkSlice read_network_slice(const std::string& path, const Network& topology, std::span<const std::int32_t> vessels);

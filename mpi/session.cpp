@@ -134,6 +134,13 @@ std::string words_of(int from, std::string words) {
   return from != 0 ? "rank " + std::to_string(from) + ": " + words : words;
 }
 
+bool lead_answer(bool answer) {
+  if (world_size() == 1) return answer;
+  int value = answer ? 1 : 0;
+  MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return value != 0;
+}
+
 void leave_collectives() { left = true; }
 bool left_collectives() { return left; }
 

@@ -56,6 +56,10 @@ void on_every_rank(const std::function<void()>& step);
 // Collective: every rank must know `from`.
 std::string words_of(int from, std::string words);
 
+// Rank 0's answer on every rank (where a rank's own view could differ: a file on its node).
+// Collective.
+bool lead_answer(bool answer);
+
 // Said by the rank that has left every collective call for good (rank 0 writing the results
 // after the last gather): its failures are then its own alone, said plainly, and end no other
 // rank (they have finished).

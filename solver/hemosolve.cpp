@@ -20,6 +20,7 @@
 #include "core/units.hpp"
 #include "core/errors.hpp"
 #include "formats/network_io.hpp"
+#include "formats/network_slice.hpp"
 #include "formats/pressure_reference.hpp"
 #include "solver/linear_run.hpp"
 #include "solver/outcome_lines.hpp"
@@ -298,6 +299,9 @@ int run_command_line(CommandLine& line, int cores) {
   // The options and the network, checked on every rank alike before any rank goes on to the
   // run (over MPI ranks a refusal is then every rank's: mpi/session.hpp).
   Network net;
+  // Whether the network is an HDF5 file, as rank 0 finds it: a slice is read from one
+  // (formats/network_slice.hpp), and every rank must take the same way.
+  const bool network_in_hdf5 = lead_answer(world_rank() == 0 && is_hdf5_network_file(line.config.network_name));
   on_every_rank([&] {
     // ---- every option, before any work ----------------------------------------------------
     if (out_dir.empty() && resume_dir.empty()) throw InputError("--out DIR is required (or --resume DIR)");
@@ -330,7 +334,13 @@ int run_command_line(CommandLine& line, int cores) {
     config.sample_interval =
         parse_quantity(line.sample_text, Dimension::time, "--sample-interval", {0, 1e6, true, false}, "s");
 
-    net = read_network(config.network_name);
+    // A steady run over ranks of an HDF5 file: each rank but the lead reads the topology here
+    // and its slice alone later (the lead reads the whole, to check it as the plain command
+    // does and write the results).
+    config.network_in_slices = line.steady && world_size() > 1 && line.pressure_at_texts.empty() && line.tracer_texts.empty() && !vtk &&
+                               frames == 0 && red_cells_named(line.red_cells) == RedCells::fixed && network_in_hdf5;
+    net = !config.network_in_slices || world_rank() == 0 ? read_network(config.network_name)
+                                                         : read_network_topology(config.network_name);
     fix_pressures(net, line.pressure_at_texts, quiet);
     if (!vtk_min_text.empty()) {
       if (!vtk && frames == 0) throw InputError("--vtk-min-diameter applies to --vtk and --frames only");

@@ -552,6 +552,7 @@ void run_steady(const Network& net, const RunConfiguration& config, RunObserver&
   request.phase_separation = config.red_cells == RedCells::transport;
   request.threads = config.solver.threads;
   request.results_format = config.results_format;
+  request.network_in_slices = config.network_in_slices;
   run_steady(net, request, observer);
 }
 

@@ -41,6 +41,10 @@ ResultsFormat results_format_named(const std::string& name);
 
 struct RunConfiguration {
   std::string network_name;  // as the caller named it (summary.json's "network")
+  // Over MPI ranks, each rank but the lead holds only its slice of the network, which it
+  // reads from network_name (an HDF5 file) itself (formats/network_slice.hpp): the network
+  // handed to the run is then whole on rank 0 and its topology on the others.
+  bool network_in_slices = false;
   std::string out_dir;       // the results folder, written as OUT.partial until the run ends
   SolverOptions solver;      // model, degrees, elements, scheme, step, wall, start, threads
   // Cycles: this many, or until every vessel's mean pressure changes by less than

@@ -70,13 +70,13 @@ std::uint64_t network_identity(const Network& net) {
 }
 
 std::string state_shaping(const RunConfiguration& config, const Network& net, double dt, Rheology rheology) {
-  const auto& [network_name, out_dir, solver, cycles, until_periodic, periodic_tolerance, max_cycles, settling_step,
+  const auto& [network_name, network_in_slices, out_dir, solver, cycles, until_periodic, periodic_tolerance, max_cycles, settling_step,
                settling_degree, balance_compliances, checkpoint_every, resume, sample_interval, probes, red_cells,
                tracers, transport_step, frames, vtk, vtk_keep, results_format, force, words] = config;
   // Not the state's: names and folders, how long the run goes on (a resume may extend it),
   // how often it is saved, what it writes besides, and what it may be forced through.
   // The settling cycle is taken before the run's first (a resume continues after it).
-  (void)network_name, (void)out_dir, (void)cycles, (void)until_periodic, (void)periodic_tolerance,
+  (void)network_name, (void)network_in_slices, (void)out_dir, (void)cycles, (void)until_periodic, (void)periodic_tolerance,
       (void)max_cycles, (void)settling_step, (void)settling_degree, (void)checkpoint_every, (void)resume, (void)frames, (void)vtk, (void)vtk_keep, (void)results_format, (void)force, (void)words;
   const auto& [model, lumped_transit, lumped_rc, lumped_sections, lumped_step, coupling_passes, lumped_passes, degree, degree_rule, elements,
                quadrature_points, scheme, asked_dt, cfl, friction_safety, external_pressure, thick_wall_ratio,

@@ -14,7 +14,9 @@
 #include "core/errors.hpp"
 #include "core/units.hpp"
 #include "distributed/steady_hematocrit_over_ranks.hpp"
+#include "distributed/steady_on_slices.hpp"
 #include "distributed/steady_over_ranks.hpp"
+#include "formats/network_io.hpp"
 #include "formats/run_boundaries.hpp"
 #include "physics/rheology.hpp"
 #include "solver/output_folder.hpp"
@@ -121,8 +123,12 @@ VesselTable steady_results(const Network& net, const CycleSummary& cycle) {
 }
 
 void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver& observer) {
-  Blood blood = net.blood.value_or(Blood{});
-  if (request.rheology_override >= 0) blood.rheology = static_cast<Rheology>(request.rheology_override);
+  auto blood_of = [&](const Network& n) {
+    Blood b = n.blood.value_or(Blood{});
+    if (request.rheology_override >= 0) b.rheology = static_cast<Rheology>(request.rheology_override);
+    return b;
+  };
+  const Blood blood = blood_of(net);
   // Over MPI ranks (distributed/steady_over_ranks.hpp) rank 0 alone takes the folder and
   // writes; its refusal is every rank's before any of them enters the solve.
   std::optional<OutputFolder> taken;
@@ -140,7 +146,18 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
     separated = std::move(over.result);
     steady = separated.flow;
   } else if (world_size() > 1) {
-    SteadyOverRanks over = solve_steady_flow_over_ranks(net, blood, net.inlet ? net.inlet->waveform.mean_value() : 0.0);
+    std::optional<SteadyOverRanks> sliced;
+    if (request.network_in_slices) sliced = solve_steady_flow_on_slices(net, request.input, blood_of);
+    // A network slices do not serve (steady_on_slices.hpp): whole on every rank.
+    Network whole;
+    if (request.network_in_slices && !sliced)
+      on_every_rank([&] {
+        if (world_rank() != 0) whole = read_network(request.input);
+      });
+    const Network& own = request.network_in_slices && world_rank() != 0 ? whole : net;
+    SteadyOverRanks over = sliced ? std::move(*sliced)
+                                  : solve_steady_flow_over_ranks(own, blood_of(own),
+                                                                 own.inlet ? own.inlet->waveform.mean_value() : 0.0);
     if (world_rank() != 0) return;
     leave_collectives();  // the others have finished: a failure of the writing is rank 0's alone
     observer.note(over.partition);

@@ -50,6 +50,9 @@ struct SteadyRunRequest {
   bool phase_separation = false;
   int threads = 1;  // the first resistances and the report in parallel (the same bytes for any count)
   ResultsFormat results_format = ResultsFormat::text;
+  // Over MPI ranks: the network is whole on rank 0 and its topology on the others, which read
+  // their slices of `input` (distributed/steady_on_slices.hpp).
+  bool network_in_slices = false;
 };
 
 // Solves and writes OUT/summary.json, OUT/vessels.csv or OUT/results.h5 (and OUT/results.vtp with vtk) through

@@ -246,6 +246,19 @@ SteadyRows steady_rows(const Network& net) {
   return rows;
 }
 
+SteadyRows boundary_rows(const Network& part) {
+  SteadyRows rows;
+  rows.shunt.assign(part.node_count(), 0.0);
+  rows.inflow.assign(part.node_count(), 0.0);
+  rows.pressure.assign(part.node_count(), 0.0);
+  rows.prescribed.assign(part.node_count(), 0);
+  if (part.boundaries.empty())
+    add_rows(part, RunBoundaries(part), rows);
+  else
+    add_rows(part, node_boundaries(part), rows);
+  return rows;
+}
+
 namespace {
 
 SteadySystem::SteadySystem(const Network& net) : net_(net), rows_(steady_rows(net)) {

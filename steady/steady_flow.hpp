@@ -45,6 +45,10 @@ struct SteadyRows {
   std::int64_t inlet_node = -1;
 };
 SteadyRows steady_rows(const Network& net);
+// The rows of a part of a network whose whole steady_rows checked (a rank's slice of it,
+// formats/network_slice.hpp): its own boundaries' rows alone (the inlet's node, where the part
+// holds the inlet, marked but given no flow), none of the whole network's checks.
+SteadyRows boundary_rows(const Network& part);
 // The refusal of a system found singular at `node` (a part whose pressure nothing fixes).
 [[noreturn]] void refuse_floating_part(const Network& net, std::int64_t node);
 

@@ -135,6 +135,14 @@ TEST(NetworkSlice, ASliceReadFromTheFileIsTheSliceOfTheWholeNetwork) {
   EXPECT_EQ(topology.to, whole.to);
   EXPECT_TRUE(topology.length.empty());
   EXPECT_TRUE(topology.inlet.has_value());
+  const Network taken = topology_of(whole);  // rank 0's, of the network it reads whole
+  EXPECT_EQ(taken.id, topology.id);
+  EXPECT_EQ(taken.node_id, topology.node_id);
+  EXPECT_EQ(taken.from, topology.from);
+  EXPECT_EQ(taken.to, topology.to);
+  EXPECT_EQ(taken.inlet->vessel, topology.inlet->vessel);
+  EXPECT_EQ(taken.provenance, topology.provenance);
+  EXPECT_TRUE(taken.length.empty() && taken.outlets.empty());
 
   const auto n = static_cast<std::int32_t>(whole.vessel_count());
   std::vector<std::int32_t> all(static_cast<std::size_t>(n));

@@ -43,6 +43,29 @@ for group in ("vessels", "boundaries"):
         assert x.dtype == y.dtype and x.shape == y.shape, name
         assert np.array_equal(x.view(np.uint8), y.view(np.uint8)), name  # bit for bit, NaNs too
 PY
+# Each rank its slice (distributed/steady_on_slices): from an HDF5 network every rank but the
+# lead reads the topology and its own vessels' rows alone; the plain run's bytes over 2 and 3
+# ranks. A value out of range in one rank's rows: refused in the plain run's words, said once,
+# nothing written.
+"$BUILD/exchange/vexport" h5 "$WORK/tree.json" -o "$WORK/tree.h5" 2>/dev/null || fail "vexport h5"
+"$HEMOSOLVE" "$WORK/tree.h5" --steady --out "$WORK/one-from-h5" 2>/dev/null || fail "hemosolve tree.h5 --steady"
+for ranks in 2 3; do
+  $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/tree.h5" --steady --out "$WORK/sliced$ranks" >"$WORK/sliced-out" 2>&1
+  status=$?
+  [ $status -eq 0 ] && grep -q "each rank its slice of the network" "$WORK/sliced-out" \
+    && same_files "$WORK/one-from-h5" "$WORK/sliced$ranks" \
+    && pass "mpirun -np $ranks hemosolve NET.h5 --steady, each rank its slice: the plain run's bytes" \
+    || fail "slices over $ranks ranks: status $status: $(head -3 "$WORK/sliced-out")"
+done
+cp "$WORK/tree.h5" "$WORK/bad.h5"
+/usr/bin/python3 -c "import h5py, sys; f = h5py.File(sys.argv[1], 'r+'); f['vessels/length'][-3] = 20.0" "$WORK/bad.h5"
+plain_words=$("$HEMOSOLVE" "$WORK/bad.h5" --steady --out "$WORK/bad-one" 2>&1)
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/bad.h5" --steady --out "$WORK/bad-3" >"$WORK/bad-out" 2>&1
+status=$?
+[ $status -eq 2 ] && [ "$(grep -c '^hemosolve: error: ' "$WORK/bad-out")" -eq 1 ] \
+  && grep -qxF -- "$plain_words" "$WORK/bad-out" && [ ! -e "$WORK/bad-3" ] \
+  && pass "a value out of range in a slice's rows: the plain run's one line, status 2, nothing written" \
+  || fail "a bad slice over 3 ranks: status $status: $(head -3 "$WORK/bad-out") (plain: $plain_words)"
 # --linear, the linear periodic state, over 2 and 3 ranks: the plain run's files byte for byte
 # (but the wall time), text and HDF5, probes included.
 "$HEMOSOLVE" "$WORK/tree.json" --linear --probe 1 --probe 40:0.3 --out "$WORK/linear-one" 2>/dev/null || fail "hemosolve --linear"
