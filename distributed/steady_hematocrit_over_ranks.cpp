@@ -19,8 +19,9 @@ SteadyHematocritOverRanks solve_steady_with_phase_separation_over_ranks(const Ne
   std::vector<double> previous_flow;                             // rank 0's
   SteadyHematocritOverRanks out;
   SteadyHematocritResult& result = out.result;
+  SteadyFlowOverRanks flow(net, blood, inlet_flow);  // set up once, solved each pass
   for (int it = 1; it <= max_iterations; ++it) {
-    SteadyOverRanks solved = solve_steady_flow_over_ranks(net, blood, inlet_flow, h);
+    SteadyOverRanks solved = flow.solve(h);
     out.partition = std::move(solved.partition);
     // Rank 0 holds the whole flow: the pass as the one-process iteration takes it, its refusal
     // (a hematocrit the law cannot give) every rank's.

@@ -11,8 +11,17 @@
 //     1e-12 relative.
 #pragma once
 
+#include <cstdint>
+#include <memory>
+#include <optional>
 #include <span>
 #include <string>
+#include <vector>
+
+#include "distributed/network_cut.hpp"
+#include "distributed/petsc_flow_network.hpp"
+#include "distributed/steady_share.hpp"
+#include "partition/partition.hpp"
 
 #include "formats/network.hpp"
 #include "physics/blood.hpp"
@@ -23,6 +32,34 @@ namespace hemotree {
 struct SteadyOverRanks {
   SteadyFlow flow;        // on rank 0; empty elsewhere
   std::string partition;  // the partition in one line (partition/partition.hpp's describe)
+};
+
+// The steady flow over the ranks set up once for several solves (the phase separation's
+// passes, each with its own hematocrits): the rows, the partition, the cut and this rank's
+// share, or PETSc's system, built by the constructor (collective; its refusals as below), and
+// each solve as solve_steady_flow_over_ranks's.
+class SteadyFlowOverRanks {
+ public:
+  SteadyFlowOverRanks(const Network& net, const Blood& blood, double inlet_flow);
+  ~SteadyFlowOverRanks();
+  SteadyFlowOverRanks(const SteadyFlowOverRanks&) = delete;
+  SteadyFlowOverRanks& operator=(const SteadyFlowOverRanks&) = delete;
+  // hematocrit: as solve_steady_flow_over_ranks's. Collective.
+  SteadyOverRanks solve(std::span<const double> hematocrit = {});
+
+ private:
+  SteadyOverRanks solve_tree(std::span<const double> hematocrit);
+  SteadyOverRanks solve_by_petsc(std::span<const double> hematocrit);
+  const Network& net_;
+  Blood blood_;
+  SteadyRows rows_;
+  Partition partition_;
+  std::optional<TreeCut> cut_;
+  std::optional<SteadyShare> share_;                    // a tree's
+  std::vector<double> resistance_;                      // a tree's: per vessel, this rank's set
+  std::vector<std::vector<std::int32_t>> held_lists_;   // a tree's, on rank 0: every rank's nodes
+  std::unique_ptr<PetscFlowNetwork> petsc_;             // any other network's
+  std::vector<double> inflow_;                          // its: the rows' inflows and the inlet's
 };
 
 // InputError as solve_steady_flow's, or where the iterative solve does not converge;
