@@ -33,6 +33,16 @@ TreeCut tree_cut(const Network& net, const Partition& partition) {
   }
 }
 
+std::optional<TreeCut> steady_tree_cut(const Network& net, const Partition& partition) {
+  if (partition.method == Partition::Method::metis) return std::nullopt;
+  if (partition.top_spread || partition.top_rank < 0) return tree_cut(net, partition);  // refused, in words
+  try {
+    return tree_cut(net, partition);
+  } catch (const SettingError&) {
+    return std::nullopt;
+  }
+}
+
 void check_one_partition(const Partition& partition) {
   std::uint64_t hash = 14695981039346656037ull;  // FNV-1a over the ranks of the vessels
   for (const std::int32_t r : partition.rank_of_vessel) hash = (hash ^ static_cast<std::uint32_t>(r)) * 1099511628211ull;

@@ -9,6 +9,7 @@
 #include "partition/partition.hpp"
 
 #include <cstdint>
+#include <optional>
 
 namespace hemotree {
 
@@ -18,6 +19,12 @@ namespace hemotree {
 // (METIS's pieces need the distributed sparse solver) or a top spread over the ranks (more
 // ranks than about the square root of an eighth of the vessels).
 TreeCut tree_cut(const Network& net, const Partition& partition);
+// The cut a steady solve over ranks takes where it can (distributed/steady_over_ranks.hpp):
+// none where the partition is METIS's (a network with loops) or where the tree's node labels
+// hang it from another node than its inlet, so that the nodal system's elimination is not cut
+// into the partition's flow subtrees (vgen's and vprune's labels start at the inlet): PETSc
+// solves those. A top spread over the ranks is refused in tree_cut's words.
+std::optional<TreeCut> steady_tree_cut(const Network& net, const Partition& partition);
 // The same refusals alone, of a partition a solve over ranks takes by subtrees.
 void check_subtree_partition(const Partition& partition);
 

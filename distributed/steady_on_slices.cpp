@@ -35,17 +35,10 @@ std::optional<SteadyOverRanks> solve_steady_flow_on_slices(const Network& held, 
   });
   const Network& topology = rank == 0 ? lead_topology : held;
   on_every_rank([&] {
-    if (2 * topology.node_count() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-      throw SettingError("ranks", placeholder("ranks") + ": " + std::to_string(topology.node_count()) +
-                                      " nodes are more than the gathering of the results on one rank takes yet");
+    check_gathered_nodes(topology.node_count());
     if (!topology.boundaries.empty()) return;  // boundaries at nodes: PETSc's solve
     partition = partition_network(topology, std::vector<double>(topology.vessel_count(), 1.0), ranks);
-    if (partition.method != Partition::Method::subtrees || partition.top_spread || partition.top_rank < 0) return;
-    try {
-      cut.emplace(tree_cut(topology, partition));
-    } catch (const SettingError&) {
-      // A tree labelled from another node than its inlet: PETSc's solve (steady_over_ranks.hpp).
-    }
+    cut = steady_tree_cut(topology, partition);
   });
   check_one_partition(partition);
   if (!cut) return std::nullopt;

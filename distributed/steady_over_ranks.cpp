@@ -32,6 +32,13 @@ std::vector<std::int32_t> node_owners(const Network& net, const Partition& parti
 
 }  // namespace
 
+void check_gathered_nodes(std::size_t nodes) {
+  // Rank 0 gathers a pressure and a flow a node, counted in MPI's ints.
+  if (2 * nodes > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw SettingError("ranks", placeholder("ranks") + ": " + std::to_string(nodes) +
+                                    " nodes are more than the gathering of the results on one rank takes yet");
+}
+
 SteadyFlowOverRanks::SteadyFlowOverRanks(const Network& net, const Blood& blood, double inlet_flow)
     : net_(net), blood_(blood) {
   const int ranks = world_size();
@@ -40,26 +47,10 @@ SteadyFlowOverRanks::SteadyFlowOverRanks(const Network& net, const Blood& blood,
   on_every_rank([&] {
     rows_ = steady_rows(net);  // its checks on every rank alike
     partition_ = partition_network(net, std::vector<double>(net.vessel_count(), 1.0), ranks);
-    iterative = partition_.method == Partition::Method::metis ||
-                std::any_of(rows_.prescribed.begin(), rows_.prescribed.end(), [](unsigned char p) { return p != 0; });
-    // Rank 0 gathers a pressure and a flow a node, counted in MPI's ints.
-    if (2 * net.node_count() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-      throw SettingError("ranks", placeholder("ranks") + ": " + std::to_string(net.node_count()) +
-                                      " nodes are more than the gathering of the results on one rank takes yet");
-    if (iterative) return;
-    // A tree whose node labels hang it from another node than its inlet (the nodal system's
-    // elimination starts at its lowest label) is not cut into subtrees of that elimination by
-    // the partition's flow subtrees: PETSc solves it instead (vgen's and vprune's labels start
-    // at the inlet).
-    if (!partition_.top_spread && partition_.top_rank >= 0) {
-      try {
-        cut_.emplace(tree_cut(net, partition_));
-      } catch (const SettingError&) {
-        iterative = true;
-      }
-    } else {
-      cut_.emplace(tree_cut(net, partition_));  // refused, in words
-    }
+    check_gathered_nodes(net.node_count());
+    if (std::none_of(rows_.prescribed.begin(), rows_.prescribed.end(), [](unsigned char p) { return p != 0; }))
+      cut_ = steady_tree_cut(net, partition_);
+    iterative = !cut_;
   });
   check_one_partition(partition_);
   if (iterative) {

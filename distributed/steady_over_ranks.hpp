@@ -62,6 +62,9 @@ class SteadyFlowOverRanks {
   std::vector<double> inflow_;                          // its: the rows' inflows and the inlet's
 };
 
+// SettingError "ranks" where a network has more nodes than rank 0 can gather the results of.
+void check_gathered_nodes(std::size_t nodes);
+
 // InputError as solve_steady_flow's, or where the iterative solve does not converge;
 // SettingError "ranks" where a tree's partition spreads its top over the ranks. hematocrit:
 // per vessel its own discharge hematocrit, its resistance's (steady/steady_flow.hpp's
