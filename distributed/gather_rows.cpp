@@ -36,8 +36,7 @@ void gather_rows(std::span<const double> rows, std::size_t width, const std::vec
     }
 }
 
-void gather_rows(std::span<const std::int32_t> items, std::span<const double> rows, std::size_t width,
-                 std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place) {
+std::vector<std::vector<std::int32_t>> gather_lists(std::span<const std::int32_t> items) {
   const int ranks = world_size();
   const bool lead = world_rank() == 0;
   const int mine = static_cast<int>(items.size());
@@ -49,7 +48,29 @@ void gather_rows(std::span<const std::int32_t> items, std::span<const double> ro
   std::vector<std::vector<std::int32_t>> lists(sizes.size());
   for (std::size_t r = 0; r < sizes.size(); ++r)
     lists[r].assign(every.begin() + offsets[r], every.begin() + offsets[r] + sizes[r]);
-  gather_rows(rows, width, lists, count, place);
+  return lists;
+}
+
+void gather_rows(std::span<const std::int32_t> items, std::span<const double> rows, std::size_t width,
+                 std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place) {
+  gather_rows(rows, width, gather_lists(items), count, place);
+}
+
+std::vector<double> scatter_values(std::span<const double> whole, const std::vector<std::vector<std::int32_t>>& lists,
+                                   std::size_t mine) {
+  const bool lead = world_rank() == 0;
+  std::vector<int> counts, offsets;
+  std::vector<double> packed;
+  if (lead)
+    for (const auto& list : lists) {
+      offsets.push_back(static_cast<int>(packed.size()));
+      counts.push_back(static_cast<int>(list.size()));
+      for (const std::int32_t item : list) packed.push_back(whole[static_cast<std::size_t>(item)]);
+    }
+  std::vector<double> out(mine);
+  MPI_Scatterv(packed.data(), counts.data(), offsets.data(), MPI_DOUBLE, out.data(), static_cast<int>(mine), MPI_DOUBLE, 0,
+               MPI_COMM_WORLD);
+  return out;
 }
 
 }  // namespace hemotree

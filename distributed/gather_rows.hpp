@@ -24,4 +24,14 @@ void gather_rows(std::span<const double> rows, std::size_t width, const std::vec
 void gather_rows(std::span<const std::int32_t> items, std::span<const double> rows, std::size_t width,
                  std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place);
 
+// Every rank's list of items on rank 0, rank after rank (empty elsewhere): what rank 0 needs to
+// place their rows or send them values. Collective.
+std::vector<std::vector<std::int32_t>> gather_lists(std::span<const std::int32_t> items);
+
+// The other way: rank 0's value of each item (whole: per item of the whole, on rank 0) sent to
+// every rank for the items of its list (lists: every rank's, on rank 0), in its list's order;
+// mine: this rank's list's length. Collective over MPI_COMM_WORLD.
+std::vector<double> scatter_values(std::span<const double> whole, const std::vector<std::vector<std::int32_t>>& lists,
+                                   std::size_t mine);
+
 }  // namespace hemotree

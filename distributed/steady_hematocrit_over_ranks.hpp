@@ -3,9 +3,11 @@
 // MPI session: each pass's flow solve over the ranks (distributed/steady_over_ranks.hpp, the
 // one-process solve's bits on a tree), the hematocrits distributed in flow order on rank 0,
 // which holds the whole flow, and the relaxed hematocrits sent to every rank for the next
-// pass's resistances. Every rank reads the whole network (for now). Collective.
+// pass's resistances. Collective.
 #pragma once
 
+#include <functional>
+#include <optional>
 #include <string>
 
 #include "physics/blood.hpp"
@@ -23,5 +25,13 @@ struct SteadyHematocritOverRanks {
 SteadyHematocritOverRanks solve_steady_with_phase_separation_over_ranks(const Network& net, const Blood& blood,
                                                                         int max_iterations, double tolerance,
                                                                         double relaxation);
+
+// The same with each rank but rank 0 holding only its slice of the network
+// (distributed/steady_on_slices.hpp): held and path as SteadyFlowOnSlices takes them; each
+// pass's hematocrits sent to each rank for its slice's vessels alone. None, on every rank
+// alike, where the slices do not serve the network: the caller then solves it whole.
+std::optional<SteadyHematocritOverRanks> solve_steady_with_phase_separation_on_slices(
+    const Network& held, const std::string& path, const std::function<Blood(const Network&)>& blood_of,
+    int max_iterations, double tolerance, double relaxation);
 
 }  // namespace hemotree

@@ -338,7 +338,7 @@ int run_command_line(CommandLine& line, int cores) {
     // and its slice alone later (the lead reads the whole, to check it as the plain command
     // does and write the results).
     config.network_in_slices = line.steady && world_size() > 1 && line.pressure_at_texts.empty() && line.tracer_texts.empty() && !vtk &&
-                               frames == 0 && red_cells_named(line.red_cells) == RedCells::fixed && network_in_hdf5;
+                               frames == 0 && network_in_hdf5;
     net = !config.network_in_slices || world_rank() == 0 ? read_network(config.network_name)
                                                          : read_network_topology(config.network_name);
     fix_pressures(net, line.pressure_at_texts, quiet);

@@ -136,32 +136,44 @@ void run_steady(const Network& net, const SteadyRunRequest& request, RunObserver
   const auto started = std::chrono::steady_clock::now();
   SteadyFlow steady;
   SteadyHematocritResult separated;
-  if (world_size() > 1 && request.phase_separation) {
-    // Each pass's flows over the ranks, the hematocrits on rank 0 (as below, relaxed by half).
-    SteadyHematocritOverRanks over =
-        solve_steady_with_phase_separation_over_ranks(net, blood, red_cell_iterations, red_cell_tolerance, 0.5);
-    if (world_rank() != 0) return;
-    leave_collectives();
-    observer.note(over.partition);
-    separated = std::move(over.result);
-    steady = separated.flow;
-  } else if (world_size() > 1) {
-    std::optional<SteadyOverRanks> sliced;
-    if (request.network_in_slices) sliced = solve_steady_flow_on_slices(net, request.input, blood_of);
-    // A network slices do not serve (steady_on_slices.hpp): whole on every rank.
-    Network whole;
-    if (request.network_in_slices && !sliced)
+  // Over ranks of an HDF5 network each rank but the lead holds its slice alone where slices
+  // serve it (distributed/steady_on_slices.hpp); a network they do not serve is read whole on
+  // every rank.
+  Network whole;
+  auto whole_here = [&]() -> const Network& {
+    if (request.network_in_slices)
       on_every_rank([&] {
         if (world_rank() != 0) whole = read_network(request.input);
       });
-    const Network& own = request.network_in_slices && world_rank() != 0 ? whole : net;
-    SteadyOverRanks over = sliced ? std::move(*sliced)
-                                  : solve_steady_flow_over_ranks(own, blood_of(own),
-                                                                 own.inlet ? own.inlet->waveform.mean_value() : 0.0);
+    return request.network_in_slices && world_rank() != 0 ? whole : net;
+  };
+  if (world_size() > 1 && request.phase_separation) {
+    // Each pass's flows over the ranks, the hematocrits on rank 0 (as below, relaxed by half).
+    std::optional<SteadyHematocritOverRanks> over;
+    if (request.network_in_slices)
+      over = solve_steady_with_phase_separation_on_slices(net, request.input, blood_of, red_cell_iterations,
+                                                          red_cell_tolerance, 0.5);
+    if (!over) {
+      const Network& own = whole_here();
+      over = solve_steady_with_phase_separation_over_ranks(own, blood_of(own), red_cell_iterations, red_cell_tolerance, 0.5);
+    }
+    if (world_rank() != 0) return;
+    leave_collectives();
+    observer.note(over->partition);
+    separated = std::move(over->result);
+    steady = separated.flow;
+  } else if (world_size() > 1) {
+    std::optional<SteadyOverRanks> over;
+    if (request.network_in_slices)
+      if (SteadyFlowOnSlices slices(net, request.input, blood_of); slices.serves()) over = slices.solve();
+    if (!over) {
+      const Network& own = whole_here();
+      over = solve_steady_flow_over_ranks(own, blood_of(own), own.inlet ? own.inlet->waveform.mean_value() : 0.0);
+    }
     if (world_rank() != 0) return;
     leave_collectives();  // the others have finished: a failure of the writing is rank 0's alone
-    observer.note(over.partition);
-    steady = std::move(over.flow);
+    observer.note(over->partition);
+    steady = std::move(over->flow);
   } else if (request.phase_separation) {
     // Under-relaxed by half: undamped, the rat mesentery's split oscillates (Gardner et al.
     // 2010 on such networks); 59 passes to 1e-10 there.

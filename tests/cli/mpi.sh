@@ -57,6 +57,16 @@ for ranks in 2 3; do
     && pass "mpirun -np $ranks hemosolve NET.h5 --steady, each rank its slice: the plain run's bytes" \
     || fail "slices over $ranks ranks: status $status: $(head -3 "$WORK/sliced-out")"
 done
+# The steady state with phase separation on slices: each pass's hematocrits sent to each rank
+# for its slice's vessels; the plain run's bytes.
+"$HEMOSOLVE" "$WORK/tree.h5" --steady --red-cells transport --out "$WORK/separated-from-h5" 2>/dev/null \
+  || fail "hemosolve tree.h5 --steady --red-cells transport"
+$MPIRUN -np 3 "$HEMOSOLVE" "$WORK/tree.h5" --steady --red-cells transport --out "$WORK/separated-sliced" >"$WORK/sliced-out" 2>&1
+status=$?
+[ $status -eq 0 ] && grep -q "each rank its slice of the network" "$WORK/sliced-out" \
+  && same_files "$WORK/separated-from-h5" "$WORK/separated-sliced" \
+  && pass "mpirun -np 3 NET.h5 --steady --red-cells transport, each rank its slice: the plain run's bytes" \
+  || fail "phase separation on slices over 3 ranks: status $status: $(head -3 "$WORK/sliced-out")"
 cp "$WORK/tree.h5" "$WORK/bad.h5"
 /usr/bin/python3 -c "import h5py, sys; f = h5py.File(sys.argv[1], 'r+'); f['vessels/length'][-3] = 20.0" "$WORK/bad.h5"
 plain_words=$("$HEMOSOLVE" "$WORK/bad.h5" --steady --out "$WORK/bad-one" 2>&1)
