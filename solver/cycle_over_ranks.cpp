@@ -1,5 +1,6 @@
 #include "solver/cycle_over_ranks.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <vector>
 
@@ -79,8 +80,12 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
 
 void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary) {
   constexpr std::size_t width = 10;  // VesselCycle's eight numbers, the two wave speeds
+  std::size_t own = 0;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) own += solver.steps_vessel(v) ? 1 : 0;
   std::vector<std::int32_t> mine;
   std::vector<double> rows;
+  mine.reserve(own);  // sized once: grown by doubling they held up to twice a share's rows
+  rows.reserve(width * own);
   for (std::size_t v = 0; v < net.vessel_count(); ++v) {
     if (!solver.steps_vessel(v)) continue;
     const VesselCycle& c = summary.vessels[v];
@@ -89,19 +94,18 @@ void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSu
     rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
                              c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
   }
+  // Rank 0's rows are copies: every vessel's entry is written in place from its rank's row (each
+  // vessel is stepped by one rank), and the 1D vessels' wave speeds kept as they come.
   std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
-  std::vector<VesselCycle> vessels(world_rank() == 0 ? net.vessel_count() : 0);
-  std::vector<WaveSpeeds> speeds(vessels.size());
-  gather_rows(mine, rows, width, net.vessel_count(), [&](std::int32_t v, const double* f) {
-    vessels[static_cast<std::size_t>(v)] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
-    speeds[static_cast<std::size_t>(v)] = {f[8], f[9]};
+  gather_rows(mine, rows, width, net.vessel_count(), [&](std::int32_t vessel, const double* f) {
+    const auto v = static_cast<std::size_t>(vessel);
+    summary.vessels[v] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
+    if (!solver.is_lumped(v)) waves.emplace_back(v, WaveSpeeds{f[8], f[9]});
   });
   if (world_rank() != 0) return;
-  summary.vessels = std::move(vessels);
   // Every 1D vessel's wave speeds (CycleSummary::waves), in the vessels' order.
-  summary.waves.clear();
-  for (std::size_t v = 0; v < speeds.size(); ++v)
-    if (!solver.is_lumped(v)) summary.waves.emplace_back(v, speeds[v]);
+  std::ranges::sort(waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
+  summary.waves = std::move(waves);
 }
 
 }  // namespace hemotree
