@@ -390,13 +390,13 @@ void FlowTransport::take_volumes() {
   std::vector<std::vector<double>> carried_before(tracers_.size(), std::vector<double>(cells));
   for (std::size_t k = 0; k < tracers_.size(); ++k)
     for (std::size_t c = 0; c < cells; ++c) carried_before[k][c] = tracers_[k].carried(*red_cells_, c);
-  if (cut_) {  // what it adds, cell by cell in the one-process order (RedCellTransport::set_volumes)
-    std::vector<double> added(now_.size());
-    for (std::size_t c = 0; c < added.size(); ++c)
-      added[c] = (now_[c] - red_cells_->volume()[c]) * red_cells_->tube_hematocrit(c);
-    cut_->adjusted = cell_sum(added, cut_->adjusted);
-  }
+  // Over ranks, what it adds cell by cell, summed in the one-process order
+  // (RedCellTransport::set_volumes' own sum is a share's).
+  const double adjusted_before = red_cells_->adjusted();
+  std::vector<double> added(cut_ ? now_.size() : 0);
+  for (std::size_t c = 0; c < added.size(); ++c) added[c] = (now_[c] - red_cells_->volume()[c]) * red_cells_->tube_hematocrit(c);
   red_cells_->set_volumes(now_);
+  if (cut_) red_cells_->set_adjusted(cell_sum(added, adjusted_before));  // rank 0's the whole's
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     TracerTransport& t = tracers_[k];
     std::vector<double>& added = carried_before[k];
@@ -418,7 +418,7 @@ FlowTransport::Totals FlowTransport::totals() const {
   const std::vector<std::int32_t> held = boundary_places();
   return {cell_sum(content, 0.0),
           lead_sum(t.entered_by_boundary(), held, cut_->run_boundaries, 0.0),
-          lead_sum(t.left_by_boundary(), held, cut_->run_boundaries, 0.0), cut_->adjusted};
+          lead_sum(t.left_by_boundary(), held, cut_->run_boundaries, 0.0), t.adjusted()};
 }
 
 void FlowTransport::face_volumes() {

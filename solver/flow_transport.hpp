@@ -172,7 +172,6 @@ class FlowTransport {
     std::vector<std::int32_t> cell_place, face_place;  // in the whole run's grid
     std::vector<signed char> face_sign;  // per face: +1, or -1 where a cut turned it round
     std::size_t cells = 0, faces = 0;    // the whole run's
-    double adjusted = 0;                 // the whole run's (rank 0)
   };
   // The cut's faces were made with the grid; the rest of the Cut from them.
   void place_cut(const TransportRanks& ranks);

@@ -271,7 +271,7 @@ void FlowTransport::save_over_ranks(CheckpointWriter* out) const {
                            lead_whole(t.volume(), cells, cut_->cells),
                            lead_whole(t.entered_by_boundary(), held, boundaries),
                            lead_whole(t.left_by_boundary(), held, boundaries),
-                           cut_->adjusted,
+                           t.adjusted(),
                            lead_whole(t.last_outflow(), held, boundaries),
                            lead_whole(applied_hematocrit_, own_vessel_places(applied_hematocrit_.empty() ? 0 : 1),
                                       applied_hematocrit_.size()),
@@ -355,8 +355,7 @@ void FlowTransport::restore_share(const RedCellState& whole) {
   for (std::size_t j = 0; j < cut_->across.size(); ++j) cut_->far[j] = discharge[static_cast<std::size_t>(cut_->across[j])];
   const BoundaryShare held = boundary_share(boundary_places(), whole.entered, whole.left, whole.last_outflow,
                                            solver_.blood().hematocrit);
-  t.restore(discharge, volume, held.entered, held.left, 0.0, held.last_outflow);
-  cut_->adjusted = whole.adjusted;
+  t.restore(discharge, volume, held.entered, held.left, whole.adjusted, held.last_outflow);
   for (std::size_t f = 0; f < face_volume_.size(); ++f)
     face_volume_[f] = cut_->face_sign[f] * whole.faces[static_cast<std::size_t>(cut_->face_place[f])];
 }

@@ -103,6 +103,8 @@ class RedCellTransport {
   const std::vector<double>& entered_by_boundary() const { return entered_; }
   const std::vector<double>& left_by_boundary() const { return left_; }
   double adjusted() const { return adjusted_; }
+  // The total a run over ranks sums in the one-process order (solver/flow_transport.hpp).
+  void set_adjusted(double total) { adjusted_ = total; }
   // The last step's red cells per face (signed as the blood's) [m^3], and the carriers.
   const CarrierStep& cells_step() const { return cells_; }
   const CarrierStep& plasma_step() const { return plasma_; }
