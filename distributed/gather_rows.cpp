@@ -56,6 +56,18 @@ void gather_rows(std::span<const std::int32_t> items, std::span<const double> ro
   gather_rows(rows, width, gather_lists(items), count, place);
 }
 
+void gather_places(std::span<const double> values, std::span<const std::int32_t> place, std::size_t count,
+                   std::span<double> into) {
+  std::vector<std::int32_t> items;
+  std::vector<double> rows;
+  for (std::size_t i = 0; i < place.size(); ++i)
+    if (place[i] >= 0) {
+      items.push_back(place[i]);
+      rows.push_back(values[i]);
+    }
+  gather_rows(items, rows, 1, count, [&](std::int32_t item, const double* row) { into[static_cast<std::size_t>(item)] = row[0]; });
+}
+
 std::vector<double> scatter_values(std::span<const double> whole, const std::vector<std::vector<std::int32_t>>& lists,
                                    std::size_t mine) {
   const bool lead = world_rank() == 0;

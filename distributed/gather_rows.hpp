@@ -24,6 +24,13 @@ void gather_rows(std::span<const double> rows, std::size_t width, const std::vec
 void gather_rows(std::span<const std::int32_t> items, std::span<const double> rows, std::size_t width,
                  std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place);
 
+// One number an item: each rank's values at their places (place[i] >= 0: value i's item in the
+// whole, of count items) written into rank 0's `into` (count long there; it may be `values`
+// itself: they are read first), rank after rank; an item no rank places is left as it is.
+// Collective; count alike on every rank.
+void gather_places(std::span<const double> values, std::span<const std::int32_t> place, std::size_t count,
+                   std::span<double> into);
+
 // Every rank's list of items on rank 0, rank after rank (empty elsewhere): what rank 0 needs to
 // place their rows or send them values. Collective.
 std::vector<std::vector<std::int32_t>> gather_lists(std::span<const std::int32_t> items);

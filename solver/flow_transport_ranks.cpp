@@ -138,15 +138,8 @@ std::vector<std::int32_t> FlowTransport::boundary_places() const {
 
 std::vector<double> FlowTransport::lead_whole(std::span<const double> values, std::span<const std::int32_t> place,
                                               std::size_t whole) const {
-  std::vector<std::int32_t> items;
-  std::vector<double> rows;
-  for (std::size_t i = 0; i < place.size(); ++i)
-    if (place[i] >= 0) {
-      items.push_back(place[i]);
-      rows.push_back(values[i]);
-    }
   std::vector<double> all(world_rank() == 0 ? whole : 0);
-  gather_rows(items, rows, 1, whole, [&](std::int32_t item, const double* row) { all[static_cast<std::size_t>(item)] = row[0]; });
+  gather_places(values, place, whole, all);
   return all;
 }
 

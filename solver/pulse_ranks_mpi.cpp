@@ -61,14 +61,9 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
   };
   ranks_.lead_whole = [](std::vector<double>& values, const std::vector<unsigned char>& mine) {
     // Every rank's own items to rank 0, the top's (lead_with_the_top above).
-    std::vector<std::int32_t> items;
-    std::vector<double> rows;
-    for (std::size_t k = 0; k < values.size(); ++k)
-      if (mine[k]) {
-        items.push_back(static_cast<std::int32_t>(k));
-        rows.push_back(values[k]);
-      }
-    gather_rows(items, rows, 1, values.size(), [&](std::int32_t item, const double* row) { values[static_cast<std::size_t>(item)] = row[0]; });
+    std::vector<std::int32_t> place(values.size());
+    for (std::size_t k = 0; k < values.size(); ++k) place[k] = mine[k] ? static_cast<std::int32_t>(k) : -1;
+    gather_places(values, place, values.size(), values);
   };
   ranks_.make_whole = [](std::vector<double>& values, const std::vector<unsigned char>& mine) {
     // Every rank's (item, value) pairs to every rank.
