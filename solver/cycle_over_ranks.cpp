@@ -80,28 +80,33 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
 
 void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary) {
   constexpr std::size_t width = 10;  // VesselCycle's eight numbers, the two wave speeds
-  std::size_t own = 0;
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) own += solver.steps_vessel(v) ? 1 : 0;
+  // A block of the vessels at a time: rank 0 receives every rank's rows of a block at once
+  // (80 MB at most), not of the whole network (300 MB on the full tree), and a rank sends at
+  // most a block's. The same places, in the same order of ranks within a block: the same bits.
+  constexpr std::size_t block = std::size_t{1} << 20;
+  const std::size_t n = net.vessel_count();
   std::vector<std::int32_t> mine;
   std::vector<double> rows;
-  mine.reserve(own);  // sized once: grown by doubling they held up to twice a share's rows
-  rows.reserve(width * own);
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) {
-    if (!solver.steps_vessel(v)) continue;
-    const VesselCycle& c = summary.vessels[v];
-    const WaveSpeeds w = summary.wave_speeds(v);
-    mine.push_back(static_cast<std::int32_t>(v));
-    rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
-                             c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
-  }
   // Rank 0's rows are copies: every vessel's entry is written in place from its rank's row (each
   // vessel is stepped by one rank), and the 1D vessels' wave speeds kept as they come.
   std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
-  gather_rows(mine, rows, width, net.vessel_count(), [&](std::int32_t vessel, const double* f) {
-    const auto v = static_cast<std::size_t>(vessel);
-    summary.vessels[v] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
-    if (!solver.is_lumped(v)) waves.emplace_back(v, WaveSpeeds{f[8], f[9]});
-  });
+  for (std::size_t first = 0; first < n; first += block) {
+    mine.clear();
+    rows.clear();
+    for (std::size_t v = first; v < std::min(n, first + block); ++v) {
+      if (!solver.steps_vessel(v)) continue;
+      const VesselCycle& c = summary.vessels[v];
+      const WaveSpeeds w = summary.wave_speeds(v);
+      mine.push_back(static_cast<std::int32_t>(v));
+      rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
+                               c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
+    }
+    gather_rows(mine, rows, width, n, [&](std::int32_t vessel, const double* f) {
+      const auto v = static_cast<std::size_t>(vessel);
+      summary.vessels[v] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
+      if (!solver.is_lumped(v)) waves.emplace_back(v, WaveSpeeds{f[8], f[9]});
+    });
+  }
   if (world_rank() != 0) return;
   // Every 1D vessel's wave speeds (CycleSummary::waves), in the vessels' order.
   std::ranges::sort(waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
