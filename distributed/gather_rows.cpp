@@ -1,5 +1,6 @@
 #include "distributed/gather_rows.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <string>
 
@@ -16,24 +17,36 @@ void gather_rows(std::span<const double> rows, std::size_t width, const std::vec
     throw Collective<SettingError>("ranks", placeholder("ranks") + ": " + std::to_string(count) + " rows of " +
                                                 std::to_string(width) +
                                                 " numbers are more than the gathering of the results on one rank takes yet");
+  // In rounds of at most about 2^23 numbers (64 MB) on rank 0: each rank sends the same part of
+  // its list in each round (the r-th of `rounds` equal parts), so that rank 0 never holds every
+  // rank's rows at once. Every item is placed once, from its own row: the same results in any
+  // number of rounds.
+  constexpr std::size_t round_numbers = std::size_t{1} << 23;
+  const std::size_t rounds = std::max<std::size_t>(1, (count * width + round_numbers - 1) / round_numbers);
+  auto part = [rounds](std::size_t length, std::size_t r) { return length * r / rounds; };
   const bool lead = world_rank() == 0;
-  std::vector<int> counts, offsets;
-  if (lead) {
-    for (const auto& list : lists) {
-      offsets.push_back(counts.empty() ? 0 : offsets.back() + counts.back());
-      counts.push_back(static_cast<int>(list.size() * width));
+  const std::size_t mine = width > 0 ? rows.size() / width : 0;
+  std::vector<double> all;
+  for (std::size_t r = 0; r < rounds; ++r) {
+    std::vector<int> counts, offsets;
+    if (lead) {
+      for (const auto& list : lists) {
+        offsets.push_back(counts.empty() ? 0 : offsets.back() + counts.back());
+        counts.push_back(static_cast<int>((part(list.size(), r + 1) - part(list.size(), r)) * width));
+      }
     }
+    all.resize(lead && !counts.empty() ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
+    const std::size_t first = part(mine, r), last = part(mine, r + 1);
+    MPI_Gatherv(rows.data() + first * width, static_cast<int>((last - first) * width), MPI_DOUBLE, all.data(),
+                counts.data(), offsets.data(), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    if (!lead) continue;
+    std::size_t from = 0;
+    for (const auto& list : lists)
+      for (std::size_t i = part(list.size(), r); i < part(list.size(), r + 1); ++i) {
+        place(list[i], all.data() + from);
+        from += width;
+      }
   }
-  std::vector<double> all(lead && !counts.empty() ? static_cast<std::size_t>(offsets.back() + counts.back()) : 0);
-  MPI_Gatherv(rows.data(), static_cast<int>(rows.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
-              0, MPI_COMM_WORLD);
-  if (!lead) return;
-  std::size_t from = 0;
-  for (const auto& list : lists)
-    for (const std::int32_t item : list) {
-      place(item, all.data() + from);
-      from += width;
-    }
 }
 
 std::vector<std::vector<std::int32_t>> gather_lists(std::span<const std::int32_t> items) {

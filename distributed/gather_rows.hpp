@@ -14,7 +14,8 @@ namespace hemotree {
 // rows: this rank's, width per item of its list. lists: on rank 0, every rank's items (rank
 // after rank; ignored elsewhere). count: the items of the whole. Rank 0 hands each row to
 // place(item, row), rank after rank (row: `width` numbers, valid during the call), so that it
-// holds the gathered rows once, not twice. Collective over MPI_COMM_WORLD; SettingError
+// holds the gathered rows once, not twice, and in rounds of at most about 64 MB of every
+// rank's rows, never all of them at once. Collective over MPI_COMM_WORLD; SettingError
 // "ranks" on every rank alike where count x width exceeds MPI's int counts.
 void gather_rows(std::span<const double> rows, std::size_t width, const std::vector<std::vector<std::int32_t>>& lists,
                  std::size_t count, const std::function<void(std::int32_t item, const double* row)>& place);
