@@ -27,12 +27,12 @@ struct NetworkSlice {
   std::int32_t node_at(std::int32_t row) const;
 };
 
-// Whether path names an HDF5 file (by its first byte), which a slice may be read from.
+// Whether path names an HDF5 file (by its eight signature bytes), which a slice may be read from.
 bool is_hdf5_network_file(const std::string& path);
 
 // The topology of the network at path (HDF5): every node's and vessel's id, every vessel's
 // ends, the blood, inlet, boundaries at nodes and provenance; every other column empty (a
-// Network only what partition/ and the cut of distributed/ read). The checks of the whole
+// Network holding only what partition/ and distributed/'s cut read). The checks of the whole
 // reader on what it reads (unique ids, ends among the nodes, an inlet's vessel), in its words.
 Network read_network_topology(const std::string& path);
 
