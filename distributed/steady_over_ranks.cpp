@@ -85,7 +85,7 @@ SteadyOverRanks SteadyFlowOverRanks::solve_by_petsc(std::span<const double> hema
       conductance[v] = 1 / resistance[v];
     }
   });
-  SteadyOverRanks out{{}, describe(partition_)};
+  SteadyOverRanks out{{}, describe(partition_) + "; every rank holds the whole network"};
   std::vector<double> pressure = rows_.pressure;
   petsc_->solve(conductance, rows_.shunt, inflow_, pressure);
   out.partition += "; PETSc's " + petsc_->method() + " in " + std::to_string(petsc_->iterations()) + " iterations";
@@ -122,7 +122,8 @@ SteadyOverRanks SteadyFlowOverRanks::solve_tree(std::span<const double> hematocr
     mine[2 * k + 1] = v >= 0 ? held_here.flow[static_cast<std::size_t>(v)] : 0.0;
   }
   const MpiTreeSystem::Traffic& traffic = share_->traffic();
-  SteadyOverRanks out{{}, describe(partition_) + "; the tree's exchange on rank 0: " + std::to_string(traffic.calls) +
+  SteadyOverRanks out{{}, describe(partition_) + "; every rank holds the whole network; the tree's exchange on rank 0: " +
+                              std::to_string(traffic.calls) +
                               " collective calls, " + std::to_string(traffic.bytes) + " bytes, " +
                               format_quantity(traffic.seconds, "s")};
   // Gathered on rank 0, each rank's nodes as it holds them.
