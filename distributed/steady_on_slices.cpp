@@ -2,11 +2,8 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <vector>
 
-#include "core/units.hpp"
-#include "distributed/gather_rows.hpp"
 #include "distributed/network_cut.hpp"
 #include "distributed/steady_share.hpp"
 #include "mpi/session.hpp"
@@ -37,7 +34,6 @@ SteadyFlowOnSlices::SteadyFlowOnSlices(const Network& held, const std::string& p
     }
   });
   const Network& topology = rank == 0 ? lead_topology : held;
-  nodes_ = topology.node_count();
   vessel_count_ = topology.vessel_count();
   blood_ = blood_of(topology);
   on_every_rank([&] {
@@ -92,7 +88,6 @@ SteadyFlowOnSlices::SteadyFlowOnSlices(const Network& held, const std::string& p
 SteadyFlowOnSlices::~SteadyFlowOnSlices() = default;
 
 SteadyOverRanks SteadyFlowOnSlices::solve(std::span<const double> hematocrit) {
-  const int rank = world_rank();
   SteadyShare& share = *share_->system;
   const std::vector<std::int32_t>& parent_vessel = share_->parent_vessel;
   const std::span<const std::int32_t> nodes = share.nodes();
@@ -122,26 +117,8 @@ SteadyOverRanks SteadyFlowOnSlices::solve(std::span<const double> hematocrit) {
     mine[2 * k + 1] = (pressure[static_cast<std::size_t>(slice_.net.from[j])] - pressure[static_cast<std::size_t>(slice_.net.to[j])]) /
                       resistance[j];
   }
-  const MpiTreeSystem::Traffic& traffic = share.traffic();
-  SteadyOverRanks out{{}, describe(partition_) + "; each rank its slice of the network; the tree's exchange on rank 0: " +
-                              std::to_string(traffic.calls) + " collective calls, " + std::to_string(traffic.bytes) +
-                              " bytes, " + format_quantity(traffic.seconds, "s")};
-  SteadyFlow& s = out.flow;
-  if (rank == 0) {
-    s.node_pressure.assign(nodes_, 0.0);
-    s.flow.assign(vessel_count_, 0.0);
-  }
-  if (rank == 0 && share_->held_lists.empty()) share_->held_lists = cut_->held_nodes();
-  gather_rows(mine, 2, share_->held_lists, nodes_,
-              [&](std::int32_t node, const double* row) {
-                s.node_pressure[static_cast<std::size_t>(node)] = row[0];
-                if (const std::int32_t v = cut_->parent_edge[static_cast<std::size_t>(node)]; v >= 0)
-                  s.flow[static_cast<std::size_t>(v)] = row[1];
-              });
-  if (rank != 0) return out;
-  s.inlet_pressure = lead_inlet_node_ >= 0 ? s.node_pressure[static_cast<std::size_t>(lead_inlet_node_)]
-                                           : std::numeric_limits<double>::quiet_NaN();
-  return out;
+  return gather_tree_flow(*cut_, partition_, "each rank its slice of the network", share.traffic(), mine,
+                          vessel_count_, lead_inlet_node_, share_->held_lists);
 }
 
 }  // namespace hemotree

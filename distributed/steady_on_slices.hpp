@@ -59,7 +59,7 @@ class SteadyFlowOnSlices {
   std::optional<TreeCut> cut_;
   NetworkSlice slice_;
   std::unique_ptr<Share> share_;
-  std::size_t nodes_ = 0, vessel_count_ = 0;  // the whole network's
+  std::size_t vessel_count_ = 0;  // the whole network's
   std::int64_t lead_inlet_node_ = -1;         // rank 0's: the inlet's node, given or found by the checks
   Blood blood_;
 };

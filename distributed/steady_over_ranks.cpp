@@ -104,7 +104,6 @@ SteadyOverRanks SteadyFlowOverRanks::solve_by_petsc(std::span<const double> hema
 // A tree: this rank's vessels' resistances, one distributed solve, gathered on rank 0.
 SteadyOverRanks SteadyFlowOverRanks::solve_tree(std::span<const double> hematocrit) {
   const Network& net = net_;
-  const int rank = world_rank();
   on_every_rank([&] {
     if (resistance_.size() != net.vessel_count()) resistance_.assign(net.vessel_count(), 0.0);
     for (const std::int32_t v : share_->vessels())
@@ -121,26 +120,34 @@ SteadyOverRanks SteadyFlowOverRanks::solve_tree(std::span<const double> hematocr
     const std::int32_t v = cut_->parent_edge[node];
     mine[2 * k + 1] = v >= 0 ? held_here.flow[static_cast<std::size_t>(v)] : 0.0;
   }
-  const MpiTreeSystem::Traffic& traffic = share_->traffic();
-  SteadyOverRanks out{{}, describe(partition_) + "; every rank holds the whole network; the tree's exchange on rank 0: " +
-                              std::to_string(traffic.calls) +
-                              " collective calls, " + std::to_string(traffic.bytes) + " bytes, " +
-                              format_quantity(traffic.seconds, "s")};
+  return gather_tree_flow(*cut_, partition_, "every rank holds the whole network", share_->traffic(), mine,
+                          net.vessel_count(), rows_.inlet_node, held_lists_);
+}
+
+SteadyOverRanks gather_tree_flow(const TreeCut& cut, const Partition& partition, const char* holding,
+                                 const MpiTreeSystem::Traffic& traffic, std::span<const double> rows,
+                                 std::size_t vessels, std::int64_t inlet_node,
+                                 std::vector<std::vector<std::int32_t>>& held_lists) {
+  const int rank = world_rank();
+  const std::size_t nodes = cut.parent_edge.size();
+  SteadyOverRanks out{{}, describe(partition) + "; " + holding + "; the tree's exchange on rank 0: " +
+                              std::to_string(traffic.calls) + " collective calls, " + std::to_string(traffic.bytes) +
+                              " bytes, " + format_quantity(traffic.seconds, "s")};
   // Gathered on rank 0, each rank's nodes as it holds them.
   SteadyFlow& s = out.flow;
   if (rank == 0) {
-    s.node_pressure.assign(net.node_count(), 0.0);
-    s.flow.assign(net.vessel_count(), 0.0);
-    if (held_lists_.empty()) held_lists_ = cut_->held_nodes();
+    s.node_pressure.assign(nodes, 0.0);
+    s.flow.assign(vessels, 0.0);
+    if (held_lists.empty()) held_lists = cut.held_nodes();
   }
-  gather_rows(mine, 2, held_lists_, net.node_count(), [&](std::int32_t node, const double* row) {
+  gather_rows(rows, 2, held_lists, nodes, [&](std::int32_t node, const double* row) {
     s.node_pressure[static_cast<std::size_t>(node)] = row[0];
-    if (const std::int32_t v = cut_->parent_edge[static_cast<std::size_t>(node)]; v >= 0)
+    if (const std::int32_t v = cut.parent_edge[static_cast<std::size_t>(node)]; v >= 0)
       s.flow[static_cast<std::size_t>(v)] = row[1];
   });
   if (rank != 0) return out;
-  s.inlet_pressure = rows_.inlet_node >= 0 ? s.node_pressure[static_cast<std::size_t>(rows_.inlet_node)]
-                                           : std::numeric_limits<double>::quiet_NaN();
+  s.inlet_pressure = inlet_node >= 0 ? s.node_pressure[static_cast<std::size_t>(inlet_node)]
+                                     : std::numeric_limits<double>::quiet_NaN();
   return out;
 }
 

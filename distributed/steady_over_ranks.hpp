@@ -65,6 +65,17 @@ class SteadyFlowOverRanks {
 // SettingError "ranks" where a network has more nodes than rank 0 can gather the results of.
 void check_gathered_nodes(std::size_t nodes);
 
+// The end of a tree's solve over ranks, whichever way the ranks hold the network: rows, per
+// node this rank holds (the cut's held_nodes order), its pressure and the flow of its edge to
+// its parent (0 at a root), gathered into rank 0's whole SteadyFlow of `vessels` vessels, the
+// inlet's pressure at inlet_node (-1: NaN); held_lists, rank 0's every rank's nodes, made at
+// the first call. The partition's line says how the network is held and what the exchange
+// cost. Collective.
+SteadyOverRanks gather_tree_flow(const TreeCut& cut, const Partition& partition, const char* holding,
+                                 const MpiTreeSystem::Traffic& traffic, std::span<const double> rows,
+                                 std::size_t vessels, std::int64_t inlet_node,
+                                 std::vector<std::vector<std::int32_t>>& held_lists);
+
 // InputError as solve_steady_flow's, or where the iterative solve does not converge;
 // SettingError "ranks" where a tree's partition spreads its top over the ranks. hematocrit:
 // per vessel its own discharge hematocrit, its resistance's (steady/steady_flow.hpp's

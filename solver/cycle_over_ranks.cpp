@@ -80,9 +80,9 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
 
 void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary) {
   constexpr std::size_t width = 10;  // VesselCycle's eight numbers, the two wave speeds
-  // A block of the vessels at a time: rank 0 receives every rank's rows of a block at once
-  // (80 MB at most), not of the whole network (300 MB on the full tree), and a rank sends at
-  // most a block's. The same places, in the same order of ranks within a block: the same bits.
+  // A block of the vessels at a time, so that a rank's rows are a block's, not its whole share's
+  // (rank 0's receiving is bounded by gather_rows' rounds). Each vessel placed from its row:
+  // the same bits.
   constexpr std::size_t block = std::size_t{1} << 20;
   const std::size_t n = net.vessel_count();
   std::vector<std::int32_t> mine;

@@ -158,24 +158,22 @@ grep -q '"type":"RCR"' "$WORK/pruned.json" && same_files "$WORK/pruned-one" "$WO
 $MPIRUN -np 3 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --format h5 --out "$WORK/pulse-h5" >/dev/null 2>&1
 same_h5 "$WORK/pulse-one-h5/results.h5" "$WORK/pulse-h5/results.h5" \
   && pass "mpirun -np 3 hemosolve --format h5 (pulsatile): the plain run's values" || fail "pulsatile --format h5 over ranks"
-# The settling cycle (a 0D step four times the run's) over ranks: the plain run's files (but
-# the wall times, the run's and the settling cycle's seconds).
-"$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-step 4 --lumped-sections 1 --out "$WORK/settled-one" >"$WORK/settled-log" 2>&1 \
-  || fail "hemosolve --settling-step 4 (pulse)"
-grep -q "settling cycle done" "$WORK/settled-log" || fail "the plain run took no settling cycle"
-$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-step 4 --out "$WORK/settled-2" >/dev/null 2>&1
-same_files "$WORK/settled-one" "$WORK/settled-2" '"seconds"' \
-  && pass "mpirun -np 2 --settling-step 4: the plain run's files (the settling cycle over ranks)" \
-  || fail "--settling-step over 2 ranks: the files differ from the plain run's"
-# The settling cycle at a lower degree (a second solver, on the run's cut) over 2 ranks: the
-# plain run's files.
-"$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-degree 1 --lumped-sections 1 --out "$WORK/coarse-one" >"$WORK/coarse-log" 2>&1 \
-  || fail "hemosolve --settling-degree 1 (pulse)"
-grep -q "settling cycle: .* at degree 1 at most" "$WORK/coarse-log" || fail "the plain run took no settling cycle at degree 1"
-$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" $pulse --settling-degree 1 --out "$WORK/coarse-2" >/dev/null 2>&1
-same_files "$WORK/coarse-one" "$WORK/coarse-2" '"seconds"' \
-  && pass "mpirun -np 2 --settling-degree 1: the plain run's files (a settling solver at a lower degree over ranks)" \
-  || fail "--settling-degree 1 over 2 ranks: the files differ from the plain run's"
+# The settling cycle over 2 ranks, with a 0D step four times the run's and at a lower degree (a
+# second solver, on the run's cut): the plain run's files (but the wall times, the run's and
+# the settling cycle's seconds).
+for settling in "--settling-step 4|settling cycle done" "--settling-degree 1|settling cycle: .* at degree 1 at most"; do
+  option=${settling%%|*} said=${settling#*|} name=settled-${option#--settling-}
+  name=${name// /-}
+  # shellcheck disable=SC2086  # option: a flag and its value
+  "$HEMOSOLVE" "$WORK/pulse.json" $pulse $option --lumped-sections 1 --out "$WORK/$name-one" >"$WORK/$name-log" 2>&1 \
+    || fail "hemosolve $option (pulse)"
+  grep -q "$said" "$WORK/$name-log" || fail "the plain run with $option took no settling cycle"
+  # shellcheck disable=SC2086
+  $MPIRUN -np 2 "$HEMOSOLVE" "$WORK/pulse.json" $pulse $option --out "$WORK/$name-2" >/dev/null 2>&1
+  same_files "$WORK/$name-one" "$WORK/$name-2" '"seconds"' \
+    && pass "mpirun -np 2 $option: the plain run's files (the settling cycle over ranks)" \
+    || fail "$option over 2 ranks: the files differ from the plain run's"
+done
 # Frames over ranks: every vessel's centre gathered on rank 0 at each frame, the plain run's
 # files (ParaView's time series and results.vtp) byte for byte.
 "$HEMOSOLVE" "$WORK/pulse.json" --cycles 1 --frames 4 --vtk --lumped-sections 1 --out "$WORK/frames-one" 2>/dev/null \
