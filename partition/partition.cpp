@@ -133,7 +133,7 @@ std::string describe(const Partition& p) {
   s << p.imbalance() << " (the largest over the mean), " << p.cut_nodes << " cut nodes";
   if (p.method == Partition::Method::subtrees && p.top_spread)
     s << ", the top's " << p.top.size() << " vessels each with its first daughter";
-  else if (p.method == Partition::Method::subtrees)
+  else if (p.method == Partition::Method::subtrees && !p.top.empty())
     s << ", the top's " << p.top.size() << " vessels on rank " << p.top_rank;
   return s.str();
 }

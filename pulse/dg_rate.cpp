@@ -21,6 +21,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <omp.h>
@@ -51,13 +52,31 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
                              &flux_a_right_, &flux_q_left_, &flux_q_right_})
     v->resize(elements);
 
-  volume_terms(t, s, rate);
-  interior_face_fluxes();
-  prescribed_end_fluxes(t);
-  coupled_end_fluxes(t, rate);
-  outlet_end_fluxes(s, rate);
-  boundary_exchange(rate);
-  junction_fluxes(t);
+  Eigen::Index bad_element = volume_terms(s, rate);
+  if (bad_element >= 0 && !one_d_cut_) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad_element])], t);
+  if (one_d_cut_) exchange_traces();
+  std::int64_t bad_junction = -1;
+  if (bad_element < 0) {
+    interior_face_fluxes();
+    prescribed_end_fluxes(t);
+    coupled_end_fluxes(t, rate);
+    outlet_end_fluxes(s, rate);
+    boundary_exchange(rate);
+    bad_junction = junction_fluxes();
+  }
+  if (one_d_cut_) {
+    // The first failure of any rank, as the one process meets it: an element's (the least)
+    // before any junction's.
+    constexpr std::int64_t none = std::numeric_limits<std::int64_t>::max();
+    const std::int64_t key = least_key_(bad_element >= 0 ? bad_element : bad_junction >= 0 ? elements + bad_junction : none);
+    bad_element = key < elements ? key : -1;
+    bad_junction = key != none && key >= elements ? key - elements : -1;
+  }
+  if (bad_element >= 0) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad_element])], t);
+  if (bad_junction >= 0) {
+    const auto first = boundaries_.junction_offset[static_cast<std::size_t>(bad_junction)];
+    throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);
+  }
   lift_to_rate(rate);
 }
 
@@ -128,7 +147,7 @@ Eigen::Index PulseSolver::element_terms(const PulseState& s, PulseState& rate, c
   return -1;
 }
 
-void PulseSolver::volume_terms(double t, const PulseState& s, PulseState& rate) {
+Eigen::Index PulseSolver::volume_terms(const PulseState& s, PulseState& rate) {
   // Element terms: each degree's block split into one part per thread, in one parallel
   // region (a region per block cost more than the 1D vessels' work on a million-vessel tree).
   Eigen::Index bad = -1;
@@ -136,7 +155,7 @@ void PulseSolver::volume_terms(double t, const PulseState& s, PulseState& rate) 
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
   {
     const int threads = omp_get_num_threads(), me = omp_get_thread_num();
-    for (const DegreeBlock& b : blocks_) {
+    for (const ElementRun& b : runs_) {
       const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
       const Eigen::Index first = b.first + b.count * me / threads, last = b.first + b.count * (me + 1) / threads;
       errors.guard(first, [&] {
@@ -149,16 +168,18 @@ void PulseSolver::volume_terms(double t, const PulseState& s, PulseState& rate) 
     }
   }
   errors.rethrow();
-  if (bad >= 0) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad])], t);
+  return bad;
 }
 
 void PulseSolver::interior_face_fluxes() {
-  const Eigen::Index elements = static_cast<Eigen::Index>(element_vessel_.size());
   // Interfaces inside vessels: between consecutive elements of one vessel (a loop over the
-  // elements, not the vessels: a full tree's millions of 0D vessels have none).
-  if (elements_per_vessel_ > 1) {
+  // elements, not the vessels: a full tree's millions of 0D vessels have none). A vessel's
+  // elements lie in one run.
+  for (const ElementRun& run : runs_) {
+    if (elements_per_vessel_ == 1) break;
+    const Eigen::Index last = run.first + run.count - 1;
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-    for (Eigen::Index el = 0; el < elements - 1; ++el) {
+    for (Eigen::Index el = run.first; el < last; ++el) {
       const std::int32_t v = element_vessel_[static_cast<std::size_t>(el)];
       if (element_vessel_[static_cast<std::size_t>(el) + 1] != v) continue;
       double fa, fq;
@@ -195,6 +216,7 @@ void PulseSolver::trace(const VesselEnd& end, double& a, double& q) const {
 void PulseSolver::prescribed_end_fluxes(double t) {
   // Prescribed flows into the network (boundaries/flow_inlet.hpp).
   for (const auto& f : boundaries_.flows) {
+    if (!steps_end(f.end)) continue;
     double a, q;
     trace(f.end, a, q);
     const double q_in = boundaries_.list.waveform(static_cast<std::size_t>(f.index))(t);
@@ -203,6 +225,7 @@ void PulseSolver::prescribed_end_fluxes(double t) {
   }
   // Prescribed pressures (boundaries/pressure_end.hpp).
   for (const auto& g : boundaries_.pressures) {
+    if (!steps_end(g.end)) continue;
     double a, q;
     trace(g.end, a, q);
     const double p = boundaries_.list.waveform(static_cast<std::size_t>(g.index))(t);
@@ -216,6 +239,7 @@ void PulseSolver::coupled_end_fluxes(double t, PulseState& rate) {
   // (boundaries/coupled_node.hpp).
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
     const auto& c = boundaries_.coupled[k];
+    if (coupled_slot_[k] < 0) continue;  // another rank's
     double a, q;
     trace(c.end, a, q);
     // The node's response r = 3/2 Z (docs/solver.md §10), its pressure at this point of the step.
@@ -234,6 +258,7 @@ void PulseSolver::outlet_end_fluxes(const PulseState& s, PulseState& rate) {
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t k = 0; k < outlets; ++k) {
     const auto& o = boundaries_.outlets[static_cast<std::size_t>(k)];
+    if (!steps_end(o.end)) continue;
     double a, q;
     trace(o.end, a, q);
     const TubeLaw& law = end_law(static_cast<std::size_t>(o.end.vessel), o.end.distal);
@@ -278,17 +303,22 @@ void PulseSolver::boundary_exchange(PulseState& rate) const {
     return end.distal ? q : -q;
   };
   for (const auto* given : {&boundaries_.flows, &boundaries_.pressures})
-    for (const auto& g : *given) rate.boundary(g.slot) = -leaving(g.end);
-  for (const auto& o : boundaries_.outlets) rate.boundary(o.slot) = -leaving(o.end);
+    for (const auto& g : *given)
+      if (steps_end(g.end)) rate.boundary(g.slot) = -leaving(g.end);
+  for (const auto& o : boundaries_.outlets)
+    if (steps_end(o.end)) rate.boundary(o.slot) = -leaving(o.end);
 }
 
-void PulseSolver::junction_fluxes(double t) {
-  // Junctions are independent: each writes only its own ends' fluxes.
-  const auto junctions = static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
+std::int64_t PulseSolver::junction_fluxes() {
+  // Junctions are independent: each writes only its own ends' fluxes. Spread over ranks, those
+  // with an end of this rank's (their other ends' traces received).
+  const auto junctions = one_d_cut_ ? static_cast<std::int64_t>(one_d_cut_->junctions.size())
+                                    : static_cast<std::int64_t>(boundaries_.junction_offset.size()) - 1;
   std::int64_t failed_junction = -1;
   // A junction of many vessels allocates its scratch (an exception must not leave the region).
   parallel_blocks(junctions, threads_, [&](std::int64_t first_junction, std::int64_t last_junction) {
-    for (std::int64_t jj = first_junction; jj < last_junction; ++jj) {
+    for (std::int64_t i = first_junction; i < last_junction; ++i) {
+      const std::int64_t jj = one_d_cut_ ? one_d_cut_->junctions[static_cast<std::size_t>(i)] : i;
       const auto j = static_cast<std::size_t>(jj);
       // Left uninitialised: only the first `count` entries are used (zeroing all 16 was 5 % of a step).
       // A node of more than 16 vessels (measured networks) takes its scratch from the heap.
@@ -335,10 +365,7 @@ void PulseSolver::junction_fluxes(double t) {
         set_end_flux(boundaries_.junction_ends[static_cast<std::size_t>(first) + i], out[i]);
     }
   });
-  if (failed_junction >= 0) {
-    const auto first = boundaries_.junction_offset[static_cast<std::size_t>(failed_junction)];
-    throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);
-  }
+  return failed_junction;
 }
 
 void PulseSolver::lift_to_rate(PulseState& rate) const {
@@ -347,7 +374,7 @@ void PulseSolver::lift_to_rate(PulseState& rate) const {
 #pragma omp parallel num_threads(threads_) if (threads_ > 1)
   {
     const int threads = omp_get_num_threads(), me = omp_get_thread_num();
-    for (const DegreeBlock& b : blocks_) {
+    for (const ElementRun& b : runs_) {
       const ModalBasis& basis = bases_[static_cast<std::size_t>(b.degree)];
       const auto right = basis.inverse_mass.cwiseProduct(basis.right);  // lifts of the end fluxes
       const auto left = basis.inverse_mass.cwiseProduct(basis.left);

@@ -79,8 +79,8 @@ void PulseSolver::sample_one_d(double x, std::span<double> area, std::span<doubl
 template <class F>
 void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) const {
   // The same element k and point xi in every vessel (locate's arithmetic). The 1D vessels are
-  // listed in the order of their elements, elements_per_vessel_ each: the j-th one's first
-  // element is j elements_per_vessel_ (first_element(v)'s, without its search).
+  // listed in the order of their elements, with their first elements (first_element(v)'s,
+  // without its search).
   const double s = std::clamp(x, 0.0, 1.0) * elements_per_vessel_;
   const auto k = std::min(static_cast<std::int32_t>(s), elements_per_vessel_ - 1);
   const double xi = 2 * (s - k) - 1;
@@ -90,7 +90,7 @@ void PulseSolver::for_each_one_d_sample(double x, bool with_pressure, F&& f) con
 #pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::int64_t j = 0; j < one_d; ++j) {
     const auto v = static_cast<std::size_t>(one_d_vessels_[static_cast<std::size_t>(j)]);
-    const Eigen::Index el = j * elements_per_vessel_ + k;
+    const Eigen::Index el = one_d_first_element_[static_cast<std::size_t>(j)] + k;
     double a = 0, q = 0;
     for (int m = 0; m <= vessel_degree_[v]; ++m) {
       a += state_.area(el, m) * phi[static_cast<std::size_t>(m)];
@@ -131,27 +131,29 @@ double PulseSolver::network_volume() const {
   return volume;
 }
 
-std::vector<double> PulseSolver::one_d_volumes() const {
+std::vector<double> PulseSolver::one_d_volumes(std::size_t vessel) const {
   std::vector<double> terms;
-  if (!one_d_here_) return terms;
-  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
-    for (auto el = first_element(v), end = end_element(v); el < end; ++el) terms.push_back(2 * half_length_(el) * state_.area(el, 0));
+  for (auto el = first_element(vessel), end = end_element(vessel); el < end; ++el) terms.push_back(2 * half_length_(el) * state_.area(el, 0));
   return terms;
 }
 
 std::vector<std::int32_t> PulseSolver::held_boundaries() const {
   std::vector<std::int32_t> held = lumped_.boundaries();
-  for (std::size_t b = 0; b < boundary_slot_.size() && one_d_here_; ++b)
-    if (boundary_slot_[b] >= 0) held.push_back(static_cast<std::int32_t>(b));
+  for (const auto* given : {&boundaries_.flows, &boundaries_.pressures})
+    for (const auto& g : *given)
+      if (one_d_here_ && steps_end(g.end)) held.push_back(g.index);
+  for (const auto& o : boundaries_.outlets)
+    if (one_d_here_ && steps_end(o.end)) held.push_back(o.boundary);
   std::sort(held.begin(), held.end());
   return held;
 }
 
 void PulseSolver::check_solution() const {
   lumped_.check(time_, net_.id);
-  for (Eigen::Index el = 0; el < state_.area.rows(); ++el)
-    if (!(state_.area(el, 0) > 0) || !state_.area.row(el).allFinite() || !state_.flow.row(el).allFinite())
-      throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], time_);
+  for (const ElementRun& r : runs_)
+    for (Eigen::Index el = r.first; el < r.first + r.count; ++el)
+      if (!(state_.area(el, 0) > 0) || !state_.area.row(el).allFinite() || !state_.flow.row(el).allFinite())
+        throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[el])], time_);
 }
 
 }  // namespace hemotree

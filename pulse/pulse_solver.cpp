@@ -139,8 +139,13 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
     }
   }
 
+  lumped_in_run_ = lumped_vessels_in_run() > 0;
+  runs_ = blocks_;
+  one_d_first_element_.clear();
+  for (std::size_t j = 0; j < one_d_vessels_.size(); ++j)
+    one_d_first_element_.push_back(static_cast<std::int32_t>(j) * elements_per_vessel_);
   if (ranks)
-    take_rank_share(*ranks);
+    take_rank_share(*ranks, options);
   else
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
   sectioned_count_ = static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t s) { return s > 1; }));
@@ -223,10 +228,15 @@ void PulseSolver::orient_pressure_boundaries(const std::optional<SteadyFlow>& st
   }
 }
 
-void PulseSolver::take_rank_share(const PulseRanks& ranks) {
+void PulseSolver::take_rank_share(const PulseRanks& ranks, const SolverOptions& options) {
   const std::size_t n = net_.vessel_count();
+  const VesselRanks dealt = ranks.vessel_ranks(zero_d_, vessel_step_costs(options));
+  if (dealt.one_d_spread) {
+    take_spread_share(ranks, dealt.rank);
+    return;
+  }
   // This rank's whole subtrees; the 1D vessels and every vessel above them the top's rank's.
-  const std::vector<std::int32_t> vessel_rank = ranks.vessel_ranks(zero_d_);
+  const std::vector<std::int32_t>& vessel_rank = dealt.rank;
   for (std::size_t v = 0; v < n; ++v)
     if (!zero_d_[v] && vessel_rank[v] != ranks.top_rank)
       throw std::invalid_argument("PulseSolver: 1D vessel " + std::to_string(net_.id[v]) + " on rank " +
@@ -259,18 +269,26 @@ void PulseSolver::take_rank_share(const PulseRanks& ranks) {
     }
   });
   one_d_here_ = cut.top();
+  if (!one_d_here_) {  // the top's
+    one_d_vessels_.clear();
+    one_d_first_element_.clear();
+  }
 }
 
 void PulseSolver::couple_lumped_ends() {
   lumped_inflow_.assign(lumped_.inflow_boundaries().size(), 0.0);
   lumped_held_.assign(lumped_.held_boundaries().size(), 0.0);
   if (!one_d_here_) return;  // every coupled end is the top's
-  for (const auto& c : boundaries_.coupled) coupled_node_.push_back(lumped_.node_of(c.node));
-  std::vector<std::int32_t> nodes = coupled_node_;
+  // With the 1D vessels spread over ranks, a coupled end is its vessel's rank's, which holds
+  // the 0D vessels at its node; another rank's end has no node here (slot -1).
+  for (const auto& c : boundaries_.coupled) coupled_node_.push_back(steps_end(c.end) ? lumped_.node_of(c.node) : -1);
+  std::vector<std::int32_t> nodes;
+  for (const std::int32_t node : coupled_node_)
+    if (node >= 0) nodes.push_back(node);
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   for (const std::int32_t node : coupled_node_)
-    coupled_slot_.push_back(static_cast<std::int32_t>(std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
+    coupled_slot_.push_back(node < 0 ? -1 : static_cast<std::int32_t>(std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
   coupled_inflow_.assign(nodes.size(), 0.0);
   lumped_.set_coupling_nodes(std::move(nodes));
   held_end_flow_.assign(boundaries_.coupled.size(), 0.0);
@@ -280,7 +298,7 @@ void PulseSolver::couple_lumped_ends() {
 void PulseSolver::allocate_state() {
   const auto rows = static_cast<Eigen::Index>(element_vessel_.size());
   Eigen::Index points = 0;
-  for (const DegreeBlock& b : blocks_) points = std::max<Eigen::Index>(points, bases_[b.degree].points);
+  for (const ElementRun& b : blocks_) points = std::max<Eigen::Index>(points, bases_[b.degree].points);
   const Eigen::Index modes = max_degree() + 1;
   state_.area.setZero(rows, modes);
   state_.flow.setZero(rows, modes);
@@ -424,7 +442,7 @@ void PulseSolver::build_taper_tables() {
       tapered_elements_.push_back(static_cast<std::int32_t>(el));
     }
   Eigen::Index points = 1;
-  for (const DegreeBlock& b : blocks_) points = std::max<Eigen::Index>(points, bases_[static_cast<std::size_t>(b.degree)].points);
+  for (const ElementRun& b : blocks_) points = std::max<Eigen::Index>(points, bases_[static_cast<std::size_t>(b.degree)].points);
   const auto rows = static_cast<Eigen::Index>(tapered_elements_.size());
   taper_beta_.setZero(rows, points);
   taper_g1_.setZero(rows, points);

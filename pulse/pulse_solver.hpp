@@ -27,6 +27,7 @@
 #include "pulse/legendre_basis.hpp"
 #include "pulse/lumped_vessels.hpp"
 #include "pulse/network_boundaries.hpp"
+#include "pulse/one_d_cut.hpp"
 #include "formats/checkpoint_file.hpp"
 #include "steady/steady_flow.hpp"
 #include "pulse/time_scheme.hpp"
@@ -116,17 +117,33 @@ struct PulseState {
   void add_scaled(double factor, const PulseState& other);  // this += factor * other
 };
 
-// A run over ranks (docs/scaling.md, "The pulsatile run over ranks"): this rank's whole
-// subtrees of 0D vessels and, on the top's rank, every 1D vessel and the 0D vessels above them
-// (pulse/lumped_cut.hpp). The caller partitions the vessels once the models are chosen
-// (vessel_ranks: per vessel its rank, given which are 0D), and carries each step's two messages
-// (link). One pi section a 0D vessel (SolverOptions::lumped_sections 1).
+// A run over ranks (docs/scaling.md, "The pulsatile run over ranks"), in one of two ways the
+// caller's partition chooses (vessel_ranks: per vessel its rank, given which are 0D and what
+// each costs a step):
+//  - a tree mostly 0D: this rank's whole subtrees of 0D vessels and, on the top's rank, every
+//    1D vessel and the 0D vessels above them (pulse/lumped_cut.hpp); each step's two messages
+//    carried by link. One pi section a 0D vessel (SolverOptions::lumped_sections 1);
+//  - the 1D vessels spread over the ranks (one_d_spread; pulse/one_d_cut.hpp), each 0D vessel
+//    on the rank of every vessel at its nodes, so that a rank's 0D system is its own; the
+//    traces at junctions across the cut exchanged at every evaluation (exchange_traces).
+struct VesselRanks {
+  std::vector<std::int32_t> rank;
+  bool one_d_spread = false;
+};
 struct PulseRanks {
   int ranks = 1, rank = 0, top_rank = 0;
-  std::function<std::vector<std::int32_t>(const std::vector<bool>& zero_d)> vessel_ranks;
+  std::function<VesselRanks(const std::vector<bool>& zero_d, std::span<const double> step_cost)> vessel_ranks;
   // Told the cut once it is made (the messages' sizes: LumpedCut::roots), before any step.
   std::function<void(const LumpedCut& cut)> cut_made;
   LumpedLink link;
+  // The 1D vessels spread: each neighbour's traces out and in (send[i] to cut.neighbours[i],
+  // receive[i] from it: A and Q of each end in the cut's order). Collective among neighbours.
+  std::function<void(const OneDCut& cut, const std::vector<std::vector<double>>& send,
+                     std::vector<std::vector<double>>& receive)>
+      exchange_traces;
+  // The least of every rank's key (a failure's place in the run's order; none: the largest
+  // int64). Collective.
+  std::function<std::int64_t(std::int64_t key)> least_key;
   // values: one per item (vessel, outlet), this rank's right where `mine` is set (each item
   // is one rank's); after the call, every rank's values are every item's holder's. Collective.
   std::function<void(std::vector<double>& values, const std::vector<unsigned char>& mine)> make_whole;
@@ -138,8 +155,7 @@ struct PulseRanks {
 class PulseSolver {
  public:
   // ranks: where given, this rank's part of a run over ranks (every rank builds the whole
-  // network's laws, models, step and start alike; it steps its own 0D vessels, the top's
-  // rank also the 1D ones).
+  // network's laws, models, step and start alike; it steps its own vessels).
   PulseSolver(const Network& net, const SolverOptions& options, const PulseRanks* ranks = nullptr);
 
   void step();  // advances one time step (one 0D step, with its 1D substeps, where there are 0D vessels)
@@ -246,12 +262,15 @@ class PulseSolver {
   }
   int elements_per_vessel() const { return elements_per_vessel_; }
   double element_half_length(std::size_t element) const { return half_length_(static_cast<Eigen::Index>(element)); }
-  // The 1D vessels (indices), in the order of their elements.
+  // The 1D vessels (indices) this rank steps (alone: every one), in the order of their elements.
   const std::vector<std::int32_t>& one_d_vessels() const { return one_d_vessels_; }
   int threads() const { return threads_; }
-  // Whether this rank steps the 1D vessels (a run over ranks: the top's rank; else always),
-  // and a vessel (over ranks: its own 0D vessels, not the top's ghosts, and there the 1D ones).
+  // Whether this rank takes the 1D substeps (alone, always; over ranks, the top's rank, or
+  // every rank where the 1D vessels are spread), and steps a vessel (over ranks: its own, not
+  // the top's ghosts).
   bool holds_one_d() const { return one_d_here_; }
+  bool one_d_spread() const { return one_d_cut_.has_value(); }
+  bool over_ranks() const { return lumped_.over_ranks() || one_d_spread(); }
   bool steps_vessel(std::size_t vessel) const { return steps_vessel_.empty() || steps_vessel_[vessel]; }
 
   // A vessel's tube law: at its `from` end (the whole vessel's unless it tapers), at one of
@@ -284,9 +303,9 @@ class PulseSolver {
   // The boundaries this rank holds (over ranks: its 0D vessels' and, on the top's rank, the
   // 1D ends'; alone: every one at a vessel), increasing.
   std::vector<std::int32_t> held_boundaries() const;
-  // network_volume()'s terms after the 0D vessels' stored volume, in its order: each 1D
-  // element's volume (on a share of a run over ranks: none).
-  std::vector<double> one_d_volumes() const;
+  // network_volume()'s terms after the 0D vessels' stored volume: 1D vessel v's elements'
+  // volumes, in its order.
+  std::vector<double> one_d_volumes(std::size_t vessel) const;
   // Throws SolutionBreakdown when A <= 0 or a value is not finite.
   void check_solution() const;
 
@@ -333,7 +352,8 @@ class PulseSolver {
  private:
   // The DG rate dU/dt of the 1D vessels at time t (pulse/dg_rate.cpp), and its steps in order.
   void evaluate(double t, const PulseState& s, PulseState& rate);
-  void volume_terms(double t, const PulseState& s, PulseState& rate);  // (F, dphi/dx), S, traces
+  // (F, dphi/dx), S, traces; returns the first element whose area is not positive and finite, or -1.
+  Eigen::Index volume_terms(const PulseState& s, PulseState& rate);
   // Returns the first element whose area is not positive and finite, or -1.
   Eigen::Index element_terms(const PulseState& s, PulseState& rate, const ModalBasis& basis, Eigen::Index first,
                              Eigen::Index count);
@@ -342,7 +362,8 @@ class PulseSolver {
   void coupled_end_fluxes(double t, PulseState& rate);  // at nodes of 0D vessels; their inflows
   void outlet_end_fluxes(const PulseState& s, PulseState& rate);  // R, RCR (dp_c/dt), reflection
   void boundary_exchange(PulseState& rate) const;       // volumes in and out through the boundaries
-  void junction_fluxes(double t);                       // each junction's Riemann problem
+  std::int64_t junction_fluxes();                       // each junction's Riemann problem; the first that fails, or -1
+  void exchange_traces();  // the 1D vessels spread: the traces at junctions across the cut (one_d_over_ranks.cpp)
   void lift_to_rate(PulseState& rate) const;            // surface term, 1/J, source's projection
   void trace(const VesselEnd& end, double& a, double& q) const;  // the inner trace at an end
   void set_end_flux(const VesselEnd& end, const EndState& u);    // F(U*) there; U* kept
@@ -365,7 +386,11 @@ class PulseSolver {
   void orient_pressure_boundaries(const std::optional<SteadyFlow>& steady);
   // Over ranks: this rank's 0D vessels of the cut the caller's partition makes, its link, and
   // which vessels and outlets it steps.
-  void take_rank_share(const PulseRanks& ranks);
+  void take_rank_share(const PulseRanks& ranks, const SolverOptions& options);
+  // The same with the 1D vessels spread over the ranks (one_d_over_ranks.cpp).
+  void take_spread_share(const PulseRanks& ranks, const std::vector<std::int32_t>& vessel_rank);
+  // Per vessel, what a step of it costs [s] (pulse/step_cost.hpp): a partition's weights.
+  std::vector<double> vessel_step_costs(const SolverOptions& options) const;
   void couple_lumped_ends();  // the 1D ends at 0D nodes: their nodes, slots, held inflows
   void allocate_state();      // the state's and the point values' storage
   void choose_models(const SolverOptions& options);
@@ -430,10 +455,6 @@ class PulseSolver {
   // Elements are numbered by degree, so that each degree is one block of rows that the
   // basis of that degree acts on at once; rows have the columns of the highest degree
   // (unused modes stay zero).
-  struct DegreeBlock {
-    int degree;
-    Eigen::Index first, count;
-  };
   std::vector<bool> zero_d_;               // per vessel
   std::vector<std::uint8_t> lumped_sections_;  // per vessel, where a 0D vessel takes more than one (else empty), until lumped_ is built
   std::size_t sectioned_count_ = 0;
@@ -454,10 +475,19 @@ class PulseSolver {
   std::vector<std::int32_t> coupled_node_; // per coupled end: its 0D node
   std::vector<double> held_end_flow_;      // per coupled end: its inflow to the node at the step's start
   std::vector<double> coupled_inflow_, coupled_volume_;  // per coupling node (LumpedVessels' order)
-  std::vector<std::int32_t> one_d_vessels_;
+  std::vector<std::int32_t> one_d_vessels_, one_d_first_element_;  // the 1D vessels stepped here, and their first elements
   std::vector<std::int32_t> coupled_slot_;                 // per coupled end: its coupling node's place there
   std::vector<ModalBasis> bases_;          // by degree; empty where unused
-  std::vector<DegreeBlock> blocks_;
+  std::vector<ElementRun> blocks_;
+  std::vector<ElementRun> runs_;  // the rows this rank steps: blocks_, or its part of them
+  // The 1D vessels spread over ranks: the cut, its messages' scratch, and the links.
+  std::optional<OneDCut> one_d_cut_;
+  std::vector<std::vector<double>> trace_out_, trace_in_;
+  std::function<void(const OneDCut&, const std::vector<std::vector<double>>&, std::vector<std::vector<double>>&)> exchange_traces_;
+  std::function<std::int64_t(std::int64_t)> least_key_;
+  // Whether an end's vessel is stepped here.
+  bool steps_end(const VesselEnd& end) const { return steps_vessel_.empty() || steps_vessel_[static_cast<std::size_t>(end.vessel)]; }
+  bool lumped_in_run_ = false;  // any 0D vessel on any rank: a step is a 0D step around 1D substeps
   std::vector<std::int8_t> vessel_degree_;  // per vessel: -1 (0D) to 30 (run_configuration)
   int elements_per_vessel_ = 1;
   // Each 1D vessel's first element, by vessel (increasing): its elements are consecutive. Only
@@ -498,8 +528,23 @@ class PulseSolver {
   std::function<void(std::vector<double>&, const std::vector<unsigned char>&)> make_whole_, lead_whole_;
   // save()'s section "pulse solver", with each boundary's 0D volume and the viscosity factors
   // (whole over ranks).
+  // The 1D vessels' evolving state as save() writes it: this rank's, or (spread over ranks) made
+  // whole on the lead rank.
+  struct OneDState {
+    const PulseState *state, *previous_rate;
+    const Eigen::MatrixXd* previous_flow;
+    std::function<EndState(std::size_t vessel, bool distal)> end_state;
+  };
   void save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume,
-                    const std::vector<double>& viscosity_factor) const;
+                    const std::vector<double>& viscosity_factor, const OneDState& one_d) const;
+  // save_over_ranks' 1D state with the vessels spread: every array whole on the lead rank
+  // (one_d_over_ranks.cpp); `whole` holds it.
+  struct WholeOneD {
+    PulseState state, previous_rate;
+    Eigen::MatrixXd previous_flow;
+    std::vector<double> ends;  // per 1D vessel (vessel order): proximal (A, Q), distal (A, Q)
+  };
+  WholeOneD whole_one_d_state() const;
   std::vector<unsigned char> steps_vessel_, holds_outlet_;
   double time_ = 0, dt_ = 0;
   std::string dt_reason_;

@@ -5,6 +5,7 @@
 // vessels and boundaries, and read by each rank for its share.
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -14,7 +15,9 @@
 namespace hemotree {
 
 void PulseSolver::save(CheckpointWriter& out) const {
-  save_section(out, lumped_boundary_volume_, viscosity_factor_);
+  save_section(out, lumped_boundary_volume_, viscosity_factor_,
+               {&state_, &previous_rate_, &previous_flow_,
+                [this](std::size_t v, bool distal) { return boundaries_.state_at(vessel_end(v, distal)); }});
   lumped_.save(out);
 }
 
@@ -55,20 +58,36 @@ void PulseSolver::save_over_ranks(CheckpointWriter* out) const {
     lead_whole_(values, mine);
     if (!out) std::vector<double>().swap(values);
   }
+  // The 1D vessels' state: the top's own, or, spread, from every rank.
+  std::optional<WholeOneD> one_d;
+  if (one_d_cut_) one_d = whole_one_d_state();
   if (!out) return;
-  save_section(*out, boundary_volume, factors);
+  if (one_d) {
+    // The ends by vessel: the k-th 1D vessel in vessel order is first_elements_[k]'s.
+    auto end_state = [&](std::size_t v, bool distal) {
+      const auto k = static_cast<std::size_t>(
+          std::lower_bound(first_elements_.begin(), first_elements_.end(), std::pair{static_cast<std::int32_t>(v), std::int32_t{-1}}) -
+          first_elements_.begin());
+      return EndState{one_d->ends[4 * k + (distal ? 2 : 0)], one_d->ends[4 * k + (distal ? 3 : 1)]};
+    };
+    save_section(*out, boundary_volume, factors, {&one_d->state, &one_d->previous_rate, &one_d->previous_flow, end_state});
+  } else {
+    save_section(*out, boundary_volume, factors,
+                 {&state_, &previous_rate_, &previous_flow_,
+                  [this](std::size_t v, bool distal) { return boundaries_.state_at(vessel_end(v, distal)); }});
+  }
   LumpedVessels::save_whole(*out, whole);
 }
 
 void PulseSolver::save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume,
-                               const std::vector<double>& viscosity_factor) const {
+                               const std::vector<double>& viscosity_factor, const OneDState& one_d) const {
   out.section("pulse solver");
   out.put(time_);
   out.put(dt_);
   out.put(static_cast<std::uint64_t>(steps_));
   out.put(have_previous_rate_);
   out.put(tracking_faces_);
-  for (const PulseState* s : {&state_, &previous_rate_}) {
+  for (const PulseState* s : {one_d.state, one_d.previous_rate}) {
     out.put(s->area);
     out.put(s->flow);
     out.put(s->capacitor);
@@ -76,7 +95,7 @@ void PulseSolver::save_section(CheckpointWriter& out, const std::vector<double>&
     out.put(s->boundary);
     out.put(s->faces);
   }
-  out.put(previous_flow_);
+  out.put(*one_d.previous_flow);
   out.put(lumped_boundary_volume);
   out.put(cycle_volume_);
   out.put(cycle_capacitor_);
@@ -92,7 +111,7 @@ void PulseSolver::save_section(CheckpointWriter& out, const std::vector<double>&
     ends.clear();
     for (std::size_t v = first; v < std::min(n, first + block); ++v) {
       for (const bool distal : {false, true}) {
-        const EndState e = zero_d_[v] ? EndState{} : boundaries_.state_at(vessel_end(v, distal));
+        const EndState e = zero_d_[v] ? EndState{} : one_d.end_state(v, distal);
         ends.push_back(e.area);
         ends.push_back(e.flow);
       }
@@ -167,7 +186,7 @@ void PulseSolver::restore(CheckpointReader& in) {
   std::vector<double> factors = in.get_vector();
   if (!factors.empty() && factors.size() != net_.vessel_count()) in.fail("viscosity factors of another network");
   set_viscosity_factors(factors);  // before the 0D vessels' resistances are rebuilt
-  if (lumped_.over_ranks()) lumped_.restore_share(in, lumped_places(net_, zero_d_));
+  if (over_ranks()) lumped_.restore_share(in, lumped_places(net_, zero_d_));
   else lumped_.restore(in);
 }
 

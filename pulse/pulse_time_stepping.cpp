@@ -71,7 +71,7 @@ int PulseSolver::choose_coupling_passes(const SolverOptions& options) const {
                       most_coupling_passes);
   // A cycle's 1D substeps, the same work for each pass, against its 0D steps at one pass's step.
   double substep = step_cost::per_step;
-  for (const DegreeBlock& b : blocks_) substep += static_cast<double>(b.count) * step_cost::element_step_seconds(b.degree);
+  for (const ElementRun& b : blocks_) substep += static_cast<double>(b.count) * step_cost::element_step_seconds(b.degree);
   const double one_d = period_ / stable_1d_ * substep;
   const double zero_d = static_cast<double>(lumped_vessels_in_run()) * step_cost::per_lumped_vessel / step_per_coupling_pass;
   return step_cost::cheapest_coupling_passes(one_d, zero_d, most_coupling_passes);
@@ -82,7 +82,7 @@ void PulseSolver::choose_stable_step(const SolverOptions& options) {
   // operator (0.50 at p = 1 down to 0.0133 at p = 7 for AB2); friction (explicit schemes):
   // dt <= safety / (k mu / (rho A)).
   std::vector<double> courant(bases_.size(), 0.0);
-  for (const DegreeBlock& b : blocks_)
+  for (const ElementRun& b : blocks_)
     courant[static_cast<std::size_t>(b.degree)] =
         options.cfl * courant_limit(b.degree, scheme_ == TimeScheme::runge_kutta4 ? TimeScheme::runge_kutta4
                                                                                   : TimeScheme::adams_bashforth2);
@@ -182,9 +182,10 @@ void PulseSolver::step_exponential(double h) {
   next_flow_.resize(elements);
   phi1_.resize(elements);
   phi2_.resize(elements);
-  for (Eigen::Index el = 0; el < elements; ++el) phi_functions(-friction_rate_(el) * h, decay_(el), phi1_(el), phi2_(el));
+  for (const ElementRun& b : runs_)
+    for (Eigen::Index el = b.first; el < b.first + b.count; ++el) phi_functions(-friction_rate_(el) * h, decay_(el), phi1_(el), phi2_(el));
   // Column by column (the storage order), over each degree's block of rows.
-  for (const DegreeBlock& b : blocks_)
+  for (const ElementRun& b : runs_)
     for (Eigen::Index j = 0; j <= b.degree; ++j) {
       const auto r = friction_rate_.segment(b.first, b.count).array();
       auto q = state_.flow.col(j).segment(b.first, b.count).array();
@@ -210,7 +211,7 @@ void PulseSolver::step() { step({}); }
 
 void PulseSolver::step(const std::function<void()>& while_waiting) {
   if (lumped_count_after_release_) throw std::logic_error("PulseSolver::step after release_lumped_state");
-  if (lumped_.empty() && !lumped_.over_ranks()) {
+  if (!lumped_in_run_) {
     step_1d(dt_);
     time_ += dt_;
   } else {
@@ -230,6 +231,7 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
   // the means the pass before let through. Over ranks, a share steps its 0D vessels alone.
   std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
   for (std::size_t k = 0; k < boundaries_.coupled.size() && one_d_here_; ++k) {
+    if (coupled_slot_[k] < 0) continue;  // another rank's (the 1D vessels spread)
     const VesselEnd& end = boundaries_.coupled[k].end;
     const EndState& u = boundaries_.state_at(end);
     held_end_flow_[k] = end.distal ? u.flow : -u.flow;
@@ -242,10 +244,19 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
     lumped_inflow_[j] = boundaries_.list.waveform(static_cast<std::size_t>(lumped_.inflow_boundaries()[j]))(t1);
   for (std::size_t j = 0; j < lumped_held_.size(); ++j)
     lumped_held_[j] = boundaries_.list.waveform(static_cast<std::size_t>(lumped_.held_boundaries()[j]))(t1);
+  // Spread over ranks, a rank's 0D system is its own (it may have none); a lumen closing on
+  // any rank is said on every rank, the least vessel's.
+  std::int64_t collapsed_vessel = -1;
   try {
-    lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
+    if (!lumped_.empty() || lumped_.over_ranks()) lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
   } catch (const LumpedVessels::CollapsedNode& collapsed) {
-    throw SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_);
+    if (!one_d_cut_) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_);
+    collapsed_vessel = collapsed.vessel;
+  }
+  if (one_d_cut_) {
+    constexpr std::int64_t none = std::numeric_limits<std::int64_t>::max();
+    const std::int64_t least = least_key_(collapsed_vessel >= 0 ? collapsed_vessel : none);
+    if (least != none) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(least)], time_);
   }
   if (while_waiting && !one_d_here_) while_waiting();  // a share: the top's rank takes its substeps
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
@@ -259,7 +270,7 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
     }
   }
   // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
-  lumped_.complete(coupled_volume_, lumped_boundary_volume_);
+  if (!lumped_.empty() || lumped_.over_ranks()) lumped_.complete(coupled_volume_, lumped_boundary_volume_);
   time_ = t1;
 }
 
@@ -272,17 +283,19 @@ void PulseSolver::take_coupled_substeps() {
     take_substeps();
     std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
     for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
+      if (coupled_slot_[k] < 0) continue;
       const auto i = static_cast<Eigen::Index>(k);
       held_end_flow_[k] = (state_.coupled(i) - before(i)) / dt_;
       coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
     }
-    lumped_.predict_again(coupled_inflow_);
+    if (!lumped_.empty()) lumped_.predict_again(coupled_inflow_);
     return_to_pass_start();
   }
   take_substeps();
   std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
-    coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
+    if (coupled_slot_[k] >= 0)
+      coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
         state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
 }
 

@@ -24,22 +24,18 @@ double network_volume_over_ranks(const Network& net, const PulseSolver& solver) 
   }
   std::vector<double> at_node(world_rank() == 0 ? net.node_count() : 0, 0.0);
   gather_rows(mine, volume, 1, net.node_count(), [&](std::int32_t node, const double* v) { at_node[static_cast<std::size_t>(node)] = *v; });
-  // The top's 1D elements, sent to rank 0 where it is elsewhere.
-  std::vector<double> one_d = solver.one_d_volumes();
-  const int top = solver.holds_one_d() ? world_rank() : -1;
-  int top_rank = -1;
-  MPI_Allreduce(&top, &top_rank, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  if (top_rank > 0) {
-    int count = static_cast<int>(one_d.size());
-    if (world_rank() == top_rank) {
-      MPI_Send(&count, 1, MPI_INT, 0, 11, MPI_COMM_WORLD);
-      MPI_Send(one_d.data(), count, MPI_DOUBLE, 0, 12, MPI_COMM_WORLD);
-    } else if (world_rank() == 0) {
-      MPI_Recv(&count, 1, MPI_INT, top_rank, 11, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-      one_d.resize(static_cast<std::size_t>(count));
-      MPI_Recv(one_d.data(), count, MPI_DOUBLE, top_rank, 12, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    }
+  // The 1D elements' volumes, a vessel's a row, from the rank that steps it.
+  const auto e = static_cast<std::size_t>(solver.elements_per_vessel());
+  std::vector<std::int32_t> one_d_mine;
+  std::vector<double> one_d_rows;
+  for (const std::int32_t v : solver.one_d_vessels()) {
+    one_d_mine.push_back(v);
+    const std::vector<double> terms = solver.one_d_volumes(static_cast<std::size_t>(v));
+    one_d_rows.insert(one_d_rows.end(), terms.begin(), terms.end());
   }
+  std::vector<double> one_d(world_rank() == 0 ? net.vessel_count() * e : 0, 0.0);
+  gather_rows(one_d_mine, one_d_rows, e, net.vessel_count(),
+              [&](std::int32_t v, const double* row) { std::copy_n(row, e, one_d.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(v) * e)); });
   if (world_rank() != 0) return std::numeric_limits<double>::quiet_NaN();
   // The one-process sum: the 0D vessels' nodes by first appearance in the network's order of
   // the 0D vessels (LumpedVessels::stored_volume), then the 1D elements.
@@ -49,7 +45,9 @@ double network_volume_over_ranks(const Network& net, const PulseSolver& solver) 
   double total = 0;
   for (const std::int32_t node : nodes_by_first_appearance(zero_d, net.from, net.to, net.node_count()))
     total += at_node[static_cast<std::size_t>(node)];
-  for (const double v : one_d) total += v;
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (!solver.is_lumped(v))
+      for (std::size_t k = 0; k < e; ++k) total += one_d[v * e + k];
   return total;
 }
 

@@ -27,7 +27,7 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 
 CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, double analysis_frequency)
     : net_(net), omega_(2 * std::numbers::pi * analysis_frequency),
-      one_d_(solver.holds_one_d() ? solver.one_d_vessels() : std::vector<std::int32_t>()) {
+      one_d_(solver.one_d_vessels()) {
   const std::size_t n = one_d_.size();
   for (auto* sums : {&p_in_, &p_out_, &u_in_, &u_out_}) sums->assign(n, 0.0);
   first_.assign(4 * n, 0.0);
@@ -47,7 +47,7 @@ void CycleStatistics::start_sums() {
 
 void CycleStatistics::begin(const PulseSolver& solver) {
   // Over ranks, rank 0's: the whole run's (solver/cycle_over_ranks.hpp).
-  const bool over_ranks = solver.lumped().over_ranks();
+  const bool over_ranks = solver.over_ranks();
   boundary_start_ = over_ranks ? boundary_volumes_over_ranks(solver) : solver.boundary_volumes();
   volume_start_ = over_ranks ? network_volume_over_ranks(net_, solver) : solver.network_volume();
 }
@@ -129,7 +129,7 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   if (sums_.empty()) start_sums();  // no sample since the last close
   // In and out: each boundary's volume, in the boundaries' order, to "in" or "out" as it
   // counts (one sum per item whatever holds it: a run over ranks gathers the same numbers).
-  const bool over_ranks = solver.lumped().over_ranks();
+  const bool over_ranks = solver.over_ranks();
   const Eigen::VectorXd through =
       (over_ranks ? boundary_volumes_over_ranks(solver) : solver.boundary_volumes()) - boundary_start_;
   Eigen::Vector2d exchanged = Eigen::Vector2d::Zero();

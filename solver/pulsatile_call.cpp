@@ -298,8 +298,9 @@ namespace {
 // given_up: the same network where the caller gave it up (its coordinates may go), else null.
 RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserver& observer, Network* given_up) {
   // Over MPI ranks (mpirun -np P, P > 1) the tree's 0D vessels are cut into whole subtrees,
-  // the 1D vessels and every vessel above them on the top's rank, rank 0
-  // (solver/pulse_ranks_mpi.hpp); every decision is agreed (solver/decisions_over_ranks.hpp)
+  // the 1D vessels and every vessel above them on the top's rank, rank 0, or, where the 1D
+  // vessels cost more than a rank's share or the network has loops, the 1D vessels are spread
+  // over the ranks (solver/pulse_ranks_mpi.hpp); every decision is agreed (solver/decisions_over_ranks.hpp)
   // and rank 0 alone writes. One pi section a 0D vessel: a cut runs between vessels
   // (pulse/lumped_cut.hpp); the run is then, and its checkpoint says so, the one-process run
   // with --lumped-sections 1.
@@ -360,7 +361,10 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   std::optional<PulseSolver> solver;
   on_every_rank([&] { solver.emplace(net, options, ranks ? &ranks->ranks() : nullptr); });
   PulseSolver& run = *solver;
-  if (ranks)
+  if (ranks && ranks->one_d_spread())
+    observer.note(describe(ranks->partition()) + ", weighed by each vessel's step; the 1D vessels spread over the ranks "
+                  "(each 0D vessel with the vessels at its nodes), their traces exchanged at the cut's junctions");
+  else if (ranks)
     observer.note(describe(ranks->partition()) + "; the top's rank steps " + std::to_string(ranks->top_vessels()) +
                   " vessels (the 1D ones and every vessel above them, with subtrees of its own; weighed for its "
                   "statistics as " + std::to_string(std::llround(ranks->top_weight())) + " vessels more)");
@@ -421,6 +425,13 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     FlowTransportOptions carried;
     carried.tracers = tracers;
     std::optional<TransportRanks> over;
+    if (ranks && ranks->one_d_spread())
+      on_every_rank([&] {
+        throw SettingError(red ? "red_cells" : "tracer",
+                           placeholder(red ? "red_cells" : "tracer") + " over MPI ranks runs on trees whose 1D vessels "
+                           "one rank holds; this network's are spread over the ranks (they cost more than a rank's "
+                           "share, or it has loops): run it on one rank");
+      });
     if (ranks) over = TransportRanks{ranks->ranks().top_rank, ranks->roots()};
     // A refusal (a tracer given where the network has no boundary) is every rank's alike.
     on_every_rank([&] { transport.emplace(net, run, red ? carried : red_cells_fixed(carried), over ? &*over : nullptr); });
@@ -456,6 +467,9 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     // which has left every collective call: a failure of its writing is its own alone.
     if (world_rank() != 0) return result;
     leave_collectives();
+    if (ranks->one_d_spread())
+      observer.note("the 1D traces' exchanges on rank 0: " + std::to_string(ranks->trace_exchanges()) +
+                    " with its neighbouring ranks");
     if (const RootExchange* exchange = ranks->exchange()) {
       const RootExchange::Traffic& t = exchange->traffic();
       observer.note("the 0D steps' exchanges on rank 0, the top's: " + std::to_string(t.calls) + " collective calls, " +

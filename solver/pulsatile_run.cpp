@@ -82,7 +82,7 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
                            std::filesystem::path folder, FlowTransport* transport)
     : net_(net), solver_(solver), plan_(std::move(plan)), folder_(std::move(folder)),
       stats_(net, solver, analysis_frequency(driving_waveform(net))), probes_(probes), transport_(transport),
-      over_ranks_(solver.lumped().over_ranks()), writes_(!over_ranks_ || world_rank() == 0) {
+      over_ranks_(solver.over_ranks()), writes_(!over_ranks_ || world_rank() == 0) {
   plan_.transport_every = std::max<std::size_t>(plan_.transport_every, 1);
   if (over_ranks_) {
     if (writes_ && !solver.holds_one_d()) throw std::logic_error("PulsatileRun over ranks: rank 0 is not the top's");

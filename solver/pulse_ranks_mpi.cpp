@@ -1,5 +1,9 @@
 #include "solver/pulse_ranks_mpi.hpp"
 
+#include <algorithm>
+#include <map>
+
+#include "core/setting_error.hpp"
 #include "distributed/gather_rows.hpp"
 #include "distributed/network_cut.hpp"
 #include "formats/topology.hpp"
@@ -9,42 +13,40 @@
 
 namespace hemotree {
 
-// The partition by the given costs first: a network with loops or too many ranks is refused
-// here, before the solver's steady solve; the top's weight needs the models, and the vessels
-// are dealt again with it once the solver has chosen them (vessel_ranks).
+// The partition by the given costs first: too many ranks are refused here, before the
+// solver's steady solve; which way the vessels are dealt, and the top's weight, need the
+// models, and the vessels are dealt again once the solver has chosen them (vessel_ranks).
 MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     : net_(net), cost_(std::move(cost)), partition_(partition_network(net, cost_, world_size())) {
-  check_subtree_partition(partition_);
   check_one_partition(partition_);
-  lead_with_the_top(partition_);  // rank 0 writes the top's state with the results (a checkpoint)
+  if (partition_.method == Partition::Method::subtrees && !partition_.top_spread) lead_with_the_top(partition_);
   ranks_.ranks = world_size();
   ranks_.rank = world_rank();
   ranks_.top_rank = partition_.top_rank;
-  ranks_.vessel_ranks = [this](const std::vector<bool>& zero_d) {
-    std::vector<std::uint8_t> on_top(zero_d.size());
-    for (std::size_t v = 0; v < zero_d.size(); ++v) on_top[v] = zero_d[v] ? 0 : 1;
-    // The top's rank takes its statistics on the step's path, a share in its wait for the
-    // top's 1D substeps (docs/scaling.md, item 7): the top should hold x = N / ((P - 1)(1 + r)
-    // + 1) of the N 0D vessels, r a sample's cost over a vessel's step. An extra weight W on
-    // the tree's root (always the top's) deals it so: x + W = (N + W) / P.
-    const int ranks = world_size();
-    const auto n = static_cast<double>(std::count(zero_d.begin(), zero_d.end(), true));
-    const double x = n / ((ranks - 1) * (1 + statistics_per_vessel_step) + 1);
-    top_weight_ = ranks > 1 ? (n - ranks * x) / (ranks - 1) : 0;
-    std::vector<double> cost = cost_;
-    if (top_weight_ > 0) {
-      cost[static_cast<std::size_t>(inlet_vessels(net_).front())] += top_weight_;  // a root: the top's
-      partition_ = partition_network(net_, cost, ranks);
-      check_subtree_partition(partition_);
-      check_one_partition(partition_);
-      lead_with_the_top(partition_);
+  ranks_.vessel_ranks = [this](const std::vector<bool>& zero_d, std::span<const double> step_cost) {
+    // The run's partition, made once: a settling solver of the same models takes the same.
+    if (!dealt_ || dealt_zero_d_ != zero_d) {
+      dealt_ = deal(zero_d, step_cost);
+      dealt_zero_d_ = zero_d;
     }
-    keep_on_top(net_, cost, on_top, partition_);
-    std::vector<std::int32_t> rank(partition_.rank_of_vessel.begin(), partition_.rank_of_vessel.end());
-    for (const std::int32_t v : partition_.top) rank[static_cast<std::size_t>(v)] = partition_.top_rank;
-    top_vessels_ = 0;
-    for (const std::int32_t r : rank) top_vessels_ += r == partition_.top_rank ? 1 : 0;
-    return rank;
+    return *dealt_;
+  };
+  ranks_.exchange_traces = [this](const OneDCut& cut, const std::vector<std::vector<double>>& send,
+                              std::vector<std::vector<double>>& receive) {
+    std::vector<MPI_Request> requests(2 * cut.neighbours.size());
+    for (std::size_t i = 0; i < cut.neighbours.size(); ++i) {
+      MPI_Irecv(receive[i].data(), static_cast<int>(receive[i].size()), MPI_DOUBLE, cut.neighbours[i].rank, 21,
+                MPI_COMM_WORLD, &requests[2 * i]);
+      MPI_Isend(send[i].data(), static_cast<int>(send[i].size()), MPI_DOUBLE, cut.neighbours[i].rank, 21, MPI_COMM_WORLD,
+                &requests[2 * i + 1]);
+    }
+    MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+    ++trace_exchanges_;
+  };
+  ranks_.least_key = [](std::int64_t key) {
+    std::int64_t least = key;
+    MPI_Allreduce(&key, &least, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
+    return least;
   };
   ranks_.cut_made = [this](const LumpedCut& cut) { roots_ = cut.roots; };
   ranks_.link.up = [this](std::span<const double> numbers, std::exception_ptr failure, bool& failed) {
@@ -78,6 +80,117 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     MPI_Allgatherv(pairs.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, MPI_COMM_WORLD);
     for (std::size_t j = 0; j < all.size(); j += 2) values[static_cast<std::size_t>(all[j])] = all[j + 1];
   };
+}
+
+VesselRanks MpiPulseRanks::deal(const std::vector<bool>& zero_d, std::span<const double> step_cost) {
+  // A tree: its top holds every 1D vessel, as long as that leaves every rank a vessel. A network
+  // with loops (no top), or a tree whose 1D vessels are nearly all of it (the large arteries'
+  // models): the 1D vessels spread (docs/scaling.md, "1D vessels across a cut").
+  const int ranks = world_size();
+  if (ranks > 1 && partition_.method == Partition::Method::metis) return spread(zero_d, step_cost);
+  try {
+    return on_top(zero_d);
+  } catch (const SettingError&) {
+    if (ranks == 1 || partition_.method != Partition::Method::subtrees || partition_.top_spread) throw;
+    return spread(zero_d, step_cost);
+  }
+}
+
+VesselRanks MpiPulseRanks::on_top(const std::vector<bool>& zero_d) {
+  const int ranks = world_size();
+  check_subtree_partition(partition_);
+  {
+    std::vector<std::uint8_t> on_top(zero_d.size());
+    for (std::size_t v = 0; v < zero_d.size(); ++v) on_top[v] = zero_d[v] ? 0 : 1;
+    // The top's rank takes its statistics on the step's path, a share in its wait for the
+    // top's 1D substeps (docs/scaling.md, item 7): the top should hold x = N / ((P - 1)(1 + r)
+    // + 1) of the N 0D vessels, r a sample's cost over a vessel's step. An extra weight W on
+    // the tree's root (always the top's) deals it so: x + W = (N + W) / P.
+    const auto n = static_cast<double>(std::count(zero_d.begin(), zero_d.end(), true));
+    const double x = n / ((ranks - 1) * (1 + statistics_per_vessel_step) + 1);
+    top_weight_ = ranks > 1 ? (n - ranks * x) / (ranks - 1) : 0;
+    std::vector<double> cost = cost_;
+    if (top_weight_ > 0) {
+      cost[static_cast<std::size_t>(inlet_vessels(net_).front())] += top_weight_;  // a root: the top's
+      partition_ = partition_network(net_, cost, ranks);
+      check_subtree_partition(partition_);
+      check_one_partition(partition_);
+      lead_with_the_top(partition_);
+    }
+    keep_on_top(net_, cost, on_top, partition_);
+    std::vector<std::int32_t> rank(partition_.rank_of_vessel.begin(), partition_.rank_of_vessel.end());
+    for (const std::int32_t v : partition_.top) rank[static_cast<std::size_t>(v)] = partition_.top_rank;
+    top_vessels_ = 0;
+    for (const std::int32_t r : rank) top_vessels_ += r == partition_.top_rank ? 1 : 0;
+    return VesselRanks{rank, false};
+  }
+}
+
+VesselRanks MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<const double> step_cost) {
+  // The partition by each vessel's step, then every vessel at a 0D vessel's node kept on one
+  // rank (a 0D system is one rank's): each such group to the rank that holds most of its cost.
+  const std::size_t n = zero_d.size();
+  Partition p = partition_network(net_, step_cost, world_size());
+  std::vector<std::int32_t> parent(n);
+  for (std::size_t v = 0; v < n; ++v) parent[v] = static_cast<std::int32_t>(v);
+  auto find = [&](std::int32_t v) {
+    while (parent[static_cast<std::size_t>(v)] != v) v = parent[static_cast<std::size_t>(v)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(v)])];
+    return v;
+  };
+  std::vector<std::int32_t> at_node(net_.node_count(), -1);  // a 0D vessel there, the first
+  for (std::size_t v = 0; v < n; ++v)
+    if (zero_d[v])
+      for (const std::int32_t node : {net_.from[v], net_.to[v]})
+        if (at_node[static_cast<std::size_t>(node)] < 0) at_node[static_cast<std::size_t>(node)] = static_cast<std::int32_t>(v);
+  for (std::size_t v = 0; v < n; ++v)
+    for (const std::int32_t node : {net_.from[v], net_.to[v]})
+      if (const std::int32_t u = at_node[static_cast<std::size_t>(node)]; u >= 0) {
+        const std::int32_t a = find(static_cast<std::int32_t>(v)), b = find(u);
+        if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+      }
+  const auto ranks = static_cast<std::size_t>(p.ranks);
+  std::vector<std::int32_t> root(n);
+  for (std::size_t v = 0; v < n; ++v) root[v] = find(static_cast<std::int32_t>(v));
+  // Per group (its root vessel) and rank, the cost there: groups are few and small.
+  std::map<std::int32_t, std::vector<double>> cost_on;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (root[v] == static_cast<std::int32_t>(v) && at_node[static_cast<std::size_t>(net_.from[v])] < 0 &&
+        at_node[static_cast<std::size_t>(net_.to[v])] < 0)
+      continue;  // a 1D vessel among 1D vessels alone
+    auto& c = cost_on[root[v]];
+    c.resize(ranks, 0.0);
+    c[static_cast<std::size_t>(p.rank_of_vessel[v])] += step_cost[v];
+  }
+  std::map<std::int32_t, std::int32_t> group_rank;
+  for (const auto& [g, c] : cost_on)
+    group_rank[g] = static_cast<std::int32_t>(std::max_element(c.begin(), c.end()) - c.begin());
+  for (std::size_t v = 0; v < n; ++v)
+    if (const auto it = group_rank.find(root[v]); it != group_rank.end()) p.rank_of_vessel[v] = it->second;
+  p.cost.assign(ranks, 0.0);
+  p.vessels.assign(ranks, 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    p.cost[static_cast<std::size_t>(p.rank_of_vessel[v])] += step_cost[v];
+    ++p.vessels[static_cast<std::size_t>(p.rank_of_vessel[v])];
+  }
+  if (const auto empty = std::find(p.vessels.begin(), p.vessels.end(), std::size_t{0}); empty != p.vessels.end()) {
+    std::map<std::int32_t, std::size_t> joined;
+    for (std::size_t v = 0; v < n; ++v)
+      if (group_rank.count(root[v])) ++joined[root[v]];
+    std::size_t largest = 0;
+    for (const auto& [g, count] : joined) largest = std::max(largest, count);
+    throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(p.ranks) + ": rank " +
+                                    std::to_string(empty - p.vessels.begin()) + " would step no vessel: one rank steps " +
+                                    "the 0D vessels joined at their nodes with every vessel there (a 0D system over ranks " +
+                                    "is built for trees mostly 0D), and here they join " + std::to_string(largest) +
+                                    " of the " + std::to_string(n) + " vessels: run it on fewer ranks");
+  }
+  p.cut_nodes = count_cut_nodes(net_, p.rank_of_vessel);
+  p.top.clear();  // no top: every rank steps its own 1D vessels
+  p.top_spread = false;
+  partition_ = std::move(p);
+  top_vessels_ = 0;
+  top_weight_ = 0;
+  return VesselRanks{std::vector<std::int32_t>(partition_.rank_of_vessel.begin(), partition_.rank_of_vessel.end()), true};
 }
 
 }  // namespace hemotree

@@ -1,13 +1,20 @@
-// A pulsatile run over MPI ranks as the solver takes it (pulse/pulse_solver.hpp's PulseRanks):
-// the tree partitioned by subtrees, the 1D vessels and every vessel above them moved to the
-// top's rank once the solver has chosen the models (partition/keep_on_top), and each step's
-// messages over MPI (solver/lumped_link_mpi.hpp), their exchange made at the first step from
-// the cut's roots per rank; per-item numbers made whole on every rank (MPI_Allgatherv of each
-// rank's items and values: the compliance balance's, once a cycle).
+// A pulsatile run over MPI ranks as the solver takes it (pulse/pulse_solver.hpp's PulseRanks),
+// dealt once the solver has chosen the models, one of two ways:
+//  - a tree: partitioned by subtrees, the 1D vessels and every vessel above them moved to the
+//    top's rank (partition/keep_on_top), and each step's messages over MPI, their exchange
+//    made at the first step from the cut's roots per rank;
+//  - where that leaves a rank without a vessel (the large arteries' models, nearly all 1D),
+//    or the network has loops (no top): the 1D vessels spread, the
+//    partition by each vessel's step (subtrees, or METIS), every vessel at a 0D vessel's node
+//    with it; the traces at junctions across the cut exchanged with each neighbouring rank
+//    (MPI_Isend, MPI_Irecv) at every evaluation, failures by one MPI_Allreduce.
+// Per-item numbers are made whole on every rank (MPI_Allgatherv of each rank's items and
+// values: the compliance balance's, once a cycle).
 #pragma once
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -20,17 +27,21 @@ namespace hemotree {
 
 class MpiPulseRanks {
  public:
-  // Over MPI_COMM_WORLD's ranks; cost: per vessel, its weight in the partition. The network
-  // must outlive this. SettingError "ranks" (every rank alike) for a network with loops or a
-  // top spread over the ranks (distributed/network_cut.hpp's check_subtree_partition).
+  // Over MPI_COMM_WORLD's ranks; cost: per vessel, its weight in a tree's partition by
+  // subtrees. The network must outlive this. SettingError "ranks" (every rank alike) for more
+  // ranks than vessels here, and, as the solver deals the vessels, for a tree's top spread over
+  // the ranks (distributed/network_cut.hpp's check_subtree_partition) or a rank left without a
+  // vessel.
   MpiPulseRanks(const Network& net, std::vector<double> cost);
   MpiPulseRanks(const MpiPulseRanks&) = delete;  // the link refers to this
   MpiPulseRanks& operator=(const MpiPulseRanks&) = delete;
 
   const PulseRanks& ranks() const { return ranks_; }
-  // After the solver is built: the partition with the 1D vessels kept on the top, and the
-  // vessels the top's rank holds.
+  // After the solver is built: the partition (with the 1D vessels kept on the top, or spread),
+  // and the vessels the top's rank holds (0 where spread).
   const Partition& partition() const { return partition_; }
+  bool one_d_spread() const { return dealt_ && dealt_->one_d_spread; }
+  std::size_t trace_exchanges() const { return trace_exchanges_; }  // with the 1D vessels spread
   std::size_t top_vessels() const { return top_vessels_; }
   const RootExchange* exchange() const { return exchange_.get(); }  // null before the first step
   // Per rank, its root vessels (LumpedCut::roots): the messages' sizes. Known once the solver is built.
@@ -51,6 +62,12 @@ class MpiPulseRanks {
   std::size_t top_vessels_ = 0;
   double top_weight_ = 0;
   std::unique_ptr<RootExchange> exchange_;
+  std::optional<VesselRanks> dealt_;
+  std::vector<bool> dealt_zero_d_;
+  std::size_t trace_exchanges_ = 0;
+  VesselRanks deal(const std::vector<bool>& zero_d, std::span<const double> step_cost);
+  VesselRanks on_top(const std::vector<bool>& zero_d);
+  VesselRanks spread(const std::vector<bool>& zero_d, std::span<const double> step_cost);
 };
 
 }  // namespace hemotree

@@ -26,7 +26,7 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   stats.begin(solver);
   double sampled_until = solver.time();
   // Over ranks every decision is every rank's (solver/decisions_over_ranks.hpp).
-  const bool over_ranks = solver.lumped().over_ranks();
+  const bool over_ranks = solver.over_ranks();
   for (std::size_t k = 0; k < steps; ++k) {
     solver.step();
     stats.sample(solver, solver.time(), solver.time() - sampled_until);
