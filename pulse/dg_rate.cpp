@@ -239,14 +239,26 @@ void PulseSolver::coupled_end_fluxes(double t, PulseState& rate) {
   // (boundaries/coupled_node.hpp).
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
     const auto& c = boundaries_.coupled[k];
-    if (coupled_slot_[k] < 0) continue;  // another rank's
+    if (!steps_end(c.end)) continue;  // another rank's
     double a, q;
     trace(c.end, a, q);
-    // The node's response r = 3/2 Z (docs/solver.md §10), its pressure at this point of the step.
+    // The node's response r = 3/2 Z (docs/solver.md §10), its pressure at this point of the step
+    // (spread over ranks, a node of another rank's as it sent it: the same arithmetic).
     const double s = dt_ > 0 ? std::clamp((t - step_start_) / dt_, 0.0, 1.0) : 0.0;
-    const auto slot = static_cast<std::size_t>(coupled_slot_[k]);
-    const double r = 1.5 * lumped_.impedance(slot);
-    const CoupledNode coupled{lumped_.pressure_during_step(slot, s), lumped_.dynamic_pressure(slot), r, held_end_flow_[k]};
+    double p, z, dynamic;
+    if (coupled_slot_[k] >= 0) {
+      const auto slot = static_cast<std::size_t>(coupled_slot_[k]);
+      p = lumped_.pressure_during_step(slot, s);
+      z = lumped_.impedance(slot);
+      dynamic = lumped_.dynamic_pressure(slot);
+    } else {
+      const auto& [p0, predicted, impedance, dynamic_there] = remote_node_[k];
+      p = p0 + s * (predicted - p0);
+      z = impedance;
+      dynamic = dynamic_there;
+    }
+    const double r = 1.5 * z;
+    const CoupledNode coupled{p, dynamic, r, held_end_flow_[k]};
     const EndState u = coupled.end_state(end_law(static_cast<std::size_t>(c.end.vessel), c.end.distal), a, q, c.end.distal);
     set_end_flux(c.end, u);
     rate.coupled(static_cast<Eigen::Index>(k)) = CoupledNode::flow_into_node(u, c.end.distal);

@@ -144,6 +144,10 @@ class LumpedVessels {
     return p0 + s * (coupling_predicted_[j] - p0);
   }
   double impedance(std::size_t j) const { return impedance_[j]; }  // at coupling node j
+  // What pressure_during_step(j, s) is made of: the pressure at the step's start and the
+  // prediction (another rank's coupled end takes them over ranks, and the same arithmetic).
+  double start_pressure(std::size_t j) const { return pressure_[static_cast<std::size_t>(coupling_nodes_[j])]; }
+  double predicted_pressure(std::size_t j) const { return coupling_predicted_[j]; }
   // predict()'s pressures at t1 at the coupling nodes again, for other held inflows (the same
   // solve, linear in them: their departures from the last held added to its forward half);
   // complete() then takes the departures from these.

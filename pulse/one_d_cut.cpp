@@ -44,4 +44,24 @@ OneDCut one_d_cut(const NetworkBoundaries& ends, std::span<const ElementRun> blo
   return cut;
 }
 
+CouplingCut coupling_cut(const NetworkBoundaries& ends, std::span<const std::int32_t> vessel_rank,
+                         std::span<const std::int32_t> node_rank, int rank) {
+  std::map<int, CouplingCut::Neighbour> by_rank;
+  for (std::size_t k = 0; k < ends.coupled.size(); ++k) {
+    const auto& c = ends.coupled[k];
+    const int end = vessel_rank[static_cast<std::size_t>(c.end.vessel)], node = node_rank[static_cast<std::size_t>(c.node)];
+    if (end == node) continue;
+    if (end == rank) {
+      by_rank[node].rank = node;
+      by_rank[node].ends.push_back(static_cast<std::int32_t>(k));
+    } else if (node == rank) {
+      by_rank[end].rank = end;
+      by_rank[end].nodes.push_back(static_cast<std::int32_t>(k));
+    }
+  }
+  CouplingCut cut;
+  for (auto& [r, n] : by_rank) cut.neighbours.push_back(std::move(n));
+  return cut;
+}
+
 }  // namespace hemotree

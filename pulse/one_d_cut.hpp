@@ -35,7 +35,35 @@ struct OneDCut {
     std::vector<VesselEnd> send, receive;
   };
   std::vector<Neighbour> neighbours;
+  std::vector<int> ranks() const {
+    std::vector<int> r;
+    for (const Neighbour& n : neighbours) r.push_back(n.rank);
+    return r;
+  }
 };
+
+// The 1D ends coupled to 0D nodes (NetworkBoundaries::coupled) whose node another rank holds:
+// per such rank, this rank's ends at its nodes (`ends`: their held inflows and volumes go
+// there, the node's pressures come back) and its ends at this rank's nodes (`nodes`), each in
+// the coupled ends' order. Each step: the held inflows out, the nodes' start and predicted
+// pressures, impedance and dynamic pressure back, the volumes let through out (and, between
+// coupling passes, the mean inflows out and the new predictions back).
+struct CouplingCut {
+  struct Neighbour {
+    int rank = 0;
+    std::vector<std::int32_t> ends, nodes;
+  };
+  std::vector<Neighbour> neighbours;
+  std::vector<int> ranks() const {
+    std::vector<int> r;
+    for (const Neighbour& n : neighbours) r.push_back(n.rank);
+    return r;
+  }
+};
+
+// node_rank: per network node, the rank of the 0D vessels there (-1: none).
+CouplingCut coupling_cut(const NetworkBoundaries& ends, std::span<const std::int32_t> vessel_rank,
+                         std::span<const std::int32_t> node_rank, int rank);
 
 // blocks: the degree blocks of the elements (every element in one); element_vessel: per
 // element its vessel; vessel_rank: per vessel its rank (a 0D vessel's not read).

@@ -1,8 +1,9 @@
 // PulseSolver with its 1D vessels spread over ranks (docs/scaling.md, "1D vessels across a
-// cut"; pulse/one_d_cut.hpp): a rank's share, the traces exchanged at every evaluation, and the
-// 1D state made whole on the lead rank for a checkpoint. Each rank steps its own vessels'
-// elements (runs_), solves the junctions where it has an end, and holds the 0D vessels whose
-// nodes only its vessels meet, as a 0D system of its own.
+// cut"; pulse/one_d_cut.hpp): a rank's share, the traces exchanged at every evaluation, the
+// 1D-0D couplings across the cut, and the 1D state made whole on the lead rank for a
+// checkpoint. Each rank steps its own vessels' elements (runs_), solves the junctions where
+// it has an end, and holds the 0D vessels meeting at its nodes as a 0D system of its own; a
+// 1D end at another rank's 0D node takes that node's pressures from it each step.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -41,17 +42,17 @@ void PulseSolver::take_spread_share(const PulseRanks& ranks, const std::vector<s
   const std::size_t n = net_.vessel_count();
   rank_ = ranks.rank;
   rank_count_ = ranks.ranks;
-  // Every vessel at a 0D vessel's node on one rank: each rank's 0D system is then whole, and
-  // every coupled 1D end's node its own.
+  // The 0D vessels meeting at a node on one rank: each rank's 0D system is then whole.
   std::vector<std::int32_t> node_rank(net_.node_count(), -1);
   for (std::size_t v = 0; v < n; ++v)
     if (zero_d_[v])
-      for (const std::int32_t node : {net_.from[v], net_.to[v]}) node_rank[static_cast<std::size_t>(node)] = vessel_rank[v];
-  for (std::size_t v = 0; v < n; ++v)
-    for (const std::int32_t node : {net_.from[v], net_.to[v]})
-      if (const std::int32_t r = node_rank[static_cast<std::size_t>(node)]; r >= 0 && r != vessel_rank[v])
-        throw std::invalid_argument("PulseSolver: vessel " + std::to_string(net_.id[v]) + " on rank " +
-                                    std::to_string(vessel_rank[v]) + ", a 0D vessel at its node on rank " + std::to_string(r));
+      for (const std::int32_t node : {net_.from[v], net_.to[v]}) {
+        std::int32_t& r = node_rank[static_cast<std::size_t>(node)];
+        if (r >= 0 && r != vessel_rank[v])
+          throw std::invalid_argument("PulseSolver: 0D vessel " + std::to_string(net_.id[v]) + " on rank " +
+                                      std::to_string(vessel_rank[v]) + ", another 0D vessel at its node on rank " + std::to_string(r));
+        r = vessel_rank[v];
+      }
   std::vector<bool> own_zero_d(n, false);
   steps_vessel_.assign(n, 0);
   for (std::size_t v = 0; v < n; ++v) {
@@ -70,7 +71,14 @@ void PulseSolver::take_spread_share(const PulseRanks& ranks, const std::vector<s
     trace_out_[i].resize(2 * one_d_cut_->neighbours[i].send.size());
     trace_in_[i].resize(2 * one_d_cut_->neighbours[i].receive.size());
   }
-  exchange_traces_ = ranks.exchange_traces;
+  trace_ranks_ = one_d_cut_->ranks();
+  coupling_cut_ = coupling_cut(boundaries_, vessel_rank, node_rank, rank_);
+  coupling_ranks_ = coupling_cut_->ranks();
+  coupling_out_.assign(coupling_ranks_.size(), {});
+  coupling_in_.assign(coupling_ranks_.size(), {});
+  remote_node_.assign(boundaries_.coupled.size(), {0.0, 0.0, 0.0, 0.0});
+  end_volume_.assign(boundaries_.coupled.size(), 0.0);
+  exchange_ = ranks.exchange;
   least_key_ = ranks.least_key;
   make_whole_ = ranks.make_whole;
   lead_whole_ = ranks.lead_whole;
@@ -91,7 +99,7 @@ void PulseSolver::exchange_traces() {
     const auto& send = cut.neighbours[i].send;
     for (std::size_t k = 0; k < send.size(); ++k) trace(send[k], trace_out_[i][2 * k], trace_out_[i][2 * k + 1]);
   }
-  exchange_traces_(cut, trace_out_, trace_in_);
+  exchange_(trace_ranks_, trace_out_, trace_in_);
   for (std::size_t i = 0; i < cut.neighbours.size(); ++i) {
     const auto& receive = cut.neighbours[i].receive;
     for (std::size_t k = 0; k < receive.size(); ++k) {
@@ -100,6 +108,37 @@ void PulseSolver::exchange_traces() {
       (e.distal ? flow_right_ : flow_left_)(e.element) = trace_in_[i][2 * k + 1];
     }
   }
+}
+
+void PulseSolver::send_to_nodes(std::vector<double>& per_end) {
+  const CouplingCut& cut = *coupling_cut_;
+  for (std::size_t i = 0; i < cut.neighbours.size(); ++i) {
+    coupling_out_[i].clear();
+    for (const std::int32_t k : cut.neighbours[i].ends) coupling_out_[i].push_back(per_end[static_cast<std::size_t>(k)]);
+    coupling_in_[i].resize(cut.neighbours[i].nodes.size());
+  }
+  exchange_(coupling_ranks_, coupling_out_, coupling_in_);
+  for (std::size_t i = 0; i < cut.neighbours.size(); ++i)
+    for (std::size_t j = 0; j < cut.neighbours[i].nodes.size(); ++j)
+      per_end[static_cast<std::size_t>(cut.neighbours[i].nodes[j])] = coupling_in_[i][j];
+}
+
+void PulseSolver::share_coupling_nodes() {
+  const CouplingCut& cut = *coupling_cut_;
+  for (std::size_t i = 0; i < cut.neighbours.size(); ++i) {
+    coupling_out_[i].clear();
+    for (const std::int32_t k : cut.neighbours[i].nodes) {
+      const auto slot = static_cast<std::size_t>(coupled_slot_[static_cast<std::size_t>(k)]);
+      coupling_out_[i].insert(coupling_out_[i].end(), {lumped_.start_pressure(slot), lumped_.predicted_pressure(slot),
+                                                       lumped_.impedance(slot), lumped_.dynamic_pressure(slot)});
+    }
+    coupling_in_[i].resize(4 * cut.neighbours[i].ends.size());
+  }
+  exchange_(coupling_ranks_, coupling_out_, coupling_in_);
+  for (std::size_t i = 0; i < cut.neighbours.size(); ++i)
+    for (std::size_t j = 0; j < cut.neighbours[i].ends.size(); ++j)
+      std::copy_n(coupling_in_[i].begin() + static_cast<std::ptrdiff_t>(4 * j), 4,
+                  remote_node_[static_cast<std::size_t>(cut.neighbours[i].ends[j])].begin());
 }
 
 PulseSolver::WholeOneD PulseSolver::whole_one_d_state() const {

@@ -173,6 +173,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   }
   choose_time_step(options);
   // The coupled ends' first linearisation needs their end states.
+  if (!coupling_ranks_.empty()) share_coupling_nodes();
   if (!boundaries_.coupled.empty() && one_d_here_) evaluate(time_, state_, rate_);
 
   law_beta_.resize(n);
@@ -279,9 +280,8 @@ void PulseSolver::couple_lumped_ends() {
   lumped_inflow_.assign(lumped_.inflow_boundaries().size(), 0.0);
   lumped_held_.assign(lumped_.held_boundaries().size(), 0.0);
   if (!one_d_here_) return;  // every coupled end is the top's
-  // With the 1D vessels spread over ranks, a coupled end is its vessel's rank's, which holds
-  // the 0D vessels at its node; another rank's end has no node here (slot -1).
-  for (const auto& c : boundaries_.coupled) coupled_node_.push_back(steps_end(c.end) ? lumped_.node_of(c.node) : -1);
+  // With the 1D vessels spread over ranks, a coupled end's node may be another rank's (slot -1).
+  for (const auto& c : boundaries_.coupled) coupled_node_.push_back(lumped_.node_of(c.node));
   std::vector<std::int32_t> nodes;
   for (const std::int32_t node : coupled_node_)
     if (node >= 0) nodes.push_back(node);
@@ -632,6 +632,7 @@ void PulseSolver::start_from(const PulseSolver& other) {
   restart_clock();
   have_previous_rate_ = false;  // the multistep history starts again
   // The coupled ends' first linearisation needs their end states (as after any start).
+  if (!coupling_ranks_.empty()) share_coupling_nodes();
   if (!boundaries_.coupled.empty() && one_d_here_) evaluate(time_, state_, rate_);
 }
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -123,9 +124,10 @@ struct PulseState {
 //  - a tree mostly 0D: this rank's whole subtrees of 0D vessels and, on the top's rank, every
 //    1D vessel and the 0D vessels above them (pulse/lumped_cut.hpp); each step's two messages
 //    carried by link. One pi section a 0D vessel (SolverOptions::lumped_sections 1);
-//  - the 1D vessels spread over the ranks (one_d_spread; pulse/one_d_cut.hpp), each 0D vessel
-//    on the rank of every vessel at its nodes, so that a rank's 0D system is its own; the
-//    traces at junctions across the cut exchanged at every evaluation (exchange_traces).
+//  - the 1D vessels spread over the ranks (one_d_spread; pulse/one_d_cut.hpp), the 0D vessels
+//    meeting at a node on one rank, so that a rank's 0D system is its own; the traces at
+//    junctions across the cut exchanged at every evaluation, and the coupled ends' inflows,
+//    nodes and volumes at every step where a 1D end's 0D node is another rank's (exchange).
 struct VesselRanks {
   std::vector<std::int32_t> rank;
   bool one_d_spread = false;
@@ -136,11 +138,12 @@ struct PulseRanks {
   // Told the cut once it is made (the messages' sizes: LumpedCut::roots), before any step.
   std::function<void(const LumpedCut& cut)> cut_made;
   LumpedLink link;
-  // The 1D vessels spread: each neighbour's traces out and in (send[i] to cut.neighbours[i],
-  // receive[i] from it: A and Q of each end in the cut's order). Collective among neighbours.
-  std::function<void(const OneDCut& cut, const std::vector<std::vector<double>>& send,
+  // The 1D vessels spread: numbers out to each neighbouring rank and in from it (send[i] to
+  // neighbours[i], receive[i] from it, each of the size both sides know). Collective among
+  // the neighbours.
+  std::function<void(std::span<const int> neighbours, const std::vector<std::vector<double>>& send,
                      std::vector<std::vector<double>>& receive)>
-      exchange_traces;
+      exchange;
   // The least of every rank's key (a failure's place in the run's order; none: the largest
   // int64). Collective.
   std::function<std::int64_t(std::int64_t key)> least_key;
@@ -483,7 +486,19 @@ class PulseSolver {
   // The 1D vessels spread over ranks: the cut, its messages' scratch, and the links.
   std::optional<OneDCut> one_d_cut_;
   std::vector<std::vector<double>> trace_out_, trace_in_;
-  std::function<void(const OneDCut&, const std::vector<std::vector<double>>&, std::vector<std::vector<double>>&)> exchange_traces_;
+  std::vector<int> trace_ranks_;
+  // The coupled ends whose node another rank holds (spread; empty elsewhere): the cut, each
+  // such end's node (start pressure, prediction, impedance, dynamic pressure) as its rank
+  // sent it, the messages' scratch, and per coupled end the value sent or received.
+  std::optional<CouplingCut> coupling_cut_;
+  std::vector<int> coupling_ranks_;
+  std::vector<std::array<double, 4>> remote_node_;
+  std::vector<std::vector<double>> coupling_out_, coupling_in_;
+  std::vector<double> end_volume_;
+  void send_to_nodes(std::vector<double>& per_end);  // each cut end's value to its node's rank
+  void share_coupling_nodes();                       // each cut node's pressures to its ends' ranks
+  void sum_held_inflows();                           // coupled_inflow_ from held_end_flow_
+  std::function<void(std::span<const int>, const std::vector<std::vector<double>>&, std::vector<std::vector<double>>&)> exchange_;
   std::function<std::int64_t(std::int64_t)> least_key_;
   // Whether an end's vessel is stepped here.
   bool steps_end(const VesselEnd& end) const { return steps_vessel_.empty() || steps_vessel_[static_cast<std::size_t>(end.vessel)]; }

@@ -229,14 +229,13 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
   // Euler response of a compliance-dominated node, it ran at 41 (docs/solver.md §10). With
   // several coupling passes the substeps are taken again, each time with the inflows held at
   // the means the pass before let through. Over ranks, a share steps its 0D vessels alone.
-  std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
   for (std::size_t k = 0; k < boundaries_.coupled.size() && one_d_here_; ++k) {
-    if (coupled_slot_[k] < 0) continue;  // another rank's (the 1D vessels spread)
     const VesselEnd& end = boundaries_.coupled[k].end;
+    if (!steps_end(end)) continue;  // another rank's (the 1D vessels spread)
     const EndState& u = boundaries_.state_at(end);
     held_end_flow_[k] = end.distal ? u.flow : -u.flow;
-    coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
   }
+  sum_held_inflows();
   step_start_ = time_;
   const double t1 = time_ + dt_;
   // The boundary flows and pressures at the 0D vessels' nodes, at the step's end.
@@ -257,6 +256,7 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
     constexpr std::int64_t none = std::numeric_limits<std::int64_t>::max();
     const std::int64_t least = least_key_(collapsed_vessel >= 0 ? collapsed_vessel : none);
     if (least != none) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(least)], time_);
+    if (!coupling_ranks_.empty()) share_coupling_nodes();
   }
   if (while_waiting && !one_d_here_) while_waiting();  // a share: the top's rank takes its substeps
   // The 1D vessels follow, seeing the coupling nodes' pressures move linearly to the prediction.
@@ -281,22 +281,37 @@ void PulseSolver::take_coupled_substeps() {
     // A pass before the last: its substeps, then the prediction again with each end's
     // inflow held at the mean it let through, and the 1D vessels back at the step's start.
     take_substeps();
-    std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
     for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k) {
-      if (coupled_slot_[k] < 0) continue;
+      if (!steps_end(boundaries_.coupled[k].end)) continue;
       const auto i = static_cast<Eigen::Index>(k);
       held_end_flow_[k] = (state_.coupled(i) - before(i)) / dt_;
-      coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
     }
+    sum_held_inflows();
     if (!lumped_.empty()) lumped_.predict_again(coupled_inflow_);
+    if (!coupling_ranks_.empty()) share_coupling_nodes();
     return_to_pass_start();
   }
   take_substeps();
+  if (!coupling_ranks_.empty()) {  // the volumes through the cut's ends to their nodes' ranks
+    for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
+      if (steps_end(boundaries_.coupled[k].end))
+        end_volume_[k] = state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
+    send_to_nodes(end_volume_);
+  }
   std::fill(coupled_volume_.begin(), coupled_volume_.end(), 0.0);
   for (std::size_t k = 0; k < boundaries_.coupled.size(); ++k)
     if (coupled_slot_[k] >= 0)
       coupled_volume_[static_cast<std::size_t>(coupled_slot_[k])] +=
-        state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k));
+          steps_end(boundaries_.coupled[k].end) ? state_.coupled(static_cast<Eigen::Index>(k)) - before(static_cast<Eigen::Index>(k))
+                                                : end_volume_[k];
+}
+
+void PulseSolver::sum_held_inflows() {
+  // Each node's held inflow, summed over its ends in their order (another rank's sent first).
+  if (!coupling_ranks_.empty()) send_to_nodes(held_end_flow_);
+  std::fill(coupled_inflow_.begin(), coupled_inflow_.end(), 0.0);
+  for (std::size_t k = 0; k < coupled_slot_.size(); ++k)  // (none on a share under the top)
+    if (coupled_slot_[k] >= 0) coupled_inflow_[static_cast<std::size_t>(coupled_slot_[k])] += held_end_flow_[k];
 }
 
 void PulseSolver::keep_pass_start() {

@@ -363,7 +363,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   PulseSolver& run = *solver;
   if (ranks && ranks->one_d_spread())
     observer.note(describe(ranks->partition()) + ", weighed by each vessel's step; the 1D vessels spread over the ranks "
-                  "(each 0D vessel with the vessels at its nodes), their traces exchanged at the cut's junctions");
+                  "(the 0D vessels meeting at a node on one rank), their traces exchanged at the cut's junctions and "
+                  "their couplings to 0D nodes across it");
   else if (ranks)
     observer.note(describe(ranks->partition()) + "; the top's rank steps " + std::to_string(ranks->top_vessels()) +
                   " vessels (the 1D ones and every vessel above them, with subtrees of its own; weighed for its "
@@ -468,8 +469,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     if (world_rank() != 0) return result;
     leave_collectives();
     if (ranks->one_d_spread())
-      observer.note("the 1D traces' exchanges on rank 0: " + std::to_string(ranks->trace_exchanges()) +
-                    " with its neighbouring ranks");
+      observer.note("the 1D vessels' exchanges on rank 0: " + std::to_string(ranks->trace_exchanges()) +
+                    " with its neighbouring ranks (traces, and coupled ends' inflows, nodes and volumes)");
     if (const RootExchange* exchange = ranks->exchange()) {
       const RootExchange::Traffic& t = exchange->traffic();
       observer.note("the 0D steps' exchanges on rank 0, the top's: " + std::to_string(t.calls) + " collective calls, " +

@@ -31,13 +31,13 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
     }
     return *dealt_;
   };
-  ranks_.exchange_traces = [this](const OneDCut& cut, const std::vector<std::vector<double>>& send,
-                              std::vector<std::vector<double>>& receive) {
-    std::vector<MPI_Request> requests(2 * cut.neighbours.size());
-    for (std::size_t i = 0; i < cut.neighbours.size(); ++i) {
-      MPI_Irecv(receive[i].data(), static_cast<int>(receive[i].size()), MPI_DOUBLE, cut.neighbours[i].rank, 21,
-                MPI_COMM_WORLD, &requests[2 * i]);
-      MPI_Isend(send[i].data(), static_cast<int>(send[i].size()), MPI_DOUBLE, cut.neighbours[i].rank, 21, MPI_COMM_WORLD,
+  ranks_.exchange = [this](std::span<const int> neighbours, const std::vector<std::vector<double>>& send,
+                           std::vector<std::vector<double>>& receive) {
+    std::vector<MPI_Request> requests(2 * neighbours.size());
+    for (std::size_t i = 0; i < neighbours.size(); ++i) {
+      MPI_Irecv(receive[i].data(), static_cast<int>(receive[i].size()), MPI_DOUBLE, neighbours[i], 21, MPI_COMM_WORLD,
+                &requests[2 * i]);
+      MPI_Isend(send[i].data(), static_cast<int>(send[i].size()), MPI_DOUBLE, neighbours[i], 21, MPI_COMM_WORLD,
                 &requests[2 * i + 1]);
     }
     MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
@@ -127,8 +127,9 @@ VesselRanks MpiPulseRanks::on_top(const std::vector<bool>& zero_d) {
 }
 
 VesselRanks MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<const double> step_cost) {
-  // The partition by each vessel's step, then every vessel at a 0D vessel's node kept on one
-  // rank (a 0D system is one rank's): each such group to the rank that holds most of its cost.
+  // The partition by each vessel's step, then the 0D vessels meeting at nodes kept on one rank
+  // (a 0D system is one rank's; the 1D ends at its nodes may be elsewhere): each such group to
+  // the rank that holds most of its cost.
   const std::size_t n = zero_d.size();
   Partition p = partition_network(net_, step_cost, world_size());
   std::vector<std::int32_t> parent(n);
@@ -140,23 +141,22 @@ VesselRanks MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<con
   std::vector<std::int32_t> at_node(net_.node_count(), -1);  // a 0D vessel there, the first
   for (std::size_t v = 0; v < n; ++v)
     if (zero_d[v])
-      for (const std::int32_t node : {net_.from[v], net_.to[v]})
-        if (at_node[static_cast<std::size_t>(node)] < 0) at_node[static_cast<std::size_t>(node)] = static_cast<std::int32_t>(v);
-  for (std::size_t v = 0; v < n; ++v)
-    for (const std::int32_t node : {net_.from[v], net_.to[v]})
-      if (const std::int32_t u = at_node[static_cast<std::size_t>(node)]; u >= 0) {
+      for (const std::int32_t node : {net_.from[v], net_.to[v]}) {
+        std::int32_t& u = at_node[static_cast<std::size_t>(node)];
+        if (u < 0) {
+          u = static_cast<std::int32_t>(v);
+          continue;
+        }
         const std::int32_t a = find(static_cast<std::int32_t>(v)), b = find(u);
         if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
       }
   const auto ranks = static_cast<std::size_t>(p.ranks);
   std::vector<std::int32_t> root(n);
   for (std::size_t v = 0; v < n; ++v) root[v] = find(static_cast<std::int32_t>(v));
-  // Per group (its root vessel) and rank, the cost there: groups are few and small.
+  // Per group of 0D vessels (its root vessel) and rank, the cost there.
   std::map<std::int32_t, std::vector<double>> cost_on;
   for (std::size_t v = 0; v < n; ++v) {
-    if (root[v] == static_cast<std::int32_t>(v) && at_node[static_cast<std::size_t>(net_.from[v])] < 0 &&
-        at_node[static_cast<std::size_t>(net_.to[v])] < 0)
-      continue;  // a 1D vessel among 1D vessels alone
+    if (!zero_d[v]) continue;
     auto& c = cost_on[root[v]];
     c.resize(ranks, 0.0);
     c[static_cast<std::size_t>(p.rank_of_vessel[v])] += step_cost[v];
@@ -180,9 +180,9 @@ VesselRanks MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<con
     for (const auto& [g, count] : joined) largest = std::max(largest, count);
     throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(p.ranks) + ": rank " +
                                     std::to_string(empty - p.vessels.begin()) + " would step no vessel: one rank steps " +
-                                    "the 0D vessels joined at their nodes with every vessel there (a 0D system over ranks " +
-                                    "is built for trees mostly 0D), and here they join " + std::to_string(largest) +
-                                    " of the " + std::to_string(n) + " vessels: run it on fewer ranks");
+                                    "the 0D vessels joined at their nodes (a 0D system over ranks is built for trees " +
+                                    "mostly 0D), and here they join " + std::to_string(largest) + " of the " +
+                                    std::to_string(n) + " vessels: run it on fewer ranks");
   }
   p.cut_nodes = count_cut_nodes(net_, p.rank_of_vessel);
   p.top.clear();  // no top: every rank steps its own 1D vessels

@@ -5,9 +5,10 @@
 //    made at the first step from the cut's roots per rank;
 //  - where that leaves a rank without a vessel (the large arteries' models, nearly all 1D),
 //    or the network has loops (no top): the 1D vessels spread, the
-//    partition by each vessel's step (subtrees, or METIS), every vessel at a 0D vessel's node
-//    with it; the traces at junctions across the cut exchanged with each neighbouring rank
-//    (MPI_Isend, MPI_Irecv) at every evaluation, failures by one MPI_Allreduce.
+//    partition by each vessel's step (subtrees, or METIS), the 0D vessels meeting at a node
+//    on one rank; the traces at junctions across the cut exchanged with each neighbouring
+//    rank (MPI_Isend, MPI_Irecv) at every evaluation, the couplings of 1D ends to another
+//    rank's 0D nodes at every step, failures by one MPI_Allreduce.
 // Per-item numbers are made whole on every rank (MPI_Allgatherv of each rank's items and
 // values: the compliance balance's, once a cycle).
 #pragma once

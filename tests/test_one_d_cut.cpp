@@ -1,6 +1,7 @@
 // The 1D vessels' cut over ranks (pulse/one_d_cut.hpp): which rows a rank steps, which
 // junctions it solves, and which traces it sends and receives; what one rank sends another
-// receives, end for end, so that both hold the same numbers at a junction.
+// receives, end for end, so that both hold the same numbers at a junction; and which coupled
+// 1D ends meet another rank's 0D node.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -99,6 +100,30 @@ TEST(OneDCut, ARankAloneSolvesItsJunctionsAndSendsNothing) {
   EXPECT_EQ(alone.runs[0].count, 5);
   EXPECT_TRUE(alone.neighbours.empty());
   EXPECT_EQ(alone.junctions.size(), 2u);
+}
+
+TEST(CouplingCut, EndsAtAnotherRanksNodesGoThereInTheCoupledEndsOrder) {
+  // Vessels 1 and 3 are 0D: vessel 0's distal end and vessel 2's proximal end meet 1 at node
+  // 1; vessel 4's proximal end meets 3 at node 2 (vessel 1's distal end is 0D).
+  const Network net = two_bifurcations();
+  const std::vector<bool> zero_d = {false, true, false, true, false};
+  const std::vector<std::int32_t> first = {0, -1, 1, -1, 2};
+  const NetworkBoundaries ends = build_boundaries(net, first, 1, zero_d);
+  ASSERT_EQ(ends.coupled.size(), 3u);
+  const std::vector<std::int32_t> rank = {0, 1, 0, 1, 0};  // the 0D vessels on rank 1
+  std::vector<std::int32_t> node_rank(net.node_count(), -1);
+  node_rank[1] = node_rank[2] = node_rank[4] = 1;
+  const CouplingCut zero = coupling_cut(ends, rank, node_rank, 0), one = coupling_cut(ends, rank, node_rank, 1);
+  ASSERT_EQ(zero.neighbours.size(), 1u);
+  ASSERT_EQ(one.neighbours.size(), 1u);
+  EXPECT_EQ(zero.neighbours[0].rank, 1);
+  EXPECT_EQ(zero.neighbours[0].ends, (std::vector<std::int32_t>{0, 1, 2}));  // all three: rank 0's ends
+  EXPECT_TRUE(zero.neighbours[0].nodes.empty());
+  EXPECT_EQ(one.neighbours[0].nodes, zero.neighbours[0].ends);
+  EXPECT_TRUE(one.neighbours[0].ends.empty());
+  // The ends and their nodes on one rank: nothing crosses.
+  const std::vector<std::int32_t> together = {1, 1, 1, 1, 1};
+  EXPECT_TRUE(coupling_cut(ends, together, node_rank, 1).neighbours.empty());
 }
 
 }  // namespace
