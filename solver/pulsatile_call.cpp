@@ -351,7 +351,10 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   SolverOptions options = solver_options(config);
   std::optional<MpiPulseRanks> ranks;
   if (over_ranks) {
-    on_every_rank([&] { ranks.emplace(net, std::vector<double>(net.vessel_count(), 1.0)); });  // a tree's subtrees
+    // A tree's subtrees; its 1D vessels spread where that balances the step, unless red cells
+    // or tracers are carried (their transport over ranks follows the subtrees under a top).
+    const OneDLayout layout = config.carries_transport() ? OneDLayout::top_where_possible : OneDLayout::balanced;
+    on_every_rank([&] { ranks.emplace(net, std::vector<double>(net.vessel_count(), 1.0), layout); });
     if (given.solver.lumped_sections > 1)
       observer.note("over " + std::to_string(world_size()) + " MPI ranks every 0D vessel is one pi section (" +
                     in_words(placeholder("lumped_sections"), config.words) + " 1): a vessel that would need more is 1D");

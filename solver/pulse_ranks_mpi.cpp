@@ -1,6 +1,8 @@
 #include "solver/pulse_ranks_mpi.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 
 #include "core/setting_error.hpp"
@@ -16,8 +18,8 @@ namespace hemotree {
 // The partition by the given costs first: too many ranks are refused here, before the
 // solver's steady solve; which way the vessels are dealt, and the top's weight, need the
 // models, and the vessels are dealt again once the solver has chosen them (vessel_ranks).
-MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
-    : net_(net), cost_(std::move(cost)), partition_(partition_network(net, cost_, world_size())) {
+MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDLayout layout)
+    : net_(net), cost_(std::move(cost)), layout_(layout), partition_(partition_network(net, cost_, world_size())) {
   check_one_partition(partition_);
   if (partition_.method == Partition::Method::subtrees && !partition_.top_spread) lead_with_the_top(partition_);
   ranks_.ranks = world_size();
@@ -83,16 +85,20 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost)
 }
 
 VesselRanks MpiPulseRanks::deal(const std::vector<bool>& zero_d, std::span<const double> step_cost) {
-  // A tree: its top holds every 1D vessel, as long as that leaves every rank a vessel. A network
-  // with loops (no top), or a tree whose 1D vessels are nearly all of it (the large arteries'
-  // models): the 1D vessels spread (docs/scaling.md, "1D vessels across a cut").
+  // A network with loops (no top): the 1D vessels spread (docs/scaling.md, "1D vessels across a
+  // cut"). A tree: spread where that balances its step (OneDLayout::balanced), else its top
+  // holds every 1D vessel, as long as that leaves every rank a vessel (a tree nearly all 1D,
+  // the large arteries' models, spread).
   const int ranks = world_size();
-  if (ranks > 1 && partition_.method == Partition::Method::metis) return spread(zero_d, step_cost);
+  constexpr double must = std::numeric_limits<double>::infinity();
+  if (ranks > 1 && partition_.method == Partition::Method::metis) return *spread(zero_d, step_cost, must);
+  if (ranks > 1 && layout_ == OneDLayout::balanced)
+    if (std::optional<VesselRanks> spread_out = spread(zero_d, step_cost, spread_balance)) return *spread_out;
   try {
     return on_top(zero_d);
   } catch (const SettingError&) {
     if (ranks == 1 || partition_.method != Partition::Method::subtrees || partition_.top_spread) throw;
-    return spread(zero_d, step_cost);
+    return *spread(zero_d, step_cost, must);
   }
 }
 
@@ -126,7 +132,8 @@ VesselRanks MpiPulseRanks::on_top(const std::vector<bool>& zero_d) {
   }
 }
 
-VesselRanks MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<const double> step_cost) {
+std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<const double> step_cost,
+                                                  double most_imbalance) {
   // The partition by each vessel's step, then the 0D vessels meeting at nodes kept on one rank
   // (a 0D system is one rank's; the 1D ends at its nodes may be elsewhere): each such group to
   // the rank that holds most of its cost.
@@ -173,6 +180,7 @@ VesselRanks MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<con
     ++p.vessels[static_cast<std::size_t>(p.rank_of_vessel[v])];
   }
   if (const auto empty = std::find(p.vessels.begin(), p.vessels.end(), std::size_t{0}); empty != p.vessels.end()) {
+    if (std::isfinite(most_imbalance)) return std::nullopt;
     std::map<std::int32_t, std::size_t> joined;
     for (std::size_t v = 0; v < n; ++v)
       if (group_rank.count(root[v])) ++joined[root[v]];
@@ -184,6 +192,7 @@ VesselRanks MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<con
                                     "mostly 0D), and here they join " + std::to_string(largest) + " of the " +
                                     std::to_string(n) + " vessels: run it on fewer ranks");
   }
+  if (p.imbalance() > most_imbalance) return std::nullopt;
   p.cut_nodes = count_cut_nodes(net_, p.rank_of_vessel);
   p.top.clear();  // no top: every rank steps its own 1D vessels
   p.top_spread = false;

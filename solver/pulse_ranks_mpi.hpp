@@ -26,6 +26,11 @@
 
 namespace hemotree {
 
+// Where a tree can be dealt either way: its top holding every 1D vessel wherever that leaves
+// every rank a vessel (what red cells and tracers over ranks take: their transport follows
+// the subtrees under the top), or the 1D vessels spread wherever that balances the step.
+enum class OneDLayout { top_where_possible, balanced };
+
 class MpiPulseRanks {
  public:
   // Over MPI_COMM_WORLD's ranks; cost: per vessel, its weight in a tree's partition by
@@ -33,7 +38,7 @@ class MpiPulseRanks {
   // ranks than vessels here, and, as the solver deals the vessels, for a tree's top spread over
   // the ranks (distributed/network_cut.hpp's check_subtree_partition) or a rank left without a
   // vessel.
-  MpiPulseRanks(const Network& net, std::vector<double> cost);
+  MpiPulseRanks(const Network& net, std::vector<double> cost, OneDLayout layout = OneDLayout::top_where_possible);
   MpiPulseRanks(const MpiPulseRanks&) = delete;  // the link refers to this
   MpiPulseRanks& operator=(const MpiPulseRanks&) = delete;
 
@@ -53,10 +58,14 @@ class MpiPulseRanks {
   // cycle): measured on the 421,047-vessel tree over 2 ranks, the best of the top's extra
   // weights 0, 0.1, 0.2, 0.3 of the vessels (bench/README.md) is 0.2, which this gives.
   static constexpr double statistics_per_vessel_step = 0.5;
+  // The largest rank's step cost over the mean that a tree's spread partition may have to be
+  // taken instead of its top (OneDLayout::balanced; docs/scaling.md, item 11).
+  static constexpr double spread_balance = 1.05;
 
  private:
   const Network& net_;
   std::vector<double> cost_;
+  OneDLayout layout_;
   Partition partition_;
   PulseRanks ranks_;
   std::vector<int> roots_;
@@ -68,7 +77,10 @@ class MpiPulseRanks {
   std::size_t trace_exchanges_ = 0;
   VesselRanks deal(const std::vector<bool>& zero_d, std::span<const double> step_cost);
   VesselRanks on_top(const std::vector<bool>& zero_d);
-  VesselRanks spread(const std::vector<bool>& zero_d, std::span<const double> step_cost);
+  // The 1D vessels spread, where the partition leaves no rank empty and its imbalance is at
+  // most most_imbalance (infinite: it must; SettingError "ranks" where a rank is left empty).
+  std::optional<VesselRanks> spread(const std::vector<bool>& zero_d, std::span<const double> step_cost,
+                                    double most_imbalance);
 };
 
 }  // namespace hemotree
