@@ -52,8 +52,19 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
                              &flux_a_right_, &flux_q_left_, &flux_q_right_})
     v->resize(elements);
 
-  Eigen::Index bad_element = volume_terms(s, rate);
-  if (bad_element >= 0 && !one_d_cut_) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad_element])], t);
+  // Spread over ranks a failure is kept for the step's end (settle_failures), where the first
+  // of every rank's is said on all of them: one reduction a step, not one an evaluation. A rank
+  // that has failed in this step computes nothing more, but keeps its neighbours' exchanges.
+  const auto evaluation = static_cast<std::int64_t>(evaluation_times_.size());
+  if (one_d_cut_) {
+    evaluation_times_.push_back(t);
+    if (first_failure_ != no_failure) {
+      exchange_traces();
+      return;
+    }
+  }
+  const Eigen::Index bad_element = volume_terms(s, rate);
+  if (bad_element >= 0 && !one_d_cut_) throw SolutionBreakdown(failed_vessel(bad_element), t);
   if (one_d_cut_) exchange_traces();
   std::int64_t bad_junction = -1;
   if (bad_element < 0) {
@@ -64,20 +75,30 @@ void PulseSolver::evaluate(double t, const PulseState& s, PulseState& rate) {
     boundary_exchange(rate);
     bad_junction = junction_fluxes();
   }
-  if (one_d_cut_) {
-    // The first failure of any rank, as the one process meets it: an element's (the least)
-    // before any junction's.
-    constexpr std::int64_t none = std::numeric_limits<std::int64_t>::max();
-    const std::int64_t key = least_key_(bad_element >= 0 ? bad_element : bad_junction >= 0 ? elements + bad_junction : none);
-    bad_element = key < elements ? key : -1;
-    bad_junction = key != none && key >= elements ? key - elements : -1;
-  }
-  if (bad_element >= 0) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(element_vessel_[bad_element])], t);
-  if (bad_junction >= 0) {
-    const auto first = boundaries_.junction_offset[static_cast<std::size_t>(bad_junction)];
-    throw SolutionBreakdown(net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)], t);
+  if (bad_element >= 0 || bad_junction >= 0) {
+    // The one process's order: an element's failure (the least) before any junction's.
+    const std::int64_t key = bad_element >= 0 ? bad_element : elements + bad_junction;
+    if (!one_d_cut_) throw SolutionBreakdown(failed_vessel(key), t);
+    first_failure_ = evaluation * failure_keys() + key;
+    return;
   }
   lift_to_rate(rate);
+}
+
+std::int64_t PulseSolver::failed_vessel(std::int64_t key) const {
+  const auto elements = static_cast<std::int64_t>(element_vessel_.size());
+  if (key < elements) return net_.id[static_cast<std::size_t>(element_vessel_[static_cast<std::size_t>(key)])];
+  const auto first = boundaries_.junction_offset[static_cast<std::size_t>(key - elements)];
+  return net_.id[static_cast<std::size_t>(boundaries_.junction_ends[static_cast<std::size_t>(first)].vessel)];
+}
+
+void PulseSolver::settle_failures() {
+  const std::int64_t first = least_key_(first_failure_);
+  std::vector<double> times;
+  std::swap(times, evaluation_times_);
+  first_failure_ = no_failure;
+  if (first == no_failure) return;
+  throw SolutionBreakdown(failed_vessel(first % failure_keys()), times[static_cast<std::size_t>(first / failure_keys())]);
 }
 
 // The element-local part of the right-hand side for elements [first, first + count): point

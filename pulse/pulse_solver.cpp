@@ -175,6 +175,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   // The coupled ends' first linearisation needs their end states.
   if (!coupling_ranks_.empty()) share_coupling_nodes();
   if (!boundaries_.coupled.empty() && one_d_here_) evaluate(time_, state_, rate_);
+  if (one_d_cut_) settle_failures();
 
   law_beta_.resize(n);
   law_area_.resize(n);
@@ -634,6 +635,7 @@ void PulseSolver::start_from(const PulseSolver& other) {
   // The coupled ends' first linearisation needs their end states (as after any start).
   if (!coupling_ranks_.empty()) share_coupling_nodes();
   if (!boundaries_.coupled.empty() && one_d_here_) evaluate(time_, state_, rate_);
+  if (one_d_cut_) settle_failures();
 }
 
 void PulseSolver::set_viscosity_factors(std::span<const double> per_vessel) {

@@ -503,6 +503,19 @@ class PulseSolver {
   // Whether an end's vessel is stepped here.
   bool steps_end(const VesselEnd& end) const { return steps_vessel_.empty() || steps_vessel_[static_cast<std::size_t>(end.vessel)]; }
   bool lumped_in_run_ = false;  // any 0D vessel on any rank: a step is a 0D step around 1D substeps
+  // Spread over ranks: the times of this step's evaluations so far, and its first failure here
+  // (the evaluation's place times failure_keys() plus the key: an element's index, or the
+  // elements' count plus a junction's), or no_failure.
+  static constexpr std::int64_t no_failure = std::numeric_limits<std::int64_t>::max();
+  std::vector<double> evaluation_times_;
+  std::int64_t first_failure_ = no_failure;
+  std::int64_t failure_keys() const {
+    return static_cast<std::int64_t>(element_vessel_.size() + boundaries_.junction_offset.size());
+  }
+  std::int64_t failed_vessel(std::int64_t key) const;  // the id of the vessel a failure's key names
+  // The first failure of this step on any rank, thrown on every rank as the one process would
+  // throw it (the same vessel, the same time); the step's record cleared. Collective.
+  void settle_failures();
   std::vector<std::int8_t> vessel_degree_;  // per vessel: -1 (0D) to 30 (run_configuration)
   int elements_per_vessel_ = 1;
   // Each 1D vessel's first element, by vessel (increasing): its elements are consecutive. Only

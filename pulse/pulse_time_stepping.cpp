@@ -213,6 +213,7 @@ void PulseSolver::step(const std::function<void()>& while_waiting) {
   if (lumped_count_after_release_) throw std::logic_error("PulseSolver::step after release_lumped_state");
   if (!lumped_in_run_) {
     step_1d(dt_);
+    if (one_d_cut_) settle_failures();
     time_ += dt_;
   } else {
     step_coupled(while_waiting);
@@ -269,6 +270,7 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
       throw;
     }
   }
+  if (one_d_cut_) settle_failures();
   // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
   if (!lumped_.empty() || lumped_.over_ranks()) lumped_.complete(coupled_volume_, lumped_boundary_volume_);
   time_ = t1;

@@ -8,7 +8,7 @@
 //    partition by each vessel's step (subtrees, or METIS), the 0D vessels meeting at a node
 //    on one rank; the traces at junctions across the cut exchanged with each neighbouring
 //    rank (MPI_Isend, MPI_Irecv) at every evaluation, the couplings of 1D ends to another
-//    rank's 0D nodes at every step, failures by one MPI_Allreduce.
+//    rank's 0D nodes at every step, failures by one MPI_Allreduce a step.
 // Per-item numbers are made whole on every rank (MPI_Allgatherv of each rank's items and
 // values: the compliance balance's, once a cycle).
 #pragma once
