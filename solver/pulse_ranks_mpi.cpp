@@ -91,7 +91,8 @@ VesselRanks MpiPulseRanks::deal(const std::vector<bool>& zero_d, std::span<const
   // the large arteries' models, spread).
   const int ranks = world_size();
   constexpr double must = std::numeric_limits<double>::infinity();
-  if (ranks > 1 && partition_.method == Partition::Method::metis) return *spread(zero_d, step_cost, must);
+  if (ranks > 1 && (partition_.method == Partition::Method::metis || layout_ == OneDLayout::spread))
+    return *spread(zero_d, step_cost, must);
   if (ranks > 1 && layout_ == OneDLayout::balanced)
     if (std::optional<VesselRanks> spread_out = spread(zero_d, step_cost, spread_balance)) return *spread_out;
   try {

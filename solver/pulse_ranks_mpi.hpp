@@ -28,8 +28,9 @@ namespace hemotree {
 
 // Where a tree can be dealt either way: its top holding every 1D vessel wherever that leaves
 // every rank a vessel (what red cells and tracers over ranks take: their transport follows
-// the subtrees under the top), or the 1D vessels spread wherever that balances the step.
-enum class OneDLayout { top_where_possible, balanced };
+// the subtrees under the top), the 1D vessels spread wherever that balances the step, or
+// spread wherever that leaves every rank a vessel.
+enum class OneDLayout { top_where_possible, balanced, spread };
 
 class MpiPulseRanks {
  public:
