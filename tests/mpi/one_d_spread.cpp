@@ -109,18 +109,7 @@ int main(int argc, char** argv) {
   }
   {
     // A small tree all 1D: a top would leave the other ranks without a vessel.
-    const Network net = [] {
-      Network full = test_networks::grown_tree(1e-3, 250e-6, 3);
-      full.blood = Blood{};
-      Inlet inlet;
-      inlet.vessel = full.id[0];
-      inlet.waveform.mean = 1.74e-6 / 60;
-      full.inlet = inlet;
-      const KeepMask keep(full.vessel_count(), 1);
-      Network pruned = extract(full, keep);
-      calibrate_outlets(full, keep, pruned, OutletParameters{});
-      return pruned;
-    }();
+    const Network net = test_networks::tree_with_waves(250e-6);
     SolverOptions options = test_networks::options_over_ranks();
     options.model = ModelChoice::one_d;
     PulseSolver whole(net, options);
