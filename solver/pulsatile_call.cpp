@@ -471,9 +471,12 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     // which has left every collective call: a failure of its writing is its own alone.
     if (world_rank() != 0) return result;
     leave_collectives();
-    if (ranks->one_d_spread())
-      observer.note("the 1D vessels' exchanges on rank 0: " + std::to_string(ranks->trace_exchanges()) +
-                    " with its neighbouring ranks (traces, and coupled ends' inflows, nodes and volumes)");
+    if (ranks->one_d_spread()) {
+      const MpiPulseRanks::SpreadTraffic& t = ranks->spread_traffic();
+      observer.note("the 1D vessels' exchanges on rank 0: " + std::to_string(t.messages) + " messages to its neighbouring ranks, " +
+                    std::to_string(t.bytes) + " bytes (traces, coupled ends), " + std::to_string(t.reductions) +
+                    " reductions, " + format_quantity(t.seconds, "s") + " inside them (waiting for the neighbours included)");
+    }
     if (const RootExchange* exchange = ranks->exchange()) {
       const RootExchange::Traffic& t = exchange->traffic();
       observer.note("the 0D steps' exchanges on rank 0, the top's: " + std::to_string(t.calls) + " collective calls, " +

@@ -35,6 +35,8 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDL
   };
   ranks_.exchange = [this](std::span<const int> neighbours, const std::vector<std::vector<double>>& send,
                            std::vector<std::vector<double>>& receive) {
+    if (neighbours.empty()) return;
+    const double started = MPI_Wtime();
     std::vector<MPI_Request> requests(2 * neighbours.size());
     for (std::size_t i = 0; i < neighbours.size(); ++i) {
       MPI_Irecv(receive[i].data(), static_cast<int>(receive[i].size()), MPI_DOUBLE, neighbours[i], 21, MPI_COMM_WORLD,
@@ -43,11 +45,16 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDL
                 &requests[2 * i + 1]);
     }
     MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
-    ++trace_exchanges_;
+    spread_traffic_.messages += neighbours.size();
+    for (const std::vector<double>& out : send) spread_traffic_.bytes += out.size() * sizeof(double);
+    spread_traffic_.seconds += MPI_Wtime() - started;
   };
-  ranks_.least_key = [](std::int64_t key) {
+  ranks_.least_key = [this](std::int64_t key) {
+    const double started = MPI_Wtime();
     std::int64_t least = key;
     MPI_Allreduce(&key, &least, 1, MPI_INT64_T, MPI_MIN, MPI_COMM_WORLD);
+    ++spread_traffic_.reductions;
+    spread_traffic_.seconds += MPI_Wtime() - started;
     return least;
   };
   ranks_.cut_made = [this](const LumpedCut& cut) { roots_ = cut.roots; };

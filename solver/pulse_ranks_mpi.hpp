@@ -48,7 +48,14 @@ class MpiPulseRanks {
   // and the vessels the top's rank holds (0 where spread).
   const Partition& partition() const { return partition_; }
   bool one_d_spread() const { return dealt_ && dealt_->one_d_spread; }
-  std::size_t trace_exchanges() const { return trace_exchanges_; }  // with the 1D vessels spread
+  // With the 1D vessels spread, this rank's messages (sent to its neighbours: traces, coupled
+  // ends), their bytes, its reductions (failures), and the seconds inside them, waiting
+  // included.
+  struct SpreadTraffic {
+    std::size_t messages = 0, bytes = 0, reductions = 0;
+    double seconds = 0;
+  };
+  const SpreadTraffic& spread_traffic() const { return spread_traffic_; }
   std::size_t top_vessels() const { return top_vessels_; }
   const RootExchange* exchange() const { return exchange_.get(); }  // null before the first step
   // Per rank, its root vessels (LumpedCut::roots): the messages' sizes. Known once the solver is built.
@@ -75,7 +82,7 @@ class MpiPulseRanks {
   std::unique_ptr<RootExchange> exchange_;
   std::optional<VesselRanks> dealt_;
   std::vector<bool> dealt_zero_d_;
-  std::size_t trace_exchanges_ = 0;
+  SpreadTraffic spread_traffic_;
   VesselRanks deal(const std::vector<bool>& zero_d, std::span<const double> step_cost);
   VesselRanks on_top(const std::vector<bool>& zero_d);
   // The 1D vessels spread, where the partition leaves no rank empty and its imbalance is at
