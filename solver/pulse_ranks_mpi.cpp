@@ -105,7 +105,9 @@ VesselRanks MpiPulseRanks::deal(const std::vector<bool>& zero_d, std::span<const
   try {
     return on_top(zero_d);
   } catch (const SettingError&) {
-    if (ranks == 1 || partition_.method != Partition::Method::subtrees || partition_.top_spread) throw;
+    // No top that leaves every rank a vessel, or a top spread over many ranks: spread needs
+    // neither (its own refusal, where it has one, is said instead).
+    if (ranks == 1) throw;
     return *spread(zero_d, step_cost, must);
   }
 }
@@ -147,6 +149,7 @@ std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d
   // the rank that holds most of its cost.
   const std::size_t n = zero_d.size();
   Partition p = partition_network(net_, step_cost, world_size());
+  check_one_partition(p);  // every rank's the same (collective: before any return)
   std::vector<std::int32_t> parent(n);
   for (std::size_t v = 0; v < n; ++v) parent[v] = static_cast<std::int32_t>(v);
   auto find = [&](std::int32_t v) {

@@ -455,6 +455,14 @@ if [ -f "$NETWORKS/openbf/boileau2015/adan56/adan56.yaml" ]; then
     && cmp -s "$WORK/adan-two/checkpoint.bin" "$WORK/adan-half/checkpoint.bin" \
     && pass "ADAN56 resumed: the plain run's checkpoint over 4 ranks, 2 ranks' as one process, the uninterrupted files" \
     || fail "ADAN56 resumed at another rank count: the files differ from the uninterrupted run's"
+  # Over 8 ranks a tree's top would be spread over them (refused for the top's layout): the 1D
+  # vessels spread need no top.
+  $MPIRUN -np 8 "$HEMOSOLVE" "$WORK/adan56.json" ${two/--cycles 2/--cycles 1} --out "$WORK/adan-8" >"$WORK/adan-out" 2>&1
+  "$HEMOSOLVE" "$WORK/adan56.json" ${two/--cycles 2/--cycles 1} --lumped-sections 1 --out "$WORK/adan-one-cycle" 2>/dev/null
+  grep -q "^hemosolve: 8 ranks by subtrees: .* the 1D vessels spread over the ranks" "$WORK/adan-out" \
+    && same_files "$WORK/adan-one-cycle" "$WORK/adan-8" \
+    && pass "ADAN56 over 8 ranks (oversubscribed), its 1D vessels spread: the plain run's files byte for byte" \
+    || fail "ADAN56 over 8 ranks: $(grep -m2 hemosolve "$WORK/adan-out")"
   "$BUILD/exchange/vimport" openbf "$NETWORKS/openbf/alastruey2007/circle_of_willis.yaml" -o "$WORK/willis.json" 2>/dev/null
   "$HEMOSOLVE" "$WORK/willis.json" --cycles 2 --probe 1 --lumped-sections 1 --out "$WORK/willis-one" 2>/dev/null
   $MPIRUN -np 2 "$HEMOSOLVE" "$WORK/willis.json" --cycles 2 --probe 1 --out "$WORK/willis-2" >"$WORK/willis-out" 2>&1
