@@ -433,8 +433,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
       on_every_rank([&] {
         throw SettingError(red ? "red_cells" : "tracer",
                            placeholder(red ? "red_cells" : "tracer") + " over MPI ranks runs on trees whose 1D vessels "
-                           "one rank holds; this network's are spread over the ranks (they cost more than a rank's "
-                           "share, or it has loops): run it on one rank");
+                           "one rank holds; this network's are spread over the ranks (a rank holding them all would "
+                           "leave another without a vessel, or the network has loops): run it on one rank");
       });
     if (ranks) over = TransportRanks{ranks->ranks().top_rank, ranks->roots()};
     // A refusal (a tracer given where the network has no boundary) is every rank's alike.
