@@ -503,6 +503,8 @@ class PulseSolver {
   // Whether an end's vessel is stepped here.
   bool steps_end(const VesselEnd& end) const { return steps_vessel_.empty() || steps_vessel_[static_cast<std::size_t>(end.vessel)]; }
   bool lumped_in_run_ = false;  // any 0D vessel on any rank: a step is a 0D step around 1D substeps
+  // Whether this rank steps a 0D system (spread over ranks a rank may have none).
+  bool steps_lumped() const { return !lumped_.empty() || lumped_.over_ranks(); }
   // Spread over ranks: the times of this step's evaluations so far, and its first failure here
   // (the evaluation's place times failure_keys() plus the key: an element's index, or the
   // elements' count plus a junction's), or no_failure.

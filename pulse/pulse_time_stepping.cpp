@@ -248,7 +248,7 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
   // any rank is said on every rank, the least vessel's.
   std::int64_t collapsed_vessel = -1;
   try {
-    if (!lumped_.empty() || lumped_.over_ranks()) lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
+    if (steps_lumped()) lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
   } catch (const LumpedVessels::CollapsedNode& collapsed) {
     if (!one_d_cut_) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_);
     collapsed_vessel = collapsed.vessel;
@@ -272,7 +272,7 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
   }
   if (one_d_cut_) settle_failures();
   // The 0D vessels receive exactly what the 1D ends let through: mass to round-off.
-  if (!lumped_.empty() || lumped_.over_ranks()) lumped_.complete(coupled_volume_, lumped_boundary_volume_);
+  if (steps_lumped()) lumped_.complete(coupled_volume_, lumped_boundary_volume_);
   time_ = t1;
 }
 

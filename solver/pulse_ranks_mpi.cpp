@@ -115,31 +115,29 @@ VesselRanks MpiPulseRanks::deal(const std::vector<bool>& zero_d, std::span<const
 VesselRanks MpiPulseRanks::on_top(const std::vector<bool>& zero_d) {
   const int ranks = world_size();
   check_subtree_partition(partition_);
-  {
-    std::vector<std::uint8_t> on_top(zero_d.size());
-    for (std::size_t v = 0; v < zero_d.size(); ++v) on_top[v] = zero_d[v] ? 0 : 1;
-    // The top's rank takes its statistics on the step's path, a share in its wait for the
-    // top's 1D substeps (docs/scaling.md, item 7): the top should hold x = N / ((P - 1)(1 + r)
-    // + 1) of the N 0D vessels, r a sample's cost over a vessel's step. An extra weight W on
-    // the tree's root (always the top's) deals it so: x + W = (N + W) / P.
-    const auto n = static_cast<double>(std::count(zero_d.begin(), zero_d.end(), true));
-    const double x = n / ((ranks - 1) * (1 + statistics_per_vessel_step) + 1);
-    top_weight_ = ranks > 1 ? (n - ranks * x) / (ranks - 1) : 0;
-    std::vector<double> cost = cost_;
-    if (top_weight_ > 0) {
-      cost[static_cast<std::size_t>(inlet_vessels(net_).front())] += top_weight_;  // a root: the top's
-      partition_ = partition_network(net_, cost, ranks);
-      check_subtree_partition(partition_);
-      check_one_partition(partition_);
-      lead_with_the_top(partition_);
-    }
-    keep_on_top(net_, cost, on_top, partition_);
-    std::vector<std::int32_t> rank(partition_.rank_of_vessel.begin(), partition_.rank_of_vessel.end());
-    for (const std::int32_t v : partition_.top) rank[static_cast<std::size_t>(v)] = partition_.top_rank;
-    top_vessels_ = 0;
-    for (const std::int32_t r : rank) top_vessels_ += r == partition_.top_rank ? 1 : 0;
-    return VesselRanks{rank, false};
+  std::vector<std::uint8_t> on_top(zero_d.size());
+  for (std::size_t v = 0; v < zero_d.size(); ++v) on_top[v] = zero_d[v] ? 0 : 1;
+  // The top's rank takes its statistics on the step's path, a share in its wait for the
+  // top's 1D substeps (docs/scaling.md, item 7): the top should hold x = N / ((P - 1)(1 + r)
+  // + 1) of the N 0D vessels, r a sample's cost over a vessel's step. An extra weight W on
+  // the tree's root (always the top's) deals it so: x + W = (N + W) / P.
+  const auto n = static_cast<double>(std::count(zero_d.begin(), zero_d.end(), true));
+  const double x = n / ((ranks - 1) * (1 + statistics_per_vessel_step) + 1);
+  top_weight_ = ranks > 1 ? (n - ranks * x) / (ranks - 1) : 0;
+  std::vector<double> cost = cost_;
+  if (top_weight_ > 0) {
+    cost[static_cast<std::size_t>(inlet_vessels(net_).front())] += top_weight_;  // a root: the top's
+    partition_ = partition_network(net_, cost, ranks);
+    check_subtree_partition(partition_);
+    check_one_partition(partition_);
+    lead_with_the_top(partition_);
   }
+  keep_on_top(net_, cost, on_top, partition_);
+  std::vector<std::int32_t> rank(partition_.rank_of_vessel.begin(), partition_.rank_of_vessel.end());
+  for (const std::int32_t v : partition_.top) rank[static_cast<std::size_t>(v)] = partition_.top_rank;
+  top_vessels_ = 0;
+  for (const std::int32_t r : rank) top_vessels_ += r == partition_.top_rank ? 1 : 0;
+  return VesselRanks{rank, false};
 }
 
 std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d, std::span<const double> step_cost,
