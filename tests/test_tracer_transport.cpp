@@ -130,6 +130,31 @@ TEST(TracerTransport, InjectionAtAFaceIsCountedApart) {
   for (int i = 0; i < 5; ++i) EXPECT_EQ(tracer.concentration()[static_cast<std::size_t>(i)], 0.0);  // upstream: none
 }
 
+// Blood circulating round a ring of three cells (an instant of circulation in a loop: no cell
+// is upstream of the others, so the step sweeps them by Gauss-Seidel): each cell's backward
+// Euler balance C+_i (V + q) = V C_i + q C+_(i-1), a 3 x 3 linear system solved here by
+// hand, from C = (1, 0, 0). Every sweep starts from the step's own C, not the last sweep's
+// (which would forget what the cells held: the fixed point then the mean of the inflows).
+TEST(TracerTransport, CirculationRoundARingSolvesEachCellsBalanceFromTheStepsStart) {
+  TransportGrid ring;
+  for (int i = 0; i < 3; ++i) ring.add_cell(i, 1.0);
+  for (int i = 0; i < 3; ++i) ring.add_face(i, (i + 1) % 3, i, 10e-6);
+  const double volume = 1e-13, q = 0.5e-13;
+  RedCellTransport cells(ring, std::vector<double>(3, volume), 0.45, RedCellOptions{false, 1, true});
+  TracerTransport tracer(3, 0, TracerCarrier::blood);
+  tracer.restore(std::vector<double>{1, 0, 0}, {}, {}, {}, 0, 0);
+  cells.step(std::vector<double>(3, q), {});
+  ASSERT_EQ(cells.order().cyclic, 3u);
+  tracer.step(cells, {}, {});
+  // a = V / (V + q), b = q / (V + q): C0 = a + b C2, C1 = b C0, C2 = b C1 = b^2 C0.
+  const double a = volume / (volume + q), b = q / (volume + q);
+  const double c0 = a / (1 - b * b * b), c1 = b * c0, c2 = b * c1;
+  EXPECT_NEAR(tracer.concentration()[0], c0, 1e-14);
+  EXPECT_NEAR(tracer.concentration()[1], c1, 1e-14);
+  EXPECT_NEAR(tracer.concentration()[2], c2, 1e-14);
+  EXPECT_NEAR(tracer.amount(cells), volume, 1e-27);  // a closed ring keeps what it holds
+}
+
 TEST(IndicatorCurves, LandmarksOfKnownCurves) {
   // A triangle from 1 to 3 s peaking at 2 s (height 1), after a bolus centred at 0.5 s.
   IndicatorCurves bolus(1, 1.0, 0.5, false);

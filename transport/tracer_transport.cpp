@@ -74,7 +74,7 @@ double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_ce
   const TransportGrid& grid = red_cells.grid();
   const CellFaces& faces = red_cells.faces();
   const std::span<const double> blood = red_cells.blood_step().face;
-  double rhs = m.before[c] * concentration_[c], carrier = m.after[c];
+  double rhs = m.before[c] * start_[c], carrier = m.after[c];
   for (auto i = faces.start[c]; i < faces.start[c + 1]; ++i) {
     const auto f = static_cast<std::size_t>(faces.face[static_cast<std::size_t>(i)]);
     if (blood[f] == 0) continue;
@@ -82,7 +82,7 @@ double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_ce
     if ((static_cast<std::size_t>(grid.a[f]) == c) == (blood[f] > 0)) carrier += through;
     else rhs += through * inflowing(f, red_cells, inflow, injected);
   }
-  return carrier > 0 ? rhs / carrier : concentration_[c];  // no carrier here or through: unchanged
+  return carrier > 0 ? rhs / carrier : start_[c];  // no carrier here or through: unchanged
 }
 
 void TracerTransport::step(const RedCellTransport& red_cells, std::span<const double> inflow,
@@ -98,6 +98,9 @@ void TracerTransport::begin_step(const RedCellTransport& red_cells, std::span<co
   if (inflow.size() != grid.boundaries || (!injected.empty() && injected.size() != grid.face_count()))
     throw InputError("tracer transport: a step needs " + std::to_string(grid.boundaries) +
                      " boundary concentrations and none or one injection per face");
+  // The step starts from these, however often a cell is solved (a circulation's sweeps, the
+  // rounds of a run over ranks).
+  start_.assign(concentration_.begin(), concentration_.end());
   // What the injections add, at the concentrations upstream before they move.
   const CarrierStep& m = carrier_step(red_cells);
   for (std::size_t f = 0; f < injected.size(); ++f) injected_ += std::abs(m.face[f]) * injected[f];

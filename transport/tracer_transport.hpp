@@ -74,6 +74,7 @@ class TracerTransport {
 
   TracerCarrier carrier_;
   std::vector<double> concentration_, face_concentration_, last_outflow_;
+  std::vector<double> start_;  // per cell, the concentration the step started from
   std::vector<double> entered_, left_;  // per boundary
   double injected_ = 0, adjusted_ = 0;
 };
