@@ -275,6 +275,10 @@ class PulseSolver {
   bool one_d_spread() const { return one_d_cut_.has_value(); }
   bool over_ranks() const { return lumped_.over_ranks() || one_d_spread(); }
   bool steps_vessel(std::size_t vessel) const { return steps_vessel_.empty() || steps_vessel_[vessel]; }
+  // With the 1D vessels spread: every vessel's rank, and this rank (what a transport over the
+  // same cut needs: solver/flow_transport_spread.cpp). Empty otherwise.
+  std::span<const std::int32_t> vessel_ranks() const { return vessel_rank_; }
+  int rank() const { return rank_; }
 
   // A vessel's tube law: at its `from` end (the whole vessel's unless it tapers), at one of
   // its ends, and at fraction x along it.
@@ -485,6 +489,7 @@ class PulseSolver {
   std::vector<ElementRun> runs_;  // the rows this rank steps: blocks_, or its part of them
   // The 1D vessels spread over ranks: the cut, its messages' scratch, and the links.
   std::optional<OneDCut> one_d_cut_;
+  std::vector<std::int32_t> vessel_rank_;  // per vessel where the 1D vessels are spread
   std::vector<std::vector<double>> trace_out_, trace_in_;
   std::vector<int> trace_ranks_;
   // The coupled ends whose node another rank holds (spread; empty elsewhere): the cut, each

@@ -26,6 +26,9 @@ double legendre_integral(int j, double lo, double hi) {
   return antiderivative(hi) - antiderivative(lo);
 }
 
+// What a 1D end meets where that is another rank's 0D node (the 1D vessels spread): a cut.
+constexpr std::int32_t remote_side = std::numeric_limits<std::int32_t>::min();
+
 // The diameter a face stands for: a tapered vessel's mean.
 double mean_diameter(const Network& net, std::size_t v) { return 0.5 * (net.diameter[v] + net.diameter_at_to(v)); }
 
@@ -64,11 +67,12 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
     cut_->across.assign(roots.size(), -1);
     cut_->far.assign(roots.size(), blood.hematocrit);
     cut_->ghost.assign(lumped.empty() ? 0 : lumped.network_node_count(), -1);
+    cut_->spread = solver.one_d_spread();
   }
   std::vector<double> volume;
   add_node_cells(grid, volume);
   const EndSides sides = add_one_d_cells(grid, volume);
-  add_faces(grid, roots, sides);
+  const EndFaces end_faces = add_faces(grid, roots, sides);
 
   inflow_hematocrit_.assign(grid.boundaries, blood.hematocrit);  // a cut's: given every step
   for (std::size_t b = 0; b < boundaries.size(); ++b) inflow_hematocrit_[b] = boundaries[b].entering_hematocrit(blood);
@@ -77,7 +81,8 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
                      RedCellOptions{options_.phase_separation, blood.phase_separation_diameter_scale(),
                                     !options_.tracers.empty()});
   face_volume_.assign(red_cells_->grid().face_count(), 0.0);
-  if (ranks) place_cut(*ranks);
+  if (cut_ && cut_->spread) place_spread_cut(end_faces);
+  else if (ranks) place_cut(*ranks);
   const std::size_t vessels = net.vessel_count();
   cycle_cells_.assign(vessels, 0.0);
   cycle_blood_.assign(vessels, 0.0);
@@ -152,18 +157,24 @@ FlowTransport::EndSides FlowTransport::add_one_d_cells(TransportGrid& grid, std:
   // Junctions of 1D vessels, and what meets each 1D end: (vessel, distal) -> cell or boundary.
   const NetworkBoundaries& ends = solver.network_boundaries();
   EndSides end_side;
+  const bool spread = cut_ && cut_->spread;
   for (std::size_t j = 0; j + 1 < ends.junction_offset.size() && solver.holds_one_d(); ++j) {
+    const std::span<const VesselEnd> at(ends.junction_ends.data() + ends.junction_offset[j],
+                                        static_cast<std::size_t>(ends.junction_offset[j + 1] - ends.junction_offset[j]));
+    // Spread: the junctions where this rank has an end, each numbered by the rank of its first.
+    if (spread && std::none_of(at.begin(), at.end(), [&](const VesselEnd& e) { return solver.steps_vessel(static_cast<std::size_t>(e.vessel)); })) continue;
     const auto cell = static_cast<std::int32_t>(grid.cell_count());
-    const VesselEnd& first = ends.junction_ends[static_cast<std::size_t>(ends.junction_offset[j])];
-    const auto v = static_cast<std::size_t>(first.vessel);
-    grid.add_cell(first.distal ? net_.to[v] : net_.from[v], 1.0);
+    const auto v = static_cast<std::size_t>(at[0].vessel);
+    if (spread && !solver.steps_vessel(v)) cut_->copies.push_back(cell);
+    grid.add_cell(at[0].distal ? net_.to[v] : net_.from[v], 1.0);
     volume.push_back(0.0);
-    for (auto e = ends.junction_offset[j]; e < ends.junction_offset[j + 1]; ++e) {
-      const VesselEnd& end = ends.junction_ends[static_cast<std::size_t>(e)];
-      end_side[{end.vessel, end.distal}] = cell;
-    }
+    for (const VesselEnd& end : at) end_side[{end.vessel, end.distal}] = cell;
   }
-  for (const auto& c : ends.coupled) end_side[{c.end.vessel, c.end.distal}] = solver.lumped().node_of(c.node);
+  // A 0D node another rank holds (the 1D vessels spread): a cut.
+  for (const auto& c : ends.coupled) {
+    const std::int32_t node = solver.lumped().empty() ? -1 : solver.lumped().node_of(c.node);
+    end_side[{c.end.vessel, c.end.distal}] = node >= 0 ? node : remote_side;
+  }
   for (const auto* given : {&ends.flows, &ends.pressures})
     for (const auto& g : *given) end_side[{g.end.vessel, g.end.distal}] = TransportGrid::boundary_side(static_cast<std::size_t>(g.index));
   for (const auto& o : ends.outlets)
@@ -171,7 +182,8 @@ FlowTransport::EndSides FlowTransport::add_one_d_cells(TransportGrid& grid, std:
   return end_side;
 }
 
-void FlowTransport::add_faces(TransportGrid& grid, const std::vector<std::int32_t>& roots, const EndSides& end_side) {
+FlowTransport::EndFaces FlowTransport::add_faces(TransportGrid& grid, const std::vector<std::int32_t>& roots,
+                                                 const EndSides& end_side) {
   const LumpedVessels& lumped = solver_.lumped();
   const RunBoundaries& boundaries = solver_.boundary_list();
   auto side_of = [&](std::int32_t v, bool distal) {
@@ -221,23 +233,52 @@ void FlowTransport::add_faces(TransportGrid& grid, const std::vector<std::int32_
     node_boundary_.push_back(static_cast<std::int32_t>(b));
     grid.add_face(k, TransportGrid::boundary_side(b), -1, 0.0);
   }
+  // The 1D vessels' faces, vessel after vessel in the one-process grid's order. Spread over the
+  // ranks, an end that meets another rank (its 0D node) goes to a cut, and an end of another
+  // rank's vessel at a junction or 0D node here is a face from there to a cut: each cell's
+  // faces in the one-process order.
+  const bool spread = cut_ && cut_->spread;
+  auto new_cut = [&grid] {
+    ++grid.cuts;
+    return TransportGrid::boundary_side(grid.boundaries++);
+  };
+  EndFaces end_faces;  // spread: per end, its face here and the cell on this side
   const int per_vessel = solver_.elements_per_vessel();
-  for (std::size_t i = 0; i < one_d_.size(); ++i) {
-    const std::int32_t v = one_d_[i];
+  for (const std::int32_t v : spread ? whole_one_d_order() : one_d_) {
     const double d0 = net_.diameter[static_cast<std::size_t>(v)], d1 = net_.diameter_at_to(static_cast<std::size_t>(v));
-    const std::int32_t first = vessel_first_cell_[i], last = first + per_vessel * slices_ - 1;
+    const std::int32_t i = one_d_place_[static_cast<std::size_t>(v)];
+    if (i < 0) {  // another rank's vessel (spread): its ends at a cell here
+      for (const bool distal : {false, true}) {
+        const auto found = end_side.find({v, distal});
+        if (found == end_side.end() || found->second < 0) continue;
+        const auto face = static_cast<std::int32_t>(grid.face_count());
+        grid.add_face(found->second, new_cut(), v, distal ? d1 : d0);
+        if (distal) turned.push_back(face);  // the one-process face runs into the cell
+        end_faces[{v, distal}] = {face, found->second};
+      }
+      continue;
+    }
+    const std::int32_t first = vessel_first_cell_[static_cast<std::size_t>(i)], last = first + per_vessel * slices_ - 1;
     vessel_first_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
-    const std::int32_t proximal = side_of(v, false), distal = side_of(v, true);
+    std::int32_t proximal = side_of(v, false), distal = side_of(v, true);
+    if (proximal == remote_side) {
+      proximal = new_cut();
+      turned.push_back(static_cast<std::int32_t>(grid.face_count()));  // the one-process face runs from the node
+    }
+    if (distal == remote_side) distal = new_cut();
+    if (spread) end_faces[{v, false}] = {static_cast<std::int32_t>(grid.face_count()), first};
     if (proximal >= 0) grid.add_face(proximal, first, v, d0);
     else grid.add_face(first, proximal, v, d0);
     proximal_sign_.push_back(proximal >= 0 ? 1 : -1);
     for (std::int32_t c = first; c < last; ++c) grid.add_face(c, c + 1, v, d0 + (d1 - d0) * (c + 1 - first) / (last - first + 1.0));
+    if (spread) end_faces[{v, true}] = {static_cast<std::int32_t>(grid.face_count()), last};
     grid.add_face(last, distal, v, d1);
   }
   if (cut_) {
     cut_->face_sign.assign(grid.face_count(), 1);
     for (const std::int32_t f : turned) cut_->face_sign[static_cast<std::size_t>(f)] = -1;
   }
+  return end_faces;
 }
 
 void FlowTransport::set_up_tracers() {
@@ -455,7 +496,9 @@ void FlowTransport::face_volumes() {
 
 void FlowTransport::advance() {
   face_volumes();
-  if (cut_) {
+  if (cut_ && cut_->spread) {
+    advance_spread();
+  } else if (cut_) {
     advance_over_ranks();
   } else {
     red_cells_->step(face_volume_, inflow_hematocrit_);
@@ -477,6 +520,7 @@ void FlowTransport::close_step() {
     const double q = face_volume_[f];
     if (v < 0 || q == 0) continue;
     const auto vi = static_cast<std::size_t>(v);
+    if (cut_ && cut_->spread && !solver_.steps_vessel(vi)) continue;  // another rank's vessel, its end here
     cycle_cells_[vi] += std::abs(cells.face[f]);
     cycle_blood_[vi] += std::abs(q);
     step_sum_[vi] += cells.face[f] / q;

@@ -19,8 +19,12 @@
 // step solves first the cells no cut's inflow reaches; the shares send r's hematocrit and
 // phase separation share up, the top solves the rest and sends u's down, the shares finish
 // (flow_transport_ranks.cpp); the tracers then ride on that step with two messages of their
-// own. Every cell's value is the one-process run's, bit for bit; every sum of the cycle, the
-// report and the checkpoint is taken on rank 0 in the one-process order.
+// own. Where the 1D vessels are spread over the ranks, each rank carries its own vessels'
+// slices, its 0D nodes and every junction where it has an end; a vessel end across the cut
+// is a face to a cut on the other side, and a step is solved in rounds, each rank's cells
+// with the cuts' inflows of the round before, until no inflow changes
+// (flow_transport_spread.cpp). Every cell's value is the one-process run's, bit for bit; every
+// sum of the cycle, the report and the checkpoint is taken on rank 0 in the one-process order.
 #pragma once
 
 #include <cstdint>
@@ -123,6 +127,14 @@ class FlowTransport {
   std::size_t advances() const { return advances_; }
   // Over ranks: the exchange of its steps' messages (its traffic); else null.
   const RootExchange* exchange() const { return cut_ ? cut_->exchange.get() : nullptr; }
+  // Where the 1D vessels are spread: this rank's transport steps, their rounds (each a solve
+  // of its cells and one message to each neighbouring rank), its messages and bytes, and the
+  // seconds inside the exchanges and reductions (null otherwise).
+  struct SpreadTraffic {
+    std::size_t steps = 0, rounds = 0, messages = 0, bytes = 0;
+    double seconds = 0;
+  };
+  const SpreadTraffic* spread_traffic() const { return cut_ && cut_->spread ? &cut_->traffic : nullptr; }
 
   void save(CheckpointWriter& out) const;
   // Over ranks: the one-process run's bytes, written to `out` on rank 0, null elsewhere. Collective.
@@ -137,7 +149,10 @@ class FlowTransport {
   using EndSides = std::map<std::pair<std::int32_t, bool>, std::int32_t>;
   void add_node_cells(TransportGrid& grid, std::vector<double>& volume) const;
   EndSides add_one_d_cells(TransportGrid& grid, std::vector<double>& volume);
-  void add_faces(TransportGrid& grid, const std::vector<std::int32_t>& roots, const EndSides& sides);
+  // Returns, the 1D vessels spread, per 1D end with a face here: that face and the cell on
+  // this side of the cut (an own vessel's end slice, or the junction or 0D node it meets here).
+  using EndFaces = std::map<std::pair<std::int32_t, bool>, std::pair<std::int32_t, std::int32_t>>;
+  EndFaces add_faces(TransportGrid& grid, const std::vector<std::int32_t>& roots, const EndSides& sides);
   void set_up_tracers();
   double fahraeus(double diameter) const;  // the Fahraeus parameter k of a lumen (1: the effect off)
   // Each 0D node's and 1D slice's volume in the solver now, into its cell's place.
@@ -172,6 +187,23 @@ class FlowTransport {
     std::vector<std::int32_t> cell_place, face_place;  // in the whole run's grid
     std::vector<signed char> face_sign;  // per face: +1, or -1 where a cut turned it round
     std::size_t cells = 0, faces = 0;    // the whole run's
+    // The 1D vessels spread (flow_transport_spread.cpp): the cells held here whose numbers are
+    // another rank's (a junction where it has an end too), and per neighbouring rank the faces
+    // whose numbers go there (with the cell on this side) and the cut faces taken from there,
+    // each in the run's order of vessel ends; whether each carries the face's volume (sent by
+    // the vessel's rank). The tracers' last inflows at the cuts (per tracer, per cut), and the
+    // exchanges' traffic.
+    bool spread = false;
+    std::vector<std::int32_t> copies;
+    struct Neighbour {
+      int rank = 0;
+      std::vector<std::int32_t> send_face, send_cell, receive_face;
+      std::vector<unsigned char> send_volume, receive_volume;
+    };
+    std::vector<Neighbour> neighbours;
+    std::size_t links = 0;  // the whole run's
+    std::vector<double> tracer_in;
+    SpreadTraffic traffic;
   };
   // The cut's faces were made with the grid; the rest of the Cut from them.
   void place_cut(const TransportRanks& ranks);
@@ -184,6 +216,24 @@ class FlowTransport {
                    const std::function<std::vector<double>()>& here,
                    const std::function<void(std::span<const double>)>& across, const std::function<void()>& rest);
   void step_tracers_over_ranks(double t0, double t1);
+  // The 1D vessels spread (flow_transport_spread.cpp): the run's 1D vessels in the
+  // one-process grid's order; the cut's places and messages once the grid is made; a step.
+  std::vector<std::int32_t> whole_one_d_order() const;
+  void place_spread_cut(const EndFaces& end_faces);
+  void advance_spread();
+  void step_tracers_spread(double t0, double t1);
+  // Each cut face's volume from the vessel's rank (into face_volume_).
+  void take_cut_volumes();
+  // Solves `solve` in rounds, each after the cuts' inflows of the last (per_link numbers a
+  // link: `here` writes this side's of a sent face, `across` takes the other side's of a
+  // received one and returns how far they moved, 0 for the same bits), until none moves on
+  // any rank. Collective.
+  void spread_rounds(std::size_t per_link, const char* what, const std::function<void()>& solve,
+                     const std::function<void(std::size_t face, std::size_t cell, double* numbers)>& here,
+                     const std::function<double(std::size_t face, const double* numbers)>& across);
+  // Numbers out to each neighbouring rank and in from it, of the sizes both sides know.
+  void exchange_numbers(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in);
+
   std::vector<TracerReport> reports_;  // over ranks, rank 0's (take_reports)
   // On rank 0 `start` plus each of the whole run's items in turn (per cell or boundary: each
   // rank's values at `place`, -1 none), in the one-process order; elsewhere `start`. Collective.

@@ -4,6 +4,7 @@
 // report's and the checkpoint taken on rank 0 in the one-process order.
 #include <mpi.h>
 
+#include <algorithm>
 #include <functional>
 
 #include "distributed/gather_rows.hpp"
@@ -115,13 +116,20 @@ void FlowTransport::join_ranks() {
 std::vector<std::int32_t> FlowTransport::own_cell_places() const {
   std::vector<std::int32_t> place = cut_->cell_place;
   for (const std::int32_t c : cut_->across) place[static_cast<std::size_t>(c)] = -1;
+  for (const std::int32_t c : cut_->copies) place[static_cast<std::size_t>(c)] = -1;
   return place;
 }
 
 std::vector<std::int32_t> FlowTransport::own_face_places() const {
   std::vector<std::int32_t> place = cut_->face_place;
-  if (cut_->top)  // its cuts' faces are the shares' root vessels
+  if (cut_->spread) {  // an end of another rank's vessel
+    for (std::size_t f = 0; f < place.size(); ++f) {
+      const std::int32_t v = red_cells_->grid().vessel[f];
+      if (v >= 0 && !solver_.steps_vessel(static_cast<std::size_t>(v))) place[f] = -1;
+    }
+  } else if (cut_->top) {  // its cuts' faces are the shares' root vessels
     for (const std::int32_t f : cut_->face) place[static_cast<std::size_t>(f)] = -1;
+  }
   return place;
 }
 
@@ -248,7 +256,10 @@ void FlowTransport::step_tracers_over_ranks(double t0, double t1) {
 void FlowTransport::close_cycle_over_ranks(RedCellCycle& c) const {
   std::vector<double>* columns[] = {&c.discharge, &c.lowest, &c.highest};
   gather_vessel_values(net_, solver_, columns);
+  // A junction held by several ranks counts once, on the rank of its first end.
   unsigned long long separating = c.separating_nodes;
+  for (const std::int32_t cell : red_cells_->separating_cells())
+    if (std::find(cut_->copies.begin(), cut_->copies.end(), cell) != cut_->copies.end()) --separating;
   MPI_Reduce(world_rank() == 0 ? MPI_IN_PLACE : &separating, &separating, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0,
              MPI_COMM_WORLD);
   c.separating_nodes = static_cast<std::size_t>(separating);

@@ -351,8 +351,9 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   SolverOptions options = solver_options(config);
   std::optional<MpiPulseRanks> ranks;
   if (over_ranks) {
-    // A tree's subtrees; its 1D vessels spread where that balances the step, unless red cells
-    // or tracers are carried (their transport over ranks follows the subtrees under a top).
+    // A tree's subtrees; its 1D vessels spread where that balances the step. With red cells or
+    // tracers, the top wherever there can be one: their step crosses a top's cut in two
+    // messages, a spread cut in rounds (solver/flow_transport_spread.cpp).
     const OneDLayout layout = config.carries_transport() ? OneDLayout::top_where_possible : OneDLayout::balanced;
     on_every_rank([&] { ranks.emplace(net, std::vector<double>(net.vessel_count(), 1.0), layout); });
     if (given.solver.lumped_sections > 1)
@@ -429,13 +430,6 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     FlowTransportOptions carried;
     carried.tracers = tracers;
     std::optional<TransportRanks> over;
-    if (ranks && ranks->one_d_spread())
-      on_every_rank([&] {
-        throw SettingError(red ? "red_cells" : "tracer",
-                           placeholder(red ? "red_cells" : "tracer") + " over MPI ranks runs on trees whose 1D vessels "
-                           "one rank holds; this network's are spread over the ranks (a rank holding them all would "
-                           "leave another without a vessel, or the network has loops): run it on one rank");
-      });
     if (ranks) over = TransportRanks{ranks->ranks().top_rank, ranks->roots()};
     // A refusal (a tracer given where the network has no boundary) is every rank's alike.
     on_every_rank([&] { transport.emplace(net, run, red ? carried : red_cells_fixed(carried), over ? &*over : nullptr); });
@@ -483,6 +477,10 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
                     std::to_string(t.bytes) + " bytes, " + format_quantity(t.seconds, "s") +
                     " inside them (waiting for the shares included)");
     }
+    if (const FlowTransport::SpreadTraffic* t = transport ? transport->spread_traffic() : nullptr)
+      observer.note("the transport's exchanges on rank 0: " + std::to_string(t->rounds) + " rounds in " +
+                    std::to_string(t->steps) + " steps, " + std::to_string(t->messages) + " messages to its neighbouring ranks, " +
+                    std::to_string(t->bytes) + " bytes, " + format_quantity(t->seconds, "s") + " inside them");
     if (const RootExchange* exchange = transport ? transport->exchange() : nullptr) {
       const RootExchange::Traffic& t = exchange->traffic();
  observer.note("the transport steps' exchanges on rank 0: " + std::to_string(t.calls) + " collective calls, " +

@@ -105,7 +105,7 @@ double RedCellTransport::left() const { return std::accumulate(left_.begin(), le
 
 void RedCellTransport::split_at_nodes(std::span<const double> face_volume) {
   std::fill(share_.begin(), share_.end(), 1.0);
-  separating_ = 0;
+  separating_.clear();
   if (!options_.phase_separation) return;
   for (const std::int32_t cell : candidates_) {
     const auto c = static_cast<std::size_t>(cell);
@@ -147,7 +147,7 @@ void RedCellTransport::split_at_nodes(std::span<const double> face_volume) {
     // 1e-27 against 1e-7) has 1 - flow_fraction = 0 exactly, and 0 / 0 put NaN in the run.
     share_[f1] = fqe * (q1 + q2) / q1;
     share_[f2] = (1 - fqe) * (q1 + q2) / q2;
-    ++separating_;
+    separating_.push_back(cell);
   }
 }
 

@@ -110,7 +110,8 @@ class RedCellTransport {
   const CarrierStep& plasma_step() const { return plasma_; }
   const CarrierStep& blood_step() const { return blood_; }
   // Cells where the phase separation law split the red cells in the last step.
-  std::size_t separating_nodes() const { return separating_; }
+  std::size_t separating_nodes() const { return separating_.size(); }
+  std::span<const std::int32_t> separating_cells() const { return separating_; }
 
  private:
   double tube(std::size_t cell, double discharge) const {
@@ -139,7 +140,7 @@ class RedCellTransport {
   // boundaries' order, so that ranks holding a few each give the one-process sum.
   std::vector<double> entered_, left_;
   double adjusted_ = 0;
-  std::size_t separating_ = 0;
+  std::vector<std::int32_t> separating_;  // the cells where it did
 };
 
 }  // namespace hemotree

@@ -1,0 +1,318 @@
+// Red cells and tracers where the 1D vessels are spread over the ranks (docs/transport.md,
+// "Over MPI ranks"; the flow's cut: pulse/one_d_cut.hpp).
+//
+// Each rank carries the slices of its own 1D vessels, the nodes of its 0D vessels and every
+// junction where one of its vessels ends (the flow solves such a junction on each of its
+// ranks alike; so does the transport, each copy numbered by the rank of its first end). An end
+// across the cut is a *link*: on the rank holding the cell it meets (a junction, a 0D node), a
+// face from that cell to a cut; where the end's vessel meets another rank's 0D node, its own
+// end face goes to a cut as well, and the node's rank answers. Each cut takes its inflow from
+// the rank of the cell across it: s_f H_D of that cell (the red cells), or what crosses the
+// face (each tracer), the product taken as the one-process run takes it; and, once a step, its
+// volume from the vessel's rank.
+//
+// The implicit upwind step needs every cell's upwind cells first, and along the 1D vessels the
+// flow crosses the cut as often as the vessels change rank: so a step is solved in rounds. Each
+// round solves every cell of the rank with the cuts' inflows of the round before (the first:
+// the last step's), then sends each link's numbers. On a tree, and wherever the flow of the
+// step has no circulation, a cell's value is a function of its upwind cells alone: once a
+// round changes no inflow on any rank, every cell holds the one-process value, bit for bit,
+// after at most one round more than the cut crossings along any path of the flow. A circulation
+// across the cut (a loop of 1D vessels) settles as the one-process run's Gauss-Seidel does, to
+// 1e-15, after that many rounds.
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "core/errors.hpp"
+#include "mpi/session.hpp"
+#include "pulse/lumped_order.hpp"
+#include "solver/flow_transport.hpp"
+
+namespace hemotree {
+
+namespace {
+constexpr std::size_t max_rounds = 10000;
+constexpr double circulation_tolerance = 1e-15;  // the one-process run's, for the cells on a circulation
+constexpr int tag = 22;
+}  // namespace
+
+std::vector<std::int32_t> FlowTransport::whole_one_d_order() const {
+  // The one-process run's 1D vessels are in the order of their elements.
+  std::vector<std::pair<std::int32_t, std::int32_t>> by_element;
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
+    if (!solver_.is_lumped(v)) by_element.emplace_back(solver_.first_element(v), static_cast<std::int32_t>(v));
+  std::sort(by_element.begin(), by_element.end());
+  std::vector<std::int32_t> order;
+  order.reserve(by_element.size());
+  for (const auto& [element, v] : by_element) order.push_back(v);
+  return order;
+}
+
+void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
+  Cut& cut = *cut_;
+  const TransportGrid& grid = red_cells_->grid();
+  const LumpedVessels& lumped = solver_.lumped();
+  const NetworkBoundaries& ends = solver_.network_boundaries();
+  const std::size_t n = net_.vessel_count();
+  const std::span<const std::int32_t> rank = solver_.vessel_ranks();
+  const int me = solver_.rank();
+
+  // The one-process grid: the 0D nodes (pulse/lumped_order), every 1D vessel's slices, the
+  // junctions; its faces: the 0D vessels, the boundaries at 0D nodes, every 1D vessel's.
+  std::vector<bool> zero_d(n);
+  for (std::size_t v = 0; v < n; ++v) zero_d[v] = solver_.is_lumped(v);
+  const LumpedOrder whole = subtree_lumped_order(net_, zero_d);
+  std::vector<std::int32_t> node_place(net_.node_count(), -1);
+  for (std::size_t k = 0; k < whole.nodes.size(); ++k) node_place[static_cast<std::size_t>(whole.nodes[k])] = static_cast<std::int32_t>(k);
+  const std::vector<std::int32_t> one_d = whole_one_d_order();
+  std::vector<std::int32_t> one_d_whole(n, -1);
+  for (std::size_t w = 0; w < one_d.size(); ++w) one_d_whole[static_cast<std::size_t>(one_d[w])] = static_cast<std::int32_t>(w);
+  const auto per_vessel = static_cast<std::int32_t>(solver_.elements_per_vessel() * slices_);
+  const std::size_t junctions = ends.junction_offset.empty() ? 0 : ends.junction_offset.size() - 1;
+  std::map<std::int64_t, std::int32_t> junction_at;  // network node -> junction
+  std::map<std::pair<std::int32_t, bool>, std::int32_t> junction_of;  // end -> junction
+  for (std::size_t j = 0; j < junctions; ++j)
+    for (auto e = ends.junction_offset[j]; e < ends.junction_offset[j + 1]; ++e) {
+      const VesselEnd& end = ends.junction_ends[static_cast<std::size_t>(e)];
+      const auto v = static_cast<std::size_t>(end.vessel);
+      junction_at[end.distal ? net_.to[v] : net_.from[v]] = static_cast<std::int32_t>(j);
+      junction_of[{end.vessel, end.distal}] = static_cast<std::int32_t>(j);
+    }
+
+  const auto slices_start = static_cast<std::int32_t>(whole.nodes.size());
+  const std::int32_t junctions_start = slices_start + static_cast<std::int32_t>(one_d.size()) * per_vessel;
+  const std::size_t here_nodes = lumped.empty() ? 0 : lumped.network_node_count();
+  cut.cell_place.assign(grid.cell_count(), -1);
+  for (std::size_t c = 0; c < here_nodes; ++c) cut.cell_place[c] = node_place[static_cast<std::size_t>(grid.node[c])];
+  for (std::size_t i = 0; i < one_d_.size(); ++i)
+    for (std::int32_t s = 0; s < per_vessel; ++s)
+      cut.cell_place[static_cast<std::size_t>(vessel_first_cell_[i] + s)] =
+          slices_start + one_d_whole[static_cast<std::size_t>(one_d_[i])] * per_vessel + s;
+  for (std::size_t c = here_nodes; c < grid.cell_count(); ++c)
+    if (grid.node[c] >= 0) cut.cell_place[c] = junctions_start + junction_at.at(grid.node[c]);
+  cut.cells = static_cast<std::size_t>(junctions_start) + junctions;
+
+  std::vector<std::int32_t> zero_d_before(n + 1, 0);
+  for (std::size_t v = 0; v < n; ++v) zero_d_before[v + 1] = zero_d_before[v] + (zero_d[v] ? 1 : 0);
+  std::vector<bool> zero_d_node(net_.node_count(), false);
+  for (const std::int32_t node : whole.nodes) zero_d_node[static_cast<std::size_t>(node)] = true;
+  const RunBoundaries& boundaries = solver_.boundary_list();
+  std::vector<std::int32_t> boundary_face_place(boundaries.size(), -1);
+  std::int32_t at_zero_d_nodes = 0;
+  for (std::size_t b = 0; b < boundaries.size(); ++b)
+    if (zero_d_node[static_cast<std::size_t>(boundaries.node(b))]) boundary_face_place[b] = at_zero_d_nodes++;
+  const std::int32_t one_d_faces = zero_d_before[n] + at_zero_d_nodes;
+  auto one_d_face = [&](std::int32_t v, std::int32_t k) {  // face k of vessel v, 0 its proximal
+    return one_d_faces + one_d_whole[static_cast<std::size_t>(v)] * (per_vessel + 1) + k;
+  };
+  cut.face_place.assign(grid.face_count(), -1);
+  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+    const std::int32_t v = grid.vessel[f];
+    if (v >= 0 && zero_d[static_cast<std::size_t>(v)]) cut.face_place[f] = zero_d_before[static_cast<std::size_t>(v)];
+    else if (v < 0) cut.face_place[f] = zero_d_before[n] + boundary_face_place[static_cast<std::size_t>(-1 - grid.b[f])];
+  }
+  for (std::size_t i = 0; i < one_d_.size(); ++i)
+    for (std::int32_t k = 0; k <= per_vessel; ++k)
+      cut.face_place[static_cast<std::size_t>(vessel_first_face_[i] + k)] = one_d_face(one_d_[i], k);
+  for (const auto& [end, face] : end_faces)
+    if (one_d_place_[static_cast<std::size_t>(end.first)] < 0)
+      cut.face_place[static_cast<std::size_t>(face.first)] = one_d_face(end.first, end.second ? per_vessel : 0);
+  cut.faces = static_cast<std::size_t>(one_d_faces) + one_d.size() * static_cast<std::size_t>(per_vessel + 1);
+
+  // The links, in the run's order of vessel ends (every rank alike): an end at a junction, to
+  // every other rank with an end there; an end at another rank's 0D node, both ways.
+  std::vector<std::int32_t> node_rank(net_.node_count(), -1);
+  for (std::size_t v = 0; v < n; ++v)
+    if (zero_d[v]) node_rank[static_cast<std::size_t>(net_.from[v])] = node_rank[static_cast<std::size_t>(net_.to[v])] = rank[v];
+  std::map<std::pair<std::int32_t, bool>, std::int64_t> coupled_node;
+  for (const auto& c : ends.coupled) coupled_node[{c.end.vessel, c.end.distal}] = c.node;
+  std::map<int, Cut::Neighbour> by_rank;
+  auto link = [&](int receiver, int supplier, std::pair<std::int32_t, bool> end, bool volume) {
+    ++cut.links;
+    if (receiver == me) {
+      Cut::Neighbour& from = by_rank[supplier];
+      from.receive_face.push_back(end_faces.at(end).first);
+      from.receive_volume.push_back(volume);
+    }
+    if (supplier == me) {
+      Cut::Neighbour& to = by_rank[receiver];
+      to.send_face.push_back(end_faces.at(end).first);
+      to.send_cell.push_back(end_faces.at(end).second);
+      to.send_volume.push_back(volume);
+    }
+  };
+  for (const std::int32_t v : one_d) {
+    const int rv = rank[static_cast<std::size_t>(v)];
+    for (const bool distal : {false, true}) {
+      const std::pair<std::int32_t, bool> end{v, distal};
+      if (const auto j = junction_of.find(end); j != junction_of.end()) {
+        std::set<int> holders;
+        const auto J = static_cast<std::size_t>(j->second);
+        for (auto e = ends.junction_offset[J]; e < ends.junction_offset[J + 1]; ++e)
+          holders.insert(rank[static_cast<std::size_t>(ends.junction_ends[static_cast<std::size_t>(e)].vessel)]);
+        for (const int r : holders)
+          if (r != rv) link(r, rv, end, true);
+      } else if (const auto c = coupled_node.find(end); c != coupled_node.end()) {
+        const int rn = node_rank[static_cast<std::size_t>(c->second)];
+        if (rn == rv) continue;
+        link(rn, rv, end, true);
+        link(rv, rn, end, false);
+      }
+    }
+  }
+  for (auto& [r, neighbour] : by_rank) {
+    neighbour.rank = r;
+    cut.neighbours.push_back(std::move(neighbour));
+  }
+}
+
+void FlowTransport::exchange_numbers(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in) {
+  Cut& cut = *cut_;
+  if (cut.neighbours.empty()) return;
+  const double started = MPI_Wtime();
+  std::vector<MPI_Request> requests(2 * cut.neighbours.size());
+  for (std::size_t i = 0; i < cut.neighbours.size(); ++i) {
+    MPI_Irecv(in[i].data(), static_cast<int>(in[i].size()), MPI_DOUBLE, cut.neighbours[i].rank, tag, MPI_COMM_WORLD,
+              &requests[2 * i]);
+    MPI_Isend(out[i].data(), static_cast<int>(out[i].size()), MPI_DOUBLE, cut.neighbours[i].rank, tag, MPI_COMM_WORLD,
+              &requests[2 * i + 1]);
+  }
+  MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+  cut.traffic.messages += cut.neighbours.size();
+  for (const std::vector<double>& numbers : out) cut.traffic.bytes += numbers.size() * sizeof(double);
+  cut.traffic.seconds += MPI_Wtime() - started;
+}
+
+void FlowTransport::take_cut_volumes() {
+  // Each link's volume, as the one-process face has it, from the vessel's rank.
+  Cut& cut = *cut_;
+  const std::size_t count = cut.neighbours.size();
+  std::vector<std::vector<double>> out(count), in(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const Cut::Neighbour& nb = cut.neighbours[i];
+    for (std::size_t k = 0; k < nb.send_face.size(); ++k)
+      if (nb.send_volume[k]) {
+        const auto f = static_cast<std::size_t>(nb.send_face[k]);
+        out[i].push_back(cut.face_sign[f] * face_volume_[f]);
+      }
+    in[i].resize(static_cast<std::size_t>(std::count(nb.receive_volume.begin(), nb.receive_volume.end(), 1)));
+  }
+  exchange_numbers(out, in);
+  for (std::size_t i = 0; i < count; ++i) {
+    const Cut::Neighbour& nb = cut.neighbours[i];
+    std::size_t j = 0;
+    for (std::size_t k = 0; k < nb.receive_face.size(); ++k)
+      if (nb.receive_volume[k]) {
+        const auto f = static_cast<std::size_t>(nb.receive_face[k]);
+        face_volume_[f] = cut.face_sign[f] * in[i][j++];
+      }
+  }
+}
+
+void FlowTransport::spread_rounds(std::size_t per_link, const char* what, const std::function<void()>& solve,
+                                  const std::function<void(std::size_t, std::size_t, double*)>& here,
+                                  const std::function<double(std::size_t, const double*)>& across) {
+  Cut& cut = *cut_;
+  const std::size_t count = cut.neighbours.size();
+  // Past one round more than the links (what any path of the flow crosses, at most), only a
+  // circulation across the cut is still moving.
+  const std::size_t exact = cut.links + 1;
+  for (std::size_t round = 1;; ++round) {
+    on_every_rank(solve);  // a failure of one rank's cells, every rank's
+    std::vector<std::vector<double>> out(count), in(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      const Cut::Neighbour& nb = cut.neighbours[i];
+      out[i].resize(per_link * nb.send_face.size());
+      for (std::size_t k = 0; k < nb.send_face.size(); ++k)
+        here(static_cast<std::size_t>(nb.send_face[k]), static_cast<std::size_t>(nb.send_cell[k]), &out[i][per_link * k]);
+      in[i].resize(per_link * nb.receive_face.size());
+    }
+    exchange_numbers(out, in);
+    double change = 0;
+    for (std::size_t i = 0; i < count; ++i)
+      for (std::size_t k = 0; k < cut.neighbours[i].receive_face.size(); ++k)
+        change = std::max(change, across(static_cast<std::size_t>(cut.neighbours[i].receive_face[k]), &in[i][per_link * k]));
+    const double started = MPI_Wtime();
+    MPI_Allreduce(MPI_IN_PLACE, &change, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    cut.traffic.seconds += MPI_Wtime() - started;
+    ++cut.traffic.rounds;
+    if (change == 0) return;
+    if (round > exact && change <= circulation_tolerance) {
+      on_every_rank(solve);  // with the inflows settled
+      return;
+    }
+    if (round >= max_rounds)
+      throw Collective<InputError>(std::string(what) + ": the inflows across the ranks' cut did not settle in " +
+                                   std::to_string(max_rounds) + " rounds (a circulation of the flow through it)");
+  }
+}
+
+void FlowTransport::advance_spread() {
+  take_cut_volumes();
+  RedCellTransport& cells = *red_cells_;
+  const TransportGrid& grid = cells.grid();
+  cells.begin_step(face_volume_);
+  spread_rounds(
+      1, "the red cells' step", [&] { cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::all); },
+      [&](std::size_t face, std::size_t cell, double* numbers) {
+        numbers[0] = cells.separation_share(face) * cells.discharge_hematocrit()[cell];
+      },
+      [&](std::size_t face, const double* numbers) {
+        double& inflow = inflow_hematocrit_[static_cast<std::size_t>(-1 - grid.b[face])];
+        const double change = inflow == numbers[0] ? 0.0 : std::abs(numbers[0] - inflow);
+        inflow = numbers[0];
+        return change;
+      });
+  cells.end_step(face_volume_, inflow_hematocrit_);
+  ++advances_;
+  ++cut_->traffic.steps;
+  mark();
+  if (!tracers_.empty()) step_tracers_spread(last_time_, solver_.time());
+  last_time_ = solver_.time();
+}
+
+void FlowTransport::step_tracers_spread(double t0, double t1) {
+  // Every tracer rides on the red cells' whole step, in rounds of its own (each link, every
+  // tracer's concentration crossing it), each starting from the cuts' inflows of its last step.
+  Cut& cut = *cut_;
+  const TransportGrid& grid = red_cells_->grid();
+  const std::size_t count = tracers_.size(), cuts = grid.cuts, first_cut = grid.boundaries - cuts;
+  if (cut.tracer_in.size() != count * cuts) cut.tracer_in.assign(count * cuts, 0.0);
+  for (std::size_t k = 0; k < count; ++k) {
+    tracer_given(k, t0, t1);
+    for (std::size_t j = 0; j < cuts; ++j) tracer_inflow_[k][first_cut + j] = cut.tracer_in[k * cuts + j];
+    tracers_[k].begin_step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+  }
+  spread_rounds(
+      count, "the tracers' step",
+      [&] {
+        for (std::size_t k = 0; k < count; ++k)
+          tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], RedCellTransport::Cells::all);
+      },
+      [&](std::size_t face, std::size_t, double* numbers) {
+        for (std::size_t k = 0; k < count; ++k)
+          numbers[k] = tracers_[k].inflowing(face, *red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+      },
+      [&](std::size_t face, const double* numbers) {
+        const auto b = static_cast<std::size_t>(-1 - grid.b[face]);
+        double change = 0;
+        for (std::size_t k = 0; k < count; ++k) {
+          double& inflow = tracer_inflow_[k][b];
+          if (inflow != numbers[k])
+            change = std::max(change, std::abs(numbers[k] - inflow) / std::max(std::abs(numbers[k]), 1.0));
+          inflow = numbers[k];
+          cut.tracer_in[k * cuts + (b - first_cut)] = numbers[k];
+        }
+        return change;
+      });
+  for (std::size_t k = 0; k < count; ++k) {
+    tracers_[k].end_step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+    follow_curve(k, t0, t1);
+  }
+}
+
+}  // namespace hemotree
