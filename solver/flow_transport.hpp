@@ -207,6 +207,19 @@ class FlowTransport {
   };
   // The cut's faces were made with the grid; the rest of the Cut from them.
   void place_cut(const TransportRanks& ranks);
+  // The one-process grid's 0D part, where both cuts place theirs: its first cells, the 0D
+  // nodes in pulse/lumped_order's order (node_place per network node, nodes of them); its
+  // first faces, the 0D vessels in the network's order, then the boundaries at 0D nodes
+  // (zero_d_faces + boundary_place[b]); the 1D faces after them (one_d_faces).
+  struct ZeroDPlaces {
+    std::vector<bool> zero_d;  // per vessel
+    std::size_t nodes = 0;
+    std::vector<std::int32_t> node_place, zero_d_before, boundary_place;
+    std::int32_t zero_d_faces = 0, one_d_faces = 0;
+    // A 0D vessel's or a boundary's face f of the grid, at its place (-1: a 1D vessel's).
+    std::int32_t face_place(const TransportGrid& grid, std::size_t f) const;
+  };
+  ZeroDPlaces zero_d_places() const;
   void advance_over_ranks();
   // A step's two messages across the cuts, per_root numbers a root each way: `here` gives this
   // side's (the shares' up, then the top's down), `across` takes the other side's as the cuts'

@@ -50,56 +50,60 @@ BoundaryShare boundary_share(std::span<const std::int32_t> held, std::span<const
 }
 }  // namespace
 
+FlowTransport::ZeroDPlaces FlowTransport::zero_d_places() const {
+  ZeroDPlaces p;
+  const std::size_t n = net_.vessel_count();
+  p.zero_d.resize(n);
+  for (std::size_t v = 0; v < n; ++v) p.zero_d[v] = solver_.is_lumped(v);
+  const LumpedOrder whole = subtree_lumped_order(net_, p.zero_d);
+  p.nodes = whole.nodes.size();
+  p.node_place.assign(net_.node_count(), -1);
+  for (std::size_t k = 0; k < whole.nodes.size(); ++k) p.node_place[static_cast<std::size_t>(whole.nodes[k])] = static_cast<std::int32_t>(k);
+  p.zero_d_before.assign(n + 1, 0);  // the 0D vessels before each
+  for (std::size_t v = 0; v < n; ++v) p.zero_d_before[v + 1] = p.zero_d_before[v] + (p.zero_d[v] ? 1 : 0);
+  const RunBoundaries& boundaries = solver_.boundary_list();
+  p.boundary_place.assign(boundaries.size(), -1);
+  std::int32_t at_zero_d_nodes = 0;
+  for (std::size_t b = 0; b < boundaries.size(); ++b)
+    if (p.node_place[static_cast<std::size_t>(boundaries.node(b))] >= 0) p.boundary_place[b] = at_zero_d_nodes++;
+  p.zero_d_faces = p.zero_d_before[n];
+  p.one_d_faces = p.zero_d_faces + at_zero_d_nodes;
+  return p;
+}
+
+std::int32_t FlowTransport::ZeroDPlaces::face_place(const TransportGrid& grid, std::size_t f) const {
+  const std::int32_t v = grid.vessel[f];
+  if (v >= 0) return zero_d[static_cast<std::size_t>(v)] ? zero_d_before[static_cast<std::size_t>(v)] : -1;
+  return zero_d_faces + boundary_place[static_cast<std::size_t>(-1 - grid.b[f])];
+}
+
 void FlowTransport::place_cut(const TransportRanks& ranks) {
   Cut& cut = *cut_;
   cut.top = solver_.holds_one_d();
   cut.exchange = std::make_shared<RootExchange>(MPI_COMM_WORLD, ranks.top_rank, ranks.roots);
   const TransportGrid& grid = red_cells_->grid();
   const LumpedVessels& lumped = solver_.lumped();
-  const std::size_t n = net_.vessel_count();
-  std::vector<bool> zero_d(n);
-  for (std::size_t v = 0; v < n; ++v) zero_d[v] = solver_.is_lumped(v);
-  // The one-process grid: the 0D nodes in the 0D vessels' order (pulse/lumped_order), the 1D
-  // vessels' slices and junctions after them, all the top's. Its faces: the 0D vessels in the
-  // network's order, the boundaries at 0D nodes, the 1D vessels'.
-  const LumpedOrder whole = subtree_lumped_order(net_, zero_d);
-  std::vector<std::int32_t> node_place(net_.node_count(), -1);
-  for (std::size_t k = 0; k < whole.nodes.size(); ++k) node_place[static_cast<std::size_t>(whole.nodes[k])] = static_cast<std::int32_t>(k);
+  // The one-process grid: the 0D part (zero_d_places), the 1D vessels' slices and junctions
+  // after it, all the top's; the top's 1D faces after the 0D part's in the grid's order.
+  const ZeroDPlaces whole = zero_d_places();
   const std::size_t here_nodes = lumped.empty() ? 0 : lumped.network_node_count();
   cut.cell_place.resize(grid.cell_count());
   for (std::size_t c = 0; c < grid.cell_count(); ++c)
-    cut.cell_place[c] = c < here_nodes ? node_place[static_cast<std::size_t>(grid.node[c])]
-                                       : static_cast<std::int32_t>(whole.nodes.size() + (c - here_nodes));
+    cut.cell_place[c] = c < here_nodes ? whole.node_place[static_cast<std::size_t>(grid.node[c])]
+                                       : static_cast<std::int32_t>(whole.nodes + (c - here_nodes));
   const std::size_t one_d_cells = grid.cell_count() - here_nodes;
-  std::vector<std::int32_t> zero_d_before(n + 1, 0);  // the 0D vessels before each
-  for (std::size_t v = 0; v < n; ++v) zero_d_before[v + 1] = zero_d_before[v] + (zero_d[v] ? 1 : 0);
-  std::vector<bool> zero_d_node(net_.node_count(), false);
-  for (const std::int32_t node : whole.nodes) zero_d_node[static_cast<std::size_t>(node)] = true;
-  const RunBoundaries& boundaries = solver_.boundary_list();
-  std::vector<std::int32_t> boundary_face_place(boundaries.size(), -1);
-  std::int32_t at_zero_d_nodes = 0;
-  for (std::size_t b = 0; b < boundaries.size(); ++b)
-    if (zero_d_node[static_cast<std::size_t>(boundaries.node(b))]) boundary_face_place[b] = at_zero_d_nodes++;
-  const std::int32_t zero_d_faces = zero_d_before[n];
-  // The top's 1D faces follow its 0D vessels' and boundaries' in the order the whole grid has.
   std::int32_t first_one_d_face = -1;
   cut.face_place.assign(grid.face_count(), -1);
   for (std::size_t f = 0; f < grid.face_count(); ++f) {
-    const std::int32_t v = grid.vessel[f];
-    if (v >= 0 && zero_d[static_cast<std::size_t>(v)]) {
-      cut.face_place[f] = zero_d_before[static_cast<std::size_t>(v)];
-    } else if (v < 0) {
-      const auto b = static_cast<std::size_t>(-1 - grid.b[f]);
-      cut.face_place[f] = zero_d_faces + boundary_face_place[b];
-    } else {
-      if (first_one_d_face < 0) first_one_d_face = static_cast<std::int32_t>(f);
-      cut.face_place[f] = zero_d_faces + at_zero_d_nodes + (static_cast<std::int32_t>(f) - first_one_d_face);
-    }
+    cut.face_place[f] = whole.face_place(grid, f);
+    if (cut.face_place[f] >= 0) continue;
+    if (first_one_d_face < 0) first_one_d_face = static_cast<std::int32_t>(f);
+    cut.face_place[f] = whole.one_d_faces + (static_cast<std::int32_t>(f) - first_one_d_face);
   }
   // The whole run's counts: every rank knows its 0D part; the top's 1D cells and faces are
   // the top's alone (said to every rank by join_ranks).
-  cut.cells = whole.nodes.size() + (cut.top ? one_d_cells : 0);
-  cut.faces = static_cast<std::size_t>(zero_d_faces + at_zero_d_nodes) +
+  cut.cells = whole.nodes + (cut.top ? one_d_cells : 0);
+  cut.faces = static_cast<std::size_t>(whole.one_d_faces) +
               (cut.top && first_one_d_face >= 0 ? grid.face_count() - static_cast<std::size_t>(first_one_d_face) : 0);
 }
 

@@ -29,7 +29,6 @@
 
 #include "core/errors.hpp"
 #include "mpi/session.hpp"
-#include "pulse/lumped_order.hpp"
 #include "solver/flow_transport.hpp"
 
 namespace hemotree {
@@ -61,13 +60,10 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
   const std::span<const std::int32_t> rank = solver_.vessel_ranks();
   const int me = solver_.rank();
 
-  // The one-process grid: the 0D nodes (pulse/lumped_order), every 1D vessel's slices, the
-  // junctions; its faces: the 0D vessels, the boundaries at 0D nodes, every 1D vessel's.
-  std::vector<bool> zero_d(n);
-  for (std::size_t v = 0; v < n; ++v) zero_d[v] = solver_.is_lumped(v);
-  const LumpedOrder whole = subtree_lumped_order(net_, zero_d);
-  std::vector<std::int32_t> node_place(net_.node_count(), -1);
-  for (std::size_t k = 0; k < whole.nodes.size(); ++k) node_place[static_cast<std::size_t>(whole.nodes[k])] = static_cast<std::int32_t>(k);
+  // The one-process grid: the 0D part (zero_d_places), every 1D vessel's slices, the
+  // junctions; its 1D faces after the 0D part's, every 1D vessel's.
+  const ZeroDPlaces whole = zero_d_places();
+  const std::vector<bool>& zero_d = whole.zero_d;
   const std::vector<std::int32_t> one_d = whole_one_d_order();
   std::vector<std::int32_t> one_d_whole(n, -1);
   for (std::size_t w = 0; w < one_d.size(); ++w) one_d_whole[static_cast<std::size_t>(one_d[w])] = static_cast<std::int32_t>(w);
@@ -83,11 +79,11 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
       junction_of[{end.vessel, end.distal}] = static_cast<std::int32_t>(j);
     }
 
-  const auto slices_start = static_cast<std::int32_t>(whole.nodes.size());
+  const auto slices_start = static_cast<std::int32_t>(whole.nodes);
   const std::int32_t junctions_start = slices_start + static_cast<std::int32_t>(one_d.size()) * per_vessel;
   const std::size_t here_nodes = lumped.empty() ? 0 : lumped.network_node_count();
   cut.cell_place.assign(grid.cell_count(), -1);
-  for (std::size_t c = 0; c < here_nodes; ++c) cut.cell_place[c] = node_place[static_cast<std::size_t>(grid.node[c])];
+  for (std::size_t c = 0; c < here_nodes; ++c) cut.cell_place[c] = whole.node_place[static_cast<std::size_t>(grid.node[c])];
   for (std::size_t i = 0; i < one_d_.size(); ++i)
     for (std::int32_t s = 0; s < per_vessel; ++s)
       cut.cell_place[static_cast<std::size_t>(vessel_first_cell_[i] + s)] =
@@ -96,32 +92,18 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
     if (grid.node[c] >= 0) cut.cell_place[c] = junctions_start + junction_at.at(grid.node[c]);
   cut.cells = static_cast<std::size_t>(junctions_start) + junctions;
 
-  std::vector<std::int32_t> zero_d_before(n + 1, 0);
-  for (std::size_t v = 0; v < n; ++v) zero_d_before[v + 1] = zero_d_before[v] + (zero_d[v] ? 1 : 0);
-  std::vector<bool> zero_d_node(net_.node_count(), false);
-  for (const std::int32_t node : whole.nodes) zero_d_node[static_cast<std::size_t>(node)] = true;
-  const RunBoundaries& boundaries = solver_.boundary_list();
-  std::vector<std::int32_t> boundary_face_place(boundaries.size(), -1);
-  std::int32_t at_zero_d_nodes = 0;
-  for (std::size_t b = 0; b < boundaries.size(); ++b)
-    if (zero_d_node[static_cast<std::size_t>(boundaries.node(b))]) boundary_face_place[b] = at_zero_d_nodes++;
-  const std::int32_t one_d_faces = zero_d_before[n] + at_zero_d_nodes;
   auto one_d_face = [&](std::int32_t v, std::int32_t k) {  // face k of vessel v, 0 its proximal
-    return one_d_faces + one_d_whole[static_cast<std::size_t>(v)] * (per_vessel + 1) + k;
+    return whole.one_d_faces + one_d_whole[static_cast<std::size_t>(v)] * (per_vessel + 1) + k;
   };
   cut.face_place.assign(grid.face_count(), -1);
-  for (std::size_t f = 0; f < grid.face_count(); ++f) {
-    const std::int32_t v = grid.vessel[f];
-    if (v >= 0 && zero_d[static_cast<std::size_t>(v)]) cut.face_place[f] = zero_d_before[static_cast<std::size_t>(v)];
-    else if (v < 0) cut.face_place[f] = zero_d_before[n] + boundary_face_place[static_cast<std::size_t>(-1 - grid.b[f])];
-  }
+  for (std::size_t f = 0; f < grid.face_count(); ++f) cut.face_place[f] = whole.face_place(grid, f);
   for (std::size_t i = 0; i < one_d_.size(); ++i)
     for (std::int32_t k = 0; k <= per_vessel; ++k)
       cut.face_place[static_cast<std::size_t>(vessel_first_face_[i] + k)] = one_d_face(one_d_[i], k);
   for (const auto& [end, face] : end_faces)
     if (one_d_place_[static_cast<std::size_t>(end.first)] < 0)
       cut.face_place[static_cast<std::size_t>(face.first)] = one_d_face(end.first, end.second ? per_vessel : 0);
-  cut.faces = static_cast<std::size_t>(one_d_faces) + one_d.size() * static_cast<std::size_t>(per_vessel + 1);
+  cut.faces = static_cast<std::size_t>(whole.one_d_faces) + one_d.size() * static_cast<std::size_t>(per_vessel + 1);
 
   // The links, in the run's order of vessel ends (every rank alike): an end at a junction, to
   // every other rank with an end there; an end at another rank's 0D node, both ways.
