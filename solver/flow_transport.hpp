@@ -241,7 +241,7 @@ class FlowTransport {
   // link: `here` writes this side's of a sent face, `across` takes the other side's of a
   // received one and returns how far they moved, 0 for the same bits), until none moves on
   // any rank. Collective.
-  void spread_rounds(std::size_t per_link, const char* what, const std::function<void()>& solve,
+  void spread_rounds(std::size_t per_link, const char* what, const std::function<void(RedCellTransport::Cells)>& solve,
                      const std::function<void(std::size_t face, std::size_t cell, double* numbers)>& here,
                      const std::function<double(std::size_t face, const double* numbers)>& across);
   // Numbers out to each neighbouring rank and in from it, of the sizes both sides know.

@@ -15,8 +15,9 @@
 // flow crosses the cut as often as the vessels change rank: so a step is solved in rounds. Each
 // round solves every cell of the rank with the cuts' inflows of the round before (the first:
 // the last step's), then sends each link's numbers. On a tree, and wherever the flow of the
-// step has no circulation, a cell's value is a function of its upwind cells alone: once a
-// round changes no inflow on any rank, every cell holds the one-process value, bit for bit,
+// step has no circulation, a cell's value is a function of its upwind cells alone (after the
+// first round only the cells a cut's inflow reaches are solved again): once a round changes
+// no inflow on any rank, every cell holds the one-process value, bit for bit,
 // after at most one round more than the cut crossings along any path of the flow. A circulation
 // across the cut (a loop of 1D vessels) settles as the one-process run's Gauss-Seidel does, to
 // 1e-15, after that many rounds.
@@ -195,7 +196,8 @@ void FlowTransport::take_cut_volumes() {
   }
 }
 
-void FlowTransport::spread_rounds(std::size_t per_link, const char* what, const std::function<void()>& solve,
+void FlowTransport::spread_rounds(std::size_t per_link, const char* what,
+                                  const std::function<void(RedCellTransport::Cells)>& solve,
                                   const std::function<void(std::size_t, std::size_t, double*)>& here,
                                   const std::function<double(std::size_t, const double*)>& across) {
   Cut& cut = *cut_;
@@ -203,8 +205,10 @@ void FlowTransport::spread_rounds(std::size_t per_link, const char* what, const 
   // Past one round more than the links (what any path of the flow crosses, at most), only a
   // circulation across the cut is still moving.
   const std::size_t exact = cut.links + 1;
+  using Cells = RedCellTransport::Cells;
   for (std::size_t round = 1;; ++round) {
-    on_every_rank(solve);  // a failure of one rank's cells, every rank's
+    // After the first round only the cells a cut's inflow reaches can change.
+    on_every_rank([&] { solve(round == 1 ? Cells::all : Cells::after_cuts); });  // a failure, every rank's
     std::vector<std::vector<double>> out(count), in(count);
     for (std::size_t i = 0; i < count; ++i) {
       const Cut::Neighbour& nb = cut.neighbours[i];
@@ -224,7 +228,7 @@ void FlowTransport::spread_rounds(std::size_t per_link, const char* what, const 
     ++cut.traffic.rounds;
     if (change == 0) return;
     if (round > exact && change <= circulation_tolerance) {
-      on_every_rank(solve);  // with the inflows settled
+      on_every_rank([&] { solve(Cells::after_cuts); });  // with the inflows settled
       return;
     }
     if (round >= max_rounds)
@@ -239,7 +243,7 @@ void FlowTransport::advance_spread() {
   const TransportGrid& grid = cells.grid();
   cells.begin_step(face_volume_);
   spread_rounds(
-      1, "the red cells' step", [&] { cells.solve(face_volume_, inflow_hematocrit_, RedCellTransport::Cells::all); },
+      1, "the red cells' step", [&](RedCellTransport::Cells which) { cells.solve(face_volume_, inflow_hematocrit_, which); },
       [&](std::size_t face, std::size_t cell, double* numbers) {
         numbers[0] = cells.separation_share(face) * cells.discharge_hematocrit()[cell];
       },
@@ -271,9 +275,8 @@ void FlowTransport::step_tracers_spread(double t0, double t1) {
   }
   spread_rounds(
       count, "the tracers' step",
-      [&] {
-        for (std::size_t k = 0; k < count; ++k)
-          tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], RedCellTransport::Cells::all);
+      [&](RedCellTransport::Cells which) {
+        for (std::size_t k = 0; k < count; ++k) tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], which);
       },
       [&](std::size_t face, std::size_t, double* numbers) {
         for (std::size_t k = 0; k < count; ++k)
