@@ -9,47 +9,10 @@
 #include <petscksp.h>
 
 #include "core/errors.hpp"
+#include "distributed/petsc_session.hpp"
 #include "mpi/session.hpp"
 
 namespace hemotree {
-
-namespace {
-
-// PETSc's error codes as exceptions; its own printing of a traceback is turned off.
-void check(PetscErrorCode code, const char* what) {
-  if (code == 0) return;
-  const char* reason = nullptr;
-  PetscErrorMessage(code, &reason, nullptr);
-  throw std::runtime_error(std::string("PETSc: ") + what + " failed: " + (reason ? reason : "error " + std::to_string(code)));
-}
-
-// PETSc on the session's MPI, once, finalised before MPI when the session ends.
-void start_petsc() {
-  PetscBool started = PETSC_FALSE;
-  check(PetscInitialized(&started), "PetscInitialized");
-  if (started) return;
-  check(PetscInitializeNoArguments(), "PetscInitialize");
-  check(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr), "PetscPushErrorHandler");
-  at_session_end([] { PetscFinalize(); });
-}
-
-// The PETSc objects of one solve, destroyed whatever happens.
-struct Objects {
-  Mat matrix = nullptr;
-  Vec x = nullptr, rhs = nullptr, everywhere = nullptr;
-  VecScatter to_all = nullptr;
-  KSP solver = nullptr;
-  ~Objects() {
-    if (solver) KSPDestroy(&solver);
-    if (to_all) VecScatterDestroy(&to_all);
-    if (everywhere) VecDestroy(&everywhere);
-    if (rhs) VecDestroy(&rhs);
-    if (x) VecDestroy(&x);
-    if (matrix) MatDestroy(&matrix);
-  }
-};
-
-}  // namespace
 
 PetscFlowNetwork::PetscFlowNetwork(std::size_t nodes, std::span<const std::int32_t> a, std::span<const std::int32_t> b,
                                    std::span<const unsigned char> prescribed, std::span<const std::int32_t> owner)
@@ -118,68 +81,64 @@ void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<cons
   }
   // PETSc's calls are collective: a failure there (a bad PETSC_OPTIONS, say) is every rank's
   // alike, passed on once all have left them (mpi/session.hpp's on_every_rank).
-  Objects o;
+  PetscObjects o;
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
   PetscReal residual = 0, scale = 0;
   on_every_rank([&] {
   const auto n = static_cast<PetscInt>(rows_), all = static_cast<PetscInt>(all_rows_);
-  check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
-  check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
-  check(MatSetType(o.matrix, MATAIJ), "MatSetType");
+  petsc_check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
+  petsc_check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
+  petsc_check(MatSetType(o.matrix, MATAIJ), "MatSetType");
   for (std::size_t k = 0; k < local; ++k) {  // parallel edges share an entry: counted once each
     in_block[k] = std::min<PetscInt>(in_block[k], n);
     off_block[k] = std::min<PetscInt>(off_block[k], all - n);
   }
-  check(MatSeqAIJSetPreallocation(o.matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
-  check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
-  check(MatSetOption(o.matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
+  petsc_check(MatSeqAIJSetPreallocation(o.matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
+  petsc_check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
+  petsc_check(MatSetOption(o.matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
   for (std::size_t k = 0; k < local; ++k) {
     const auto r = static_cast<PetscInt>(first_row_ + static_cast<std::int64_t>(k));
-    check(MatSetValue(o.matrix, r, r, diagonal[k], ADD_VALUES), "MatSetValue");
+    petsc_check(MatSetValue(o.matrix, r, r, diagonal[k], ADD_VALUES), "MatSetValue");
   }
   for (std::size_t q = 0; q < entry.size(); ++q)
-    check(MatSetValue(o.matrix, entry_at[q].first, entry_at[q].second, entry[q], ADD_VALUES), "MatSetValue");
-  check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-  check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
-  check(MatSetOption(o.matrix, MAT_SPD, PETSC_TRUE), "MatSetOption");
+    petsc_check(MatSetValue(o.matrix, entry_at[q].first, entry_at[q].second, entry[q], ADD_VALUES), "MatSetValue");
+  petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  petsc_check(MatSetOption(o.matrix, MAT_SPD, PETSC_TRUE), "MatSetOption");
 
-  check(MatCreateVecs(o.matrix, &o.x, &o.rhs), "MatCreateVecs");
+  petsc_check(MatCreateVecs(o.matrix, &o.x, &o.rhs), "MatCreateVecs");
   PetscScalar* values = nullptr;
-  check(VecGetArray(o.rhs, &values), "VecGetArray");
+  petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
   std::copy(rhs.begin(), rhs.end(), values);
-  check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+  petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
 
-  check(KSPCreate(PETSC_COMM_WORLD, &o.solver), "KSPCreate");
-  check(KSPSetOperators(o.solver, o.matrix, o.matrix), "KSPSetOperators");
-  check(KSPSetType(o.solver, KSPCG), "KSPSetType");
+  petsc_check(KSPCreate(PETSC_COMM_WORLD, &o.solver), "KSPCreate");
+  petsc_check(KSPSetOperators(o.solver, o.matrix, o.matrix), "KSPSetOperators");
+  petsc_check(KSPSetType(o.solver, KSPCG), "KSPSetType");
   PC preconditioner = nullptr;
-  check(KSPGetPC(o.solver, &preconditioner), "KSPGetPC");
-  check(PCSetType(preconditioner, PCHYPRE), "PCSetType");
-  check(PCHYPRESetType(preconditioner, "boomeramg"), "PCHYPRESetType");
-  check(KSPSetTolerances(o.solver, 1e-13, 0.0, PETSC_DEFAULT, 2000), "KSPSetTolerances");
+  petsc_check(KSPGetPC(o.solver, &preconditioner), "KSPGetPC");
+  petsc_check(PCSetType(preconditioner, PCHYPRE), "PCSetType");
+  petsc_check(PCHYPRESetType(preconditioner, "boomeramg"), "PCHYPRESetType");
+  petsc_check(KSPSetTolerances(o.solver, 1e-13, 0.0, PETSC_DEFAULT, 2000), "KSPSetTolerances");
   // PETSC_OPTIONS may tune it: options it does not know are the user's input, refused so.
-  if (const PetscErrorCode code = KSPSetFromOptions(o.solver); code != 0) {
-    const char* reason = nullptr;
-    PetscErrorMessage(code, &reason, nullptr);
-    throw InputError(std::string("PETSC_OPTIONS: ") + (reason ? reason : "refused by PETSc"));
-  }
-  check(KSPSolve(o.solver, o.rhs, o.x), "KSPSolve");
-  check(KSPGetConvergedReason(o.solver, &reason), "KSPGetConvergedReason");
+  petsc_options_check(KSPSetFromOptions(o.solver));
+  petsc_check(KSPSolve(o.solver, o.rhs, o.x), "KSPSolve");
+  petsc_check(KSPGetConvergedReason(o.solver, &reason), "KSPGetConvergedReason");
   PetscInt iterations = 0;
-  check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
+  petsc_check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
   iterations_ = static_cast<int>(iterations);
   KSPType ksp_type = nullptr;
   PCType pc_type = nullptr;
-  check(KSPGetType(o.solver, &ksp_type), "KSPGetType");
-  check(PCGetType(preconditioner, &pc_type), "PCGetType");
+  petsc_check(KSPGetType(o.solver, &ksp_type), "KSPGetType");
+  petsc_check(PCGetType(preconditioner, &pc_type), "PCGetType");
   method_ = std::string(ksp_type ? ksp_type : "?") + " with " + (pc_type ? pc_type : "?");
   // The true residual, whatever the options asked of the solver: |b - A x| / |b|.
-  check(VecDuplicate(o.rhs, &o.everywhere), "VecDuplicate");
-  check(MatMult(o.matrix, o.x, o.everywhere), "MatMult");
-  check(VecAYPX(o.everywhere, -1.0, o.rhs), "VecAYPX");
-  check(VecNorm(o.everywhere, NORM_2, &residual), "VecNorm");
-  check(VecNorm(o.rhs, NORM_2, &scale), "VecNorm");
-  check(VecDestroy(&o.everywhere), "VecDestroy");
+  petsc_check(VecDuplicate(o.rhs, &o.everywhere), "VecDuplicate");
+  petsc_check(MatMult(o.matrix, o.x, o.everywhere), "MatMult");
+  petsc_check(VecAYPX(o.everywhere, -1.0, o.rhs), "VecAYPX");
+  petsc_check(VecNorm(o.everywhere, NORM_2, &residual), "VecNorm");
+  petsc_check(VecNorm(o.rhs, NORM_2, &scale), "VecNorm");
+  petsc_check(VecDestroy(&o.everywhere), "VecDestroy");
   });
   // Every rank's solver and norms say the same: refused alike.
   const double relative = scale > 0 ? residual / scale : residual;
@@ -191,14 +150,14 @@ void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<cons
                                  "little");
 
   // Every rank gets every free node's potential.
-  check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");
-  check(VecScatterBegin(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-  check(VecScatterEnd(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  petsc_check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");
+  petsc_check(VecScatterBegin(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+  petsc_check(VecScatterEnd(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
   const PetscScalar* solved = nullptr;
-  check(VecGetArrayRead(o.everywhere, &solved), "VecGetArrayRead");
+  petsc_check(VecGetArrayRead(o.everywhere, &solved), "VecGetArrayRead");
   for (std::size_t i = 0; i < nodes_; ++i)
     if (!prescribed_[i]) pressure[i] = solved[row_[i]];
-  check(VecRestoreArrayRead(o.everywhere, &solved), "VecRestoreArrayRead");
+  petsc_check(VecRestoreArrayRead(o.everywhere, &solved), "VecRestoreArrayRead");
 }
 
 }  // namespace hemotree

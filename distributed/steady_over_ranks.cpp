@@ -17,21 +17,6 @@
 
 namespace hemotree {
 
-namespace {
-
-// The nodes' owners for PETSc: each node on the rank of a vessel leaving it (METIS's pieces go
-// with their `from` nodes), else of one entering it.
-std::vector<std::int32_t> node_owners(const Network& net, const Partition& partition) {
-  std::vector<std::int32_t> owner(net.node_count(), -1);
-  for (std::size_t v = 0; v < net.vessel_count(); ++v) owner[static_cast<std::size_t>(net.from[v])] = partition.rank_of_vessel[v];
-  for (std::size_t v = 0; v < net.vessel_count(); ++v)
-    if (std::int32_t& o = owner[static_cast<std::size_t>(net.to[v])]; o < 0) o = partition.rank_of_vessel[v];
-  for (std::int32_t& o : owner) o = std::max(o, 0);  // a node no vessel touches: a unit shunt, rank 0's
-  return owner;
-}
-
-}  // namespace
-
 void check_gathered_nodes(std::size_t nodes) {
   // Rank 0 gathers a pressure and a flow a node, counted in MPI's ints.
   if (2 * nodes > static_cast<std::size_t>(std::numeric_limits<int>::max()))

@@ -29,6 +29,15 @@ const char* to_string(Partition::Method method) {
   return "?";
 }
 
+std::vector<std::int32_t> node_owners(const Network& net, const Partition& partition) {
+  std::vector<std::int32_t> owner(net.node_count(), -1);
+  for (std::size_t v = 0; v < net.vessel_count(); ++v) owner[static_cast<std::size_t>(net.from[v])] = partition.rank_of_vessel[v];
+  for (std::size_t v = 0; v < net.vessel_count(); ++v)
+    if (std::int32_t& o = owner[static_cast<std::size_t>(net.to[v])]; o < 0) o = partition.rank_of_vessel[v];
+  for (std::int32_t& o : owner) o = std::max(o, 0);
+  return owner;
+}
+
 std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> rank_of_vessel) {
   std::vector<std::int32_t> seen(net.node_count(), -1);
   std::vector<std::uint8_t> cut(net.node_count(), 0);

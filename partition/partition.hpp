@@ -57,6 +57,11 @@ void keep_on_top(const Network& net, std::span<const double> cost, std::span<con
 // (its checkpoint) takes. The same balance and cut. Nothing to do without a top on one rank.
 void lead_with_the_top(Partition& p);
 
+// Each node's rank, where a distributed solve (PETSc) assembles its rows: the rank of a vessel
+// leaving it (METIS's pieces go with their `from` nodes), else of one entering it; rank 0
+// for a node no vessel touches.
+std::vector<std::int32_t> node_owners(const Network& net, const Partition& partition);
+
 // Nodes whose vessels lie on more than one rank.
 std::size_t count_cut_nodes(const Network& net, std::span<const std::int32_t> rank_of_vessel);
 
