@@ -10,12 +10,15 @@
 
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
+#include "core/units.hpp"
 #include "distributed/distended_over_ranks.hpp"
 #include "distributed/harmonic_tree_share.hpp"
 #include "distributed/mpi_harmonic_tree.hpp"
 #include "distributed/network_cut.hpp"
+#include "distributed/petsc_harmonic_network.hpp"
 #include "formats/run_boundaries.hpp"
 #include "mpi/session.hpp"
+#include "partition/partition_methods.hpp"
 
 namespace hemotree {
 
@@ -236,20 +239,118 @@ struct RankHarmonics {
   }
 };
 
-}  // namespace
+// Where each rank's results are, for rank 0's gather: per rank its vessels (increasing) and
+// its nodes (in the order its results list them), and each vessel's rank.
+void place_results(LinearPeriodicOverRanks& out, const std::vector<std::int32_t>& vessel_rank,
+                   std::vector<std::vector<std::int32_t>> nodes_of) {
+  out.vessel_rank = vessel_rank;
+  out.vessels_of.assign(nodes_of.size(), {});
+  for (std::size_t v = 0; v < vessel_rank.size(); ++v)
+    out.vessels_of[static_cast<std::size_t>(vessel_rank[v])].push_back(static_cast<std::int32_t>(v));
+  out.nodes_of = std::move(nodes_of);
+}
 
-LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const Blood& blood,
-                                                         std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
-                                                         int harmonics, int threads,
-                                                         const std::function<bool(const VesselLine&)>& shift_source) {
+// A network with loops or pressures held at nodes: the vessels split by METIS, every rank the
+// whole distended steady state (as every rank holds the whole network), each rank the lines
+// of every vessel (its own answered, the others' ghosts), and each harmonic's system assembled
+// over the ranks and solved by PETSc (petsc_harmonic_network.hpp): only the solves and the
+// results are divided, for now.
+LinearPeriodicOverRanks solve_on_graph(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                       const ViscosityTable& viscosity, int harmonics, int threads,
+                                       const std::function<bool(const VesselLine&)>& shift_source) {
+  const int ranks = world_size(), rank = world_rank();
+  const std::size_t n = net.vessel_count(), nodes = net.node_count();
+  const RunBoundaries boundaries(net);
+  Partition partition;
+  std::vector<std::int32_t> node_owner;
+  SteadyFlow steady;
+  on_every_rank([&] {
+    partition = partition_network(net, std::vector<double>(n, 1.0), ranks);
+    node_owner = node_owners(net, partition);
+    steady = solve_distended_steady_flow(net, blood, laws, viscosity, net.inlet ? net.inlet->waveform.mean_value() : 0.0,
+                                         nullptr, threads);
+  });
+  check_one_partition(partition);
+  HarmonicShare share;
+  std::vector<unsigned char> ghost(n, 0);
+  for (std::size_t v = 0; v < n; ++v)
+    if (partition.rank_of_vessel[v] == rank) share.vessels.push_back(static_cast<std::int32_t>(v));
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (node_owner[i] == rank) share.nodes.push_back(static_cast<std::int32_t>(i));
+  // Every other vessel a ghost: each rank holds the whole network's lines, so that the mean
+  // shift of a vessel a wave travels in finds its ends' neighbours whatever rank they are on.
+  for (std::size_t v = 0; v < n; ++v)
+    if (partition.rank_of_vessel[v] != rank) share.ghosts.push_back(static_cast<std::int32_t>(v));
+  share.holds_every_vessel = true;
+  PetscHarmonicNetwork system(nodes, net.from, net.to, node_owner, partition.rank_of_vessel);
+  std::vector<TwoPort> two_ports(n);
+  std::vector<Complex> potential(nodes);
+  share.solve = [&](double, std::span<const Complex> shunt, std::span<Complex> current,
+                    const std::function<TwoPort(std::size_t)>& two_port) {
+    for (const std::int32_t v : share.vessels) two_ports[static_cast<std::size_t>(v)] = two_port(static_cast<std::size_t>(v));
+    system.solve(two_ports, shunt, current, potential);
+    std::copy(potential.begin(), potential.end(), current.begin());
+  };
+  share.on_every_share = [](const std::function<void()>& step) { on_every_rank(step); };
+  LinearPeriodicOverRanks out;
+  out.periodic = solve_linear_periodic(net, blood, laws, viscosity, steady, boundaries, harmonics, threads, shift_source, share);
+  out.vessels = share.vessels;
+  out.nodes = share.nodes;
+  std::vector<std::vector<std::int32_t>> nodes_of(static_cast<std::size_t>(ranks));
+  for (std::size_t i = 0; i < nodes; ++i) nodes_of[static_cast<std::size_t>(node_owner[i])].push_back(static_cast<std::int32_t>(i));
+  place_results(out, partition.rank_of_vessel, std::move(nodes_of));
+  out.partition = std::move(partition);
+  out.solver = "every harmonic's nodal system by PETSc's " + system.method();
+  return out;
+}
+
+// Whether the linear periodic state over ranks needs the graph's solve: loops, or a pressure
+// held at a node (a tree's distributed elimination takes a tree fed by its inflow).
+bool needs_graph_solve(const Network& net) {
+  const RunBoundaries boundaries(net);
+  for (std::size_t i = 0; i < boundaries.size(); ++i)
+    if (boundaries.type(i) == BoundaryType::pressure) return true;
+  return !is_forest(net);
+}
+
+// A tree fed by its inflow: the distributed elimination of each harmonic (RankHarmonics).
+LinearPeriodicOverRanks solve_on_tree(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
+                                      const ViscosityTable& viscosity, int harmonics, int threads,
+                                      const std::function<bool(const VesselLine&)>& shift_source) {
   RankHarmonics::Forced forced;
   if (shift_source)
     forced = [&](const DistendedOverRanks& d) { return forced_everywhere(net, blood, laws, viscosity, d, shift_source); };
   const auto rank = std::make_unique<RankHarmonics>(net, blood, laws, viscosity, threads, forced);
   LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, rank->distended.flow, rank->boundaries,
                                                   harmonics, threads, shift_source, rank->share);
-  return {std::move(periodic), rank->share.vessels, rank->share.nodes, std::move(rank->partition), std::move(rank->cut),
-          rank->system->traffic()};
+  LinearPeriodicOverRanks out{std::move(periodic), rank->share.vessels, rank->share.nodes, std::move(rank->partition),
+                              std::move(rank->cut), rank->system->traffic()};
+  // The results by the cut: a rank's nodes as it holds them, its vessels their edges to their parents.
+  std::vector<std::vector<std::int32_t>> nodes_of = out.cut->held_nodes();
+  std::vector<std::int32_t> vessel_rank = out.cut->edge_ranks();
+  place_results(out, vessel_rank, std::move(nodes_of));
+  const RootExchange::Traffic& t = out.traffic;
+  out.solver = "the harmonics' exchanges on rank 0: " + std::to_string(t.calls) + " collective calls, " +
+               std::to_string(t.bytes) + " bytes, " + format_quantity(t.seconds, "s");
+  return out;
+}
+
+}  // namespace
+
+LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const Blood& blood,
+                                                         std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
+                                                         int harmonics, int threads,
+                                                         const std::function<bool(const VesselLine&)>& shift_source) {
+  if (!needs_graph_solve(net)) {
+    try {
+      return solve_on_tree(net, blood, laws, viscosity, harmonics, threads, shift_source);
+    } catch (const Collective<SettingError>& e) {
+      // A tree whose cut cannot be made (its top spread over the ranks, or the vessels a wave
+      // travels in leaving a rank empty on the top: ADAN56): every rank alike, the graph's solve.
+      if (e.setting() != "ranks") throw;
+    }
+  }
+  return solve_on_graph(net, blood, laws, viscosity, harmonics, threads, shift_source);
 }
 
 PeriodicInstantOverRanks solve_periodic_instant_over_ranks(const Network& net, const Blood& blood,

@@ -12,7 +12,9 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "distributed/root_exchange.hpp"
@@ -30,17 +32,24 @@ struct LinearPeriodicOverRanks {
   LinearPeriodic periodic;                   // what this rank holds of it (periodic.holds)
   std::vector<std::int32_t> vessels, nodes;  // this rank's: increasing vessels, its nodes (TreeCut::held_nodes)
   Partition partition;                       // the vessels' split (the same on every rank)
-  TreeCut cut;                               // and the tree's, by it
+  std::optional<TreeCut> cut;                // and the tree's, by it (none on a graph's solve)
   RootExchange::Traffic traffic;             // this rank's exchanges in the harmonics' solves
+  // Where the results are, on every rank alike: per rank its vessels (increasing) and its
+  // nodes (in its `nodes`' order), and each vessel's rank.
+  std::vector<std::vector<std::int32_t>> vessels_of, nodes_of;
+  std::vector<std::int32_t> vessel_rank;
+  std::string solver;  // how the harmonics were solved over the ranks, in words
 };
 
 // The arguments of the one-process solve_linear_periodic (the steady state is solved here, at
-// the inlet's mean flow). The vessels are split by whole subtrees, one a vessel; where a
-// forced vessel (shift_source: a 1D vessel of the run) crosses the cut, every forced vessel
-// and those above it move to the top's rank (partition/'s keep_on_top), their steady state
-// with them. InputError as the one-process solve, on every rank alike; a
-// network with loops, a spread top or a pressure held at a node (its harmonic system is not
-// the cut's forest) is refused: SettingError "ranks", InputError.
+// the inlet's mean flow). A tree fed by its inflow: the vessels are split by whole subtrees,
+// one a vessel; where a forced vessel (shift_source: a 1D vessel of the run) crosses the cut,
+// every forced vessel and those above it move to the top's rank (partition/'s keep_on_top),
+// their steady state with them; a spread top is refused (SettingError "ranks"). A network
+// with loops or a pressure held at a node: split by METIS, each harmonic's system over the
+// ranks by PETSc (petsc_harmonic_network.hpp), the plain solve's to its 1e-10 (every rank holds
+// every vessel's line; the solves and the results are divided). InputError as the one-process
+// solve, on every rank alike.
 LinearPeriodicOverRanks solve_linear_periodic_over_ranks(const Network& net, const Blood& blood,
                                                          std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                                                          int harmonics, int threads,

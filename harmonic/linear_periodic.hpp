@@ -168,13 +168,17 @@ struct HarmonicShare {
   // Runs a step that may fail on one share alone so that its failure is every share's
   // (mpi/session.hpp's on_every_rank).
   std::function<void(const std::function<void()>&)> on_every_share;
+  // Whether its ghosts are every vessel it does not answer for (a share holding the whole
+  // network's lines): then a ghost that is a shift source has its ends' neighbours too, and is
+  // taken, not refused.
+  bool holds_every_vessel = false;
 };
 
 // The linear periodic state of a share: the lines, amplitudes, mean and shift of its vessels
 // and ghosts (those it holds: `holds`), each the bits of the one-process solve. steady: the
 // distended state's pressures at the ends of its vessels and ghosts and their flows. Every
 // share calls it alike. A ghost that is a shift source (a 1D vessel across a cut) is refused
-// on every share: InputError.
+// on every share (InputError), unless the share holds every vessel.
 LinearPeriodic solve_linear_periodic(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                      const ViscosityTable& viscosity, const SteadyFlow& steady,
                                      const RunBoundaries& boundaries, int harmonics, int threads,

@@ -248,8 +248,8 @@ void bind_options(CLI::App& app, CommandLine& line, int cores) {
       "--linear", linear,
       "the linear periodic state about the steady one as the result, harmonic by harmonic (every vessel a "
       "transmission line, every outlet its impedance): the same files as a run, in seconds on 100,000 vessels and about 12 s on 3.8 million from and to HDF5 (two threads), for "
-      "screening (docs/solver.md §6a gives its error against a run); under mpirun -np P over P ranks on a tree fed by its "
-      "inflow (the same files byte for byte)");
+      "screening (docs/solver.md §6a gives its error against a run); under mpirun -np P over P ranks (a tree fed by its "
+      "inflow: the same files byte for byte; any other network: PETSc, to 1e-10)");
   app.add_option("--harmonics", options.periodic_harmonics,
                  "the inflow's harmonics the linear periodic state takes (--linear, --start periodic), in [1, 1000]")
       ->capture_default_str();

@@ -222,7 +222,6 @@ LinearOutcome linear_over_ranks(const Network& net, const Blood& blood, const Vi
   const LinearPeriodicOverRanks mine =
       solve_linear_periodic_over_ranks(net, blood, laws, viscosity, options.periodic_harmonics, options.threads, travels);
   const LinearPeriodic& periodic = mine.periodic;
-  const TreeCut* cut = &mine.cut;
   const LinearVessels results(net, blood, viscosity, laws, periodic, options, analysis);
   // Per vessel: its cycle's eight numbers, whether a wave travels, its Womersley number and
   // wave speeds of theory, and the two measured where a wave travels (else NaN).
@@ -248,7 +247,7 @@ LinearOutcome linear_over_ranks(const Network& net, const Blood& blood, const Vi
   std::vector<double> node_rows;
   for (const std::int32_t node : mine.nodes) node_rows.push_back(periodic.mean_node_pressure(static_cast<std::size_t>(node)));
   // Each probe's period, by the rank that holds its vessel.
-  const std::vector<std::int32_t> vessel_rank = cut->edge_ranks();
+  const std::vector<std::int32_t>& vessel_rank = mine.vessel_rank;
   constexpr std::size_t probe_width = 3 * (samples_per_period + 1);
   std::vector<double> probe_rows;
   for (const Probe& probe : probes) {
@@ -259,27 +258,16 @@ LinearOutcome linear_over_ranks(const Network& net, const Blood& blood, const Vi
       probe_rows.insert(probe_rows.end(), {p, q, laws[probe.vessel].area(p)});
     }
   }
-  // Every rank's lists, on rank 0: its vessels (its nodes' edges to their parents, increasing),
-  // its nodes, its probes.
-  std::vector<std::vector<std::int32_t>> vessels_of, nodes_of, probes_of;
+  // Every rank's lists, on rank 0: its vessels, its nodes, its probes.
+  const std::vector<std::vector<std::int32_t>>& vessels_of = mine.vessels_of;
+  const std::vector<std::vector<std::int32_t>>& nodes_of = mine.nodes_of;
+  std::vector<std::vector<std::int32_t>> probes_of;
   if (rank == 0) {
-    nodes_of = cut->held_nodes();
-    for (const auto& nodes : nodes_of) {
-      std::vector<std::int32_t> edges;
-      for (const std::int32_t node : nodes)
-        if (const std::int32_t e = cut->parent_edge[static_cast<std::size_t>(node)]; e >= 0) edges.push_back(e);
-      std::sort(edges.begin(), edges.end());
-      vessels_of.push_back(std::move(edges));
-    }
     probes_of.resize(static_cast<std::size_t>(ranks));
     for (std::size_t j = 0; j < probes.size(); ++j)
       probes_of[static_cast<std::size_t>(vessel_rank[probes[j].vessel])].push_back(static_cast<std::int32_t>(j));
   }
-  const RootExchange::Traffic& traffic = mine.traffic;
-  LinearOutcome out{{}, ProbeRecorder(probes), {}, periodic.harmonics(),
-                    describe(mine.partition) + "; the harmonics' exchanges on rank 0: " + std::to_string(traffic.calls) +
-                        " collective calls, " + std::to_string(traffic.bytes) + " bytes, " +
-                        format_quantity(traffic.seconds, "s")};
+  LinearOutcome out{{}, ProbeRecorder(probes), {}, periodic.harmonics(), describe(mine.partition) + "; " + mine.solver};
   LinearCycle& linear = out.linear;
   std::vector<WaveSpeeds> speeds;
   if (rank == 0) {
