@@ -23,23 +23,16 @@ PetscFlowNetwork::PetscFlowNetwork(std::size_t nodes, std::span<const std::int32
   if (nodes > static_cast<std::size_t>(std::numeric_limits<PetscInt>::max()))
     throw std::invalid_argument("PetscFlowNetwork: more nodes than PETSc's indices hold");
   start_petsc();
-  const int ranks = world_size(), rank = world_rank();
+  const int ranks = world_size();
   // The free nodes numbered rank by rank, each rank's in the order of the nodes.
-  std::vector<std::int64_t> count(static_cast<std::size_t>(ranks) + 1, 0);
   for (std::size_t i = 0; i < nodes; ++i)
-    if (!prescribed_[i]) {
-      if (owner_[i] < 0 || owner_[i] >= ranks)
-        throw std::invalid_argument("PetscFlowNetwork: node " + std::to_string(i) + " on rank " + std::to_string(owner_[i]));
-      ++count[static_cast<std::size_t>(owner_[i]) + 1];
-    }
-  for (int r = 0; r < ranks; ++r) count[static_cast<std::size_t>(r) + 1] += count[static_cast<std::size_t>(r)];
-  first_row_ = count[static_cast<std::size_t>(rank)];
-  rows_ = count[static_cast<std::size_t>(rank) + 1] - first_row_;
-  all_rows_ = count.back();
-  row_.assign(nodes, -1);
-  std::vector<std::int64_t> next(count.begin(), count.end() - 1);
-  for (std::size_t i = 0; i < nodes; ++i)
-    if (!prescribed_[i]) row_[i] = next[static_cast<std::size_t>(owner_[i])]++;
+    if (owner_[i] < 0 || owner_[i] >= ranks)
+      throw std::invalid_argument("PetscFlowNetwork: node " + std::to_string(i) + " on rank " + std::to_string(owner_[i]));
+  PetscRows rows = petsc_rows(owner_, prescribed_, 1);
+  row_ = std::move(rows.row);
+  first_row_ = rows.first;
+  rows_ = rows.count;
+  all_rows_ = rows.all;
 }
 
 PetscFlowNetwork::~PetscFlowNetwork() = default;
@@ -82,8 +75,7 @@ void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<cons
   // PETSc's calls are collective: a failure there (a bad PETSC_OPTIONS, say) is every rank's
   // alike, passed on once all have left them (mpi/session.hpp's on_every_rank).
   PetscObjects o;
-  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
-  PetscReal residual = 0, scale = 0;
+  PetscOutcome outcome;
   on_every_rank([&] {
   const auto n = static_cast<PetscInt>(rows_), all = static_cast<PetscInt>(all_rows_);
   petsc_check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
@@ -102,62 +94,29 @@ void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<cons
   }
   for (std::size_t q = 0; q < entry.size(); ++q)
     petsc_check(MatSetValue(o.matrix, entry_at[q].first, entry_at[q].second, entry[q], ADD_VALUES), "MatSetValue");
-  petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-  petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  const PC preconditioner = petsc_prepare(o, rhs, KSPCG);
   petsc_check(MatSetOption(o.matrix, MAT_SPD, PETSC_TRUE), "MatSetOption");
-
-  petsc_check(MatCreateVecs(o.matrix, &o.x, &o.rhs), "MatCreateVecs");
-  PetscScalar* values = nullptr;
-  petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
-  std::copy(rhs.begin(), rhs.end(), values);
-  petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
-
-  petsc_check(KSPCreate(PETSC_COMM_WORLD, &o.solver), "KSPCreate");
-  petsc_check(KSPSetOperators(o.solver, o.matrix, o.matrix), "KSPSetOperators");
-  petsc_check(KSPSetType(o.solver, KSPCG), "KSPSetType");
-  PC preconditioner = nullptr;
-  petsc_check(KSPGetPC(o.solver, &preconditioner), "KSPGetPC");
   petsc_check(PCSetType(preconditioner, PCHYPRE), "PCSetType");
   petsc_check(PCHYPRESetType(preconditioner, "boomeramg"), "PCHYPRESetType");
   petsc_check(KSPSetTolerances(o.solver, 1e-13, 0.0, PETSC_DEFAULT, 2000), "KSPSetTolerances");
-  // PETSC_OPTIONS may tune it: options it does not know are the user's input, refused so.
-  petsc_options_check(KSPSetFromOptions(o.solver));
-  petsc_check(KSPSolve(o.solver, o.rhs, o.x), "KSPSolve");
-  petsc_check(KSPGetConvergedReason(o.solver, &reason), "KSPGetConvergedReason");
-  PetscInt iterations = 0;
-  petsc_check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
-  iterations_ = static_cast<int>(iterations);
-  KSPType ksp_type = nullptr;
-  PCType pc_type = nullptr;
-  petsc_check(KSPGetType(o.solver, &ksp_type), "KSPGetType");
-  petsc_check(PCGetType(preconditioner, &pc_type), "PCGetType");
-  method_ = std::string(ksp_type ? ksp_type : "?") + " with " + (pc_type ? pc_type : "?");
-  // The true residual, whatever the options asked of the solver: |b - A x| / |b|.
-  petsc_check(VecDuplicate(o.rhs, &o.everywhere), "VecDuplicate");
-  petsc_check(MatMult(o.matrix, o.x, o.everywhere), "MatMult");
-  petsc_check(VecAYPX(o.everywhere, -1.0, o.rhs), "VecAYPX");
-  petsc_check(VecNorm(o.everywhere, NORM_2, &residual), "VecNorm");
-  petsc_check(VecNorm(o.rhs, NORM_2, &scale), "VecNorm");
-  petsc_check(VecDestroy(&o.everywhere), "VecDestroy");
+  outcome = petsc_solve(o);  // PETSC_OPTIONS may tune it
   });
+  iterations_ = outcome.iterations;
+  method_ = outcome.method;
+  const double relative = outcome.relative;
   // Every rank's solver and norms say the same: refused alike.
-  const double relative = scale > 0 ? residual / scale : residual;
-  if (reason < 0 || !(relative <= 1e-10))
+  if (outcome.reason < 0 || !(relative <= 1e-10))
     throw Collective<InputError>("the distributed solve (PETSc's " + method_ + ") left a relative residual of " +
                                  std::to_string(relative) + " after " + std::to_string(iterations_) +
-                                 " iterations (PETSc's reason " + std::to_string(reason) +
+                                 " iterations (PETSc's reason " + std::to_string(outcome.reason) +
                                  "; 1e-10 is needed): resistances too far apart for it, or PETSC_OPTIONS that ask too "
                                  "little");
 
   // Every rank gets every free node's potential.
-  petsc_check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");
-  petsc_check(VecScatterBegin(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-  petsc_check(VecScatterEnd(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
-  const PetscScalar* solved = nullptr;
-  petsc_check(VecGetArrayRead(o.everywhere, &solved), "VecGetArrayRead");
-  for (std::size_t i = 0; i < nodes_; ++i)
-    if (!prescribed_[i]) pressure[i] = solved[row_[i]];
-  petsc_check(VecRestoreArrayRead(o.everywhere, &solved), "VecRestoreArrayRead");
+  petsc_read_everywhere(o, [&](const PetscScalar* solved) {
+    for (std::size_t i = 0; i < nodes_; ++i)
+      if (!prescribed_[i]) pressure[i] = solved[row_[i]];
+  });
 }
 
 }  // namespace hemotree

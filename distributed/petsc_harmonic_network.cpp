@@ -41,18 +41,11 @@ PetscHarmonicNetwork::PetscHarmonicNetwork(std::size_t nodes, std::span<const st
       throw std::invalid_argument("PetscHarmonicNetwork: edge " + std::to_string(e) + " leaves the graph");
   start_petsc();
   // Two rows a node, the nodes numbered rank by rank, each rank's in the order of the nodes.
-  std::vector<std::int64_t> count(static_cast<std::size_t>(ranks) + 1, 0);
-  for (std::size_t i = 0; i < nodes; ++i) count[static_cast<std::size_t>(node_owner_[i]) + 1] += 2;
-  for (int r = 0; r < ranks; ++r) count[static_cast<std::size_t>(r) + 1] += count[static_cast<std::size_t>(r)];
-  first_row_ = count[static_cast<std::size_t>(rank)];
-  rows_ = count[static_cast<std::size_t>(rank) + 1] - first_row_;
-  all_rows_ = count.back();
-  row_.assign(nodes, -1);
-  std::vector<std::int64_t> next(count.begin(), count.end() - 1);
-  for (std::size_t i = 0; i < nodes; ++i) {
-    row_[i] = next[static_cast<std::size_t>(node_owner_[i])];
-    next[static_cast<std::size_t>(node_owner_[i])] += 2;
-  }
+  PetscRows rows = petsc_rows(node_owner_, {}, 2);
+  row_ = std::move(rows.row);
+  first_row_ = rows.first;
+  rows_ = rows.count;
+  all_rows_ = rows.all;
   // Each own row: its node's block and two columns for each edge there (parallel edges
   // counted apart: a little over), split by whether the node across is this rank's.
   in_block_.assign(static_cast<std::size_t>(rows_), 2);
@@ -116,8 +109,7 @@ void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const 
   const int rank = world_rank();
   refuse_ungrounded(edge, shunt);
   PetscObjects o;
-  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
-  PetscReal residual = 0, scale = 0;
+  PetscOutcome outcome;
   // z as its real 2 x 2 block at the rows of node i and the columns of node j.
   auto add = [&](std::size_t i, std::size_t j, Complex z) {
     const PetscInt rows[2] = {static_cast<PetscInt>(row_[i]), static_cast<PetscInt>(row_[i] + 1)};
@@ -145,66 +137,31 @@ void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const 
       add(eb, ea, edge[e].ba);
       add(eb, eb, edge[e].bb);
     }
-    petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-    petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
-
-    petsc_check(MatCreateVecs(o.matrix, &o.x, &o.rhs), "MatCreateVecs");
-    PetscScalar* values = nullptr;
-    petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
+    std::vector<double> rhs(static_cast<std::size_t>(rows_));
     for (std::size_t i = 0; i < nodes_; ++i)
       if (node_owner_[i] == rank) {
         const auto k = static_cast<std::size_t>(row_[i] - first_row_);
-        values[k] = current[i].real();
-        values[k + 1] = current[i].imag();
+        rhs[k] = current[i].real();
+        rhs[k + 1] = current[i].imag();
       }
-    petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
-
-    petsc_check(KSPCreate(PETSC_COMM_WORLD, &o.solver), "KSPCreate");
-    petsc_check(KSPSetOperators(o.solver, o.matrix, o.matrix), "KSPSetOperators");
-    petsc_check(KSPSetType(o.solver, KSPPREONLY), "KSPSetType");
-    PC preconditioner = nullptr;
-    petsc_check(KSPGetPC(o.solver, &preconditioner), "KSPGetPC");
+    const PC preconditioner = petsc_prepare(o, rhs, KSPPREONLY);
     petsc_check(PCSetType(preconditioner, PCLU), "PCSetType");
     petsc_check(PCFactorSetMatSolverType(preconditioner, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
     petsc_check(KSPSetErrorIfNotConverged(o.solver, PETSC_FALSE), "KSPSetErrorIfNotConverged");
-    petsc_options_check(KSPSetFromOptions(o.solver));
-    // A singular system (a part with no admittance to ground) fails the factorisation: PETSc
-    // says so as an error or a reason; either way the residual below refuses it.
-    const PetscErrorCode solved = KSPSolve(o.solver, o.rhs, o.x);
-    if (solved != 0) petsc_check(VecSet(o.x, 0.0), "VecSet");
-    petsc_check(KSPGetConvergedReason(o.solver, &reason), "KSPGetConvergedReason");
-    PetscInt iterations = 0;
-    petsc_check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
-    iterations_ = static_cast<int>(iterations);
-    KSPType ksp_type = nullptr;
-    PCType pc_type = nullptr;
-    MatSolverType factor = nullptr;
-    petsc_check(KSPGetType(o.solver, &ksp_type), "KSPGetType");
-    petsc_check(PCGetType(preconditioner, &pc_type), "PCGetType");
-    if (PCFactorGetMatSolverType(preconditioner, &factor) != 0) factor = nullptr;
-    method_ = std::string(ksp_type ? ksp_type : "?") + " with " + (pc_type ? pc_type : "?") +
-              (factor ? std::string(" (") + factor + ")" : std::string());
-    petsc_check(VecDuplicate(o.rhs, &o.everywhere), "VecDuplicate");
-    petsc_check(MatMult(o.matrix, o.x, o.everywhere), "MatMult");
-    petsc_check(VecAYPX(o.everywhere, -1.0, o.rhs), "VecAYPX");
-    petsc_check(VecNorm(o.everywhere, NORM_2, &residual), "VecNorm");
-    petsc_check(VecNorm(o.rhs, NORM_2, &scale), "VecNorm");
-    petsc_check(VecDestroy(&o.everywhere), "VecDestroy");
+    outcome = petsc_solve(o);  // a singular system's failed factorisation: refused below
   });
-  const double relative = scale > 0 ? residual / scale : residual;
-  if (reason < 0 || !(relative <= 1e-10))
+  iterations_ = outcome.iterations;
+  method_ = outcome.method;
+  const double relative = outcome.relative;
+  if (outcome.reason < 0 || !(relative <= 1e-10))
     throw Collective<InputError>("a harmonic's distributed solve (PETSc's " + method_ + ") left a relative residual of " +
-                                 scientific(relative) + " (PETSc's reason " + std::to_string(reason) +
+                                 scientific(relative) + " (PETSc's reason " + std::to_string(outcome.reason) +
                                  "; 1e-10 is needed): a part of the network with no path to an outlet or a pressure, "
                                  "or PETSC_OPTIONS that ask too little");
   on_every_rank([&] {
-    petsc_check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");
-    petsc_check(VecScatterBegin(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-    petsc_check(VecScatterEnd(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
-    const PetscScalar* x = nullptr;
-    petsc_check(VecGetArrayRead(o.everywhere, &x), "VecGetArrayRead");
-    for (std::size_t i = 0; i < nodes_; ++i) potential[i] = {x[row_[i]], x[row_[i] + 1]};
-    petsc_check(VecRestoreArrayRead(o.everywhere, &x), "VecRestoreArrayRead");
+    petsc_read_everywhere(o, [&](const PetscScalar* x) {
+      for (std::size_t i = 0; i < nodes_; ++i) potential[i] = {x[row_[i]], x[row_[i] + 1]};
+    });
   });
 }
 

@@ -1,5 +1,6 @@
 #include "distributed/petsc_session.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -29,6 +30,81 @@ void start_petsc() {
   petsc_check(PetscInitializeNoArguments(), "PetscInitialize");
   petsc_check(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr), "PetscPushErrorHandler");
   at_session_end([] { PetscFinalize(); });
+}
+
+PetscRows petsc_rows(std::span<const std::int32_t> owner, std::span<const unsigned char> skip, int per_node) {
+  const int ranks = world_size(), rank = world_rank();
+  auto rows_of = [&](std::size_t i) { return skip.empty() || !skip[i] ? per_node : 0; };
+  std::vector<std::int64_t> count(static_cast<std::size_t>(ranks) + 1, 0);
+  for (std::size_t i = 0; i < owner.size(); ++i) count[static_cast<std::size_t>(owner[i]) + 1] += rows_of(i);
+  for (int r = 0; r < ranks; ++r) count[static_cast<std::size_t>(r) + 1] += count[static_cast<std::size_t>(r)];
+  PetscRows rows;
+  rows.first = count[static_cast<std::size_t>(rank)];
+  rows.count = count[static_cast<std::size_t>(rank) + 1] - rows.first;
+  rows.all = count.back();
+  rows.row.assign(owner.size(), -1);
+  std::vector<std::int64_t> next(count.begin(), count.end() - 1);
+  for (std::size_t i = 0; i < owner.size(); ++i)
+    if (rows_of(i) > 0) {
+      rows.row[i] = next[static_cast<std::size_t>(owner[i])];
+      next[static_cast<std::size_t>(owner[i])] += rows_of(i);
+    }
+  return rows;
+}
+
+PC petsc_prepare(PetscObjects& o, std::span<const double> local_rhs, KSPType type) {
+  petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  petsc_check(MatCreateVecs(o.matrix, &o.x, &o.rhs), "MatCreateVecs");
+  PetscScalar* values = nullptr;
+  petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
+  std::copy(local_rhs.begin(), local_rhs.end(), values);
+  petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+  petsc_check(KSPCreate(PETSC_COMM_WORLD, &o.solver), "KSPCreate");
+  petsc_check(KSPSetOperators(o.solver, o.matrix, o.matrix), "KSPSetOperators");
+  petsc_check(KSPSetType(o.solver, type), "KSPSetType");
+  PC preconditioner = nullptr;
+  petsc_check(KSPGetPC(o.solver, &preconditioner), "KSPGetPC");
+  return preconditioner;
+}
+
+PetscOutcome petsc_solve(PetscObjects& o) {
+  petsc_options_check(KSPSetFromOptions(o.solver));
+  if (KSPSolve(o.solver, o.rhs, o.x) != 0) petsc_check(VecSet(o.x, 0.0), "VecSet");
+  PetscOutcome out;
+  petsc_check(KSPGetConvergedReason(o.solver, &out.reason), "KSPGetConvergedReason");
+  PetscInt iterations = 0;
+  petsc_check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
+  out.iterations = static_cast<int>(iterations);
+  KSPType ksp_type = nullptr;
+  PCType pc_type = nullptr;
+  PC preconditioner = nullptr;
+  MatSolverType factor = nullptr;
+  petsc_check(KSPGetType(o.solver, &ksp_type), "KSPGetType");
+  petsc_check(KSPGetPC(o.solver, &preconditioner), "KSPGetPC");
+  petsc_check(PCGetType(preconditioner, &pc_type), "PCGetType");
+  if (PCFactorGetMatSolverType(preconditioner, &factor) != 0) factor = nullptr;  // not a factorisation
+  out.method = std::string(ksp_type ? ksp_type : "?") + " with " + (pc_type ? pc_type : "?") +
+               (factor ? std::string(" (") + factor + ")" : std::string());
+  PetscReal residual = 0, scale = 0;
+  petsc_check(VecDuplicate(o.rhs, &o.everywhere), "VecDuplicate");
+  petsc_check(MatMult(o.matrix, o.x, o.everywhere), "MatMult");
+  petsc_check(VecAYPX(o.everywhere, -1.0, o.rhs), "VecAYPX");
+  petsc_check(VecNorm(o.everywhere, NORM_2, &residual), "VecNorm");
+  petsc_check(VecNorm(o.rhs, NORM_2, &scale), "VecNorm");
+  petsc_check(VecDestroy(&o.everywhere), "VecDestroy");
+  out.relative = scale > 0 ? residual / scale : residual;
+  return out;
+}
+
+void petsc_read_everywhere(PetscObjects& o, const std::function<void(const PetscScalar*)>& read) {
+  petsc_check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");
+  petsc_check(VecScatterBegin(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+  petsc_check(VecScatterEnd(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  const PetscScalar* values = nullptr;
+  petsc_check(VecGetArrayRead(o.everywhere, &values), "VecGetArrayRead");
+  read(values);
+  petsc_check(VecRestoreArrayRead(o.everywhere, &values), "VecRestoreArrayRead");
 }
 
 }  // namespace hemotree

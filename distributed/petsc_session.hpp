@@ -4,6 +4,11 @@
 // a solve.
 #pragma once
 
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
 #include <petscksp.h>
 
 namespace hemotree {
@@ -13,6 +18,36 @@ void start_petsc();
 void petsc_check(PetscErrorCode code, const char* what);
 // PETSC_OPTIONS given to a solver (KSPSetFromOptions' code): InputError where it refuses them.
 void petsc_options_check(PetscErrorCode code);
+
+// The rows of a nodal system over the ranks: per node `per_node` rows (none where skip[i] is
+// set; skip may be empty), numbered rank by rank (owner[i]: its rank), each rank's nodes in
+// their order. row: per node its first row, -1 where skipped; this rank's rows [first,
+// first + count); all of them.
+struct PetscRows {
+  std::vector<std::int64_t> row;
+  std::int64_t first = 0, count = 0, all = 0;
+};
+PetscRows petsc_rows(std::span<const std::int32_t> owner, std::span<const unsigned char> skip, int per_node);
+
+struct PetscObjects;
+// The matrix in `o`, its values set, assembled; its vectors, the right-hand side this rank's
+// rows (local_rhs); a solver of `type` on it. Returns the solver's preconditioner, for the
+// caller to choose. Collective.
+PC petsc_prepare(PetscObjects& o, std::span<const double> local_rhs, KSPType type);
+// Solves in `o` once PETSC_OPTIONS have had their say (options PETSc does not know are the
+// user's input: InputError), and says what it came to: PETSc's reason and iterations, the
+// method in words ("cg with hypre", "preonly with lu (mumps)"), and the true relative residual
+// |b - A x| / |b| (whatever the options asked of the solver). A solve PETSc gives up (a
+// factorisation that meets a zero pivot) leaves x zero, so that the residual says so. Collective.
+struct PetscOutcome {
+  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+  int iterations = 0;
+  std::string method;
+  double relative = 0;
+};
+PetscOutcome petsc_solve(PetscObjects& o);
+// o.x on every rank, handed to read(values) in the global rows' order. Collective.
+void petsc_read_everywhere(PetscObjects& o, const std::function<void(const PetscScalar*)>& read);
 
 // The PETSc objects of one solve, destroyed whatever happens.
 struct PetscObjects {
