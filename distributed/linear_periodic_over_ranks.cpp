@@ -250,11 +250,11 @@ void place_results(LinearPeriodicOverRanks& out, const std::vector<std::int32_t>
   out.nodes_of = std::move(nodes_of);
 }
 
-// A network with loops or pressures held at nodes: the vessels split by METIS, every rank the
-// whole distended steady state (as every rank holds the whole network), each rank the lines
-// of every vessel (its own answered, the others' ghosts), and each harmonic's system assembled
-// over the ranks and solved by PETSc (petsc_harmonic_network.hpp): only the solves and the
-// results are divided, for now.
+// A network with loops or pressures held at nodes, or a tree whose cut cannot be made: the
+// vessels split by METIS (a tree's by subtrees), every rank the whole distended steady state
+// (as every rank holds the whole network) and the lines of every vessel (its own answered,
+// the others' ghosts), and each harmonic's system assembled over the ranks and solved by
+// PETSc (petsc_harmonic_network.hpp): only the solves and the results are divided, for now.
 LinearPeriodicOverRanks solve_on_graph(const Network& net, const Blood& blood, std::span<const TubeLaw> laws,
                                        const ViscosityTable& viscosity, int harmonics, int threads,
                                        const std::function<bool(const VesselLine&)>& shift_source) {
@@ -272,7 +272,6 @@ LinearPeriodicOverRanks solve_on_graph(const Network& net, const Blood& blood, s
   });
   check_one_partition(partition);
   HarmonicShare share;
-  std::vector<unsigned char> ghost(n, 0);
   for (std::size_t v = 0; v < n; ++v)
     if (partition.rank_of_vessel[v] == rank) share.vessels.push_back(static_cast<std::int32_t>(v));
   for (std::size_t i = 0; i < nodes; ++i)
