@@ -322,8 +322,13 @@ LinearPeriodicOverRanks solve_on_tree(const Network& net, const Blood& blood, st
   const auto rank = std::make_unique<RankHarmonics>(net, blood, laws, viscosity, threads, forced);
   LinearPeriodic periodic = solve_linear_periodic(net, blood, laws, viscosity, rank->distended.flow, rank->boundaries,
                                                   harmonics, threads, shift_source, rank->share);
-  LinearPeriodicOverRanks out{std::move(periodic), rank->share.vessels, rank->share.nodes, std::move(rank->partition),
-                              std::move(rank->cut), rank->system->traffic()};
+  LinearPeriodicOverRanks out;
+  out.periodic = std::move(periodic);
+  out.vessels = rank->share.vessels;
+  out.nodes = rank->share.nodes;
+  out.partition = std::move(rank->partition);
+  out.cut = std::move(rank->cut);
+  out.traffic = rank->system->traffic();
   // The results by the cut: a rank's nodes as it holds them, its vessels their edges to their parents.
   std::vector<std::vector<std::int32_t>> nodes_of = out.cut->held_nodes();
   std::vector<std::int32_t> vessel_rank = out.cut->edge_ranks();
