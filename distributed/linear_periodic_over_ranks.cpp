@@ -281,7 +281,7 @@ LinearPeriodicOverRanks solve_on_graph(const Network& net, const Blood& blood, s
   for (std::size_t v = 0; v < n; ++v)
     if (partition.rank_of_vessel[v] != rank) share.ghosts.push_back(static_cast<std::int32_t>(v));
   share.holds_every_vessel = true;
-  PetscHarmonicNetwork system(nodes, net.from, net.to, node_owner, partition.rank_of_vessel);
+  PetscHarmonicNetwork system(nodes, net.from, net.to, node_owner, partition.rank_of_vessel, net.node_id);
   std::vector<TwoPort> two_ports(n);
   std::vector<Complex> potential(nodes);
   share.solve = [&](double, std::span<const Complex> shunt, std::span<Complex> current,

@@ -25,10 +25,11 @@ std::string scientific(double x) {
 
 PetscHarmonicNetwork::PetscHarmonicNetwork(std::size_t nodes, std::span<const std::int32_t> a,
                                            std::span<const std::int32_t> b, std::span<const std::int32_t> node_owner,
-                                           std::span<const std::int32_t> edge_owner)
+                                           std::span<const std::int32_t> edge_owner, std::span<const std::int64_t> node_name)
     : nodes_(nodes), a_(a.begin(), a.end()), b_(b.begin(), b.end()), node_owner_(node_owner.begin(), node_owner.end()),
-      edge_owner_(edge_owner.begin(), edge_owner.end()) {
-  if (a.size() != b.size() || edge_owner.size() != a.size() || node_owner.size() != nodes)
+      edge_owner_(edge_owner.begin(), edge_owner.end()), node_name_(node_name.begin(), node_name.end()) {
+  if (a.size() != b.size() || edge_owner.size() != a.size() || node_owner.size() != nodes ||
+      (!node_name.empty() && node_name.size() != nodes))
     throw std::invalid_argument("PetscHarmonicNetwork: two nodes and an owner per edge, an owner per node");
   if (2 * nodes > static_cast<std::size_t>(std::numeric_limits<PetscInt>::max()))
     throw std::invalid_argument("PetscHarmonicNetwork: more rows than PETSc's indices hold");
@@ -98,8 +99,9 @@ void PetscHarmonicNetwork::refuse_ungrounded(std::span<const TwoPort> edge, std:
     if (grounded[i]) part_grounded[static_cast<std::size_t>(root(static_cast<std::int32_t>(i)))] = 1;
   for (std::size_t i = 0; i < nodes_; ++i)
     if (root(static_cast<std::int32_t>(i)) == static_cast<std::int32_t>(i) && !part_grounded[i])
-      throw Collective<InputError>("a harmonic's distributed solve: the part of the network that holds node index " +
-                                   std::to_string(i) + " has no path to an outlet or a pressure");
+      throw Collective<InputError>("a harmonic's distributed solve: the part of the network that holds node " +
+                                   (node_name_.empty() ? "index " + std::to_string(i) : std::to_string(node_name_[i])) +
+                                   " has no path to an outlet or a pressure");
 }
 
 void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const Complex> shunt,

@@ -29,10 +29,12 @@ namespace hemotree {
 class PetscHarmonicNetwork {
  public:
   // The graph of `nodes` nodes and edges (a[e], b[e]); node_owner, edge_owner: each one's
-  // rank. std::invalid_argument for sizes that do not match or a rank outside the session's.
+  // rank; node_name: each node's name in a refusal (a network's node ids; empty: its index).
+  // std::invalid_argument for sizes that do not match or a rank outside the session's.
   // Collective (starts PETSc on the MPI session once).
   PetscHarmonicNetwork(std::size_t nodes, std::span<const std::int32_t> a, std::span<const std::int32_t> b,
-                       std::span<const std::int32_t> node_owner, std::span<const std::int32_t> edge_owner);
+                       std::span<const std::int32_t> node_owner, std::span<const std::int32_t> edge_owner,
+                       std::span<const std::int64_t> node_name = {});
 
   // edge: per edge, read where this rank owns it (the currents into its ends: aa x_a + ab x_b
   // into a, ba x_a + bb x_b into b); shunt and current: per node, read where it owns the node;
@@ -47,6 +49,7 @@ class PetscHarmonicNetwork {
  private:
   std::size_t nodes_;
   std::vector<std::int32_t> a_, b_, node_owner_, edge_owner_;
+  std::vector<std::int64_t> node_name_;
   std::vector<std::int64_t> row_;  // per node: its first row (two a node), rank by rank
   std::int64_t first_row_ = 0, rows_ = 0, all_rows_ = 0;  // this rank's rows: [first, first + rows)
   std::vector<std::int32_t> in_block_, off_block_;        // per row of this rank: entries to preallocate
