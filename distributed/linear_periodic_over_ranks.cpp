@@ -239,11 +239,12 @@ struct RankHarmonics {
   }
 };
 
-// Where each rank's results are, for rank 0's gather: per rank its vessels (increasing) and
-// its nodes (in the order its results list them), and each vessel's rank.
+// Where each rank's results are: each vessel's rank, and for rank 0's gather (on rank 0 alone)
+// per rank its vessels (increasing) and its nodes (in the order its results list them).
 void place_results(LinearPeriodicOverRanks& out, const std::vector<std::int32_t>& vessel_rank,
                    std::vector<std::vector<std::int32_t>> nodes_of) {
   out.vessel_rank = vessel_rank;
+  if (world_rank() != 0) return;
   out.vessels_of.assign(nodes_of.size(), {});
   for (std::size_t v = 0; v < vessel_rank.size(); ++v)
     out.vessels_of[static_cast<std::size_t>(vessel_rank[v])].push_back(static_cast<std::int32_t>(v));
@@ -295,8 +296,9 @@ LinearPeriodicOverRanks solve_on_graph(const Network& net, const Blood& blood, s
   out.periodic = solve_linear_periodic(net, blood, laws, viscosity, steady, boundaries, harmonics, threads, shift_source, share);
   out.vessels = share.vessels;
   out.nodes = share.nodes;
-  std::vector<std::vector<std::int32_t>> nodes_of(static_cast<std::size_t>(ranks));
-  for (std::size_t i = 0; i < nodes; ++i) nodes_of[static_cast<std::size_t>(node_owner[i])].push_back(static_cast<std::int32_t>(i));
+  std::vector<std::vector<std::int32_t>> nodes_of(rank == 0 ? static_cast<std::size_t>(ranks) : 0);
+  for (std::size_t i = 0; i < nodes && rank == 0; ++i)
+    nodes_of[static_cast<std::size_t>(node_owner[i])].push_back(static_cast<std::int32_t>(i));
   place_results(out, partition.rank_of_vessel, std::move(nodes_of));
   out.partition = std::move(partition);
   out.solver = "every harmonic's nodal system by PETSc's " + system.method();
@@ -330,9 +332,7 @@ LinearPeriodicOverRanks solve_on_tree(const Network& net, const Blood& blood, st
   out.cut = std::move(rank->cut);
   out.traffic = rank->system->traffic();
   // The results by the cut: a rank's nodes as it holds them, its vessels their edges to their parents.
-  std::vector<std::vector<std::int32_t>> nodes_of = out.cut->held_nodes();
-  std::vector<std::int32_t> vessel_rank = out.cut->edge_ranks();
-  place_results(out, vessel_rank, std::move(nodes_of));
+  place_results(out, out.cut->edge_ranks(), world_rank() == 0 ? out.cut->held_nodes() : std::vector<std::vector<std::int32_t>>{});
   const RootExchange::Traffic& t = out.traffic;
   out.solver = "the harmonics' exchanges on rank 0: " + std::to_string(t.calls) + " collective calls, " +
                std::to_string(t.bytes) + " bytes, " + format_quantity(t.seconds, "s");

@@ -34,8 +34,8 @@ struct LinearPeriodicOverRanks {
   Partition partition;                       // the vessels' split (the same on every rank)
   std::optional<TreeCut> cut;                // and the tree's, by it (none on a graph's solve)
   RootExchange::Traffic traffic;             // this rank's exchanges in the harmonics' solves
-  // Where the results are, on every rank alike: per rank its vessels (increasing) and its
-  // nodes (in its `nodes`' order), and each vessel's rank.
+  // Where the results are: each vessel's rank (every rank alike), and on rank 0 per rank its
+  // vessels (increasing) and its nodes (in that rank's `nodes`' order).
   std::vector<std::vector<std::int32_t>> vessels_of, nodes_of;
   std::vector<std::int32_t> vessel_rank;
   std::string solver;  // how the harmonics were solved over the ranks, in words

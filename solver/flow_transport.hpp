@@ -38,6 +38,7 @@
 
 #include <Eigen/Dense>
 
+#include "distributed/neighbour_exchange.hpp"
 #include "formats/network.hpp"
 #include "physics/rheology.hpp"
 #include "formats/checkpoint_file.hpp"
@@ -130,9 +131,8 @@ class FlowTransport {
   // Where the 1D vessels are spread: this rank's transport steps, their rounds (each a solve
   // of its cells and one message to each neighbouring rank), its messages and bytes, and the
   // seconds inside the exchanges and reductions (null otherwise).
-  struct SpreadTraffic {
-    std::size_t steps = 0, rounds = 0, messages = 0, bytes = 0;
-    double seconds = 0;
+  struct SpreadTraffic : NeighbourTraffic {
+    std::size_t steps = 0, rounds = 0;
   };
   const SpreadTraffic* spread_traffic() const { return cut_ && cut_->spread ? &cut_->traffic : nullptr; }
 

@@ -155,19 +155,9 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
 
 void FlowTransport::exchange_numbers(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in) {
   Cut& cut = *cut_;
-  if (cut.neighbours.empty()) return;
-  const double started = MPI_Wtime();
-  std::vector<MPI_Request> requests(2 * cut.neighbours.size());
-  for (std::size_t i = 0; i < cut.neighbours.size(); ++i) {
-    MPI_Irecv(in[i].data(), static_cast<int>(in[i].size()), MPI_DOUBLE, cut.neighbours[i].rank, tag, MPI_COMM_WORLD,
-              &requests[2 * i]);
-    MPI_Isend(out[i].data(), static_cast<int>(out[i].size()), MPI_DOUBLE, cut.neighbours[i].rank, tag, MPI_COMM_WORLD,
-              &requests[2 * i + 1]);
-  }
-  MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
-  cut.traffic.messages += cut.neighbours.size();
-  for (const std::vector<double>& numbers : out) cut.traffic.bytes += numbers.size() * sizeof(double);
-  cut.traffic.seconds += MPI_Wtime() - started;
+  std::vector<int> ranks;
+  for (const Cut::Neighbour& nb : cut.neighbours) ranks.push_back(nb.rank);
+  exchange_with_neighbours(ranks, out, in, tag, cut.traffic);
 }
 
 void FlowTransport::take_cut_volumes() {

@@ -7,6 +7,7 @@
 
 #include "core/setting_error.hpp"
 #include "distributed/gather_rows.hpp"
+#include "distributed/neighbour_exchange.hpp"
 #include "distributed/network_cut.hpp"
 #include "formats/topology.hpp"
 #include "mpi/session.hpp"
@@ -35,19 +36,7 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDL
   };
   ranks_.exchange = [this](std::span<const int> neighbours, const std::vector<std::vector<double>>& send,
                            std::vector<std::vector<double>>& receive) {
-    if (neighbours.empty()) return;
-    const double started = MPI_Wtime();
-    std::vector<MPI_Request> requests(2 * neighbours.size());
-    for (std::size_t i = 0; i < neighbours.size(); ++i) {
-      MPI_Irecv(receive[i].data(), static_cast<int>(receive[i].size()), MPI_DOUBLE, neighbours[i], 21, MPI_COMM_WORLD,
-                &requests[2 * i]);
-      MPI_Isend(send[i].data(), static_cast<int>(send[i].size()), MPI_DOUBLE, neighbours[i], 21, MPI_COMM_WORLD,
-                &requests[2 * i + 1]);
-    }
-    MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
-    spread_traffic_.messages += neighbours.size();
-    for (const std::vector<double>& out : send) spread_traffic_.bytes += out.size() * sizeof(double);
-    spread_traffic_.seconds += MPI_Wtime() - started;
+    exchange_with_neighbours(neighbours, send, receive, 21, spread_traffic_);
   };
   ranks_.least_key = [this](std::int64_t key) {
     const double started = MPI_Wtime();

@@ -19,6 +19,7 @@
 #include <span>
 #include <vector>
 
+#include "distributed/neighbour_exchange.hpp"
 #include "distributed/root_exchange.hpp"
 #include "formats/network.hpp"
 #include "partition/partition.hpp"
@@ -51,9 +52,8 @@ class MpiPulseRanks {
   // With the 1D vessels spread, this rank's messages (sent to its neighbours: traces, coupled
   // ends), their bytes, its reductions (failures), and the seconds inside them, waiting
   // included.
-  struct SpreadTraffic {
-    std::size_t messages = 0, bytes = 0, reductions = 0;
-    double seconds = 0;
+  struct SpreadTraffic : NeighbourTraffic {
+    std::size_t reductions = 0;
   };
   const SpreadTraffic& spread_traffic() const { return spread_traffic_; }
   std::size_t top_vessels() const { return top_vessels_; }
