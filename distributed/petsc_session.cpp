@@ -68,6 +68,19 @@ PC petsc_prepare(PetscObjects& o, std::span<const double> local_rhs, KSPType typ
   return preconditioner;
 }
 
+std::string petsc_method(KSP solver) {
+  KSPType ksp_type = nullptr;
+  PCType pc_type = nullptr;
+  PC preconditioner = nullptr;
+  MatSolverType factor = nullptr;
+  petsc_check(KSPGetType(solver, &ksp_type), "KSPGetType");
+  petsc_check(KSPGetPC(solver, &preconditioner), "KSPGetPC");
+  petsc_check(PCGetType(preconditioner, &pc_type), "PCGetType");
+  if (PCFactorGetMatSolverType(preconditioner, &factor) != 0) factor = nullptr;  // not a factorisation
+  return std::string(ksp_type ? ksp_type : "?") + " with " + (pc_type ? pc_type : "?") +
+         (factor ? std::string(" (") + factor + ")" : std::string());
+}
+
 PetscOutcome petsc_solve(PetscObjects& o) {
   petsc_options_check(KSPSetFromOptions(o.solver));
   if (KSPSolve(o.solver, o.rhs, o.x) != 0) petsc_check(VecSet(o.x, 0.0), "VecSet");
@@ -76,16 +89,7 @@ PetscOutcome petsc_solve(PetscObjects& o) {
   PetscInt iterations = 0;
   petsc_check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
   out.iterations = static_cast<int>(iterations);
-  KSPType ksp_type = nullptr;
-  PCType pc_type = nullptr;
-  PC preconditioner = nullptr;
-  MatSolverType factor = nullptr;
-  petsc_check(KSPGetType(o.solver, &ksp_type), "KSPGetType");
-  petsc_check(KSPGetPC(o.solver, &preconditioner), "KSPGetPC");
-  petsc_check(PCGetType(preconditioner, &pc_type), "PCGetType");
-  if (PCFactorGetMatSolverType(preconditioner, &factor) != 0) factor = nullptr;  // not a factorisation
-  out.method = std::string(ksp_type ? ksp_type : "?") + " with " + (pc_type ? pc_type : "?") +
-               (factor ? std::string(" (") + factor + ")" : std::string());
+  out.method = petsc_method(o.solver);
   PetscReal residual = 0, scale = 0;
   petsc_check(VecDuplicate(o.rhs, &o.everywhere), "VecDuplicate");
   petsc_check(MatMult(o.matrix, o.x, o.everywhere), "MatMult");

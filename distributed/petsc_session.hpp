@@ -39,6 +39,8 @@ PC petsc_prepare(PetscObjects& o, std::span<const double> local_rhs, KSPType typ
 // method in words ("cg with hypre", "preonly with lu (mumps)"), and the true relative residual
 // |b - A x| / |b| (whatever the options asked of the solver). A solve PETSc gives up (a
 // factorisation that meets a zero pivot) leaves x zero, so that the residual says so. Collective.
+// A solver's method in words ("cg with hypre", "preonly with lu (mumps)").
+std::string petsc_method(KSP solver);
 struct PetscOutcome {
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
   int iterations = 0;

@@ -20,13 +20,13 @@ namespace hemotree {
 LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                              const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of,
                              std::span<const VesselTaper> tapers, std::span<const std::uint8_t> sections,
-                             const LumpedCut* cut)
+                             const LumpedCut* cut, const LumpedHalo* halo)
     : density_(blood.density), friction_k_(friction_coefficient(blood.alpha)), viscosity_(&viscosity) {
   const std::size_t n = net.vessel_count();
   node_of_.assign(net.node_count(), -1);
   index_of_vessel_.assign(n, -1);
   // Every subtree contiguous (pulse/lumped_order.hpp): the elimination's tasks stream.
-  LumpedOrder order = cut ? cut->order : subtree_lumped_order(net, zero_d);
+  LumpedOrder order = cut ? cut->order : halo ? halo->order : subtree_lumped_order(net, zero_d);
   for (std::size_t k = 0; k < order.nodes.size(); ++k)
     node_of_[static_cast<std::size_t>(order.nodes[k])] = static_cast<std::int32_t>(k);
   auto sections_of = [&](std::size_t v) {
@@ -71,12 +71,14 @@ LumpedVessels::LumpedVessels(const Network& net, std::span<const TubeLaw> laws, 
   if (!taper_edge_.empty()) taper_edge_.resize(vessel_edges_);
   if (vessels_.empty()) {
     if (cut) hold_cut(*cut);  // a rank with none still takes its part in every step's messages
+    if (halo) hold_halo(*halo);
     return;
   }
   network_nodes_ = order.nodes.size();
   std::vector<std::int32_t>().swap(order.nodes);
   nodes_ = network_nodes_;
   if (cut) hold_cut(*cut);
+  if (halo) hold_halo(*halo);
   shunt_.assign(network_nodes_, 0.0);
   shunt_pressure_.assign(network_nodes_, 0.0);
   volume_b_.assign(network_nodes_, 0.0);
@@ -158,13 +160,12 @@ void LumpedVessels::share_shunt_pressure() {
 }
 
 void LumpedVessels::allocate_system() {
-  system_ = NodalSystem(nodes_, a_, b_);
-  if (share_.on) {
-    // The capacitors' and inner nodes' rows, and the R1 edges, are the rank's own.
-    if (!share_.ghost_node.empty()) share_.ghost_node.resize(nodes_, 0);
-    if (!share_.ghost_edge.empty()) share_.ghost_edge.resize(a_.size(), 0);
-    if (!share_.top) system_.open_edges(share_.root_edge);
-  }
+  // In a halo the system is the link's (every rank's rows), not one of its own.
+  if (!halo_.on) system_ = NodalSystem(nodes_, a_, b_);
+  // The capacitors' and inner nodes' rows, and the R1 edges, are the rank's own.
+  if (!share_.ghost_node.empty()) share_.ghost_node.resize(nodes_, 0);
+  if (!share_.ghost_edge.empty()) share_.ghost_edge.resize(a_.size(), 0);
+  if (share_.on && !share_.top) system_.open_edges(share_.root_edge);
   const std::size_t edges = a_.size();
   volume_.assign(nodes_, 0.0);
   previous_volume_ = pressure_ = previous_pressure_ = volume_;
@@ -198,6 +199,7 @@ void LumpedVessels::allocate_step_arrays() {
   if (rhs_.size() == nodes_) return;
   const std::size_t edges = a_.size();
   rhs_.assign(nodes_, 0.0);
+  if (halo_.on) halo_.shunt.assign(nodes_, 0.0);
   conductance_.assign(edges, 0.0);
   history_.assign(edges, 0.0);
   // The R1 edges of RCR outlets keep their conductance, and have no inertance.
@@ -205,18 +207,23 @@ void LumpedVessels::allocate_step_arrays() {
 }
 
 void LumpedVessels::release_step_arrays() {
-  for (std::vector<double>* v : {&rhs_, &conductance_, &history_}) std::vector<double>().swap(*v);
+  for (std::vector<double>* v : {&rhs_, &conductance_, &history_, &halo_.shunt}) std::vector<double>().swap(*v);
   linearised_dt_ = 0;  // the next step linearises its edges again
   system_.release_factorization();
 }
 
 void LumpedVessels::set_passes(int passes) {
-  if (share_.on && passes != 1)
+  if ((share_.on || halo_.on) && passes != 1)
     throw std::invalid_argument("LumpedVessels: a run over ranks takes one linearisation a step, not " + std::to_string(passes));
   passes_ = passes;
 }
 
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
+  // A coupled end's prediction and impedance are partial solves of a factorisation this rank
+  // does not hold in a halo (a 0D system with loops is spread over ranks only where no 1D
+  // vessel meets it).
+  if (halo_.on && !nodes.empty())
+    throw std::invalid_argument("LumpedVessels: a 1D vessel ends at a node of a 0D system spread over ranks");
   coupling_nodes_ = std::move(nodes);
   held_inflow_.assign(coupling_nodes_.size(), 0.0);
   impedance_.assign(coupling_nodes_.size(), 0.0);
@@ -503,7 +510,7 @@ void LumpedVessels::linearise(bool extrapolated, std::span<const double> coupled
       }
     });
   linearised_dt_ = 0;
-  double* const system_shunt = system_.shunt_workspace().data();
+  double* const system_shunt = halo_.on ? halo_.shunt.data() : system_.shunt_workspace().data();
   // BDF2 for a node's volume, V(p) linearised at p*:
   // (3 (V* + C* (p - p*)) - 4 V^n + V^(n-1)) / (2 dt) = inflows at t1. False where the
   // compliance is not positive (a lumen closing there).
@@ -560,6 +567,10 @@ void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, d
 
 void LumpedVessels::predict(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
                             std::span<const double> held_pressure) {
+  if (halo_.on) {
+    predict_on_halo(dt, coupled_inflow, inflow, held_pressure);
+    return;
+  }
   if (!share_.on) {
     predict_step(dt, coupled_inflow, inflow, held_pressure);
     return;
@@ -606,6 +617,7 @@ void LumpedVessels::predict_step(double dt, std::span<const double> coupled_infl
   for (int pass = 0; pass < passes_; ++pass) {
     // Each further (Picard) pass takes the coefficients again at the last solution.
     linearise(pass == 0, coupled_inflow);
+    if (halo_.on) return;  // solved over every rank's rows (predict_on_halo)
     // The forward half of the solve goes with the factorisation; complete() adds the 1D
     // ends' departures from the held inflows to it and takes the backward half.
     if (system_.factorize_forward_in_place(conductance_, rhs_) >= 0)
@@ -656,14 +668,17 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, std::span<d
 }
 
 void LumpedVessels::complete_step(std::span<const double> coupled_volume, std::span<double> boundary_volume) {
-  if (empty()) return;
+  if (empty()) {
+    if (halo_.on) halo_.link.fill_ghosts({});  // collective
+    return;
+  }
   const double dt = dt_;
   // The departure of the 1D ends' mean inflows from those held, into the forward half.
   if (!coupling_nodes_.empty()) {
     for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_scratch_[j] = coupled_volume[j] / dt - held_inflow_[j];
     system_.add_forward(coupling_nodes_, coupling_scratch_, rhs_);
   }
-  system_.backward(rhs_, rhs_);
+  if (!halo_.on) system_.backward(rhs_, rhs_);  // a halo's rhs_ holds the pressures already
   if (share_.on && share_.top) answer_potentials();  // the shares' backward halves go on meanwhile
   const std::vector<double>& p1 = rhs_;  // now the pressures at t1
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_predicted_[j] = p1[static_cast<std::size_t>(coupling_nodes_[j])];
@@ -726,6 +741,11 @@ void LumpedVessels::complete_step(std::span<const double> coupled_volume, std::s
       pressure_[u] = share_.root_row[j];
       volume_[u] = node_excess(u, pressure_[u]);
     }
+  if (halo_.on) {  // the ghosts' pressures as their owners completed them
+    halo_.link.fill_ghosts(pressure_);
+    for (std::size_t k = 0; k < nodes_; ++k)
+      if (is_ghost_node(k)) volume_[k] = node_excess(k, pressure_[k]);
+  }
   for (std::size_t e = 0; e < passed_.size(); ++e) passed_[e] += dt * flow_[e];
   update_resistances_and_linearise(dt);
   update_dynamic_pressures();

@@ -49,6 +49,7 @@
 #include "formats/checkpoint_file.hpp"
 #include "physics/vessel_taper.hpp"
 #include "pulse/lumped_cut.hpp"
+#include "pulse/lumped_halo.hpp"
 #include "pulse/lumped_order.hpp"
 
 namespace hemotree {
@@ -73,10 +74,13 @@ class LumpedVessels {
   // and their nodes in the whole run's order, the top's rank with the other ranks' root vessels
   // as ghosts), whose steps exchange their messages through set_link's link; else every 0D
   // vessel, in pulse/lumped_order's subtree order.
+  // halo: where given instead, one rank's part of a 0D system with loops over ranks
+  // (pulse/lumped_halo.hpp: its vessels and the halo of other ranks' at its nodes), whose
+  // steps are solved through set_halo_link's link.
   LumpedVessels(const Network& net, std::span<const TubeLaw> laws, const ViscosityTable& viscosity,
                 const Blood& blood, const std::vector<bool>& zero_d, std::span<const std::int32_t> taper_of = {},
                 std::span<const VesselTaper> tapers = {}, std::span<const std::uint8_t> sections = {},
-                const LumpedCut* cut = nullptr);
+                const LumpedCut* cut = nullptr, const LumpedHalo* halo = nullptr);
   // Solves a step takes (1: the extrapolated linearisation alone; the only one over ranks,
   // std::invalid_argument for more), and the threads of its loops over vessels and nodes and
   // of the elimination's subtrees.
@@ -179,9 +183,16 @@ class LumpedVessels {
     share_.failure_words = std::move(words);
   }
   bool over_ranks() const { return share_.on; }
+  // A rank's part of a 0D system with loops (built with a LumpedHalo): its system as the
+  // link's solver numbers it, and the link, which predict() and complete() call on every rank
+  // every step (collectively: a rank with no 0D vessel still calls them).
+  bool halo() const { return halo_.on; }
+  LumpedHaloSystem halo_system() const;
+  void set_halo_link(LumpedHaloLink link) { halo_.link = std::move(link); }
   [[noreturn]] void abandon_step(std::exception_ptr failure);
   // Whether a node or a 0D vessel is held for another rank's sums only (its numbers are that
-  // rank's): the top's rank's ghosts, a share's nodes above its roots.
+  // rank's): the top's rank's ghosts, a share's nodes above its roots; in a halo, the nodes
+  // other ranks own and the other ranks' vessels.
   bool ghost_node(std::int32_t node) const { return is_ghost_node(static_cast<std::size_t>(node)); }
   bool ghost_vessel(std::int32_t index) const { return is_ghost_edge(first_edge(static_cast<std::size_t>(index))); }
   // The root vessels (their indices here) in the messages' order: on the top's rank its ghosts,
@@ -535,6 +546,18 @@ class LumpedVessels {
   bool waits_for_roots(std::size_t k) const { return !share_.ghost_node.empty() && share_.ghost_node[k] == 2; }
   bool is_ghost_edge(std::size_t e) const { return !share_.ghost_edge.empty() && share_.ghost_edge[e]; }
   void hold_cut(const LumpedCut& cut);  // the constructor's: ghosts and root edges
+  // A rank's part of a 0D system with loops: its ghost nodes (share_.ghost_node 1) and halo
+  // vessels (share_.ghost_edge) are marked as a share's; every key's rank, the shunts of its
+  // rows (the system is the link's: system_ holds none), the link.
+  struct Halo {
+    bool on = false;
+    std::vector<std::int32_t> key_rank;
+    std::vector<double> shunt;
+    LumpedHaloLink link;
+  } halo_;
+  void hold_halo(const LumpedHalo& halo);  // the constructor's
+  void predict_on_halo(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
+                       std::span<const double> held_pressure);
   // A root vessel's (edge e's) ends: u, the top's node above it, and r, the share's root below
   // it. Every node hangs from one before it in the whole run's order, and so in a rank's.
   std::size_t root_upper(std::size_t e) const { return static_cast<std::size_t>(std::min(a_[e], b_[e])); }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -38,28 +39,43 @@ std::vector<double> PulseSolver::vessel_step_costs(const SolverOptions& options)
   return cost;
 }
 
-void PulseSolver::take_spread_share(const PulseRanks& ranks, const std::vector<std::int32_t>& vessel_rank) {
+void PulseSolver::take_spread_share(const PulseRanks& ranks, const VesselRanks& dealt) {
   const std::size_t n = net_.vessel_count();
+  const std::vector<std::int32_t>& vessel_rank = dealt.rank;
   rank_ = ranks.rank;
   rank_count_ = ranks.ranks;
-  // The 0D vessels meeting at a node on one rank: each rank's 0D system is then whole.
   std::vector<std::int32_t> node_rank(net_.node_count(), -1);
-  for (std::size_t v = 0; v < n; ++v)
-    if (zero_d_[v])
-      for (const std::int32_t node : {net_.from[v], net_.to[v]}) {
-        std::int32_t& r = node_rank[static_cast<std::size_t>(node)];
-        if (r >= 0 && r != vessel_rank[v])
-          throw std::invalid_argument("PulseSolver: 0D vessel " + std::to_string(net_.id[v]) + " on rank " +
-                                      std::to_string(vessel_rank[v]) + ", another 0D vessel at its node on rank " + std::to_string(r));
-        r = vessel_rank[v];
-      }
+  std::optional<LumpedHalo> halo;
+  if (dealt.zero_d_spread) {
+    // The 0D vessels spread too: each node its first vessel's rank's, this rank's vessels and
+    // a halo of the others' at its nodes (pulse/lumped_halo.hpp).
+    const LumpedOrder whole = subtree_lumped_order(net_, zero_d_);
+    halo = lumped_halo(net_, whole, vessel_rank, ranks.ranks, rank_);
+    node_rank = lumped_node_ranks(net_, whole, vessel_rank);
+  } else {
+    // The 0D vessels meeting at a node on one rank: each rank's 0D system is then whole.
+    for (std::size_t v = 0; v < n; ++v)
+      if (zero_d_[v])
+        for (const std::int32_t node : {net_.from[v], net_.to[v]}) {
+          std::int32_t& r = node_rank[static_cast<std::size_t>(node)];
+          if (r >= 0 && r != vessel_rank[v])
+            throw std::invalid_argument("PulseSolver: 0D vessel " + std::to_string(net_.id[v]) + " on rank " +
+                                        std::to_string(vessel_rank[v]) + ", another 0D vessel at its node on rank " + std::to_string(r));
+          r = vessel_rank[v];
+        }
+  }
   std::vector<bool> own_zero_d(n, false);
   steps_vessel_.assign(n, 0);
   for (std::size_t v = 0; v < n; ++v) {
     steps_vessel_[v] = vessel_rank[v] == rank_;
     own_zero_d[v] = zero_d_[v] && steps_vessel_[v];
   }
-  lumped_ = LumpedVessels(net_, laws_, viscosity_, blood_, own_zero_d, taper_of_, tapers_, lumped_sections_);
+  if (halo) {
+    lumped_ = LumpedVessels(net_, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_, nullptr, &*halo);
+    lumped_.set_halo_link(ranks.halo_link(lumped_.halo_system()));
+  } else {
+    lumped_ = LumpedVessels(net_, laws_, viscosity_, blood_, own_zero_d, taper_of_, tapers_, lumped_sections_);
+  }
   const RunBoundaries run(net_);
   for (std::size_t i = 0; i < run.size(); ++i)
     if (run.is_outlet(i)) holds_outlet_.push_back(steps_vessel_[static_cast<std::size_t>(run.outlet(i).vessel)]);

@@ -234,7 +234,7 @@ void PulseSolver::take_rank_share(const PulseRanks& ranks, const SolverOptions& 
   const std::size_t n = net_.vessel_count();
   const VesselRanks dealt = ranks.vessel_ranks(zero_d_, vessel_step_costs(options));
   if (dealt.one_d_spread) {
-    take_spread_share(ranks, dealt.rank);
+    take_spread_share(ranks, dealt);
     return;
   }
   // This rank's whole subtrees; the 1D vessels and every vessel above them the top's rank's.

@@ -127,10 +127,13 @@ struct PulseState {
 //  - the 1D vessels spread over the ranks (one_d_spread; pulse/one_d_cut.hpp), the 0D vessels
 //    meeting at a node on one rank, so that a rank's 0D system is its own; the traces at
 //    junctions across the cut exchanged at every evaluation, and the coupled ends' inflows,
-//    nodes and volumes at every step where a 1D end's 0D node is another rank's (exchange).
+//    nodes and volumes at every step where a 1D end's 0D node is another rank's (exchange);
+//    and where no 1D vessel meets the 0D vessels (a network of capillaries with loops), the
+//    0D vessels spread too (zero_d_spread): each rank its own and a halo of the others' at its
+//    nodes (pulse/lumped_halo.hpp), each step solved over every rank's rows (halo_link).
 struct VesselRanks {
   std::vector<std::int32_t> rank;
-  bool one_d_spread = false;
+  bool one_d_spread = false, zero_d_spread = false;
 };
 struct PulseRanks {
   int ranks = 1, rank = 0, top_rank = 0;
@@ -138,6 +141,9 @@ struct PulseRanks {
   // Told the cut once it is made (the messages' sizes: LumpedCut::roots), before any step.
   std::function<void(const LumpedCut& cut)> cut_made;
   LumpedLink link;
+  // The 0D vessels spread (zero_d_spread): the link of a rank's halo, made for its system.
+  // Collective.
+  std::function<LumpedHaloLink(const LumpedHaloSystem& system)> halo_link;
   // The 1D vessels spread: numbers out to each neighbouring rank and in from it (send[i] to
   // neighbours[i], receive[i] from it, each of the size both sides know). Collective among
   // the neighbours.
@@ -395,7 +401,7 @@ class PulseSolver {
   // which vessels and outlets it steps.
   void take_rank_share(const PulseRanks& ranks, const SolverOptions& options);
   // The same with the 1D vessels spread over the ranks (one_d_over_ranks.cpp).
-  void take_spread_share(const PulseRanks& ranks, const std::vector<std::int32_t>& vessel_rank);
+  void take_spread_share(const PulseRanks& ranks, const VesselRanks& dealt);
   // Per vessel, what a step of it costs [s] (pulse/step_cost.hpp): a partition's weights.
   std::vector<double> vessel_step_costs(const SolverOptions& options) const;
   void couple_lumped_ends();  // the 1D ends at 0D nodes: their nodes, slots, held inflows
@@ -509,7 +515,7 @@ class PulseSolver {
   bool steps_end(const VesselEnd& end) const { return steps_vessel_.empty() || steps_vessel_[static_cast<std::size_t>(end.vessel)]; }
   bool lumped_in_run_ = false;  // any 0D vessel on any rank: a step is a 0D step around 1D substeps
   // Whether this rank steps a 0D system (spread over ranks a rank may have none).
-  bool steps_lumped() const { return !lumped_.empty() || lumped_.over_ranks(); }
+  bool steps_lumped() const { return !lumped_.empty() || lumped_.over_ranks() || lumped_.halo(); }
   // Spread over ranks: the times of this step's evaluations so far, and its first failure here
   // (the evaluation's place times failure_keys() plus the key: an element's index, or the
   // elements' count plus a junction's), or no_failure.

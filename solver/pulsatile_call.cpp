@@ -365,7 +365,20 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   std::optional<PulseSolver> solver;
   on_every_rank([&] { solver.emplace(net, options, ranks ? &ranks->ranks() : nullptr); });
   PulseSolver& run = *solver;
-  if (ranks && ranks->one_d_spread())
+  // Red cells and tracers over ranks move through whole 0D systems (a top's subtrees, or
+  // each spread rank's own): a 0D system spread over the ranks has no such transport yet.
+  if (ranks && ranks->zero_d_spread() && config.carries_transport()) {
+    const std::string option = config.red_cells == RedCells::transport ? "red_cells" : "tracer";
+    throw Collective<SettingError>(option, placeholder(option) + " over " + std::to_string(world_size()) +
+                                               " MPI ranks: this network's 0D vessels are spread over the ranks (loops, "
+                                               "no 1D vessel among them), and red cells and tracers are not yet carried "
+                                               "across such a cut: run it as one process");
+  }
+  if (ranks && ranks->zero_d_spread())
+    observer.note(describe(ranks->partition()) + ", weighed by each vessel's step; the 0D vessels spread over the ranks, "
+                  "each rank with a halo of the others' at its nodes, every step solved over the ranks by PETSc (" +
+                  ranks->zero_d_method() + "): the plain command's numbers to about 1e-8, not bit for bit");
+  else if (ranks && ranks->one_d_spread())
     observer.note(describe(ranks->partition()) + ", weighed by each vessel's step; the 1D vessels spread over the ranks "
                   "(the 0D vessels meeting at a node on one rank), their traces exchanged at the cut's junctions and "
                   "their couplings to 0D nodes across it");
@@ -465,6 +478,11 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     // which has left every collective call: a failure of its writing is its own alone.
     if (world_rank() != 0) return result;
     leave_collectives();
+    if (ranks->zero_d_spread())
+      observer.note("the 0D steps' solves on rank 0: " + std::to_string(ranks->zero_d_solves()) + " solves, " +
+                    std::to_string(ranks->zero_d_iterations()) + " iterations, " +
+                    std::to_string(ranks->zero_d_setups()) + " preconditioner set-ups, " +
+                    format_quantity(ranks->zero_d_seconds(), "s") + " inside them");
     if (ranks->one_d_spread()) {
       const MpiPulseRanks::SpreadTraffic& t = ranks->spread_traffic();
       observer.note("the 1D vessels' exchanges on rank 0: " + std::to_string(t.messages) + " messages to its neighbouring ranks, " +

@@ -9,6 +9,7 @@
 #include "distributed/gather_rows.hpp"
 #include "distributed/neighbour_exchange.hpp"
 #include "distributed/network_cut.hpp"
+#include "distributed/petsc_nodal_system.hpp"
 #include "formats/topology.hpp"
 #include "mpi/session.hpp"
 #include "solver/decisions_over_ranks.hpp"
@@ -47,6 +48,18 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDL
     return least;
   };
   ranks_.cut_made = [this](const LumpedCut& cut) { roots_ = cut.roots; };
+  ranks_.halo_link = [this](const LumpedHaloSystem& halo) {
+    // PETSc's solve over every rank's rows (distributed/petsc_nodal_system.hpp), kept here for
+    // the run's account of its time.
+    auto system = std::make_shared<PetscNodalSystem>(halo.key_rank, halo.node_key, halo.a, halo.b);
+    halo_systems_.push_back(system);
+    LumpedHaloLink link;
+    link.least = ranks_.least_key;
+    link.solve = [system](std::span<const double> conductance, std::span<const double> shunt, std::span<const double> rhs,
+                          std::span<double> x) { system->solve(conductance, shunt, rhs, x); };
+    link.fill_ghosts = [system](std::span<double> values) { system->fill_ghosts(values); };
+    return link;
+  };
   ranks_.link.up = [this](std::span<const double> numbers, std::exception_ptr failure, bool& failed) {
     if (!exchange_) exchange_ = std::make_unique<RootExchange>(MPI_COMM_WORLD, ranks_.top_rank, roots_);
     return exchange_->gather(numbers, failure, LumpedLink::up_per_root, failed);
@@ -158,6 +171,17 @@ std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d
   const auto ranks = static_cast<std::size_t>(p.ranks);
   std::vector<std::int32_t> root(n);
   for (std::size_t v = 0; v < n; ++v) root[v] = find(static_cast<std::int32_t>(v));
+  // A 0D system that no 1D vessel meets (a network of capillaries) may be spread over the
+  // ranks as the partition has it, each rank with a halo (pulse/lumped_halo.hpp), where
+  // keeping each whole would leave a rank empty or the step out of balance: its step is then
+  // solved over every rank's rows (PETSc), to 1e-12 of the one-process solve, not bit for bit.
+  bool one_d_meets_zero_d = false, any_zero_d = false;
+  for (std::size_t v = 0; v < n; ++v) {
+    any_zero_d = any_zero_d || zero_d[v];
+    if (!zero_d[v])
+      for (const std::int32_t node : {net_.from[v], net_.to[v]}) one_d_meets_zero_d = one_d_meets_zero_d || at_node[static_cast<std::size_t>(node)] >= 0;
+  }
+  const Partition as_given = p;
   // Per group of 0D vessels (its root vessel) and rank, the cost there.
   std::map<std::int32_t, std::vector<double>> cost_on;
   for (std::size_t v = 0; v < n; ++v) {
@@ -177,6 +201,14 @@ std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d
     p.cost[static_cast<std::size_t>(p.rank_of_vessel[v])] += step_cost[v];
     ++p.vessels[static_cast<std::size_t>(p.rank_of_vessel[v])];
   }
+  const bool unbalanced = std::find(p.vessels.begin(), p.vessels.end(), std::size_t{0}) != p.vessels.end() ||
+                          p.imbalance() > spread_balance;
+  bool zero_d_spread = false;
+  if (unbalanced && !std::isfinite(most_imbalance) && as_given.method == Partition::Method::metis && any_zero_d &&
+      !one_d_meets_zero_d) {
+    p = as_given;
+    zero_d_spread = true;
+  }
   if (const auto empty = std::find(p.vessels.begin(), p.vessels.end(), std::size_t{0}); empty != p.vessels.end()) {
     if (std::isfinite(most_imbalance)) return std::nullopt;
     std::map<std::int32_t, std::size_t> joined;
@@ -186,9 +218,10 @@ std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d
     for (const auto& [g, count] : joined) largest = std::max(largest, count);
     throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(p.ranks) + ": rank " +
                                     std::to_string(empty - p.vessels.begin()) + " would step no vessel: one rank steps " +
-                                    "the 0D vessels joined at their nodes (a 0D system over ranks is built for trees " +
-                                    "mostly 0D), and here they join " + std::to_string(largest) + " of the " +
-                                    std::to_string(n) + " vessels: run it on fewer ranks");
+                                    "the 0D vessels joined at their nodes where a 1D vessel meets them (a 0D system over " +
+                                    "ranks is built for trees mostly 0D, and for 0D systems no 1D vessel meets), and here " +
+                                    "they join " + std::to_string(largest) + " of the " + std::to_string(n) +
+                                    " vessels: run it on fewer ranks");
   }
   if (p.imbalance() > most_imbalance) return std::nullopt;
   p.cut_nodes = count_cut_nodes(net_, p.rank_of_vessel);
@@ -197,7 +230,35 @@ std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d
   partition_ = std::move(p);
   top_vessels_ = 0;
   top_weight_ = 0;
-  return VesselRanks{std::vector<std::int32_t>(partition_.rank_of_vessel.begin(), partition_.rank_of_vessel.end()), true};
+  zero_d_spread_ = zero_d_spread;
+  return VesselRanks{std::vector<std::int32_t>(partition_.rank_of_vessel.begin(), partition_.rank_of_vessel.end()), true,
+                     zero_d_spread};
 }
+
+std::size_t MpiPulseRanks::zero_d_solves() const {
+  std::size_t solves = 0;
+  for (const auto& system : halo_systems_) solves += system->solves();
+  return solves;
+}
+
+std::size_t MpiPulseRanks::zero_d_iterations() const {
+  std::size_t iterations = 0;
+  for (const auto& system : halo_systems_) iterations += system->iterations();
+  return iterations;
+}
+
+std::size_t MpiPulseRanks::zero_d_setups() const {
+  std::size_t setups = 0;
+  for (const auto& system : halo_systems_) setups += system->preconditioner_setups();
+  return setups;
+}
+
+double MpiPulseRanks::zero_d_seconds() const {
+  double seconds = 0;
+  for (const auto& system : halo_systems_) seconds += system->seconds();
+  return seconds;
+}
+
+std::string MpiPulseRanks::zero_d_method() const { return halo_systems_.empty() ? std::string() : halo_systems_.front()->method(); }
 
 }  // namespace hemotree

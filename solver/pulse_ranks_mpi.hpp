@@ -8,7 +8,9 @@
 //    partition by each vessel's step (subtrees, or METIS), the 0D vessels meeting at a node
 //    on one rank; the traces at junctions across the cut exchanged with each neighbouring
 //    rank (MPI_Isend, MPI_Irecv) at every evaluation, the couplings of 1D ends to another
-//    rank's 0D nodes at every step, failures by one MPI_Allreduce a step.
+//    rank's 0D nodes at every step, failures by one MPI_Allreduce a step; a 0D system that no
+//    1D vessel meets spread over the ranks where keeping it on one would leave a rank empty or
+//    the step out of balance, each step solved by PETSc (distributed/petsc_nodal_system.hpp).
 // Per-item numbers are made whole on every rank (MPI_Allgatherv of each rank's items and
 // values: the compliance balance's, once a cycle).
 #pragma once
@@ -16,6 +18,7 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <string>
 #include <span>
 #include <vector>
 
@@ -26,6 +29,8 @@
 #include "pulse/pulse_solver.hpp"
 
 namespace hemotree {
+
+class PetscNodalSystem;
 
 // Where a tree can be dealt either way: its top holding every 1D vessel wherever that leaves
 // every rank a vessel (what red cells and tracers over ranks take: their transport follows
@@ -49,6 +54,12 @@ class MpiPulseRanks {
   // and the vessels the top's rank holds (0 where spread).
   const Partition& partition() const { return partition_; }
   bool one_d_spread() const { return dealt_ && dealt_->one_d_spread; }
+  // Whether the 0D vessels are spread over the ranks (a 0D system with loops), and the
+  // solves of its steps on this rank: how many, and the seconds inside them.
+  bool zero_d_spread() const { return zero_d_spread_; }
+  std::size_t zero_d_solves() const, zero_d_iterations() const, zero_d_setups() const;
+  double zero_d_seconds() const;
+  std::string zero_d_method() const;
   // With the 1D vessels spread, this rank's messages (sent to its neighbours: traces, coupled
   // ends), their bytes, its reductions (failures), and the seconds inside them, waiting
   // included.
@@ -83,6 +94,8 @@ class MpiPulseRanks {
   std::optional<VesselRanks> dealt_;
   std::vector<bool> dealt_zero_d_;
   SpreadTraffic spread_traffic_;
+  bool zero_d_spread_ = false;
+  std::vector<std::shared_ptr<PetscNodalSystem>> halo_systems_;
   VesselRanks deal(const std::vector<bool>& zero_d, std::span<const double> step_cost);
   VesselRanks on_top(const std::vector<bool>& zero_d);
   // The 1D vessels spread, where the partition leaves no rank empty and its imbalance is at

@@ -21,9 +21,11 @@
 #include "physics/viscosity_table.hpp"
 #include "pulse/lumped_cut.hpp"
 #include "pulse/lumped_vessels.hpp"
+#include "tests/played_ranks.hpp"
 #include "steady/vessel_laws.hpp"
 
 using namespace hemotree;
+using namespace hemotree::test_networks;
 
 namespace {
 
@@ -90,26 +92,6 @@ class PlayedLink {
 };
 
 bool same(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
-
-// step(r, its vessels) of every played rank, each on a thread of its own, as ranks run at
-// once; per rank the words of what it threw ("" where nothing).
-template <class Step>
-std::vector<std::string> on_every_played_rank(std::vector<LumpedVessels>& part, Step&& step) {
-  std::vector<std::string> said(part.size());
-  std::vector<std::thread> threads;
-  for (std::size_t r = 0; r < part.size(); ++r)
-    threads.emplace_back([&, r] {
-      try {
-        step(static_cast<int>(r), part[r]);
-      } catch (const std::exception& e) {
-        said[r] = e.what();
-      } catch (...) {
-        said[r] = "not a std::exception";
-      }
-    });
-  for (std::thread& th : threads) th.join();
-  return said;
-}
 
 // A grown tree (about 16,500 vessels) fed at its root, every vessel 0D and one pi section,
 // leaves to RCR outlets.
