@@ -171,6 +171,21 @@ std::vector<std::int32_t> ranks_by_metis(const Network& net, int ranks) {
   return {p.rank_of_vessel.begin(), p.rank_of_vessel.end()};
 }
 
+// Every played rank's vessels by METIS, linked through `played`, started at the given state.
+std::vector<LumpedVessels> ranks_started(const Mesh& m, int ranks, PlayedHalo& played, const std::vector<double>& pressure,
+                                         const std::vector<double>& flow) {
+  const std::vector<std::int32_t> rank = ranks_by_metis(m.net, ranks);
+  std::vector<LumpedVessels> part;
+  for (int r = 0; r < ranks; ++r) {
+    const LumpedHalo halo = lumped_halo(m.net, m.whole_order, rank, ranks, r);
+    part.push_back(m.lumped(&halo));
+    EXPECT_TRUE(part.back().halo());
+    part.back().set_halo_link(played.for_rank(r, part.back().halo_system()));
+    part.back().start(pressure, flow);
+  }
+  return part;
+}
+
 }  // namespace
 
 // On a square of four vessels (0-1, 1-2, 2-3, 3-0) with ranks 0, 0, 1, 1: each node goes with
@@ -219,17 +234,8 @@ TEST(LumpedHalo, EveryRankStepsToTheWholeRunsBits) {
     SCOPED_TRACE(std::to_string(ranks) + " ranks");
     LumpedVessels reference = m.lumped();
     reference.start(pressure, flow);
-    const std::vector<std::int32_t> rank = ranks_by_metis(m.net, ranks);
-    std::vector<LumpedHalo> halos;
-    std::vector<LumpedVessels> part;
     PlayedHalo played(m.net, reference, ranks);
-    for (int r = 0; r < ranks; ++r) {
-      halos.push_back(lumped_halo(m.net, m.whole_order, rank, ranks, r));
-      part.push_back(m.lumped(&halos.back()));
-      EXPECT_TRUE(part.back().halo());
-      part.back().set_halo_link(played.for_rank(r, part.back().halo_system()));
-      part.back().start(pressure, flow);
-    }
+    std::vector<LumpedVessels> part = ranks_started(m, ranks, played, pressure, flow);
     EXPECT_THROW(part[0].set_coupling_nodes({0}), std::invalid_argument);
     EXPECT_THROW(part[0].set_passes(2), std::invalid_argument);
     const double dt = 1e-3 * 0.05;
@@ -278,7 +284,6 @@ TEST(LumpedHalo, EveryRankStepsToTheWholeRunsBits) {
 TEST(LumpedHalo, ALumenClosingOnOneRankIsSaidOnEveryRank) {
   const Mesh m(6);
   const int ranks = 3;
-  const std::vector<std::int32_t> rank = ranks_by_metis(m.net, ranks);
   std::vector<double> pressure(m.net.node_count(), 1500.0), flow(m.net.vessel_count(), 0.0);
   pressure[14] = -1e9;
   LumpedVessels reference = m.lumped();
@@ -291,15 +296,8 @@ TEST(LumpedHalo, ALumenClosingOnOneRankIsSaidOnEveryRank) {
     closing = c.vessel;
   }
   ASSERT_GE(closing, 0);
-  std::vector<LumpedHalo> halos;
-  std::vector<LumpedVessels> part;
   PlayedHalo played(m.net, reference, ranks);
-  for (int r = 0; r < ranks; ++r) {
-    halos.push_back(lumped_halo(m.net, m.whole_order, rank, ranks, r));
-    part.push_back(m.lumped(&halos.back()));
-    part.back().set_halo_link(played.for_rank(r, part.back().halo_system()));
-    part.back().start(pressure, flow);
-  }
+  std::vector<LumpedVessels> part = ranks_started(m, ranks, played, pressure, flow);
   const std::vector<std::string> said = on_every_played_rank(part, [&](int, LumpedVessels& mine) {
     mine.predict(1e-5, {}, std::vector<double>(mine.inflow_boundaries().size(), 1e-10),
                  std::vector<double>(mine.held_boundaries().size(), 1500.0));

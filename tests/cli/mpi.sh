@@ -282,6 +282,30 @@ status=$?
   && cmp -s "$WORK/six-one/vessels.csv" "$WORK/pulse-killed/vessels.csv" && cmp -s "$WORK/six-one/probes.csv" "$WORK/pulse-killed/probes.csv" \
   && pass "a rank killed: the run ends on every rank, OUT.partial keeps its checkpoint, resumed over 3 ranks to the uninterrupted files" \
   || fail "a rank killed: status $status: $(tail -3 "$WORK/killed") / $(tail -2 "$WORK/resumed" 2>/dev/null)"
+# Runs over ranks whose sums PETSc takes in its own order (loops): NAME REFERENCE RUN TOLERANCE
+# FILE...: every number of each file within TOLERANCE of its column's largest (the
+# pulsatility index, a ratio, within TOLERANCE of 1), the rest of the text the same.
+near_files() {
+  local name=$1 reference=$2 run=$3 tolerance=$4
+  shift 4
+  /usr/bin/python3 - "$reference" "$run" "$tolerance" "$@" <<'PY' && pass "$name: the plain run's within $tolerance" \
+    || fail "$name: beyond $tolerance of the plain run"
+import sys, numpy as np, pandas as pd
+reference, run, tolerance = sys.argv[1], sys.argv[2], float(sys.argv[3])
+for name in sys.argv[4:]:
+    a, b = pd.read_csv(f"{reference}/{name}"), pd.read_csv(f"{run}/{name}")
+    assert list(a.columns) == list(b.columns) and len(a) == len(b), name
+    for c in a.columns:
+        if a[c].dtype.kind != "f":
+            assert (a[c].astype(str) == b[c].astype(str)).all(), (name, c)
+            continue
+        x, y = a[c].to_numpy(), b[c].to_numpy()
+        assert (np.isfinite(x) == np.isfinite(y)).all(), (name, c)
+        f = np.isfinite(x)
+        scale = 1.0 if c == "pulsatility_index" else max(np.abs(x[f]).max(initial=0), 1e-300)
+        assert np.abs(x[f] - y[f]).max(initial=0) <= tolerance * scale, (name, c)
+PY
+}
 # A network with loops and pressures prescribed at nodes (the rat mesentery): PETSc's
 # conjugate gradients over the ranks, within 1e-10 of the plain run (relative to each
 # column's largest value).
@@ -326,23 +350,6 @@ PY
   # run (one pi section a vessel) in every column of vessels.csv and probes.csv, relative to
   # the column's largest; the pulsatility index, a difference of nearly equal flows in these
   # capillaries (1e-4), within 1e-7 of itself. Measured: 5e-9 at most.
-  near_pulse() {  # NAME REFERENCE RUN
-    /usr/bin/python3 - "$2" "$3" <<'PY' && pass "$1" || fail "$1: beyond 1e-7 of the plain run"
-import sys, numpy as np, pandas as pd
-for name in ("vessels.csv", "probes.csv"):
-    a, b = pd.read_csv(f"{sys.argv[1]}/{name}"), pd.read_csv(f"{sys.argv[2]}/{name}")
-    assert list(a.columns) == list(b.columns) and len(a) == len(b), name
-    for c in a.columns:
-        if a[c].dtype.kind != "f":
-            assert (a[c].astype(str) == b[c].astype(str)).all(), c
-            continue
-        x, y = a[c].to_numpy(), b[c].to_numpy()
-        assert (np.isfinite(x) == np.isfinite(y)).all(), c
-        f = np.isfinite(x)
-        scale = 1.0 if c == "pulsatility_index" else max(np.abs(x[f]).max(initial=0), 1e-300)
-        assert np.abs(x[f] - y[f]).max(initial=0) <= 1e-7 * scale, (name, c)
-PY
-  }
   pulse="--cycles 2 --probe 100 --probe 700:0.3"
   "$HEMOSOLVE" "$WORK/mesentery.json" $pulse --lumped-sections 1 --out "$WORK/mes-pulse-one" 2>/dev/null \
     || fail "the mesentery's pulsatile run, plain"
@@ -350,8 +357,8 @@ PY
     $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/mesentery.json" $pulse --out "$WORK/mes-pulse-$ranks" >"$WORK/mp-out" 2>&1
     grep -q "^hemosolve: $ranks ranks by METIS: .*the 0D vessels spread over the ranks" "$WORK/mp-out" \
       && grep -q "^hemosolve: the 0D steps' solves on rank 0: 2000 solves" "$WORK/mp-out" \
-      && near_pulse "the mesentery's pulsatile run over $ranks ranks, its 0D vessels spread (PETSc): the plain run's within 1e-7" \
-           "$WORK/mes-pulse-one" "$WORK/mes-pulse-$ranks" \
+      && near_files "the mesentery's pulsatile run over $ranks ranks, its 0D vessels spread (PETSc)" \
+           "$WORK/mes-pulse-one" "$WORK/mes-pulse-$ranks" 1e-7 vessels.csv probes.csv \
       || fail "the mesentery's pulsatile run over $ranks ranks: $(grep -m2 'error\|METIS' "$WORK/mp-out")"
   done
   # Its checkpoint: a cycle over 2 ranks, resumed over 3 ranks and by the plain command for the
@@ -360,11 +367,11 @@ PY
     --out "$WORK/mes-ck" >/dev/null 2>&1
   cp -r "$WORK/mes-ck" "$WORK/mes-ck-plain"
   $MPIRUN -np 3 "$HEMOSOLVE" "$WORK/mesentery.json" $pulse --checkpoint-every 1 --resume "$WORK/mes-ck" >/dev/null 2>&1 \
-    && near_pulse "the mesentery's checkpoint over 2 ranks resumed over 3: the plain run's within 1e-7" "$WORK/mes-pulse-one" "$WORK/mes-ck" \
+    && near_files "the mesentery's checkpoint over 2 ranks resumed over 3" "$WORK/mes-pulse-one" "$WORK/mes-ck" 1e-7 vessels.csv probes.csv \
     || fail "the mesentery's checkpoint over 2 ranks resumed over 3"
   "$HEMOSOLVE" "$WORK/mesentery.json" $pulse --lumped-sections 1 --checkpoint-every 1 --resume "$WORK/mes-ck-plain" >/dev/null 2>&1 \
-    && near_pulse "the mesentery's checkpoint over 2 ranks resumed by the plain command: the plain run's within 1e-7" \
-         "$WORK/mes-pulse-one" "$WORK/mes-ck-plain" \
+    && near_files "the mesentery's checkpoint over 2 ranks resumed by the plain command" \
+         "$WORK/mes-pulse-one" "$WORK/mes-ck-plain" 1e-7 vessels.csv probes.csv \
     || fail "the mesentery's checkpoint over 2 ranks resumed by the plain command"
 else
   echo "skip: the mesentery over ranks (no shared networks)"
@@ -415,27 +422,11 @@ done
 # tree whose wave-carrying vessels would leave a rank empty on its top): each harmonic's
 # system over the ranks by PETSc (distributed/petsc_harmonic_network), the plain run's within
 # 1e-10 in every column of vessels.csv.
-near_files() {  # NAME REFERENCE RUN: every number of vessels.csv within 1e-10 of the column's largest
-  /usr/bin/python3 - "$2/vessels.csv" "$3/vessels.csv" <<'PY' && pass "$1: the plain run's within 1e-10" || fail "$1: beyond 1e-10 of the plain run"
-import sys, numpy as np, pandas as pd
-a, b = pd.read_csv(sys.argv[1]), pd.read_csv(sys.argv[2])
-assert list(a.columns) == list(b.columns) and len(a) == len(b)
-for c in a.columns:
-    if a[c].dtype.kind != "f":
-        assert (a[c].astype(str) == b[c].astype(str)).all(), c
-        continue
-    x, y = a[c].to_numpy(), b[c].to_numpy()
-    assert (np.isfinite(x) == np.isfinite(y)).all(), c
-    f = np.isfinite(x)
-    if f.any():
-        assert np.abs(x[f] - y[f]).max() <= 1e-10 * max(np.abs(x[f]).max(), 1e-300), c
-PY
-}
 linear_by_petsc() {  # NAME NETWORK RANKS
   "$HEMOSOLVE" "$2" --linear --out "$WORK/linear-graph-one" 2>/dev/null
   $MPIRUN -np "$3" "$HEMOSOLVE" "$2" --linear --out "$WORK/linear-graph-$3" >"$WORK/linear-graph-out" 2>&1
   grep -q "every harmonic's nodal system by PETSc's" "$WORK/linear-graph-out" \
-    && near_files "$1" "$WORK/linear-graph-one" "$WORK/linear-graph-$3" \
+    && near_files "$1" "$WORK/linear-graph-one" "$WORK/linear-graph-$3" 1e-10 vessels.csv \
     || fail "$1: $(grep -m2 hemosolve "$WORK/linear-graph-out")"
   rm -rf "$WORK/linear-graph-one" "$WORK/linear-graph-$3"
 }
