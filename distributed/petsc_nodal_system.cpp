@@ -18,7 +18,7 @@ namespace hemotree {
 
 struct PetscNodalSystem::Objects {
   Mat matrix = nullptr;
-  Vec x = nullptr, rhs = nullptr, residual = nullptr, owned = nullptr, local = nullptr;
+  Vec x = nullptr, rhs = nullptr, residual = nullptr, owned = nullptr, local = nullptr, guess = nullptr;
   IS rows = nullptr;
   VecScatter to_nodes = nullptr;
   KSP solver = nullptr;
@@ -29,7 +29,7 @@ struct PetscNodalSystem::Objects {
     if (solver) KSPDestroy(&solver);
     if (to_nodes) VecScatterDestroy(&to_nodes);
     if (rows) ISDestroy(&rows);
-    for (Vec* v : {&x, &rhs, &residual, &owned, &local})
+    for (Vec* v : {&x, &rhs, &residual, &owned, &local, &guess})
       if (*v) VecDestroy(v);
     if (matrix) MatDestroy(&matrix);
   }
@@ -104,6 +104,7 @@ PetscNodalSystem::PetscNodalSystem(std::span<const std::int32_t> key_rank, std::
   petsc_check(MatCreateVecs(o.matrix, &o.x, &o.rhs), "MatCreateVecs");
   petsc_check(VecDuplicate(o.rhs, &o.residual), "VecDuplicate");
   petsc_check(VecDuplicate(o.rhs, &o.owned), "VecDuplicate");
+  petsc_check(VecDuplicate(o.rhs, &o.guess), "VecDuplicate");
   // Every node this rank holds, owned or ghost, from the rows of the whole.
   std::vector<PetscInt> held(row_.begin(), row_.end());
   petsc_check(VecCreateSeq(PETSC_COMM_SELF, static_cast<PetscInt>(nodes), &o.local), "VecCreateSeq");
@@ -147,6 +148,26 @@ void PetscNodalSystem::solve(std::span<const double> conductance, std::span<cons
     throw std::invalid_argument("PetscNodalSystem::solve: a conductance per edge, a shunt, a right-hand side and x per node");
   const double started = MPI_Wtime();
   Objects& o = *o_;
+  assemble(conductance, shunt);
+  if (solves_ > 0) petsc_check(VecCopy(o.guess, o.x), "VecCopy");  // the last step's solution
+  solve_rows(rhs, x, true);
+  petsc_check(VecCopy(o.x, o.guess), "VecCopy");
+  seconds_ += MPI_Wtime() - started;
+}
+
+void PetscNodalSystem::solve_again(std::span<const double> rhs, std::span<double> x) {
+  if (rhs.size() != row_.size() || x.size() != row_.size())
+    throw std::invalid_argument("PetscNodalSystem::solve_again: a right-hand side and x per node");
+  if (solves_ == 0) throw std::logic_error("PetscNodalSystem::solve_again before a solve");
+  const double started = MPI_Wtime();
+  petsc_check(VecSet(o_->x, 0.0), "VecSet");
+  solve_rows(rhs, x, false);
+  seconds_ += MPI_Wtime() - started;
+}
+
+void PetscNodalSystem::assemble(std::span<const double> conductance, std::span<const double> shunt) {
+  const std::size_t nodes = row_.size();
+  Objects& o = *o_;
   // This rank's rows: the same entries as the pattern, their values anew.
   petsc_check(MatZeroEntries(o.matrix), "MatZeroEntries");
   for (std::size_t k = 0; k < nodes; ++k)
@@ -162,6 +183,11 @@ void PetscNodalSystem::solve(std::span<const double> conductance, std::span<cons
   }
   petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+}
+
+void PetscNodalSystem::solve_rows(std::span<const double> rhs, std::span<double> x, bool step) {
+  const std::size_t nodes = row_.size();
+  Objects& o = *o_;
   PetscScalar* values = nullptr;
   petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
   for (std::size_t k = 0; k < nodes; ++k)
@@ -175,7 +201,7 @@ void PetscNodalSystem::solve(std::span<const double> conductance, std::span<cons
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
   PetscInt iterations = 0;
   for (bool again = true; again;) {
-    const bool reused = reuse_;
+    const bool reused = reuse_ || !step;
     petsc_check(KSPSetReusePreconditioner(o.solver, reused ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
     if (KSPSolve(o.solver, o.rhs, o.x) != 0) petsc_check(VecSet(o.x, 0.0), "VecSet");
     petsc_check(KSPGetConvergedReason(o.solver, &reason), "KSPGetConvergedReason");
@@ -184,8 +210,11 @@ void PetscNodalSystem::solve(std::span<const double> conductance, std::span<cons
       ++setups_;
       fresh_iterations_ = static_cast<int>(iterations);
     }
-    reuse_ = reason >= 0 && iterations <= fresh_iterations_ + more_iterations;
+    // A step's solve decides the next step's preconditioner (a solve again, from zero, takes
+    // more iterations than a step's from the last solution, and decides nothing).
+    if (step || !reused) reuse_ = reason >= 0 && iterations <= fresh_iterations_ + more_iterations;
     again = reused && reason < 0;
+    if (again) reuse_ = false;
     if (again) petsc_check(VecSet(o.x, 0.0), "VecSet");
   }
   iterations_ += static_cast<std::size_t>(iterations);
@@ -214,7 +243,6 @@ void PetscNodalSystem::solve(std::span<const double> conductance, std::span<cons
   petsc_check(VecGetArrayRead(o.local, &solved), "VecGetArrayRead");
   std::copy_n(solved, nodes, x.begin());
   petsc_check(VecRestoreArrayRead(o.local, &solved), "VecRestoreArrayRead");
-  seconds_ += MPI_Wtime() - started;
 }
 
 void PetscNodalSystem::fill_ghosts(std::span<double> values) {

@@ -40,6 +40,8 @@ class PetscNodalSystem {
   // or leaves a true relative residual above 1e-10.
   void solve(std::span<const double> conductance, std::span<const double> shunt, std::span<const double> rhs,
              std::span<double> x);
+  // The last solve's system with another right-hand side, from zero. Collective.
+  void solve_again(std::span<const double> rhs, std::span<double> x);
   // values per node: each ghost's set to its owner's. Collective.
   void fill_ghosts(std::span<double> values);
 
@@ -69,6 +71,10 @@ class PetscNodalSystem {
   static constexpr double relative_tolerance = 1e-15, most_residual = 1e-13;
   static constexpr int most_iterations = 50, more_iterations = 2;
   double seconds_ = 0;
+  void assemble(std::span<const double> conductance, std::span<const double> shunt);
+  // rhs into x by the solver from o.x (step: a step's solve, which decides the next's
+  // preconditioner), checked, scattered to every node held.
+  void solve_rows(std::span<const double> rhs, std::span<double> x, bool step);
 };
 
 }  // namespace hemotree

@@ -1,5 +1,7 @@
 #include "pulse/lumped_halo.hpp"
 
+#include <algorithm>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -85,6 +87,50 @@ void LumpedVessels::predict_on_halo(double dt, std::span<const double> coupled_i
   }
   if (const std::int64_t least = halo_.link.least(collapsed); least != none) throw CollapsedNode{static_cast<std::int32_t>(least)};
   halo_.link.solve(conductance_, halo_.shunt, rhs_, rhs_);  // rhs_: the pressures at t1, ghosts too
+  if (halo_.coupled_node.empty()) return;
+  // Each coupling node's response z_j = K^-1 e_j (the same system: the one-process run's
+  // selected inversion and partial solves are of a factorisation no rank holds here): its
+  // impedance at its owner, and what its 1D ends' departures from the held inflows move
+  // (predict_again, complete).
+  const std::size_t couplings = halo_.coupled_node.size();
+  halo_.response.resize(couplings * nodes_);
+  std::vector<double> unit(nodes_, 0.0);
+  for (std::size_t j = 0; j < couplings; ++j) {
+    const std::int32_t k = halo_.coupled_node[j];
+    if (k >= 0 && !is_ghost_node(static_cast<std::size_t>(k))) unit[static_cast<std::size_t>(k)] = 1;
+    halo_.link.solve_again(unit, std::span<double>(halo_.response).subspan(j * nodes_, nodes_));
+    if (k >= 0) unit[static_cast<std::size_t>(k)] = 0;
+    if (const std::int32_t slot = halo_.coupled_slot[j]; slot >= 0)
+      impedance_[static_cast<std::size_t>(slot)] = halo_.response[j * nodes_ + static_cast<std::size_t>(k)];
+  }
+  std::copy(coupled_inflow.begin(), coupled_inflow.end(), held_inflow_.begin());
+  for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_predicted_[j] = rhs_[static_cast<std::size_t>(coupling_nodes_[j])];
+}
+
+void LumpedVessels::set_halo_coupling(std::span<const std::int64_t> network_nodes) {
+  if (!halo_.on) throw std::logic_error("LumpedVessels::set_halo_coupling without a halo");
+  halo_.coupled_node.clear();
+  halo_.coupled_slot.clear();
+  for (const std::int64_t node : network_nodes) {
+    const std::int32_t k = node_of_.empty() ? -1 : node_of_[static_cast<std::size_t>(node)];
+    halo_.coupled_node.push_back(k);
+    const auto at = std::find(coupling_nodes_.begin(), coupling_nodes_.end(), k);
+    halo_.coupled_slot.push_back(k >= 0 && at != coupling_nodes_.end() ? static_cast<std::int32_t>(at - coupling_nodes_.begin()) : -1);
+  }
+  halo_.departure.assign(network_nodes.size(), 0.0);
+}
+
+void LumpedVessels::add_halo_departures(const std::function<double(std::size_t slot)>& departure) {
+  const std::size_t couplings = halo_.coupled_node.size();
+  if (couplings == 0) return;
+  for (std::size_t j = 0; j < couplings; ++j)
+    halo_.departure[j] = halo_.coupled_slot[j] >= 0 ? departure(static_cast<std::size_t>(halo_.coupled_slot[j])) : 0.0;
+  halo_.link.sum(halo_.departure);  // each its owner's alone: every rank the same bits
+  for (std::size_t j = 0; j < couplings; ++j) {
+    const double d = halo_.departure[j];
+    const double* z = halo_.response.data() + j * nodes_;
+    for (std::size_t k = 0; k < nodes_; ++k) rhs_[k] += d * z[k];
+  }
 }
 
 }  // namespace hemotree

@@ -46,7 +46,7 @@ std::vector<std::int32_t> lumped_node_ranks(const Network& net, const LumpedOrde
 LumpedHalo lumped_halo(const Network& net, const LumpedOrder& whole, std::span<const std::int32_t> vessel_rank,
                        int ranks, int rank);
 
-// A step's collective calls, carried by the caller (over MPI: PETSc's solve).
+// A step's collective calls, carried by the caller (over MPI: PETSc's solve and reductions).
 struct LumpedHaloLink {
   // The least of every rank's key (a lumen closing: its vessel; none: the largest int64).
   std::function<std::int64_t(std::int64_t key)> least;
@@ -55,15 +55,20 @@ struct LumpedHaloLink {
   std::function<void(std::span<const double> conductance, std::span<const double> shunt, std::span<const double> rhs,
                      std::span<double> x)>
       solve;
+  // The last solve's system again with another right-hand side (per node, the owner's rows).
+  std::function<void(std::span<const double> rhs, std::span<double> x)> solve_again;
   // values per node: the owned nodes' in, every ghost's from its owner out.
   std::function<void(std::span<double> values)> fill_ghosts;
+  // Each value summed over the ranks (in place, every rank's result the same bits).
+  std::function<void(std::span<double> values)> sum;
 };
 
 // A rank's system as its link's solver numbers it: per node its key (its network node, or
 // network nodes + outlet for a capacitor), every key's rank (LumpedHalo::key_rank), the edges.
+// Copies: a solver may keep them.
 struct LumpedHaloSystem {
   std::vector<std::int64_t> node_key;
-  std::span<const std::int32_t> key_rank, a, b;
+  std::vector<std::int32_t> key_rank, a, b;
 };
 
 }  // namespace hemotree

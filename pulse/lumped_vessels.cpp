@@ -219,11 +219,10 @@ void LumpedVessels::set_passes(int passes) {
 }
 
 void LumpedVessels::set_coupling_nodes(std::vector<std::int32_t> nodes) {
-  // A coupled end's prediction and impedance are partial solves of a factorisation this rank
-  // does not hold in a halo (a 0D system with loops is spread over ranks only where no 1D
-  // vessel meets it).
-  if (halo_.on && !nodes.empty())
-    throw std::invalid_argument("LumpedVessels: a 1D vessel ends at a node of a 0D system spread over ranks");
+  // In a halo a coupling node is its owner's (set_halo_coupling: the run's).
+  for (const std::int32_t k : nodes)
+    if (is_ghost_node(static_cast<std::size_t>(k)))
+      throw std::invalid_argument("LumpedVessels: coupling node " + std::to_string(k) + " is another rank's");
   coupling_nodes_ = std::move(nodes);
   held_inflow_.assign(coupling_nodes_.size(), 0.0);
   impedance_.assign(coupling_nodes_.size(), 0.0);
@@ -633,6 +632,12 @@ void LumpedVessels::predict_step(double dt, std::span<const double> coupled_infl
 }
 
 void LumpedVessels::predict_again(std::span<const double> coupled_inflow) {
+  if (halo_.on) {  // collective: every rank, own coupling nodes or none
+    add_halo_departures([&](std::size_t s) { return coupled_inflow[s] - held_inflow_[s]; });
+    std::copy(coupled_inflow.begin(), coupled_inflow.end(), held_inflow_.begin());
+    for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_predicted_[j] = rhs_[static_cast<std::size_t>(coupling_nodes_[j])];
+    return;
+  }
   if (coupling_nodes_.empty()) return;
   for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_scratch_[j] = coupled_inflow[j] - held_inflow_[j];
   system_.add_forward(coupling_nodes_, coupling_scratch_, rhs_);
@@ -668,13 +673,15 @@ void LumpedVessels::complete(std::span<const double> coupled_volume, std::span<d
 }
 
 void LumpedVessels::complete_step(std::span<const double> coupled_volume, std::span<double> boundary_volume) {
+  const double dt = dt_;
+  if (halo_.on)  // collective: the departures, then (below) the ghosts
+    add_halo_departures([&](std::size_t s) { return coupled_volume[s] / dt - held_inflow_[s]; });
   if (empty()) {
-    if (halo_.on) halo_.link.fill_ghosts({});  // collective
+    if (halo_.on) halo_.link.fill_ghosts({});
     return;
   }
-  const double dt = dt_;
   // The departure of the 1D ends' mean inflows from those held, into the forward half.
-  if (!coupling_nodes_.empty()) {
+  if (!coupling_nodes_.empty() && !halo_.on) {
     for (std::size_t j = 0; j < coupling_nodes_.size(); ++j) coupling_scratch_[j] = coupled_volume[j] / dt - held_inflow_[j];
     system_.add_forward(coupling_nodes_, coupling_scratch_, rhs_);
   }

@@ -189,6 +189,11 @@ class LumpedVessels {
   bool halo() const { return halo_.on; }
   LumpedHaloSystem halo_system() const;
   void set_halo_link(LumpedHaloLink link) { halo_.link = std::move(link); }
+  // Every coupling node of the run (network nodes where 1D ends meet the 0D system), every
+  // rank's alike: each step solves K z = e_j for each (every rank its part of z_j), the
+  // impedance at its owner, and moves every rank's pressures by its 1D ends' departures from
+  // the held inflows (set_coupling_nodes takes this rank's own, none of its ghosts).
+  void set_halo_coupling(std::span<const std::int64_t> network_nodes);
   [[noreturn]] void abandon_step(std::exception_ptr failure);
   // Whether a node or a 0D vessel is held for another rank's sums only (its numbers are that
   // rank's): the top's rank's ghosts, a share's nodes above its roots; in a halo, the nodes
@@ -554,10 +559,18 @@ class LumpedVessels {
     std::vector<std::int32_t> key_rank;
     std::vector<double> shunt;
     LumpedHaloLink link;
+    // The run's coupling nodes: per one, its node here (-1: none) and its slot among this
+    // rank's own (-1: another rank's); z_j = K^-1 e_j, node after node (one column a
+    // coupling node); the departures of the step.
+    std::vector<std::int32_t> coupled_node, coupled_slot;
+    std::vector<double> response, departure;
   } halo_;
   void hold_halo(const LumpedHalo& halo);  // the constructor's
   void predict_on_halo(double dt, std::span<const double> coupled_inflow, std::span<const double> inflow,
                        std::span<const double> held_pressure);
+  // rhs_ (the pressures at t1) moved by each coupling node's departure from its held inflow:
+  // per own coupling slot, its departure (summed over the ranks first).
+  void add_halo_departures(const std::function<double(std::size_t slot)>& departure);
   // A root vessel's (edge e's) ends: u, the top's node above it, and r, the share's root below
   // it. Every node hangs from one before it in the whole run's order, and so in a rank's.
   std::size_t root_upper(std::size_t e) const { return static_cast<std::size_t>(std::min(a_[e], b_[e])); }

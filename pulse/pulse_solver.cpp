@@ -281,8 +281,12 @@ void PulseSolver::couple_lumped_ends() {
   lumped_inflow_.assign(lumped_.inflow_boundaries().size(), 0.0);
   lumped_held_.assign(lumped_.held_boundaries().size(), 0.0);
   if (!one_d_here_) return;  // every coupled end is the top's
-  // With the 1D vessels spread over ranks, a coupled end's node may be another rank's (slot -1).
-  for (const auto& c : boundaries_.coupled) coupled_node_.push_back(lumped_.node_of(c.node));
+  // With the 1D vessels spread over ranks, a coupled end's node may be another rank's (slot
+  // -1): in a halo, a ghost is.
+  for (const auto& c : boundaries_.coupled) {
+    const std::int32_t k = lumped_.node_of(c.node);
+    coupled_node_.push_back(k >= 0 && lumped_.ghost_node(k) ? -1 : k);
+  }
   std::vector<std::int32_t> nodes;
   for (const std::int32_t node : coupled_node_)
     if (node >= 0) nodes.push_back(node);
@@ -292,6 +296,13 @@ void PulseSolver::couple_lumped_ends() {
     coupled_slot_.push_back(node < 0 ? -1 : static_cast<std::int32_t>(std::lower_bound(nodes.begin(), nodes.end(), node) - nodes.begin()));
   coupled_inflow_.assign(nodes.size(), 0.0);
   lumped_.set_coupling_nodes(std::move(nodes));
+  if (lumped_.halo()) {  // the run's coupling nodes, every rank's alike
+    std::vector<std::int64_t> coupled;
+    for (const auto& c : boundaries_.coupled) coupled.push_back(c.node);
+    std::sort(coupled.begin(), coupled.end());
+    coupled.erase(std::unique(coupled.begin(), coupled.end()), coupled.end());
+    lumped_.set_halo_coupling(coupled);
+  }
   held_end_flow_.assign(boundaries_.coupled.size(), 0.0);
   coupled_volume_ = coupled_inflow_;
 }

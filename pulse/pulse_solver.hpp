@@ -128,9 +128,9 @@ struct PulseState {
 //    meeting at a node on one rank, so that a rank's 0D system is its own; the traces at
 //    junctions across the cut exchanged at every evaluation, and the coupled ends' inflows,
 //    nodes and volumes at every step where a 1D end's 0D node is another rank's (exchange);
-//    and where no 1D vessel meets the 0D vessels (a network of capillaries with loops), the
-//    0D vessels spread too (zero_d_spread): each rank its own and a halo of the others' at its
-//    nodes (pulse/lumped_halo.hpp), each step solved over every rank's rows (halo_link).
+//    or the 0D vessels spread too (zero_d_spread: a capillary bed that whole would leave a
+//    rank empty): each rank its own and a halo of the others' at its nodes
+//    (pulse/lumped_halo.hpp), each step solved over every rank's rows (halo_link).
 struct VesselRanks {
   std::vector<std::int32_t> rank;
   bool one_d_spread = false, zero_d_spread = false;

@@ -289,7 +289,7 @@ void PulseSolver::take_coupled_substeps() {
       held_end_flow_[k] = (state_.coupled(i) - before(i)) / dt_;
     }
     sum_held_inflows();
-    if (!lumped_.empty()) lumped_.predict_again(coupled_inflow_);
+    if (steps_lumped()) lumped_.predict_again(coupled_inflow_);  // collective in a halo
     if (!coupling_ranks_.empty()) share_coupling_nodes();
     return_to_pass_start();
   }

@@ -8,9 +8,10 @@
 //    partition by each vessel's step (subtrees, or METIS), the 0D vessels meeting at a node
 //    on one rank; the traces at junctions across the cut exchanged with each neighbouring
 //    rank (MPI_Isend, MPI_Irecv) at every evaluation, the couplings of 1D ends to another
-//    rank's 0D nodes at every step, failures by one MPI_Allreduce a step; a 0D system that no
-//    1D vessel meets spread over the ranks where keeping it on one would leave a rank empty or
-//    the step out of balance, each step solved by PETSc (distributed/petsc_nodal_system.hpp).
+//    rank's 0D nodes at every step, failures by one MPI_Allreduce a step; the 0D vessels spread
+//    too where keeping each system of them on one rank would leave a rank empty (or, where no
+//    1D vessel meets them, the step out of balance), each step solved by PETSc
+//    (distributed/petsc_nodal_system.hpp).
 // Per-item numbers are made whole on every rank (MPI_Allgatherv of each rank's items and
 // values: the compliance balance's, once a cycle).
 #pragma once
