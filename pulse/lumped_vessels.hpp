@@ -194,6 +194,7 @@ class LumpedVessels {
   // impedance at its owner, and moves every rank's pressures by its 1D ends' departures from
   // the held inflows (set_coupling_nodes takes this rank's own, none of its ghosts).
   void set_halo_coupling(std::span<const std::int64_t> network_nodes);
+  std::size_t halo_couplings() const { return halo_.coupled_node.size(); }
   [[noreturn]] void abandon_step(std::exception_ptr failure);
   // Whether a node or a 0D vessel is held for another rank's sums only (its numbers are that
   // rank's): the top's rank's ghosts, a share's nodes above its roots; in a halo, the nodes

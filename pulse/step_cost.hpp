@@ -18,6 +18,14 @@ inline constexpr double per_mode_pair = 18e-9;  // [s per element, step and (p +
 // threads' 1.8-fold speed-up: 100 ns, so that the estimate errs long.
 inline constexpr double per_lumped_vessel = 100e-9;  // [s per 0D vessel and step]
 
+// A 0D system spread over ranks (pulse/lumped_halo.hpp): each step solves it over the ranks
+// (PETSc), once and once more per coupling node, each solve a few collective calls and a few
+// iterations over a rank's nodes. Measured (bench/README.md, "A 0D system with loops over
+// ranks", 2 ranks): the mesentery's 565 nodes a rank 0.3 to 0.4 ms a solve, a mesh's 20,000
+// nodes a rank 17 ms: 0.3 ms and 0.85 us a node, rounded up.
+inline constexpr double per_spread_solve = 0.4e-3;   // [s per solve]
+inline constexpr double per_spread_node = 1e-6;      // [s per node of a rank and solve]
+
 // One step of one element of degree p, fitted to steps of one degree everywhere
 // (bench/README.md, "Cost model"): a fixed part per element (traces, Riemann problems,
 // friction) and a part that grows with the modes times the quadrature points of the degree's

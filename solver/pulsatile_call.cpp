@@ -110,9 +110,14 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
   // Over P ranks each steps about a P-th of the 0D vessels; the 1D vessels are the top's.
   const int ranks = world_size();
   const double lumped = static_cast<double>(run.lumped_vessels_in_run()) / ranks, substeps = run.substeps() * run.coupling_passes();
-  RunEstimate per_cycle = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), threads, substeps, lumped);
-  RunEstimate whole =
-      estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned, threads, substeps, lumped);
+  // A 0D system spread over the ranks: its solves a step, over a rank's nodes.
+  const LumpedVessels& zero_d = run.lumped();
+  const double spread_solves = zero_d.halo() ? 1.0 + static_cast<double>(zero_d.halo_couplings()) : 0.0;
+  const double spread_nodes = static_cast<double>(zero_d.node_count());
+  RunEstimate per_cycle = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle), threads, substeps, lumped,
+                                       spread_solves, spread_nodes);
+  RunEstimate whole = estimate_run(elements_of_degree, static_cast<double>(steps_per_cycle) * planned, threads, substeps,
+                                   lumped, spread_solves, spread_nodes);
   if (config.carries_transport()) {
     // Its cells: a node's of the 0D vessels (about one a vessel), the 1D elements' slices (a
     // degree's modes each); a rank carries its own. Its steps: as the run takes them below.

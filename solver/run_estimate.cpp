@@ -8,13 +8,14 @@
 namespace hemotree {
 
 RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads, double substeps,
-                         double lumped_vessels) {
+                         double lumped_vessels, double spread_solves, double spread_nodes) {
   double substep = step_cost::per_step;
   for (std::size_t p = 0; p < elements_of_degree.size(); ++p)
     substep += elements_of_degree[p] * step_cost::element_step_seconds(static_cast<int>(p));
   // Two threads gave 1.8 times one thread's speed from 5000 vessels up (bench/README.md).
   const double speedup = threads > 1 ? 0.9 * threads : 1.0;
-  return {steps, steps * (substeps * substep + lumped_vessels * step_cost::per_lumped_vessel) / speedup};
+  const double spread = spread_solves * (step_cost::per_spread_solve + spread_nodes * step_cost::per_spread_node);
+  return {steps, steps * (substeps * substep + lumped_vessels * step_cost::per_lumped_vessel) / speedup + steps * spread};
 }
 
 std::string describe_duration(double seconds) {

@@ -16,9 +16,12 @@ struct RunEstimate {
 };
 
 // elements_of_degree[p]: 1D elements of degree p, each step of the run substeps steps of
-// theirs; lumped_vessels: 0D vessels, one implicit step per step.
+// theirs; lumped_vessels: 0D vessels, one implicit step per step; spread_solves: where the 0D
+// vessels are spread over ranks, the solves over the ranks a step (pulse/step_cost.hpp), each
+// over spread_nodes nodes a rank.
 RunEstimate estimate_run(const std::vector<double>& elements_of_degree, double steps, int threads,
-                         double substeps = 1, double lumped_vessels = 0);
+                         double substeps = 1, double lumped_vessels = 0, double spread_solves = 0,
+                         double spread_nodes = 0);
 
 // A red-cell or tracer transport step, per cell: measured 85 ns of wall time a cell and
 // transport step on two threads, on the 421,047-vessel tree and on the full tree alike

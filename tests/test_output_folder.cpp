@@ -210,6 +210,9 @@ TEST(RunEstimate, ScalesWithStepsElementsAndThreads) {
   EXPECT_NEAR(one.seconds, 1000 * (10e-6 + 1000 * (300e-9 + 72e-9)), 1e-12);
   EXPECT_NEAR(estimate_run({0, 1000}, 2000, 1).seconds, 2 * one.seconds, 1e-12);
   EXPECT_NEAR(estimate_run({0, 1000}, 1000, 2).seconds, one.seconds / 1.8, 1e-12);
+  // A 0D system spread over ranks: 0.4 ms a solve and 1 us a node of the rank, two solves a
+  // step (one coupling node) over 500 nodes, on no thread's speed-up (its calls are collective).
+  EXPECT_NEAR(estimate_run({0, 1000}, 1000, 2, 1, 0, 2, 500).seconds - one.seconds / 1.8, 1000 * 2 * (0.4e-3 + 500e-6), 1e-12);
   // Counts far beyond any run stay finite numbers, so that the refusal can say them.
   EXPECT_TRUE(std::isfinite(estimate_run({0, 0, 0, 0, 0, 0, 0, 1e6}, 2.6e14, 1).seconds));
 }
