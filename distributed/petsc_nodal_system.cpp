@@ -200,23 +200,23 @@ void PetscNodalSystem::solve_rows(std::span<const double> rhs, std::span<double>
   // true residual below.
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
   PetscInt iterations = 0;
-  for (bool again = true; again;) {
-    const bool reused = reuse_ || !step;
+  // A solve again reuses the step's preconditioner, made for this matrix or an earlier one.
+  bool reused = reuse_ || !step;
+  for (;;) {
     petsc_check(KSPSetReusePreconditioner(o.solver, reused ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
     if (KSPSolve(o.solver, o.rhs, o.x) != 0) petsc_check(VecSet(o.x, 0.0), "VecSet");
     petsc_check(KSPGetConvergedReason(o.solver, &reason), "KSPGetConvergedReason");
     petsc_check(KSPGetIterationNumber(o.solver, &iterations), "KSPGetIterationNumber");
-    if (!reused) {
-      ++setups_;
-      fresh_iterations_ = static_cast<int>(iterations);
-    }
-    // A step's solve decides the next step's preconditioner (a solve again, from zero, takes
-    // more iterations than a step's from the last solution, and decides nothing).
-    if (step || !reused) reuse_ = reason >= 0 && iterations <= fresh_iterations_ + more_iterations;
-    again = reused && reason < 0;
-    if (again) reuse_ = false;
-    if (again) petsc_check(VecSet(o.x, 0.0), "VecSet");
+    if (!reused) ++setups_;
+    if (!reused && step) fresh_iterations_ = static_cast<int>(iterations);
+    if (reason >= 0 || !reused) break;
+    reused = false;  // once more, with a preconditioner made for this matrix
+    petsc_check(VecSet(o.x, 0.0), "VecSet");
   }
+  // A step's solve decides the next step's preconditioner (a solve again, from zero, takes
+  // more iterations than a step's from the last solution: it decides only where it made one).
+  if (step) reuse_ = reason >= 0 && iterations <= fresh_iterations_ + more_iterations;
+  else if (!reused) reuse_ = reason >= 0;
   iterations_ += static_cast<std::size_t>(iterations);
   // The true residual of the system scaled by its diagonal, D^-1/2 (b - A x) against D^-1/2 b.
   PetscReal residual = 0, scale = 0;
