@@ -65,6 +65,10 @@ PetscNodalSystem::PetscNodalSystem(std::span<const std::int32_t> key_rank, std::
     if (seen[static_cast<std::size_t>(local_row_[k])]++)
       throw std::invalid_argument("PetscNodalSystem: key " + std::to_string(key) + " held twice");
   }
+  // A row of this rank's that no node here holds would be empty: the system singular.
+  if (const auto held = static_cast<std::int64_t>(std::count(seen.begin(), seen.end(), 1)); held != rows_)
+    throw std::invalid_argument("PetscNodalSystem: " + std::to_string(rows_ - held) + " of this rank's " +
+                                std::to_string(rows_) + " keys held by no node here");
   for (std::size_t e = 0; e < a_.size(); ++e)
     for (const std::int32_t k : {a_[e], b_[e]})
       if (k < 0 || static_cast<std::size_t>(k) >= nodes || a_[e] == b_[e])

@@ -42,9 +42,15 @@ LumpedHalo lumped_halo(const Network& net, const LumpedOrder& whole, std::span<c
   for (const std::int32_t node : halo.order.nodes)
     if (owner[static_cast<std::size_t>(node)] != rank) halo.ghost_nodes.push_back(node);
   halo.key_rank = owner;
+  // An outlet's capacitor node where LumpedVessels makes one (an RCR with a capacitance at a
+  // 0D node: lumped_places' rule), its node's owner's; no node, no row, elsewhere.
   const RunBoundaries boundaries(net);
-  for (std::size_t i = 0; i < boundaries.size(); ++i)
-    if (boundaries.is_outlet(i)) halo.key_rank.push_back(owner[static_cast<std::size_t>(boundaries.node(i))]);
+  for (std::size_t i = 0; i < boundaries.size(); ++i) {
+    if (!boundaries.is_outlet(i)) continue;
+    const Outlet& o = boundaries.outlet(i);
+    const std::int32_t at = owner[static_cast<std::size_t>(boundaries.node(i))];
+    halo.key_rank.push_back(at >= 0 && o.type == BoundaryType::rcr && o.c > 0 ? at : -1);
+  }
   return halo;
 }
 

@@ -31,8 +31,8 @@ struct LumpedHalo {
   std::vector<std::int32_t> halo_vessels;  // other ranks' vessels at its nodes
   std::vector<std::int32_t> ghost_nodes;   // the nodes of its vessels and halo it does not own
   // Per network node its owner (-1: no 0D vessel's), then per run outlet (RunBoundaries'
-  // outlet order) its capacitor's: its node's owner. What a distributed solver numbers every
-  // rank's rows by.
+  // outlet order) its capacitor's: its node's owner (-1: no capacitor). What a distributed
+  // solver numbers every rank's rows by.
   std::vector<std::int32_t> key_rank;
 };
 

@@ -390,6 +390,15 @@ grep -q "the 1D vessels spread over the ranks (the 0D vessels meeting at a node 
   && same_files "$WORK/fed-one" "$WORK/fed-2" \
   && pass "a capillary bed fed by a 1D artery over 2 ranks, each whole: the plain run's files byte for byte" \
   || fail "the fed capillary bed over 2 ranks: $(grep -m2 'error\|METIS' "$WORK/fed-out")"
+# The same bed drained through RCR and R outlets over 2 ranks: a capacitor node is a row of
+# its outlet node's owner; an R outlet none.
+"$(dirname "$0")/../../bench/capillary-mesh" 20 --windkessels -o "$WORK/wk-bed.json"
+"$HEMOSOLVE" "$WORK/wk-bed.json" --cycles 2 --probe 100 --lumped-sections 1 --out "$WORK/wk-one" 2>/dev/null || fail "the windkessel bed, plain"
+$MPIRUN -np 2 "$HEMOSOLVE" "$WORK/wk-bed.json" --cycles 2 --probe 100 --out "$WORK/wk-2" >"$WORK/wk-out" 2>&1
+grep -q "the 0D vessels spread over the ranks" "$WORK/wk-out" \
+  && near_files "a capillary bed drained through RCR and R outlets over 2 ranks, spread" "$WORK/wk-one" "$WORK/wk-2" 1e-7 \
+       vessels.csv probes.csv \
+  || fail "the windkessel bed over 2 ranks: $(grep -m2 'error\|METIS' "$WORK/wk-out")"
 for ranks in 3; do  # (and 4 by hand: 6e-10)
   $MPIRUN -np $ranks "$HEMOSOLVE" "$WORK/fed-bed.json" $fed --out "$WORK/fed-$ranks" >"$WORK/fed-out" 2>&1
   grep -q "^hemosolve: $ranks ranks by METIS: .*the 0D vessels spread over the ranks" "$WORK/fed-out" \
