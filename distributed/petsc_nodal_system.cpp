@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -15,6 +16,20 @@
 #include "mpi/session.hpp"
 
 namespace hemotree {
+
+namespace {
+
+// from's values at every node a rank holds, through the scatter to them, handed to read.
+void scatter_to_nodes(VecScatter to_nodes, Vec from, Vec local, const std::function<void(const PetscScalar*)>& read) {
+  petsc_check(VecScatterBegin(to_nodes, from, local, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+  petsc_check(VecScatterEnd(to_nodes, from, local, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  const PetscScalar* held = nullptr;
+  petsc_check(VecGetArrayRead(local, &held), "VecGetArrayRead");
+  read(held);
+  petsc_check(VecRestoreArrayRead(local, &held), "VecRestoreArrayRead");
+}
+
+}  // namespace
 
 struct PetscNodalSystem::Objects {
   Mat matrix = nullptr;
@@ -241,13 +256,9 @@ void PetscNodalSystem::solve_rows(std::span<const double> rhs, std::span<double>
                                  " (PETSc's reason " + std::to_string(reason) +
                                  "; 1e-13 is needed): a part of the 0D vessels with no path to an outlet, or "
                                  "PETSC_OPTIONS that ask too little");
-  petsc_check(VecScatterBegin(o.to_nodes, o.x, o.local, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-  petsc_check(VecScatterEnd(o.to_nodes, o.x, o.local, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
-  const PetscScalar* solved = nullptr;
-  petsc_check(VecGetArrayRead(o.local, &solved), "VecGetArrayRead");
-  std::copy_n(solved, nodes, x.begin());
-  petsc_check(VecRestoreArrayRead(o.local, &solved), "VecRestoreArrayRead");
+  scatter_to_nodes(o.to_nodes, o.x, o.local, [&](const PetscScalar* solved) { std::copy_n(solved, nodes, x.begin()); });
 }
+
 
 void PetscNodalSystem::fill_ghosts(std::span<double> values) {
   const std::size_t nodes = row_.size();
@@ -259,13 +270,10 @@ void PetscNodalSystem::fill_ghosts(std::span<double> values) {
   for (std::size_t k = 0; k < nodes; ++k)
     if (own_[k]) owned[local_row_[k]] = values[k];
   petsc_check(VecRestoreArray(o.owned, &owned), "VecRestoreArray");
-  petsc_check(VecScatterBegin(o.to_nodes, o.owned, o.local, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
-  petsc_check(VecScatterEnd(o.to_nodes, o.owned, o.local, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
-  const PetscScalar* held = nullptr;
-  petsc_check(VecGetArrayRead(o.local, &held), "VecGetArrayRead");
-  for (std::size_t k = 0; k < nodes; ++k)
-    if (!own_[k]) values[k] = held[k];
-  petsc_check(VecRestoreArrayRead(o.local, &held), "VecRestoreArrayRead");
+  scatter_to_nodes(o.to_nodes, o.owned, o.local, [&](const PetscScalar* held) {
+    for (std::size_t k = 0; k < nodes; ++k)
+      if (!own_[k]) values[k] = held[k];
+  });
   seconds_ += MPI_Wtime() - started;
 }
 

@@ -49,9 +49,8 @@ void PulseSolver::take_spread_share(const PulseRanks& ranks, const VesselRanks& 
   if (dealt.zero_d_spread) {
     // The 0D vessels spread too: each node its first vessel's rank's, this rank's vessels and
     // a halo of the others' at its nodes (pulse/lumped_halo.hpp).
-    const LumpedOrder whole = subtree_lumped_order(net_, zero_d_);
-    halo = lumped_halo(net_, whole, vessel_rank, ranks.ranks, rank_);
-    node_rank = lumped_node_ranks(net_, whole, vessel_rank);
+    halo = lumped_halo(net_, subtree_lumped_order(net_, zero_d_), vessel_rank, ranks.ranks, rank_);
+    std::copy_n(halo->key_rank.begin(), net_.node_count(), node_rank.begin());  // the network nodes' keys
   } else {
     // The 0D vessels meeting at a node on one rank: each rank's 0D system is then whole.
     for (std::size_t v = 0; v < n; ++v)

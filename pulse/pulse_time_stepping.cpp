@@ -245,18 +245,20 @@ void PulseSolver::step_coupled(const std::function<void()>& while_waiting) {
   for (std::size_t j = 0; j < lumped_held_.size(); ++j)
     lumped_held_[j] = boundaries_.list.waveform(static_cast<std::size_t>(lumped_.held_boundaries()[j]))(t1);
   // Spread over ranks, a rank's 0D system is its own (it may have none); a lumen closing on
-  // any rank is said on every rank, the least vessel's.
+  // any rank is said on every rank, the least vessel's. A halo's predict has agreed it
+  // already (before its solve, which every rank enters): thrown on every rank alike.
   std::int64_t collapsed_vessel = -1;
   try {
     if (steps_lumped()) lumped_.predict(dt_, coupled_inflow_, lumped_inflow_, lumped_held_);
   } catch (const LumpedVessels::CollapsedNode& collapsed) {
-    if (!one_d_cut_) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_);
+    if (!one_d_cut_ || lumped_.halo()) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(collapsed.vessel)], time_);
     collapsed_vessel = collapsed.vessel;
   }
   if (one_d_cut_) {
     constexpr std::int64_t none = std::numeric_limits<std::int64_t>::max();
-    const std::int64_t least = least_key_(collapsed_vessel >= 0 ? collapsed_vessel : none);
-    if (least != none) throw SolutionBreakdown(net_.id[static_cast<std::size_t>(least)], time_);
+    if (!lumped_.halo())
+      if (const std::int64_t least = least_key_(collapsed_vessel >= 0 ? collapsed_vessel : none); least != none)
+        throw SolutionBreakdown(net_.id[static_cast<std::size_t>(least)], time_);
     if (!coupling_ranks_.empty()) share_coupling_nodes();
   }
   if (while_waiting && !one_d_here_) while_waiting();  // a share: the top's rank takes its substeps

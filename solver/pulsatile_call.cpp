@@ -383,7 +383,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   if (ranks && ranks->zero_d_spread())
     observer.note(describe(ranks->partition()) + ", weighed by each vessel's step; the 0D vessels spread over the ranks, "
                   "each rank with a halo of the others' at its nodes, every step solved over the ranks by PETSc (" +
-                  ranks->zero_d_method() + "): the plain command's numbers to about 1e-8, not bit for bit");
+                  ranks->zero_d_solves().method + "): the plain command's numbers to about 1e-8, not bit for bit");
   else if (ranks && ranks->one_d_spread())
     observer.note(describe(ranks->partition()) + ", weighed by each vessel's step; the 1D vessels spread over the ranks "
                   "(the 0D vessels meeting at a node on one rank), their traces exchanged at the cut's junctions and "
@@ -484,11 +484,12 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     // which has left every collective call: a failure of its writing is its own alone.
     if (world_rank() != 0) return result;
     leave_collectives();
-    if (ranks->zero_d_spread())
-      observer.note("the 0D steps' solves on rank 0: " + std::to_string(ranks->zero_d_solves()) + " solves, " +
-                    std::to_string(ranks->zero_d_iterations()) + " iterations, " +
-                    std::to_string(ranks->zero_d_setups()) + " preconditioner set-ups, " +
-                    format_quantity(ranks->zero_d_seconds(), "s") + " inside them");
+    if (ranks->zero_d_spread()) {
+      const MpiPulseRanks::ZeroDSolves s = ranks->zero_d_solves();
+      observer.note("the 0D steps' solves on rank 0: " + std::to_string(s.solves) + " solves, " +
+                    std::to_string(s.iterations) + " iterations, " + std::to_string(s.setups) +
+                    " preconditioner set-ups, " + format_quantity(s.seconds, "s") + " inside them");
+    }
     if (ranks->one_d_spread()) {
       const MpiPulseRanks::SpreadTraffic& t = ranks->spread_traffic();
       observer.note("the 1D vessels' exchanges on rank 0: " + std::to_string(t.messages) + " messages to its neighbouring ranks, " +

@@ -242,30 +242,16 @@ std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d
                      zero_d_spread};
 }
 
-std::size_t MpiPulseRanks::zero_d_solves() const {
-  std::size_t solves = 0;
-  for (const auto& system : halo_systems_) solves += system->solves();
-  return solves;
+MpiPulseRanks::ZeroDSolves MpiPulseRanks::zero_d_solves() const {
+  ZeroDSolves all;
+  for (const auto& system : halo_systems_) {
+    all.solves += system->solves();
+    all.iterations += system->iterations();
+    all.setups += system->preconditioner_setups();
+    all.seconds += system->seconds();
+  }
+  if (!halo_systems_.empty()) all.method = halo_systems_.front()->method();
+  return all;
 }
-
-std::size_t MpiPulseRanks::zero_d_iterations() const {
-  std::size_t iterations = 0;
-  for (const auto& system : halo_systems_) iterations += system->iterations();
-  return iterations;
-}
-
-std::size_t MpiPulseRanks::zero_d_setups() const {
-  std::size_t setups = 0;
-  for (const auto& system : halo_systems_) setups += system->preconditioner_setups();
-  return setups;
-}
-
-double MpiPulseRanks::zero_d_seconds() const {
-  double seconds = 0;
-  for (const auto& system : halo_systems_) seconds += system->seconds();
-  return seconds;
-}
-
-std::string MpiPulseRanks::zero_d_method() const { return halo_systems_.empty() ? std::string() : halo_systems_.front()->method(); }
 
 }  // namespace hemotree

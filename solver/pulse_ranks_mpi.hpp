@@ -56,11 +56,15 @@ class MpiPulseRanks {
   const Partition& partition() const { return partition_; }
   bool one_d_spread() const { return dealt_ && dealt_->one_d_spread; }
   // Whether the 0D vessels are spread over the ranks (a 0D system with loops), and the
-  // solves of its steps on this rank: how many, and the seconds inside them.
+  // solves of its steps on this rank (the run's solver's and a settling solver's): how many,
+  // their iterations and preconditioner set-ups, the seconds inside them, PETSc's method.
   bool zero_d_spread() const { return zero_d_spread_; }
-  std::size_t zero_d_solves() const, zero_d_iterations() const, zero_d_setups() const;
-  double zero_d_seconds() const;
-  std::string zero_d_method() const;
+  struct ZeroDSolves {
+    std::size_t solves = 0, iterations = 0, setups = 0;
+    double seconds = 0;
+    std::string method;
+  };
+  ZeroDSolves zero_d_solves() const;
   // With the 1D vessels spread, this rank's messages (sent to its neighbours: traces, coupled
   // ends), their bytes, its reductions (failures), and the seconds inside them, waiting
   // included.
