@@ -20,6 +20,25 @@ std::vector<std::int32_t> lumped_node_ranks(const Network& net, const LumpedOrde
   return owner;
 }
 
+std::size_t hold_at_an_own_node(const Network& net, const LumpedOrder& whole, std::span<std::int32_t> vessel_rank,
+                                int ranks) {
+  const std::vector<std::int32_t> owner = lumped_node_ranks(net, whole, vessel_rank);
+  std::vector<std::size_t> vessels(static_cast<std::size_t>(ranks), 0);
+  for (const std::int32_t r : vessel_rank) ++vessels[static_cast<std::size_t>(r)];
+  std::size_t moved = 0;
+  for (const std::int32_t v : whole.vessels) {
+    std::int32_t& r = vessel_rank[static_cast<std::size_t>(v)];
+    const std::int32_t from = owner[static_cast<std::size_t>(net.from[static_cast<std::size_t>(v)])],
+                       to = owner[static_cast<std::size_t>(net.to[static_cast<std::size_t>(v)])];
+    if (r == from || r == to || vessels[static_cast<std::size_t>(r)] == 1) continue;
+    --vessels[static_cast<std::size_t>(r)];
+    ++vessels[static_cast<std::size_t>(from)];
+    r = from;
+    ++moved;
+  }
+  return moved;
+}
+
 LumpedHalo lumped_halo(const Network& net, const LumpedOrder& whole, std::span<const std::int32_t> vessel_rank,
                        int ranks, int rank) {
   for (const std::int32_t v : whole.vessels)

@@ -41,6 +41,15 @@ struct LumpedHalo {
 std::vector<std::int32_t> lumped_node_ranks(const Network& net, const LumpedOrder& whole,
                                             std::span<const std::int32_t> vessel_rank);
 
+// Each 0D vessel whose rank owns neither of its nodes (both nodes' first vessels another
+// rank's) moved to its `from` node's owner: being the first vessel at neither node, it moves no
+// node's owner, so one pass leaves every rank owning a node of each of its 0D vessels. The
+// red cells' transport needs it (a vessel's faces lie at the nodes their owners solve, and its
+// rank reads them); it also leaves no rank linearising a vessel of no row of its own. A vessel
+// that is its rank's last stays. Returns how many moved.
+std::size_t hold_at_an_own_node(const Network& net, const LumpedOrder& whole, std::span<std::int32_t> vessel_rank,
+                                int ranks);
+
 // The halo of `rank` (one pi section a vessel). std::invalid_argument for a vessel of `whole`
 // on no rank in [0, ranks).
 LumpedHalo lumped_halo(const Network& net, const LumpedOrder& whole, std::span<const std::int32_t> vessel_rank,

@@ -80,6 +80,7 @@ void PulseSolver::take_spread_share(const PulseRanks& ranks, const VesselRanks& 
     if (run.is_outlet(i)) holds_outlet_.push_back(steps_vessel_[static_cast<std::size_t>(run.outlet(i).vessel)]);
   one_d_cut_ = one_d_cut(boundaries_, blocks_, element_vessel_, vessel_rank, rank_);
   vessel_rank_ = vessel_rank;
+  lumped_node_rank_ = node_rank;
   runs_ = one_d_cut_->runs;
   trace_out_.assign(one_d_cut_->neighbours.size(), {});
   trace_in_.assign(one_d_cut_->neighbours.size(), {});

@@ -284,7 +284,11 @@ class PulseSolver {
   // With the 1D vessels spread: every vessel's rank, and this rank (what a transport over the
   // same cut needs: solver/flow_transport_spread.cpp). Empty otherwise.
   std::span<const std::int32_t> vessel_ranks() const { return vessel_rank_; }
+  // Per network node the rank that owns it among the 0D vessels' nodes (-1: none's): its
+  // system's rank, or in a halo its first vessel's (pulse/lumped_halo.hpp). Empty likewise.
+  std::span<const std::int32_t> lumped_node_ranks() const { return lumped_node_rank_; }
   int rank() const { return rank_; }
+  int rank_count() const { return rank_count_; }
 
   // A vessel's tube law: at its `from` end (the whole vessel's unless it tapers), at one of
   // its ends, and at fraction x along it.
@@ -496,6 +500,7 @@ class PulseSolver {
   // The 1D vessels spread over ranks: the cut, its messages' scratch, and the links.
   std::optional<OneDCut> one_d_cut_;
   std::vector<std::int32_t> vessel_rank_;  // per vessel where the 1D vessels are spread
+  std::vector<std::int32_t> lumped_node_rank_;  // per network node, likewise
   std::vector<std::vector<double>> trace_out_, trace_in_;
   std::vector<int> trace_ranks_;
   // The coupled ends whose node another rank holds (spread; empty elsewhere): the cut, each

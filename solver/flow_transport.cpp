@@ -172,8 +172,9 @@ FlowTransport::EndSides FlowTransport::add_one_d_cells(TransportGrid& grid, std:
   }
   // A 0D node another rank holds (the 1D vessels spread): a cut.
   for (const auto& c : ends.coupled) {
-    const std::int32_t node = solver.lumped().empty() ? -1 : solver.lumped().node_of(c.node);
-    end_side[{c.end.vessel, c.end.distal}] = node >= 0 ? node : remote_side;
+    const LumpedVessels& lumped = solver.lumped();
+    const std::int32_t node = lumped.empty() ? -1 : lumped.node_of(c.node);
+    end_side[{c.end.vessel, c.end.distal}] = node >= 0 && !lumped.ghost_node(node) ? node : remote_side;
   }
   for (const auto* given : {&ends.flows, &ends.pressures})
     for (const auto& g : *given) end_side[{g.end.vessel, g.end.distal}] = TransportGrid::boundary_side(static_cast<std::size_t>(g.index));
@@ -199,9 +200,19 @@ FlowTransport::EndFaces FlowTransport::add_faces(TransportGrid& grid, const std:
     for (std::size_t j = 0; j < roots.size(); ++j) root_of[static_cast<std::size_t>(roots[j])] = static_cast<std::int32_t>(j);
     cut_->face_sign.clear();
   }
+  auto new_cut = [&grid] {
+    ++grid.cuts;
+    return TransportGrid::boundary_side(grid.boundaries++);
+  };
+  EndFaces end_faces;  // spread: per end, its face here and the cell on this side
   // Faces: the 0D vessels, the boundaries at 0D nodes, then each 1D vessel's. Over ranks a
   // root vessel's joins the node on this side to its cut (turned round where that node is its
   // `to` node); the node across, held for the flow's sums alone, is an empty cell of no face.
+  // A 0D system spread with a halo: a vessel's face on each rank that owns one of its nodes,
+  // from there to the other node, or to a cut where another rank owns that one (turned round
+  // where it is its `from` node); its ghost there an empty cell of no face, holding the value
+  // its owner sends.
+  const bool halo = cut_ && lumped.halo();
   lumped_face_.assign(lumped.vessel_count(), -1);
   std::vector<std::int32_t> turned;
   for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
@@ -211,6 +222,19 @@ FlowTransport::EndFaces FlowTransport::add_faces(TransportGrid& grid, const std:
     const auto face = static_cast<std::int32_t>(grid.face_count());
     lumped_face_[static_cast<std::size_t>(i)] = face;
     const std::int32_t a = lumped.from_node(i), b = lumped.to_node(i);
+    if (halo) {
+      const bool a_here = !lumped.ghost_node(a), b_here = !lumped.ghost_node(b);
+      if (!a_here && !b_here)  // hold_at_an_own_node left it: its rank's only vessel
+        throw SettingError("ranks", placeholder("ranks") + " " + std::to_string(solver_.rank_count()) +
+                                        ": vessel " + std::to_string(net_.id[v]) + " is the only vessel of rank " +
+                                        std::to_string(solver_.rank()) + ", which owns neither of its nodes, and " +
+                                        "red cells and tracers are carried at the nodes' owners: run it on fewer ranks");
+      grid.add_face(a_here ? a : b, a_here && b_here ? b : new_cut(), static_cast<std::int32_t>(v), mean_diameter(net_, v));
+      if (!a_here) turned.push_back(face);
+      end_faces[{static_cast<std::int32_t>(v), false}] = {face, a};
+      end_faces[{static_cast<std::int32_t>(v), true}] = {face, b};
+      continue;
+    }
     const std::int32_t root = cut_ ? root_of[static_cast<std::size_t>(i)] : -1;
     if (root < 0) {
       grid.add_face(a, b, static_cast<std::int32_t>(v), mean_diameter(net_, v));
@@ -238,11 +262,6 @@ FlowTransport::EndFaces FlowTransport::add_faces(TransportGrid& grid, const std:
   // rank's vessel at a junction or 0D node here is a face from there to a cut: each cell's
   // faces in the one-process order.
   const bool spread = cut_ && cut_->spread;
-  auto new_cut = [&grid] {
-    ++grid.cuts;
-    return TransportGrid::boundary_side(grid.boundaries++);
-  };
-  EndFaces end_faces;  // spread: per end, its face here and the cell on this side
   const int per_vessel = solver_.elements_per_vessel();
   for (const std::int32_t v : spread ? whole_one_d_order() : one_d_) {
     const double d0 = net_.diameter[static_cast<std::size_t>(v)], d1 = net_.diameter_at_to(static_cast<std::size_t>(v));
@@ -395,11 +414,16 @@ double FlowTransport::tracer_at(std::size_t k, std::size_t v, double x) const {
   return tracers_[k].concentration()[c];
 }
 
+bool FlowTransport::empty_node_cell(std::size_t c) const {
+  if (!cut_ || c >= cut_->ghost.size()) return false;
+  return cut_->ghost[c] >= 0 || (solver_.lumped().halo() && solver_.lumped().ghost_node(static_cast<std::int32_t>(c)));
+}
+
 void FlowTransport::solver_volumes(std::vector<double>& volume) const {
   const LumpedVessels& lumped = solver_.lumped();
   if (!lumped.empty())
     for (std::size_t k = 0; k < lumped.network_node_count(); ++k)  // a node across a cut holds none here
-      volume[k] = cut_ && cut_->ghost[k] >= 0 ? 0.0 : lumped.stored_volume(static_cast<std::int32_t>(k));
+      volume[k] = empty_node_cell(k) ? 0.0 : lumped.stored_volume(static_cast<std::int32_t>(k));
   const Eigen::MatrixXd& area = solver_.state().area;
   const std::vector<std::int32_t>& one_d = one_d_;
   for (std::size_t i = 0; i < one_d.size(); ++i) {
@@ -520,7 +544,9 @@ void FlowTransport::close_step() {
     const double q = face_volume_[f];
     if (v < 0 || q == 0) continue;
     const auto vi = static_cast<std::size_t>(v);
-    if (cut_ && cut_->spread && !solver_.steps_vessel(vi)) continue;  // another rank's vessel, its end here
+    // Another rank's 1D vessel, its end here. (A 0D vessel in a halo is followed as its own
+    // rank follows it, from the same bits: its viscosity enters this rank's rows too.)
+    if (cut_ && cut_->spread && !solver_.steps_vessel(vi) && !solver_.is_lumped(vi)) continue;
     cycle_cells_[vi] += std::abs(cells.face[f]);
     cycle_blood_[vi] += std::abs(q);
     step_sum_[vi] += cells.face[f] / q;

@@ -23,8 +23,10 @@
 // slices, its 0D nodes and every junction where it has an end; a vessel end across the cut
 // is a face to a cut on the other side, and a step is solved in rounds, each rank's cells
 // with the cuts' inflows of the round before, until no inflow changes
-// (flow_transport_spread.cpp). Every cell's value is the one-process run's, bit for bit; every
-// sum of the cycle, the report and the checkpoint is taken on rank 0 in the one-process order.
+// (flow_transport_spread.cpp); a 0D system spread over the ranks is crossed the same way, each
+// node's cell its owner's. Every cell's value is the one-process run's, bit for bit (where the
+// 0D system is spread, to the flow's agreement with it); every sum of the cycle, the report and
+// the checkpoint is taken on rank 0 in the one-process order.
 #pragma once
 
 #include <cstdint>
@@ -150,7 +152,9 @@ class FlowTransport {
   void add_node_cells(TransportGrid& grid, std::vector<double>& volume) const;
   EndSides add_one_d_cells(TransportGrid& grid, std::vector<double>& volume);
   // Returns, the 1D vessels spread, per 1D end with a face here: that face and the cell on
-  // this side of the cut (an own vessel's end slice, or the junction or 0D node it meets here).
+  // this side of the cut (an own vessel's end slice, or the junction or 0D node it meets here);
+  // and where the 0D system is spread too, per end of a 0D vessel with a face here: that face
+  // and the cell of the end's node (this rank's, or a ghost standing for its owner's).
   using EndFaces = std::map<std::pair<std::int32_t, bool>, std::pair<std::int32_t, std::int32_t>>;
   EndFaces add_faces(TransportGrid& grid, const std::vector<std::int32_t>& roots, const EndSides& sides);
   void set_up_tracers();
@@ -199,6 +203,9 @@ class FlowTransport {
       int rank = 0;
       std::vector<std::int32_t> send_face, send_cell, receive_face;
       std::vector<unsigned char> send_volume, receive_volume;
+      // Per received link, the cell here that stands for the sender's (a ghost node of a
+      // spread 0D system, which takes the sent values), or -1.
+      std::vector<std::int32_t> receive_cell;
     };
     std::vector<Neighbour> neighbours;
     std::size_t links = 0;  // the whole run's
@@ -239,11 +246,13 @@ class FlowTransport {
   void take_cut_volumes();
   // Solves `solve` in rounds, each after the cuts' inflows of the last (per_link numbers a
   // link: `here` writes this side's of a sent face, `across` takes the other side's of a
-  // received one and returns how far they moved, 0 for the same bits), until none moves on
-  // any rank. Collective.
+  // received one, with the cell here that stands for the sender's or -1, and returns how far
+  // they moved, 0 for the same bits), until none moves on any rank. Collective.
   void spread_rounds(std::size_t per_link, const char* what, const std::function<void(RedCellTransport::Cells)>& solve,
                      const std::function<void(std::size_t face, std::size_t cell, double* numbers)>& here,
-                     const std::function<double(std::size_t face, const double* numbers)>& across);
+                     const std::function<double(std::size_t face, std::int32_t held, const double* numbers)>& across);
+  // A node's cell that holds no blood here: across a tree's cut, or a ghost of a spread 0D system.
+  bool empty_node_cell(std::size_t cell) const;
   // Numbers out to each neighbouring rank and in from it, of the sizes both sides know.
   void exchange_numbers(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in);
 

@@ -358,7 +358,7 @@ void FlowTransport::restore_share(const RedCellState& whole) {
   std::vector<double> discharge(grid.cell_count()), volume(grid.cell_count(), 0.0);
   for (std::size_t c = 0; c < discharge.size(); ++c) {
     discharge[c] = whole.discharge[static_cast<std::size_t>(cut_->cell_place[c])];
-    volume[c] = c >= cut_->ghost.size() || cut_->ghost[c] < 0 ? whole.volume[static_cast<std::size_t>(cut_->cell_place[c])] : 0.0;
+    volume[c] = empty_node_cell(c) ? 0.0 : whole.volume[static_cast<std::size_t>(cut_->cell_place[c])];
   }
   for (std::size_t j = 0; j < cut_->across.size(); ++j) cut_->far[j] = discharge[static_cast<std::size_t>(cut_->across[j])];
   const BoundaryShare held = boundary_share(boundary_places(), whole.entered, whole.left, whole.last_outflow,

@@ -11,6 +11,11 @@
 // face (each tracer), the product taken as the one-process run takes it; and, once a step, its
 // volume from the vessel's rank.
 //
+// Where the 0D system is spread too (a halo: pulse/lumped_halo.hpp), each node's cell is its
+// owner's, with every face at it; a 0D vessel whose nodes two ranks own has a face on both, to
+// a cut on each, and each node's owner sends the other its s_f H_D and H_D (the other's ghost
+// cell takes H_D, for probes). Both compute the face's volume from the same flow: none crosses.
+//
 // The implicit upwind step needs every cell's upwind cells first, and along the 1D vessels the
 // flow crosses the cut as often as the vessels change rank: so a step is solved in rounds. Each
 // round solves every cell of the rank with the cuts' inflows of the round before (the first:
@@ -84,7 +89,10 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
   const std::int32_t junctions_start = slices_start + static_cast<std::int32_t>(one_d.size()) * per_vessel;
   const std::size_t here_nodes = lumped.empty() ? 0 : lumped.network_node_count();
   cut.cell_place.assign(grid.cell_count(), -1);
-  for (std::size_t c = 0; c < here_nodes; ++c) cut.cell_place[c] = whole.node_place[static_cast<std::size_t>(grid.node[c])];
+  for (std::size_t c = 0; c < here_nodes; ++c) {
+    cut.cell_place[c] = whole.node_place[static_cast<std::size_t>(grid.node[c])];
+    if (lumped.halo() && lumped.ghost_node(static_cast<std::int32_t>(c))) cut.copies.push_back(static_cast<std::int32_t>(c));
+  }
   for (std::size_t i = 0; i < one_d_.size(); ++i)
     for (std::int32_t s = 0; s < per_vessel; ++s)
       cut.cell_place[static_cast<std::size_t>(vessel_first_cell_[i] + s)] =
@@ -101,25 +109,25 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
   for (std::size_t i = 0; i < one_d_.size(); ++i)
     for (std::int32_t k = 0; k <= per_vessel; ++k)
       cut.face_place[static_cast<std::size_t>(vessel_first_face_[i] + k)] = one_d_face(one_d_[i], k);
-  for (const auto& [end, face] : end_faces)
-    if (one_d_place_[static_cast<std::size_t>(end.first)] < 0)
+  for (const auto& [end, face] : end_faces)  // another rank's 1D vessel's end
+    if (!zero_d[static_cast<std::size_t>(end.first)] && one_d_place_[static_cast<std::size_t>(end.first)] < 0)
       cut.face_place[static_cast<std::size_t>(face.first)] = one_d_face(end.first, end.second ? per_vessel : 0);
   cut.faces = static_cast<std::size_t>(whole.one_d_faces) + one_d.size() * static_cast<std::size_t>(per_vessel + 1);
 
-  // The links, in the run's order of vessel ends (every rank alike): an end at a junction, to
-  // every other rank with an end there; an end at another rank's 0D node, both ways.
-  std::vector<std::int32_t> node_rank(net_.node_count(), -1);
-  for (std::size_t v = 0; v < n; ++v)
-    if (zero_d[v]) node_rank[static_cast<std::size_t>(net_.from[v])] = node_rank[static_cast<std::size_t>(net_.to[v])] = rank[v];
+  // The links, in the run's order of vessel ends (every rank alike): a 1D end at a junction,
+  // to every other rank with an end there; at another rank's 0D node, both ways; then, the 0D
+  // system spread, each 0D vessel whose nodes two ranks own, each node's owner to the other.
+  const std::span<const std::int32_t> node_rank = solver_.lumped_node_ranks();
   std::map<std::pair<std::int32_t, bool>, std::int64_t> coupled_node;
   for (const auto& c : ends.coupled) coupled_node[{c.end.vessel, c.end.distal}] = c.node;
   std::map<int, Cut::Neighbour> by_rank;
-  auto link = [&](int receiver, int supplier, std::pair<std::int32_t, bool> end, bool volume) {
+  auto link = [&](int receiver, int supplier, std::pair<std::int32_t, bool> end, bool volume, bool held = false) {
     ++cut.links;
     if (receiver == me) {
       Cut::Neighbour& from = by_rank[supplier];
       from.receive_face.push_back(end_faces.at(end).first);
       from.receive_volume.push_back(volume);
+      from.receive_cell.push_back(held ? end_faces.at(end).second : -1);
     }
     if (supplier == me) {
       Cut::Neighbour& to = by_rank[receiver];
@@ -147,6 +155,14 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
       }
     }
   }
+  if (lumped.halo())
+    for (std::size_t v = 0; v < n; ++v) {
+      if (!zero_d[v]) continue;
+      const int ra = node_rank[static_cast<std::size_t>(net_.from[v])], rb = node_rank[static_cast<std::size_t>(net_.to[v])];
+      if (ra == rb) continue;
+      link(rb, ra, {static_cast<std::int32_t>(v), false}, false, true);
+      link(ra, rb, {static_cast<std::int32_t>(v), true}, false, true);
+    }
   for (auto& [r, neighbour] : by_rank) {
     neighbour.rank = r;
     cut.neighbours.push_back(std::move(neighbour));
@@ -189,7 +205,7 @@ void FlowTransport::take_cut_volumes() {
 void FlowTransport::spread_rounds(std::size_t per_link, const char* what,
                                   const std::function<void(RedCellTransport::Cells)>& solve,
                                   const std::function<void(std::size_t, std::size_t, double*)>& here,
-                                  const std::function<double(std::size_t, const double*)>& across) {
+                                  const std::function<double(std::size_t, std::int32_t, const double*)>& across) {
   Cut& cut = *cut_;
   const std::size_t count = cut.neighbours.size();
   // Past one round more than the links (what any path of the flow crosses, at most), only a
@@ -209,9 +225,11 @@ void FlowTransport::spread_rounds(std::size_t per_link, const char* what,
     }
     exchange_numbers(out, in);
     double change = 0;
-    for (std::size_t i = 0; i < count; ++i)
-      for (std::size_t k = 0; k < cut.neighbours[i].receive_face.size(); ++k)
-        change = std::max(change, across(static_cast<std::size_t>(cut.neighbours[i].receive_face[k]), &in[i][per_link * k]));
+    for (std::size_t i = 0; i < count; ++i) {
+      const Cut::Neighbour& nb = cut.neighbours[i];
+      for (std::size_t k = 0; k < nb.receive_face.size(); ++k)
+        change = std::max(change, across(static_cast<std::size_t>(nb.receive_face[k]), nb.receive_cell[k], &in[i][per_link * k]));
+    }
     const double started = MPI_Wtime();
     MPI_Allreduce(MPI_IN_PLACE, &change, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
     cut.traffic.seconds += MPI_Wtime() - started;
@@ -232,15 +250,26 @@ void FlowTransport::advance_spread() {
   RedCellTransport& cells = *red_cells_;
   const TransportGrid& grid = cells.grid();
   cells.begin_step(face_volume_);
+  // A link's numbers: what enters through it (s_f H_D of the cell it leaves), and that cell's
+  // H_D (a ghost node's, for the probes there).
+  auto moved = [](double& held, double sent) {
+    const double change = held == sent ? 0.0 : std::abs(sent - held);
+    held = sent;
+    return change;
+  };
   spread_rounds(
-      1, "the red cells' step", [&](RedCellTransport::Cells which) { cells.solve(face_volume_, inflow_hematocrit_, which); },
+      2, "the red cells' step", [&](RedCellTransport::Cells which) { cells.solve(face_volume_, inflow_hematocrit_, which); },
       [&](std::size_t face, std::size_t cell, double* numbers) {
         numbers[0] = cells.separation_share(face) * cells.discharge_hematocrit()[cell];
+        numbers[1] = cells.discharge_hematocrit()[cell];
       },
-      [&](std::size_t face, const double* numbers) {
-        double& inflow = inflow_hematocrit_[static_cast<std::size_t>(-1 - grid.b[face])];
-        const double change = inflow == numbers[0] ? 0.0 : std::abs(numbers[0] - inflow);
-        inflow = numbers[0];
+      [&](std::size_t face, std::int32_t held, const double* numbers) {
+        double change = moved(inflow_hematocrit_[static_cast<std::size_t>(-1 - grid.b[face])], numbers[0]);
+        if (held >= 0) {
+          double h = cells.discharge_hematocrit()[static_cast<std::size_t>(held)];
+          change = std::max(change, moved(h, numbers[1]));
+          cells.hold(static_cast<std::size_t>(held), h);
+        }
         return change;
       });
   cells.end_step(face_volume_, inflow_hematocrit_);
@@ -263,24 +292,34 @@ void FlowTransport::step_tracers_spread(double t0, double t1) {
     for (std::size_t j = 0; j < cuts; ++j) tracer_inflow_[k][first_cut + j] = cut.tracer_in[k * cuts + j];
     tracers_[k].begin_step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
   }
+  // A link's numbers: each tracer's concentration entering through it, then each one's in the
+  // cell it leaves (a ghost node's, for the probes there).
   spread_rounds(
-      count, "the tracers' step",
+      2 * count, "the tracers' step",
       [&](RedCellTransport::Cells which) {
         for (std::size_t k = 0; k < count; ++k) tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], which);
       },
-      [&](std::size_t face, std::size_t, double* numbers) {
-        for (std::size_t k = 0; k < count; ++k)
+      [&](std::size_t face, std::size_t cell, double* numbers) {
+        for (std::size_t k = 0; k < count; ++k) {
           numbers[k] = tracers_[k].inflowing(face, *red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+          numbers[count + k] = tracers_[k].concentration()[cell];
+        }
       },
-      [&](std::size_t face, const double* numbers) {
+      [&](std::size_t face, std::int32_t held, const double* numbers) {
         const auto b = static_cast<std::size_t>(-1 - grid.b[face]);
+        auto moved = [](double& value, double sent) {
+          const double change = value == sent ? 0.0 : std::abs(sent - value) / std::max(std::abs(sent), 1.0);
+          value = sent;
+          return change;
+        };
         double change = 0;
         for (std::size_t k = 0; k < count; ++k) {
-          double& inflow = tracer_inflow_[k][b];
-          if (inflow != numbers[k])
-            change = std::max(change, std::abs(numbers[k] - inflow) / std::max(std::abs(numbers[k]), 1.0));
-          inflow = numbers[k];
+          change = std::max(change, moved(tracer_inflow_[k][b], numbers[k]));
           cut.tracer_in[k * cuts + (b - first_cut)] = numbers[k];
+          if (held < 0) continue;
+          double c = tracers_[k].concentration()[static_cast<std::size_t>(held)];
+          change = std::max(change, moved(c, numbers[count + k]));
+          tracers_[k].hold(static_cast<std::size_t>(held), c);
         }
         return change;
       });

@@ -370,16 +370,6 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   std::optional<PulseSolver> solver;
   on_every_rank([&] { solver.emplace(net, options, ranks ? &ranks->ranks() : nullptr); });
   PulseSolver& run = *solver;
-  // Red cells and tracers over ranks move through whole 0D systems (a top's subtrees, or
-  // each spread rank's own): a 0D system spread over the ranks (a halo) has no such
-  // transport yet.
-  if (ranks && ranks->zero_d_spread() && config.carries_transport()) {
-    const std::string option = config.red_cells == RedCells::transport ? "red_cells" : "tracer";
-    throw Collective<SettingError>(option, placeholder(option) + " over " + std::to_string(world_size()) +
-                                               " MPI ranks: this network's 0D vessels are spread over the ranks (a 0D system "
-                                               "that on one rank would leave another empty), and red cells and tracers are "
-                                               "not yet carried across such a cut: run it on fewer ranks or as one process");
-  }
   if (ranks && ranks->zero_d_spread())
     observer.note(describe(ranks->partition()) + ", weighed by each vessel's step; the 0D vessels spread over the ranks, "
                   "each rank with a halo of the others' at its nodes, every step solved over the ranks by PETSc (" +

@@ -14,6 +14,8 @@
 #include "mpi/session.hpp"
 #include "solver/decisions_over_ranks.hpp"
 #include "pulse/lumped_cut.hpp"
+#include "pulse/lumped_halo.hpp"
+#include "pulse/lumped_order.hpp"
 
 namespace hemotree {
 
@@ -204,18 +206,23 @@ std::optional<VesselRanks> MpiPulseRanks::spread(const std::vector<bool>& zero_d
     group_rank[g] = static_cast<std::int32_t>(std::max_element(c.begin(), c.end()) - c.begin());
   for (std::size_t v = 0; v < n; ++v)
     if (const auto it = group_rank.find(root[v]); it != group_rank.end()) p.rank_of_vessel[v] = it->second;
-  p.cost.assign(ranks, 0.0);
-  p.vessels.assign(ranks, 0);
-  for (std::size_t v = 0; v < n; ++v) {
-    p.cost[static_cast<std::size_t>(p.rank_of_vessel[v])] += step_cost[v];
-    ++p.vessels[static_cast<std::size_t>(p.rank_of_vessel[v])];
-  }
+  auto tally = [&](Partition& q) {
+    q.cost.assign(ranks, 0.0);
+    q.vessels.assign(ranks, 0);
+    for (std::size_t v = 0; v < n; ++v) {
+      q.cost[static_cast<std::size_t>(q.rank_of_vessel[v])] += step_cost[v];
+      ++q.vessels[static_cast<std::size_t>(q.rank_of_vessel[v])];
+    }
+  };
+  tally(p);
   const bool leaves_empty = std::find(p.vessels.begin(), p.vessels.end(), std::size_t{0}) != p.vessels.end();
   const bool unbalanced = leaves_empty || (p.imbalance() > spread_balance && !one_d_meets_zero_d);
   bool zero_d_spread = false;
   if (unbalanced && !std::isfinite(most_imbalance) && as_given.method == Partition::Method::metis && any_zero_d) {
     p = as_given;
     zero_d_spread = true;
+    // Every 0D vessel on a rank that owns one of its nodes (what the halo's transport needs).
+    if (hold_at_an_own_node(net_, subtree_lumped_order(net_, zero_d), p.rank_of_vessel, p.ranks) > 0) tally(p);
   }
   if (const auto empty = std::find(p.vessels.begin(), p.vessels.end(), std::size_t{0}); empty != p.vessels.end()) {
     if (std::isfinite(most_imbalance)) return std::nullopt;

@@ -233,6 +233,26 @@ TEST(LumpedHalo, EachRankHoldsItsVesselsAndTheOthersAtItsNodes) {
   EXPECT_THROW(lumped_halo(net, whole, std::vector<std::int32_t>{0, 0, 2, 1}, 2, 0), std::invalid_argument);
 }
 
+// The square with a diagonal, vessel 4 (0-2), on rank 1: rank 0 owns both its nodes (vessels 0
+// and 1 come first there), so it moves to rank 0, its `from` node's owner, and no node's owner
+// changes. On a third rank of its own it stays: a rank is not emptied.
+TEST(LumpedHalo, AVesselGoesWhereOneOfItsNodesIsOwned) {
+  Network net;
+  for (int k = 0; k < 4; ++k) net.add_node(k);
+  for (int v = 0; v < 4; ++v) net.add_vessel(v, v, (v + 1) % 4, 2e-4, 20e-6, 2e-6, 1e6, 0);
+  net.add_vessel(4, 0, 2, 2e-4, 20e-6, 2e-6, 1e6, 0);
+  const LumpedOrder whole = network_lumped_order(net, std::vector<bool>(5, true));
+  std::vector<std::int32_t> rank = {0, 0, 1, 1, 1};
+  const std::vector<std::int32_t> owners = lumped_node_ranks(net, whole, rank);
+  EXPECT_EQ(hold_at_an_own_node(net, whole, rank, 2), 1u);
+  EXPECT_EQ(rank, (std::vector<std::int32_t>{0, 0, 1, 1, 0}));
+  EXPECT_EQ(lumped_node_ranks(net, whole, rank), owners);
+  EXPECT_EQ(hold_at_an_own_node(net, whole, rank, 2), 0u);  // nothing left to move
+  std::vector<std::int32_t> alone = {0, 0, 1, 1, 2};
+  EXPECT_EQ(hold_at_an_own_node(net, whole, alone, 3), 0u);
+  EXPECT_EQ(alone[4], 2);
+}
+
 // Steps of the whole and of every played rank side by side, a pulsatile inflow, a held
 // pressure, an RCR and a resistance outlet: after every step each rank's own nodes, vessels and
 // capacitors are the whole's bits.

@@ -80,6 +80,9 @@ class RedCellTransport {
   // keeping their hematocrits; the red cells that adds or removes are kept in adjusted().
   void set_volumes(std::span<const double> volume);
   void set_hematocrit(std::span<const double> discharge);
+  // A cell of no faces that stands for another's (over ranks, a node its owner solves): the
+  // value it was sent. A step keeps it, as it keeps any cell nothing flows through.
+  void hold(std::size_t cell, double discharge) { discharge_[cell] = discharge; }
   // The whole state, as a checkpoint holds it (sizes checked by the caller): entered and left
   // per boundary.
   void restore(std::span<const double> discharge, std::span<const double> volume, std::span<const double> entered,

@@ -63,6 +63,9 @@ class TracerTransport {
   double adjusted() const { return adjusted_; }
   void set_adjusted(double total) { adjusted_ = total; }
 
+  // A cell of no faces that stands for another's (RedCellTransport::hold): the value sent.
+  void hold(std::size_t cell, double concentration) { concentration_[cell] = concentration; }
+
   // The state as a checkpoint keeps it (entered and left per boundary).
   void restore(std::span<const double> concentration, std::span<const double> last_outflow,
                std::span<const double> entered, std::span<const double> left, double injected, double adjusted);
