@@ -107,8 +107,22 @@ Discretisation decide_discretisation(const Network& net, PulseSolver& run, const
     degree_list += (degree_list.empty() ? "" : ", ") + std::to_string(count) + " of degree " + std::to_string(p);
   }
   const int planned = config.planned_cycles(), threads = config.solver.threads;
-  // Over P ranks each steps about a P-th of the 0D vessels; the 1D vessels are the top's.
+  // Over P ranks each steps about a P-th of the 0D vessels; the 1D vessels are the top's, or,
+  // spread over the ranks, each rank's own: the rank with the costliest substep sets the pace.
   const int ranks = world_size();
+  if (run.one_d_spread()) {
+    const std::span<const std::int32_t> rank_of = run.vessel_ranks();
+    std::vector<std::vector<double>> of_rank(static_cast<std::size_t>(ranks), std::vector<double>(elements_of_degree.size(), 0.0));
+    for (std::size_t v = 0; v < net.vessel_count(); ++v)
+      if (!run.is_lumped(v))
+        of_rank[static_cast<std::size_t>(rank_of[v])][static_cast<std::size_t>(run.degree(v))] += config.solver.elements;
+    double costliest = -1;
+    for (const std::vector<double>& elements : of_rank)
+      if (const double cost = estimate_run(elements, 1.0, 1, 1.0, 0.0).seconds; cost > costliest) {
+        costliest = cost;
+        elements_of_degree = elements;
+      }
+  }
   const double lumped = static_cast<double>(run.lumped_vessels_in_run()) / ranks, substeps = run.substeps() * run.coupling_passes();
   // A 0D system spread over the ranks: its solves a step, over a rank's nodes.
   const LumpedVessels& zero_d = run.lumped();
