@@ -67,6 +67,8 @@ PetscHarmonicNetwork::PetscHarmonicNetwork(std::size_t nodes, std::span<const st
   }
 }
 
+PetscHarmonicNetwork::~PetscHarmonicNetwork() = default;
+
 void PetscHarmonicNetwork::refuse_ungrounded(std::span<const TwoPort> edge, std::span<const Complex> shunt) const {
   // A node is grounded where its shunt is not zero or an edge there leaks current (its
   // two-port's row at that end does not sum to zero: a line's shunt admittance); each rank
@@ -110,7 +112,9 @@ void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const 
     throw std::invalid_argument("PetscHarmonicNetwork::solve: a two-port per edge, a shunt, a current and a potential per node");
   const int rank = world_rank();
   refuse_ungrounded(edge, shunt);
-  PetscObjects o;
+  const bool first = !held_;
+  if (first) held_ = std::make_unique<PetscObjects>();
+  PetscObjects& o = *held_;
   PetscOutcome outcome;
   // z as its real 2 x 2 block at the rows of node i and the columns of node j.
   auto add = [&](std::size_t i, std::size_t j, Complex z) {
@@ -119,16 +123,29 @@ void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const 
     const PetscScalar block[4] = {z.real(), -z.imag(), z.imag(), z.real()};
     petsc_check(MatSetValues(o.matrix, 2, rows, 2, columns, block, ADD_VALUES), "MatSetValues");
   };
-  // PETSc's calls are collective: a failure there is every rank's alike (on_every_rank).
+  // PETSc's calls are collective: a failure there is every rank's alike (on_every_rank),
+  // and so is starting afresh after one.
+  struct Afresh {
+    std::unique_ptr<PetscObjects>& held;
+    bool solved = false;
+    ~Afresh() {
+      if (!solved) held.reset();
+    }
+  } afresh{held_};
   on_every_rank([&] {
-    const auto n = static_cast<PetscInt>(rows_), all = static_cast<PetscInt>(all_rows_);
-    std::vector<PetscInt> in_block(in_block_.begin(), in_block_.end()), off_block(off_block_.begin(), off_block_.end());
-    petsc_check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
-    petsc_check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
-    petsc_check(MatSetType(o.matrix, MATAIJ), "MatSetType");
-    petsc_check(MatSeqAIJSetPreallocation(o.matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
-    petsc_check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
-    petsc_check(MatSetOption(o.matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
+    if (first) {
+      const auto n = static_cast<PetscInt>(rows_), all = static_cast<PetscInt>(all_rows_);
+      std::vector<PetscInt> in_block(in_block_.begin(), in_block_.end()), off_block(off_block_.begin(), off_block_.end());
+      petsc_check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
+      petsc_check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
+      petsc_check(MatSetType(o.matrix, MATAIJ), "MatSetType");
+      petsc_check(MatSeqAIJSetPreallocation(o.matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
+      petsc_check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
+      petsc_check(MatSetOption(o.matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
+    } else {
+      // The same entries as the first solve's (every block is set, zeros too): its pattern.
+      petsc_check(MatZeroEntries(o.matrix), "MatZeroEntries");
+    }
     for (std::size_t i = 0; i < nodes_; ++i)
       if (node_owner_[i] == rank) add(i, i, shunt[i]);
     for (std::size_t e = 0; e < a_.size(); ++e) {
@@ -146,10 +163,19 @@ void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const 
         rhs[k] = current[i].real();
         rhs[k + 1] = current[i].imag();
       }
-    const PC preconditioner = petsc_prepare(o, rhs, KSPPREONLY);
-    petsc_check(PCSetType(preconditioner, PCLU), "PCSetType");
-    petsc_check(PCFactorSetMatSolverType(preconditioner, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
-    petsc_check(KSPSetErrorIfNotConverged(o.solver, PETSC_FALSE), "KSPSetErrorIfNotConverged");
+    if (first) {
+      const PC preconditioner = petsc_prepare(o, rhs, KSPPREONLY);
+      petsc_check(PCSetType(preconditioner, PCLU), "PCSetType");
+      petsc_check(PCFactorSetMatSolverType(preconditioner, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
+      petsc_check(KSPSetErrorIfNotConverged(o.solver, PETSC_FALSE), "KSPSetErrorIfNotConverged");
+    } else {
+      petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+      petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+      PetscScalar* values = nullptr;
+      petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
+      std::copy(rhs.begin(), rhs.end(), values);
+      petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+    }
     outcome = petsc_solve(o);  // a singular system's failed factorisation: refused below
   });
   iterations_ = outcome.iterations;
@@ -165,6 +191,7 @@ void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const 
       for (std::size_t i = 0; i < nodes_; ++i) potential[i] = {x[row_[i]], x[row_[i] + 1]};
     });
   });
+  afresh.solved = true;
 }
 
 }  // namespace hemotree

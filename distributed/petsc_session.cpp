@@ -91,18 +91,20 @@ PetscOutcome petsc_solve(PetscObjects& o) {
   out.iterations = static_cast<int>(iterations);
   out.method = petsc_method(o.solver);
   PetscReal residual = 0, scale = 0;
-  petsc_check(VecDuplicate(o.rhs, &o.everywhere), "VecDuplicate");
-  petsc_check(MatMult(o.matrix, o.x, o.everywhere), "MatMult");
-  petsc_check(VecAYPX(o.everywhere, -1.0, o.rhs), "VecAYPX");
-  petsc_check(VecNorm(o.everywhere, NORM_2, &residual), "VecNorm");
+  Vec r = nullptr;  // b - A x (o.everywhere is the solution's, where a solver keeps it)
+  petsc_check(VecDuplicate(o.rhs, &r), "VecDuplicate");
+  PetscErrorCode code = MatMult(o.matrix, o.x, r);
+  if (code == 0) code = VecAYPX(r, -1.0, o.rhs);
+  if (code == 0) code = VecNorm(r, NORM_2, &residual);
+  VecDestroy(&r);
+  petsc_check(code, "the residual");
   petsc_check(VecNorm(o.rhs, NORM_2, &scale), "VecNorm");
-  petsc_check(VecDestroy(&o.everywhere), "VecDestroy");
   out.relative = scale > 0 ? residual / scale : residual;
   return out;
 }
 
 void petsc_read_everywhere(PetscObjects& o, const std::function<void(const PetscScalar*)>& read) {
-  petsc_check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");
+  if (!o.to_all) petsc_check(VecScatterCreateToAll(o.x, &o.to_all, &o.everywhere), "VecScatterCreateToAll");
   petsc_check(VecScatterBegin(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
   petsc_check(VecScatterEnd(o.to_all, o.x, o.everywhere, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
   const PetscScalar* values = nullptr;
