@@ -67,11 +67,19 @@ void PetscFlowNetwork::make(std::span<const double> local_rhs) {
   petsc_check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
   petsc_check(MatSetOption(o.matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
   petsc_check(MatSetOption(o.matrix, MAT_SPD, PETSC_TRUE), "MatSetOption");
-  // Every entry set (zeros too), so that each solve's matrix has the first one's pattern.
+  // The pattern: every entry a solve sets, as zeros before the first assembly (which drops
+  // the preallocation it does not see used: an entry added after it is a malloc).
   for (std::size_t k = 0; k < local; ++k) {
     const auto r = static_cast<PetscInt>(first_row_ + static_cast<std::int64_t>(k));
     petsc_check(MatSetValue(o.matrix, r, r, 0.0, ADD_VALUES), "MatSetValue");
   }
+  for (std::size_t e = 0; e < a_.size(); ++e)
+    for (const bool from_a : {true, false}) {
+      const auto i = static_cast<std::size_t>(from_a ? a_[e] : b_[e]), j = static_cast<std::size_t>(from_a ? b_[e] : a_[e]);
+      if (mine(i) && !prescribed_[j])
+        petsc_check(MatSetValue(o.matrix, static_cast<PetscInt>(row_[i]), static_cast<PetscInt>(row_[j]), 0.0, ADD_VALUES),
+                    "MatSetValue");
+    }
   const PC preconditioner = petsc_prepare(o, local_rhs, KSPCG);
   petsc_check(VecSet(o.x, 0.0), "VecSet");  // the first solve's start
   petsc_check(PCSetType(preconditioner, PCHYPRE), "PCSetType");
