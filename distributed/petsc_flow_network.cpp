@@ -55,16 +55,8 @@ void PetscFlowNetwork::make(std::span<const double> local_rhs) {
       const auto i = static_cast<std::size_t>(from_a ? a_[e] : b_[e]), j = static_cast<std::size_t>(from_a ? b_[e] : a_[e]);
       if (mine(i) && !prescribed_[j]) (owner_[j] == rank ? in_block : off_block)[static_cast<std::size_t>(row_[i] - first_row_)] += 1;
     }
-  for (std::size_t k = 0; k < local; ++k) {  // parallel edges share an entry: counted once each
-    in_block[k] = std::min<PetscInt>(in_block[k], n);
-    off_block[k] = std::min<PetscInt>(off_block[k], all - n);
-  }
   PetscObjects& o = *held_;
-  petsc_check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
-  petsc_check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
-  petsc_check(MatSetType(o.matrix, MATAIJ), "MatSetType");
-  petsc_check(MatSeqAIJSetPreallocation(o.matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
-  petsc_check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
+  o.matrix = petsc_matrix(n, all, std::move(in_block), std::move(off_block));  // (parallel edges counted apart: a little over)
   petsc_check(MatSetOption(o.matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
   petsc_check(MatSetOption(o.matrix, MAT_SPD, PETSC_TRUE), "MatSetOption");
   // The pattern: every entry a solve sets, as zeros before the first assembly (which drops

@@ -60,11 +60,6 @@ PetscHarmonicNetwork::PetscHarmonicNetwork(std::size_t nodes, std::span<const st
       block[k] += 2;
       block[k + 1] += 2;
     }
-  const auto n = static_cast<std::int32_t>(rows_), others = static_cast<std::int32_t>(all_rows_ - rows_);
-  for (std::size_t k = 0; k < in_block_.size(); ++k) {
-    in_block_[k] = std::min(in_block_[k], n);
-    off_block_[k] = std::min(off_block_[k], others);
-  }
 }
 
 PetscHarmonicNetwork::~PetscHarmonicNetwork() = default;
@@ -134,13 +129,9 @@ void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const 
   } afresh{held_};
   on_every_rank([&] {
     if (first) {
-      const auto n = static_cast<PetscInt>(rows_), all = static_cast<PetscInt>(all_rows_);
-      std::vector<PetscInt> in_block(in_block_.begin(), in_block_.end()), off_block(off_block_.begin(), off_block_.end());
-      petsc_check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
-      petsc_check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
-      petsc_check(MatSetType(o.matrix, MATAIJ), "MatSetType");
-      petsc_check(MatSeqAIJSetPreallocation(o.matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
-      petsc_check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
+      o.matrix = petsc_matrix(static_cast<PetscInt>(rows_), static_cast<PetscInt>(all_rows_),
+                              std::vector<PetscInt>(in_block_.begin(), in_block_.end()),
+                              std::vector<PetscInt>(off_block_.begin(), off_block_.end()));
       petsc_check(MatSetOption(o.matrix, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE), "MatSetOption");
     } else {
       // The same entries as the first solve's (every block is set, zeros too): its pattern.

@@ -100,15 +100,7 @@ PetscNodalSystem::PetscNodalSystem(std::span<const std::int32_t> key_rank, std::
       const auto i = static_cast<std::size_t>(from_a ? a_[e] : b_[e]), j = static_cast<std::size_t>(from_a ? b_[e] : a_[e]);
       if (own_[i]) (own_[j] ? in_block : off_block)[static_cast<std::size_t>(local_row_[i])] += 1;
     }
-  for (std::size_t k = 0; k < in_block.size(); ++k) {
-    in_block[k] = std::min(in_block[k], n);
-    off_block[k] = std::min(off_block[k], all - n);
-  }
-  petsc_check(MatCreate(PETSC_COMM_WORLD, &o.matrix), "MatCreate");
-  petsc_check(MatSetSizes(o.matrix, n, n, all, all), "MatSetSizes");
-  petsc_check(MatSetType(o.matrix, MATAIJ), "MatSetType");
-  petsc_check(MatSeqAIJSetPreallocation(o.matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
-  petsc_check(MatMPIAIJSetPreallocation(o.matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
+  o.matrix = petsc_matrix(n, all, std::move(in_block), std::move(off_block));
   for (std::size_t k = 0; k < nodes; ++k)
     if (own_[k]) petsc_check(MatSetValue(o.matrix, row_[k], row_[k], 0.0, INSERT_VALUES), "MatSetValue");
   for (std::size_t e = 0; e < a_.size(); ++e)

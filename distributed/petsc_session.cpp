@@ -52,6 +52,20 @@ PetscRows petsc_rows(std::span<const std::int32_t> owner, std::span<const unsign
   return rows;
 }
 
+Mat petsc_matrix(PetscInt rows, PetscInt all, std::vector<PetscInt> in_block, std::vector<PetscInt> off_block) {
+  for (std::size_t k = 0; k < in_block.size(); ++k) {
+    in_block[k] = std::min(in_block[k], rows);
+    off_block[k] = std::min(off_block[k], all - rows);
+  }
+  Mat matrix = nullptr;
+  petsc_check(MatCreate(PETSC_COMM_WORLD, &matrix), "MatCreate");
+  petsc_check(MatSetSizes(matrix, rows, rows, all, all), "MatSetSizes");
+  petsc_check(MatSetType(matrix, MATAIJ), "MatSetType");
+  petsc_check(MatSeqAIJSetPreallocation(matrix, 0, in_block.data()), "MatSeqAIJSetPreallocation");
+  petsc_check(MatMPIAIJSetPreallocation(matrix, 0, in_block.data(), 0, off_block.data()), "MatMPIAIJSetPreallocation");
+  return matrix;
+}
+
 PC petsc_prepare(PetscObjects& o, std::span<const double> local_rhs, KSPType type) {
   petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");

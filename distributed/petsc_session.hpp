@@ -29,6 +29,11 @@ struct PetscRows {
 };
 PetscRows petsc_rows(std::span<const std::int32_t> owner, std::span<const unsigned char> skip, int per_node);
 
+// A square AIJ matrix over the ranks, `rows` of its `all` rows this rank's, each preallocated
+// for in_block entries in this rank's columns and off_block in the others' (upper bounds:
+// clipped to the columns there are). Collective.
+Mat petsc_matrix(PetscInt rows, PetscInt all, std::vector<PetscInt> in_block, std::vector<PetscInt> off_block);
+
 struct PetscObjects;
 // The matrix in `o`, its values set, assembled; its vectors, the right-hand side this rank's
 // rows (local_rhs); a solver of `type` on it. Returns the solver's preconditioner, for the
