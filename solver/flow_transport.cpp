@@ -62,12 +62,12 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   if (ranks) {
     cut_.emplace();
     cut_->run_boundaries = boundaries.size();
-    cut_->face.assign(roots.size(), -1);
-    cut_->cell.assign(roots.size(), -1);
-    cut_->across.assign(roots.size(), -1);
-    cut_->far.assign(roots.size(), blood.hematocrit);
-    cut_->ghost.assign(lumped.empty() ? 0 : lumped.network_node_count(), -1);
-    cut_->spread = solver.one_d_spread();
+    cut_->roots.face.assign(roots.size(), -1);
+    cut_->roots.cell.assign(roots.size(), -1);
+    cut_->roots.across.assign(roots.size(), -1);
+    cut_->roots.far.assign(roots.size(), blood.hematocrit);
+    cut_->roots.ghost.assign(lumped.empty() ? 0 : lumped.network_node_count(), -1);
+    if (solver.one_d_spread()) cut_->spread.emplace();
   }
   std::vector<double> volume;
   add_node_cells(grid, volume);
@@ -244,10 +244,10 @@ FlowTransport::EndFaces FlowTransport::add_faces(TransportGrid& grid, const std:
     const std::int32_t here = a_across ? b : a, across = a_across ? a : b;
     grid.add_face(here, TransportGrid::boundary_side(boundaries.size() + static_cast<std::size_t>(root)),
                   static_cast<std::int32_t>(v), mean_diameter(net_, v));
-    cut_->face[static_cast<std::size_t>(root)] = face;
-    cut_->cell[static_cast<std::size_t>(root)] = here;
-    cut_->across[static_cast<std::size_t>(root)] = across;
-    cut_->ghost[static_cast<std::size_t>(across)] = root;
+    cut_->roots.face[static_cast<std::size_t>(root)] = face;
+    cut_->roots.cell[static_cast<std::size_t>(root)] = here;
+    cut_->roots.across[static_cast<std::size_t>(root)] = across;
+    cut_->roots.ghost[static_cast<std::size_t>(across)] = root;
     if (a_across) turned.push_back(face);
   }
   for (std::size_t b = 0; b < boundaries.size(); ++b) {
@@ -334,7 +334,7 @@ void FlowTransport::set_up_tracers() {
   }
   tracer_inflow_.resize(tracers_.size());
   tracer_injected_.resize(tracers_.size());
-  if (cut_) cut_->tracer_far.assign(tracers_.size() * cut_->face.size(), 0.0);
+  if (cut_) cut_->roots.tracer_far.assign(tracers_.size() * cut_->roots.face.size(), 0.0);
 }
 
 void FlowTransport::tracer_given(std::size_t k, double t0, double t1) {
@@ -403,20 +403,20 @@ std::size_t FlowTransport::cell_at(std::size_t v, double x) const {
 double FlowTransport::hematocrit_at(std::size_t v, double x) const {
   const std::size_t c = cell_at(v, x);
   // Over ranks a root vessel's node across the cut: its hematocrit as the last step sent it.
-  if (cut_ && c < cut_->ghost.size() && cut_->ghost[c] >= 0) return cut_->far[static_cast<std::size_t>(cut_->ghost[c])];
+  if (cut_ && c < cut_->roots.ghost.size() && cut_->roots.ghost[c] >= 0) return cut_->roots.far[static_cast<std::size_t>(cut_->roots.ghost[c])];
   return red_cells_->discharge_hematocrit()[c];
 }
 
 double FlowTransport::tracer_at(std::size_t k, std::size_t v, double x) const {
   const std::size_t c = cell_at(v, x);
-  if (cut_ && c < cut_->ghost.size() && cut_->ghost[c] >= 0)
-    return cut_->tracer_far[k * cut_->face.size() + static_cast<std::size_t>(cut_->ghost[c])];
+  if (cut_ && c < cut_->roots.ghost.size() && cut_->roots.ghost[c] >= 0)
+    return cut_->roots.tracer_far[k * cut_->roots.face.size() + static_cast<std::size_t>(cut_->roots.ghost[c])];
   return tracers_[k].concentration()[c];
 }
 
 bool FlowTransport::empty_node_cell(std::size_t c) const {
-  if (!cut_ || c >= cut_->ghost.size()) return false;
-  return cut_->ghost[c] >= 0 || (solver_.lumped().halo() && solver_.lumped().ghost_node(static_cast<std::int32_t>(c)));
+  if (!cut_ || c >= cut_->roots.ghost.size()) return false;  // (sized to the node cells in either layout)
+  return cut_->roots.ghost[c] >= 0 || (solver_.lumped().halo() && solver_.lumped().ghost_node(static_cast<std::int32_t>(c)));
 }
 
 void FlowTransport::solver_volumes(std::vector<double>& volume) const {

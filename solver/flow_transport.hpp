@@ -129,14 +129,14 @@ class FlowTransport {
   std::size_t cell_count() const { return cut_ ? cut_->cells : red_cells_->grid().cell_count(); }
   std::size_t advances() const { return advances_; }
   // Over ranks: the exchange of its steps' messages (its traffic); else null.
-  const RootExchange* exchange() const { return cut_ ? cut_->exchange.get() : nullptr; }
+  const RootExchange* exchange() const { return cut_ ? cut_->roots.exchange.get() : nullptr; }
   // Where the 1D vessels are spread: this rank's transport steps, their rounds (each a solve
   // of its cells and one message to each neighbouring rank), its messages and bytes, and the
   // seconds inside the exchanges and reductions (null otherwise).
   struct SpreadTraffic : NeighbourTraffic {
     std::size_t steps = 0, rounds = 0;
   };
-  const SpreadTraffic* spread_traffic() const { return cut_ && cut_->spread ? &cut_->traffic : nullptr; }
+  const SpreadTraffic* spread_traffic() const { return cut_ && cut_->spread ? &cut_->spread->traffic : nullptr; }
 
   void save(CheckpointWriter& out) const;
   // Over ranks: the one-process run's bytes, written to `out` on rank 0, null elsewhere. Collective.
@@ -176,41 +176,49 @@ class FlowTransport {
   Totals totals() const;
   void close_step();    // the cycle's sums and the viscosities after a step
 
-  // Over ranks (flow_transport_ranks.cpp): the cut's faces and where every cell, face and
-  // boundary of this rank lies in the whole run's grid (the one-process order).
+  // Over ranks: where every cell, face and boundary of this rank lies in the whole run's grid
+  // (the one-process order), and the cut of the flow's layout, a tree's roots or the links of
+  // the spread vessels.
   struct Cut {
-    bool top = false;
-    std::shared_ptr<RootExchange> exchange;
     std::size_t run_boundaries = 0;   // the network's (the grid's first ones)
-    std::vector<std::int32_t> face;   // per root (the messages' order): its face here
-    std::vector<std::int32_t> cell;   // the cell on this side of it
-    std::vector<std::int32_t> across; // the empty cell of the node across it
-    std::vector<double> far;          // the hematocrit of the cell across it (a share's probes)
-    std::vector<double> tracer_far;   // per tracer, per root: its concentration there
-    std::vector<std::int32_t> ghost;  // per cell: the root it is the node across (-1: a cell of its own)
     std::vector<std::int32_t> cell_place, face_place;  // in the whole run's grid
     std::vector<signed char> face_sign;  // per face: +1, or -1 where a cut turned it round
     std::size_t cells = 0, faces = 0;    // the whole run's
-    // The 1D vessels spread (flow_transport_spread.cpp): the cells held here whose numbers are
-    // another rank's (a junction where it has an end too), and per neighbouring rank the faces
-    // whose numbers go there (with the cell on this side) and the cut faces taken from there,
-    // each in the run's order of vessel ends; whether each carries the face's volume (sent by
-    // the vessel's rank). The tracers' last inflows at the cuts (per tracer, per cut), and the
-    // exchanges' traffic.
-    bool spread = false;
+    // The cells held here whose numbers are another rank's (a junction where it has an end
+    // too, a ghost node of a spread 0D system).
     std::vector<std::int32_t> copies;
-    struct Neighbour {
-      int rank = 0;
-      std::vector<std::int32_t> send_face, send_cell, receive_face;
-      std::vector<unsigned char> send_volume, receive_volume;
-      // Per received link, the cell here that stands for the sender's (a ghost node of a
-      // spread 0D system, which takes the sent values), or -1.
-      std::vector<std::int32_t> receive_cell;
+    // A tree's top and shares (flow_transport_ranks.cpp): a face per root vessel, to a cut on
+    // either side, crossed by two messages a step.
+    struct Roots {
+      bool top = false;
+      std::shared_ptr<RootExchange> exchange;
+      std::vector<std::int32_t> face;   // per root (the messages' order): its face here
+      std::vector<std::int32_t> cell;   // the cell on this side of it
+      std::vector<std::int32_t> across; // the empty cell of the node across it
+      std::vector<double> far;          // the hematocrit of the cell across it (a share's probes)
+      std::vector<double> tracer_far;   // per tracer, per root: its concentration there
+      std::vector<std::int32_t> ghost;  // per node cell: the root it is the node across (-1: its own)
+    } roots;
+    // The 1D vessels spread, and a 0D system with them (flow_transport_spread.cpp): per
+    // neighbouring rank the faces whose numbers go there (with the cell on this side) and the
+    // cut faces taken from there, each in the run's order of vessel ends, and whether each
+    // carries the face's volume (sent by the vessel's rank); the tracers' last inflows at the
+    // cuts (per tracer, per cut); the exchanges' traffic. None where the layout is a tree's.
+    struct Links {
+      struct Neighbour {
+        int rank = 0;
+        std::vector<std::int32_t> send_face, send_cell, receive_face;
+        std::vector<unsigned char> send_volume, receive_volume;
+        // Per received link, the cell here that stands for the sender's (a ghost node of a
+        // spread 0D system, which takes the sent values), or -1.
+        std::vector<std::int32_t> receive_cell;
+      };
+      std::vector<Neighbour> neighbours;
+      std::size_t count = 0;  // the whole run's links
+      std::vector<double> tracer_in;
+      SpreadTraffic traffic;
     };
-    std::vector<Neighbour> neighbours;
-    std::size_t links = 0;  // the whole run's
-    std::vector<double> tracer_in;
-    SpreadTraffic traffic;
+    std::optional<Links> spread;
   };
   // The cut's faces were made with the grid; the rest of the Cut from them.
   void place_cut(const TransportRanks& ranks);

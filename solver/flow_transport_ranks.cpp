@@ -79,8 +79,8 @@ std::int32_t FlowTransport::ZeroDPlaces::face_place(const TransportGrid& grid, s
 
 void FlowTransport::place_cut(const TransportRanks& ranks) {
   Cut& cut = *cut_;
-  cut.top = solver_.holds_one_d();
-  cut.exchange = std::make_shared<RootExchange>(MPI_COMM_WORLD, ranks.top_rank, ranks.roots);
+  cut.roots.top = solver_.holds_one_d();
+  cut.roots.exchange = std::make_shared<RootExchange>(MPI_COMM_WORLD, ranks.top_rank, ranks.roots);
   const TransportGrid& grid = red_cells_->grid();
   const LumpedVessels& lumped = solver_.lumped();
   // The one-process grid: the 0D part (zero_d_places), the 1D vessels' slices and junctions
@@ -102,9 +102,9 @@ void FlowTransport::place_cut(const TransportRanks& ranks) {
   }
   // The whole run's counts: every rank knows its 0D part; the top's 1D cells and faces are
   // the top's alone (said to every rank by join_ranks).
-  cut.cells = whole.nodes + (cut.top ? one_d_cells : 0);
+  cut.cells = whole.nodes + (cut.roots.top ? one_d_cells : 0);
   cut.faces = static_cast<std::size_t>(whole.one_d_faces) +
-              (cut.top && first_one_d_face >= 0 ? grid.face_count() - static_cast<std::size_t>(first_one_d_face) : 0);
+              (cut.roots.top && first_one_d_face >= 0 ? grid.face_count() - static_cast<std::size_t>(first_one_d_face) : 0);
 }
 
 void FlowTransport::join_ranks() {
@@ -119,7 +119,7 @@ void FlowTransport::join_ranks() {
 
 std::vector<std::int32_t> FlowTransport::own_cell_places() const {
   std::vector<std::int32_t> place = cut_->cell_place;
-  for (const std::int32_t c : cut_->across) place[static_cast<std::size_t>(c)] = -1;
+  for (const std::int32_t c : cut_->roots.across) place[static_cast<std::size_t>(c)] = -1;
   for (const std::int32_t c : cut_->copies) place[static_cast<std::size_t>(c)] = -1;
   return place;
 }
@@ -131,8 +131,8 @@ std::vector<std::int32_t> FlowTransport::own_face_places() const {
       const std::int32_t v = red_cells_->grid().vessel[f];
       if (v >= 0 && !solver_.steps_vessel(static_cast<std::size_t>(v))) place[f] = -1;
     }
-  } else if (cut_->top) {  // its cuts' faces are the shares' root vessels
-    for (const std::int32_t f : cut_->face) place[static_cast<std::size_t>(f)] = -1;
+  } else if (cut_->roots.top) {  // its cuts' faces are the shares' root vessels
+    for (const std::int32_t f : cut_->roots.face) place[static_cast<std::size_t>(f)] = -1;
   }
   return place;
 }
@@ -169,9 +169,9 @@ void FlowTransport::across_cuts(std::size_t per_root, std::exception_ptr failure
   Cut& cut = *cut_;
   // Up: the shares' root nodes (what the top's nodes above take where blood flows up).
   bool failed = false;
-  const std::vector<double> up = cut.exchange->gather(cut.top ? std::vector<double>() : here(), failure, per_root, failed);
+  const std::vector<double> up = cut.roots.exchange->gather(cut.roots.top ? std::vector<double>() : here(), failure, per_root, failed);
   std::vector<double> down;
-  if (cut.top && !failed && !failure) {
+  if (cut.roots.top && !failed && !failure) {
     try {
       across(up);
       rest();
@@ -181,8 +181,8 @@ void FlowTransport::across_cuts(std::size_t per_root, std::exception_ptr failure
     }
   }
   // Down: the top's nodes above the roots; then a share finishes its subtrees below them.
-  const std::vector<double> mine = cut.exchange->scatter(down, failure, per_root, what);
-  if (cut.top) return;
+  const std::vector<double> mine = cut.roots.exchange->scatter(down, failure, per_root, what);
+  if (cut.roots.top) return;
   across(mine);
   rest();
 }
@@ -191,20 +191,20 @@ void FlowTransport::advance_over_ranks() {
   Cut& cut = *cut_;
   RedCellTransport& cells = *red_cells_;
   const std::span<const double> hematocrit = cells.discharge_hematocrit();
-  const std::size_t roots = cut.face.size();
+  const std::size_t roots = cut.roots.face.size();
   // Blood leaving through a cut carries s_f H_D of the cell it leaves; entering, what the
   // other side's cell sends (the product taken as the one-process run takes it).
   auto from_across = [&](std::span<const double> numbers) {
     for (std::size_t j = 0; j < roots; ++j) {
-      cut.far[j] = numbers[per_root * j];
+      cut.roots.far[j] = numbers[per_root * j];
       inflow_hematocrit_[cut.run_boundaries + j] = numbers[per_root * j + 1] * numbers[per_root * j];
     }
   };
   auto from_here = [&] {
     std::vector<double> numbers(per_root * roots);
     for (std::size_t j = 0; j < roots; ++j) {
-      numbers[per_root * j] = hematocrit[static_cast<std::size_t>(cut.cell[j])];
-      numbers[per_root * j + 1] = cells.separation_share(static_cast<std::size_t>(cut.face[j]));
+      numbers[per_root * j] = hematocrit[static_cast<std::size_t>(cut.roots.cell[j])];
+      numbers[per_root * j + 1] = cells.separation_share(static_cast<std::size_t>(cut.roots.face[j]));
     }
     return numbers;
   };
@@ -223,7 +223,7 @@ void FlowTransport::step_tracers_over_ranks(double t0, double t1) {
   // The red cells' step is whole: every tracer rides on its carriers, in its split, with two
   // messages of its own (each root's concentration of every tracer up, then down).
   Cut& cut = *cut_;
-  const std::size_t roots = cut.face.size(), count = tracers_.size();
+  const std::size_t roots = cut.roots.face.size(), count = tracers_.size();
   using Cells = RedCellTransport::Cells;
   auto solve = [&](Cells cells) {
     for (std::size_t k = 0; k < count; ++k) tracers_[k].solve(*red_cells_, tracer_inflow_[k], tracer_injected_[k], cells);
@@ -240,14 +240,14 @@ void FlowTransport::step_tracers_over_ranks(double t0, double t1) {
     for (std::size_t j = 0; j < roots; ++j)
       for (std::size_t k = 0; k < count; ++k)
         numbers[count * j + k] =
-            tracers_[k].inflowing(static_cast<std::size_t>(cut.face[j]), *red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+            tracers_[k].inflowing(static_cast<std::size_t>(cut.roots.face[j]), *red_cells_, tracer_inflow_[k], tracer_injected_[k]);
     return numbers;
   };
   auto from_across = [&](std::span<const double> numbers) {
     for (std::size_t j = 0; j < roots; ++j)
       for (std::size_t k = 0; k < count; ++k) {
         tracer_inflow_[k][cut.run_boundaries + j] = numbers[count * j + k];
-        cut.tracer_far[k * roots + j] = numbers[count * j + k];
+        cut.roots.tracer_far[k * roots + j] = numbers[count * j + k];
       }
   };
   across_cuts(count, failure, "the tracers' step", from_here, from_across, [&] { solve(Cells::after_cuts); });
@@ -321,8 +321,8 @@ void FlowTransport::restore_tracer_share(std::size_t k, const TracerState& whole
   const TransportGrid& grid = red_cells_->grid();
   std::vector<double> concentration(grid.cell_count());
   for (std::size_t c = 0; c < concentration.size(); ++c) concentration[c] = whole.concentration[static_cast<std::size_t>(cut_->cell_place[c])];
-  const std::size_t roots = cut_->across.size();
-  for (std::size_t j = 0; j < roots; ++j) cut_->tracer_far[k * roots + j] = concentration[static_cast<std::size_t>(cut_->across[j])];
+  const std::size_t roots = cut_->roots.across.size();
+  for (std::size_t j = 0; j < roots; ++j) cut_->roots.tracer_far[k * roots + j] = concentration[static_cast<std::size_t>(cut_->roots.across[j])];
   const BoundaryShare held = boundary_share(boundary_places(), whole.entered, whole.left, whole.last_outflow, 0.0);
   // The injection's and the balance's totals are rank 0's (the whole run's), and what the
   // injecting rank adds from here on: the same sums, in the same order, there.
@@ -360,7 +360,7 @@ void FlowTransport::restore_share(const RedCellState& whole) {
     discharge[c] = whole.discharge[static_cast<std::size_t>(cut_->cell_place[c])];
     volume[c] = empty_node_cell(c) ? 0.0 : whole.volume[static_cast<std::size_t>(cut_->cell_place[c])];
   }
-  for (std::size_t j = 0; j < cut_->across.size(); ++j) cut_->far[j] = discharge[static_cast<std::size_t>(cut_->across[j])];
+  for (std::size_t j = 0; j < cut_->roots.across.size(); ++j) cut_->roots.far[j] = discharge[static_cast<std::size_t>(cut_->roots.across[j])];
   const BoundaryShare held = boundary_share(boundary_places(), whole.entered, whole.left, whole.last_outflow,
                                            solver_.blood().hematocrit);
   t.restore(discharge, volume, held.entered, held.left, whole.adjusted, held.last_outflow);

@@ -120,17 +120,17 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
   const std::span<const std::int32_t> node_rank = solver_.lumped_node_ranks();
   std::map<std::pair<std::int32_t, bool>, std::int64_t> coupled_node;
   for (const auto& c : ends.coupled) coupled_node[{c.end.vessel, c.end.distal}] = c.node;
-  std::map<int, Cut::Neighbour> by_rank;
+  std::map<int, Cut::Links::Neighbour> by_rank;
   auto link = [&](int receiver, int supplier, std::pair<std::int32_t, bool> end, bool volume, bool held = false) {
-    ++cut.links;
+    ++cut.spread->count;
     if (receiver == me) {
-      Cut::Neighbour& from = by_rank[supplier];
+      Cut::Links::Neighbour& from = by_rank[supplier];
       from.receive_face.push_back(end_faces.at(end).first);
       from.receive_volume.push_back(volume);
       from.receive_cell.push_back(held ? end_faces.at(end).second : -1);
     }
     if (supplier == me) {
-      Cut::Neighbour& to = by_rank[receiver];
+      Cut::Links::Neighbour& to = by_rank[receiver];
       to.send_face.push_back(end_faces.at(end).first);
       to.send_cell.push_back(end_faces.at(end).second);
       to.send_volume.push_back(volume);
@@ -165,24 +165,24 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
     }
   for (auto& [r, neighbour] : by_rank) {
     neighbour.rank = r;
-    cut.neighbours.push_back(std::move(neighbour));
+    cut.spread->neighbours.push_back(std::move(neighbour));
   }
 }
 
 void FlowTransport::exchange_numbers(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in) {
   Cut& cut = *cut_;
   std::vector<int> ranks;
-  for (const Cut::Neighbour& nb : cut.neighbours) ranks.push_back(nb.rank);
-  exchange_with_neighbours(ranks, out, in, tag, cut.traffic);
+  for (const Cut::Links::Neighbour& nb : cut.spread->neighbours) ranks.push_back(nb.rank);
+  exchange_with_neighbours(ranks, out, in, tag, cut.spread->traffic);
 }
 
 void FlowTransport::take_cut_volumes() {
   // Each link's volume, as the one-process face has it, from the vessel's rank.
   Cut& cut = *cut_;
-  const std::size_t count = cut.neighbours.size();
+  const std::size_t count = cut.spread->neighbours.size();
   std::vector<std::vector<double>> out(count), in(count);
   for (std::size_t i = 0; i < count; ++i) {
-    const Cut::Neighbour& nb = cut.neighbours[i];
+    const Cut::Links::Neighbour& nb = cut.spread->neighbours[i];
     for (std::size_t k = 0; k < nb.send_face.size(); ++k)
       if (nb.send_volume[k]) {
         const auto f = static_cast<std::size_t>(nb.send_face[k]);
@@ -192,7 +192,7 @@ void FlowTransport::take_cut_volumes() {
   }
   exchange_numbers(out, in);
   for (std::size_t i = 0; i < count; ++i) {
-    const Cut::Neighbour& nb = cut.neighbours[i];
+    const Cut::Links::Neighbour& nb = cut.spread->neighbours[i];
     std::size_t j = 0;
     for (std::size_t k = 0; k < nb.receive_face.size(); ++k)
       if (nb.receive_volume[k]) {
@@ -207,17 +207,17 @@ void FlowTransport::spread_rounds(std::size_t per_link, const char* what,
                                   const std::function<void(std::size_t, std::size_t, double*)>& here,
                                   const std::function<double(std::size_t, std::int32_t, const double*)>& across) {
   Cut& cut = *cut_;
-  const std::size_t count = cut.neighbours.size();
+  const std::size_t count = cut.spread->neighbours.size();
   // Past one round more than the links (what any path of the flow crosses, at most), only a
   // circulation across the cut is still moving.
-  const std::size_t exact = cut.links + 1;
+  const std::size_t exact = cut.spread->count + 1;
   using Cells = RedCellTransport::Cells;
   for (std::size_t round = 1;; ++round) {
     // After the first round only the cells a cut's inflow reaches can change.
     on_every_rank([&] { solve(round == 1 ? Cells::all : Cells::after_cuts); });  // a failure, every rank's
     std::vector<std::vector<double>> out(count), in(count);
     for (std::size_t i = 0; i < count; ++i) {
-      const Cut::Neighbour& nb = cut.neighbours[i];
+      const Cut::Links::Neighbour& nb = cut.spread->neighbours[i];
       out[i].resize(per_link * nb.send_face.size());
       for (std::size_t k = 0; k < nb.send_face.size(); ++k)
         here(static_cast<std::size_t>(nb.send_face[k]), static_cast<std::size_t>(nb.send_cell[k]), &out[i][per_link * k]);
@@ -226,14 +226,14 @@ void FlowTransport::spread_rounds(std::size_t per_link, const char* what,
     exchange_numbers(out, in);
     double change = 0;
     for (std::size_t i = 0; i < count; ++i) {
-      const Cut::Neighbour& nb = cut.neighbours[i];
+      const Cut::Links::Neighbour& nb = cut.spread->neighbours[i];
       for (std::size_t k = 0; k < nb.receive_face.size(); ++k)
         change = std::max(change, across(static_cast<std::size_t>(nb.receive_face[k]), nb.receive_cell[k], &in[i][per_link * k]));
     }
     const double started = MPI_Wtime();
     MPI_Allreduce(MPI_IN_PLACE, &change, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-    cut.traffic.seconds += MPI_Wtime() - started;
-    ++cut.traffic.rounds;
+    cut.spread->traffic.seconds += MPI_Wtime() - started;
+    ++cut.spread->traffic.rounds;
     if (change == 0) return;
     if (round > exact && change <= circulation_tolerance) {
       on_every_rank([&] { solve(Cells::after_cuts); });  // with the inflows settled
@@ -274,7 +274,7 @@ void FlowTransport::advance_spread() {
       });
   cells.end_step(face_volume_, inflow_hematocrit_);
   ++advances_;
-  ++cut_->traffic.steps;
+  ++cut_->spread->traffic.steps;
   mark();
   if (!tracers_.empty()) step_tracers_spread(last_time_, solver_.time());
   last_time_ = solver_.time();
@@ -286,10 +286,10 @@ void FlowTransport::step_tracers_spread(double t0, double t1) {
   Cut& cut = *cut_;
   const TransportGrid& grid = red_cells_->grid();
   const std::size_t count = tracers_.size(), cuts = grid.cuts, first_cut = grid.boundaries - cuts;
-  if (cut.tracer_in.size() != count * cuts) cut.tracer_in.assign(count * cuts, 0.0);
+  if (cut.spread->tracer_in.size() != count * cuts) cut.spread->tracer_in.assign(count * cuts, 0.0);
   for (std::size_t k = 0; k < count; ++k) {
     tracer_given(k, t0, t1);
-    for (std::size_t j = 0; j < cuts; ++j) tracer_inflow_[k][first_cut + j] = cut.tracer_in[k * cuts + j];
+    for (std::size_t j = 0; j < cuts; ++j) tracer_inflow_[k][first_cut + j] = cut.spread->tracer_in[k * cuts + j];
     tracers_[k].begin_step(*red_cells_, tracer_inflow_[k], tracer_injected_[k]);
   }
   // A link's numbers: each tracer's concentration entering through it, then each one's in the
@@ -315,7 +315,7 @@ void FlowTransport::step_tracers_spread(double t0, double t1) {
         double change = 0;
         for (std::size_t k = 0; k < count; ++k) {
           change = std::max(change, moved(tracer_inflow_[k][b], numbers[k]));
-          cut.tracer_in[k * cuts + (b - first_cut)] = numbers[k];
+          cut.spread->tracer_in[k * cuts + (b - first_cut)] = numbers[k];
           if (held < 0) continue;
           double c = tracers_[k].concentration()[static_cast<std::size_t>(held)];
           change = std::max(change, moved(c, numbers[count + k]));
