@@ -136,12 +136,7 @@ void PetscFlowNetwork::solve(std::span<const double> conductance, std::span<cons
       }
       for (std::size_t q = 0; q < entry.size(); ++q)
         petsc_check(MatSetValue(o.matrix, entry_at[q].first, entry_at[q].second, entry[q], ADD_VALUES), "MatSetValue");
-      petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-      petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
-      PetscScalar* values = nullptr;
-      petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
-      std::copy(rhs.begin(), rhs.end(), values);
-      petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+      petsc_refill(o, rhs);
       // The last solve's preconditioner while it serves; one that does not converge is made
       // anew for this matrix, the solve taken again from the last solution.
       bool reused = reuse_;

@@ -160,12 +160,7 @@ void PetscHarmonicNetwork::solve(std::span<const TwoPort> edge, std::span<const 
       petsc_check(PCFactorSetMatSolverType(preconditioner, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
       petsc_check(KSPSetErrorIfNotConverged(o.solver, PETSC_FALSE), "KSPSetErrorIfNotConverged");
     } else {
-      petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-      petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
-      PetscScalar* values = nullptr;
-      petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
-      std::copy(rhs.begin(), rhs.end(), values);
-      petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+      petsc_refill(o, rhs);
     }
     outcome = petsc_solve(o);  // a singular system's failed factorisation: refused below
   });

@@ -66,6 +66,15 @@ Mat petsc_matrix(PetscInt rows, PetscInt all, std::vector<PetscInt> in_block, st
   return matrix;
 }
 
+void petsc_refill(PetscObjects& o, std::span<const double> local_rhs) {
+  petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  PetscScalar* values = nullptr;
+  petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
+  std::copy(local_rhs.begin(), local_rhs.end(), values);
+  petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+}
+
 PC petsc_prepare(PetscObjects& o, std::span<const double> local_rhs, KSPType type) {
   petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");

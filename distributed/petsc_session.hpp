@@ -39,6 +39,9 @@ struct PetscObjects;
 // rows (local_rhs); a solver of `type` on it. Returns the solver's preconditioner, for the
 // caller to choose. Collective.
 PC petsc_prepare(PetscObjects& o, std::span<const double> local_rhs, KSPType type);
+// The matrix in `o` assembled again (its values set anew on its pattern) and the right-hand
+// side this rank's rows: a kept solver's next solve. Collective.
+void petsc_refill(PetscObjects& o, std::span<const double> local_rhs);
 // Solves in `o` once PETSC_OPTIONS have had their say (options PETSc does not know are the
 // user's input: InputError), and says what it came to: PETSc's reason and iterations, the
 // method in words ("cg with hypre", "preonly with lu (mumps)"), and the true relative residual
