@@ -19,14 +19,14 @@ std::vector<double> PulseSolver::capacitor_pressures() const {
     if (o.capacitor >= 0) p[static_cast<std::size_t>(o.index)] = state_.capacitor(o.capacitor);
   for (std::size_t k = 0; k < p.size(); ++k)
     if (std::isnan(p[k])) p[k] = lumped_.capacitor_pressure(k);
-  if (make_whole_) make_whole_(p, holds_outlet_);  // over ranks: each outlet's from its rank
+  if (lead_whole_) lead_whole_(p, holds_outlet_);  // over ranks: each outlet's from its rank, on the lead
   return p;
 }
 
 std::vector<double> PulseSolver::vessel_volumes() const {
   std::vector<double> volume(net_.vessel_count(), 0.0);
   for (std::size_t v = 0; v < volume.size(); ++v) {
-    if (make_whole_ && !steps_vessel_[v]) continue;  // another rank's (below)
+    if (!steps_vessel(v)) continue;  // another rank's (below)
     if (zero_d_[v]) {  // half at each node's pressure, as the 0D scheme holds it
       const std::int32_t e = lumped_.vessel_index(v);
       const TubeLaw tube = law(v);
@@ -36,12 +36,80 @@ std::vector<double> PulseSolver::vessel_volumes() const {
     }
     for (auto el = first_element(v), end = end_element(v); el < end; ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
   }
-  if (make_whole_) make_whole_(volume, steps_vessel_);  // over ranks: each vessel's from its rank
+  if (lead_whole_) lead_whole_(volume, steps_vessel_);  // over ranks: each vessel's from its rank, on the lead
   return volume;
 }
 
 std::size_t PulseSolver::balance_compliances(double period, std::vector<double> mean_pressure) {
-  if (steady_resistance_.empty()) return 0;
+  if (!balances_) return 0;
+  const std::size_t n = net_.vessel_count();
+  // Each vessel's volume and dA/dp at its mean area, now: over ranks the lead's whole, every
+  // other rank's for its own vessels (what it moves).
+  const std::vector<double> volume = vessel_volumes();
+  std::vector<double> area_per_pressure(n);
+  for (std::size_t v = 0; v < n; ++v)
+    if (leads() || steps_vessel(v)) area_per_pressure[v] = law(v).compliance_per_length(volume[v] / net_.length[v]);
+  // A tapered vessel's dA/dp changes along it: each element's at its mean area and centre
+  // (a 0D one's, the mean of its ends'), and the vessel's the mean of those.
+  std::vector<double> element_area_per_pressure;
+  if (!tapers_.empty()) {
+    element_area_per_pressure.assign(static_cast<std::size_t>(state_.area.rows()), 0.0);
+    for (std::size_t v = 0; v < n; ++v) {
+      if (!is_tapered(v) || !steps_vessel(v)) continue;
+      double sum = 0;
+      if (zero_d_[v]) {
+        const std::int32_t e = lumped_.vessel_index(v);
+        for (const double x : {0.0, 1.0}) {
+          const TubeLaw at = law_at(v, x);
+          sum += at.compliance_per_length(at.area(lumped_.pressure_at(e, x))) / 2;  // the mean of the two ends'
+        }
+      } else {
+        const auto first = first_element(v);
+        for (auto el = first, end = end_element(v); el < end; ++el) {
+          const double x = (el - first + 0.5) / elements_per_vessel_;
+          const double c = law_at(v, x).compliance_per_length(state_.area(el, 0));
+          element_area_per_pressure[static_cast<std::size_t>(el)] = c;
+          sum += c / elements_per_vessel_;
+        }
+      }
+      area_per_pressure[v] = sum;
+    }
+    if (lead_whole_) lead_whole_(area_per_pressure, steps_vessel_);  // the tapered vessels' from their ranks
+  }
+  // Without RCR outlets no capacitor is balanced: their arrays stay empty (a tree's two
+  // million capillary outlets would hold 15 MB of NaN or 0 in each).
+  const std::vector<double> capacitor_now = rcr_outlets_ ? capacitor_pressures() : std::vector<double>();
+  if (!cycle_marked_) {
+    if (leads()) {
+      cycle_volume_ = volume;
+      cycle_capacitor_ = capacitor_now;
+    }
+    cycle_marked_ = true;
+    return 0;
+  }
+  // The moves: the lead's solve of the whole network, sent to every other rank.
+  TreePotentials move;
+  if (leads()) move = compliance_moves(period, std::move(mean_pressure), volume, area_per_pressure, capacitor_now);
+  if (from_lead_) {
+    from_lead_(move.node);
+    from_lead_(move.capacitor);
+  }
+  move_compliances(move, area_per_pressure, element_area_per_pressure);
+  move = {};
+  cycle_volume_ = vessel_volumes();
+  cycle_capacitor_ = rcr_outlets_ ? capacitor_pressures() : std::vector<double>();
+  if (!leads()) {  // the marks are the lead's
+    std::vector<double>().swap(cycle_volume_);
+    std::vector<double>().swap(cycle_capacitor_);
+  }
+  have_previous_rate_ = false;  // the multistep history belongs to the state before the move
+  return n;
+}
+
+TreePotentials PulseSolver::compliance_moves(double period, std::vector<double> mean_pressure,
+                                             const std::vector<double>& volume,
+                                             const std::vector<double>& area_per_pressure,
+                                             const std::vector<double>& capacitor_now) {
   const std::size_t n = net_.vessel_count();
   std::vector<double> resistance(steady_resistance_.begin(), steady_resistance_.end());
   // The conductances at the last cycle's mean state, where the run has one: in a full tree
@@ -62,45 +130,6 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
         resistance[v] = poiseuille_resistance(viscosity_(area), net_.length[v], std::sqrt(4 / std::numbers::pi * area), blood_.alpha);
     }
   std::vector<double>().swap(mean_pressure);
-  // Each vessel's volume and dA/dp at its mean area, now.
-  const std::vector<double> volume = vessel_volumes();
-  std::vector<double> area_per_pressure(n);
-  for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = law(v).compliance_per_length(volume[v] / net_.length[v]);
-  // A tapered vessel's dA/dp changes along it: each element's at its mean area and centre
-  // (a 0D one's, the mean of its ends'), and the vessel's the mean of those.
-  std::vector<double> element_area_per_pressure;
-  if (!tapers_.empty()) {
-    element_area_per_pressure.assign(static_cast<std::size_t>(state_.area.rows()), 0.0);
-    for (std::size_t v = 0; v < n; ++v) {
-      if (!is_tapered(v) || (make_whole_ && !steps_vessel_[v])) continue;
-      double sum = 0;
-      if (zero_d_[v]) {
-        const std::int32_t e = lumped_.vessel_index(v);
-        for (const double x : {0.0, 1.0}) {
-          const TubeLaw at = law_at(v, x);
-          sum += at.compliance_per_length(at.area(lumped_.pressure_at(e, x))) / 2;  // the mean of the two ends'
-        }
-      } else {
-        const auto first = first_element(v);
-        for (auto el = first, end = end_element(v); el < end; ++el) {
-          const double x = (el - first + 0.5) / elements_per_vessel_;
-          const double c = law_at(v, x).compliance_per_length(state_.area(el, 0));
-          element_area_per_pressure[static_cast<std::size_t>(el)] = c;
-          sum += c / elements_per_vessel_;
-        }
-      }
-      area_per_pressure[v] = sum;
-    }
-    if (make_whole_) make_whole_(area_per_pressure, steps_vessel_);  // the tapered vessels' from their ranks
-  }
-  // Without RCR outlets no capacitor is balanced: their arrays stay empty (a tree's two
-  // million capillary outlets would hold 15 MB of NaN or 0 in each).
-  const std::vector<double> capacitor_now = rcr_outlets_ ? capacitor_pressures() : std::vector<double>();
-  if (cycle_volume_.empty()) {
-    cycle_volume_ = volume;
-    cycle_capacitor_ = capacitor_now;
-    return 0;
-  }
   // Volume rates over the last cycle: each vessel's half to each of its nodes.
   TreeLoads loads;
   loads.node_shunt.assign(net_.node_count(), 0.0);
@@ -153,12 +182,17 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
       largest = std::max(largest, std::abs(area_per_pressure[v] * move.node[static_cast<std::size_t>(node)]) /
                                       (volume[v] / net_.length[v]));
   const double scale = largest > 0.2 ? 0.2 / largest : 1.0;
-  // Every vessel's pressure shifts linearly between its nodes' moves.
-  const int e = elements_per_vessel_;
   for (auto& y : move.node) y *= scale;
   for (auto& y : move.capacitor) y *= scale;
-  for (std::size_t v = 0; v < n; ++v) {
-    if (zero_d_[v]) continue;
+  return move;
+}
+
+void PulseSolver::move_compliances(const TreePotentials& move, const std::vector<double>& area_per_pressure,
+                                   const std::vector<double>& element_area_per_pressure) {
+  // Every vessel's pressure shifts linearly between its nodes' moves.
+  const int e = elements_per_vessel_;
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
+    if (zero_d_[v] || !steps_vessel(v)) continue;
     const double y0 = move.node[static_cast<std::size_t>(net_.from[v])], y1 = move.node[static_cast<std::size_t>(net_.to[v])];
     for (int k = 0; k < e; ++k) {
       const auto el = first_element(v) + k;
@@ -170,10 +204,6 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
   for (const auto& o : boundaries_.outlets)
     if (o.capacitor >= 0) state_.capacitor(o.capacitor) += move.capacitor[static_cast<std::size_t>(o.index)];
   lumped_.shift_pressures(move.node, move.capacitor);
-  cycle_volume_ = vessel_volumes();
-  cycle_capacitor_ = rcr_outlets_ ? capacitor_pressures() : std::vector<double>();
-  have_previous_rate_ = false;  // the multistep history belongs to the state before the move
-  return n;
 }
 
 }  // namespace hemotree

@@ -144,9 +144,12 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   one_d_first_element_.clear();
   for (std::size_t j = 0; j < one_d_vessels_.size(); ++j)
     one_d_first_element_.push_back(static_cast<std::int32_t>(j) * elements_per_vessel_);
-  if (ranks)
+  if (ranks) {
     take_rank_share(*ranks, options);
-  else
+    from_lead_ = ranks->from_lead;
+    lead_rank_ = ranks->lead_rank;
+    if (!leads()) std::vector<float>().swap(steady_resistance_);  // the balance is the lead's
+  } else
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
   sectioned_count_ = static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t s) { return s > 1; }));
   std::vector<std::uint8_t>().swap(lumped_sections_);  // a byte a vessel the run no longer reads
@@ -199,6 +202,7 @@ std::optional<SteadyFlow> PulseSolver::solve_steady_flow() {
     steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet ? net.inlet->waveform.mean_value() : 0.0,
                                          &resistance, threads_);
     steady_resistance_.assign(resistance.begin(), resistance.end());
+    balances_ = true;
   } catch (const InputError& e) {
     steady_refusal_ = e.what();
   }

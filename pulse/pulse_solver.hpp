@@ -36,6 +36,8 @@
 
 namespace hemotree {
 
+struct TreePotentials;  // steady/loaded_tree.hpp: the compliance balance's moves
+
 // Which vessels are 1D (DG) and which 0D (lumped): all of one kind, or chosen per vessel.
 enum class ModelChoice { automatic, one_d, zero_d };
 
@@ -159,6 +161,10 @@ struct PulseRanks {
   // The same on the top's rank alone (the others' values left as they are): a checkpoint's.
   // (Over MPI the top is rank 0, which writes the results: solver/pulse_ranks_mpi.hpp.)
   std::function<void(std::vector<double>& values, const std::vector<unsigned char>& mine)> lead_whole;
+  // The lead's values (any length) on every rank: what the lead alone computes from the whole,
+  // e.g. the compliance balance's moves. Collective.
+  std::function<void(std::vector<double>& values)> from_lead;
+  int lead_rank = 0;  // where lead_whole gathers and from_lead sends from (the results' writer)
 };
 
 class PulseSolver {
@@ -281,6 +287,9 @@ class PulseSolver {
   bool one_d_spread() const { return one_d_cut_.has_value(); }
   bool over_ranks() const { return lumped_.over_ranks() || one_d_spread(); }
   bool steps_vessel(std::size_t vessel) const { return steps_vessel_.empty() || steps_vessel_[vessel]; }
+  // Whether this rank holds the whole run's numbers (alone, always; over ranks the lead, which
+  // gathers and writes them): the compliance balance is solved there.
+  bool leads() const { return !from_lead_ || rank_ == lead_rank_; }
   // With the 1D vessels spread: every vessel's rank, and this rank (what a transport over the
   // same cut needs: solver/flow_transport_spread.cpp). Empty otherwise.
   std::span<const std::int32_t> vessel_ranks() const { return vessel_rank_; }
@@ -557,10 +566,18 @@ class PulseSolver {
   Eigen::VectorXd element_viscosity_factor_;  // per element (empty: 1)
   // Poiseuille at the steady state, per vessel; empty without a steady solution. Only what
   // the balance falls back on (before a cycle's mean, or for a lumen closed at it): a
-  // linearisation's conductance, in float.
+  // linearisation's conductance, in float. Over ranks the lead's alone, as the marks below.
   std::vector<float> steady_resistance_;
+  bool balances_ = false;                  // whether the run has a steady solution (every rank alike)
   std::vector<double> cycle_volume_;       // per vessel, at the last cycle end
   std::vector<double> cycle_capacitor_;    // the capacitors there, per network outlet
+  bool cycle_marked_ = false;              // whether the marks are set (every rank alike)
+  // The balance's parts: the moves of the nodes and capacitors (the lead's, from the whole
+  // network's volumes), and each rank's own 1D elements and capacitors moved by them.
+  TreePotentials compliance_moves(double period, std::vector<double> mean_pressure, const std::vector<double>& volume,
+                                  const std::vector<double>& area_per_pressure, const std::vector<double>& capacitor_now);
+  void move_compliances(const TreePotentials& move, const std::vector<double>& area_per_pressure,
+                        const std::vector<double>& element_area_per_pressure);
   Eigen::VectorXd decay_, phi1_, phi2_, next_flow_;  // ETD2: e^(-r h), phi1, phi2 per element; scratch
   Eigen::MatrixXd previous_flow_;
   bool have_previous_rate_ = false;
@@ -572,6 +589,8 @@ class PulseSolver {
   // Over ranks: PulseRanks::make_whole, and whether this rank steps each vessel and holds each
   // run outlet's state (the compliance balance's inputs, made whole on every rank).
   std::function<void(std::vector<double>&, const std::vector<unsigned char>&)> make_whole_, lead_whole_;
+  std::function<void(std::vector<double>&)> from_lead_;
+  int lead_rank_ = 0;  // PulseRanks::lead_rank
   // save()'s section "pulse solver", with each boundary's 0D volume and the viscosity factors
   // (whole over ranks).
   // The 1D vessels' evolving state as save() writes it: this rank's, or (spread over ranks) made

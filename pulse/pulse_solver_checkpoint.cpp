@@ -169,6 +169,11 @@ void PulseSolver::restore(CheckpointReader& in) {
     in.fail("outlets of another network");
   if (rcr_outlets_ && !cycle_volume_.empty() && cycle_capacitor_.size() != outlet_count_)
     in.fail("outlets of another network");
+  cycle_marked_ = !cycle_volume_.empty();
+  if (!leads()) {  // over ranks the marks are the lead's (compliance_balance.cpp)
+    std::vector<double>().swap(cycle_volume_);
+    std::vector<double>().swap(cycle_capacitor_);
+  }
   const std::vector<double> ends = in.get_vector();
   if (ends.size() != 4 * net_.vessel_count()) in.fail("vessel ends of another network");
   for (std::size_t v = 0; v < net_.vessel_count(); ++v)

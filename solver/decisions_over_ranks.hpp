@@ -20,8 +20,8 @@ namespace hemotree {
 int interrupt_on_any_rank(int signal);
 // The largest over the ranks: the slowest rank's seconds.
 double largest_on_ranks(double value);
-// Rank 0's values (any length) on every rank: the last cycle's mean pressures, which the
-// compliance balance takes whole and only rank 0 holds.
+// Rank 0's values (any length) on every rank: what rank 0 alone computes from the whole
+// cycle's results (the compliance balance's moves, the red cells' change).
 void take_lead_values(std::vector<double>& values);
 // Rank 0's text (any length: a checkpoint's bytes) on every rank.
 void take_lead_text(std::string& text);

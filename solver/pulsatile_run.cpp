@@ -491,8 +491,8 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       begin_snapshot();
       std::vector<double>().swap(previous_mean_pressure_);
       if (plan_.balance_compliances) {
-        std::vector<double> mean_pressure = mean_pressures(last_.vessels);
-        if (over_ranks_) take_lead_values(mean_pressure);
+        // (The balance is solved by the lead, which alone holds the whole cycle.)
+        std::vector<double> mean_pressure = solver_.leads() ? mean_pressures(last_.vessels) : std::vector<double>();
         set_aside_last_vessels();
         if (solver_.balance_compliances(period, std::move(mean_pressure)) > 0) ++balances_;
       } else {

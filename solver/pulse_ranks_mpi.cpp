@@ -87,6 +87,7 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDL
     for (std::size_t k = 0; k < values.size(); ++k) place[k] = mine[k] ? static_cast<std::int32_t>(k) : -1;
     gather_places(values, place, values.size(), values);
   };
+  ranks_.from_lead = [](std::vector<double>& values) { take_lead_values(values); };  // rank 0's, as lead_whole's
   ranks_.make_whole = [](std::vector<double>& values, const std::vector<unsigned char>& mine) {
     // Every rank's (item, value) pairs to every rank.
     std::vector<double> pairs;

@@ -39,8 +39,9 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   if (over_ranks) check_solution_on_every_rank(solver);
   else solver.check_solution();
   solver.release_step_arrays();
-  std::vector<double> mean_pressure = mean_pressures(stats.close(solver).vessels);  // the rest freed here
-  if (over_ranks) take_lead_values(mean_pressure);  // rank 0 alone has the whole cycle
+  // The rest freed here; the balance is the lead's, which alone holds the whole cycle.
+  std::vector<double> mean_pressure = mean_pressures(stats.close(solver).vessels);
+  if (!solver.leads()) std::vector<double>().swap(mean_pressure);
   solver.balance_compliances(period, std::move(mean_pressure));
   solver.set_time_step(run_step);
   solver.set_coupling_passes(run_passes);
