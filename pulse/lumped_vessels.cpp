@@ -905,6 +905,7 @@ void LumpedVessels::sample(double x, std::span<double> area, std::span<double> f
 
 void LumpedVessels::centre_batch(std::size_t first, std::size_t n, CentreBatch& batch) const {
   batch.n = n;
+  batch.first = first;
   if (sectioned()) {
     for (std::size_t i = 0; i < n; ++i) {
       const auto index = static_cast<std::int32_t>(first + i);

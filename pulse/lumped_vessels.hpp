@@ -92,6 +92,7 @@ class LumpedVessels {
 
   bool empty() const { return vessels_.empty(); }
   std::size_t vessel_count() const { return vessels_.size(); }
+  std::size_t network_vessel(std::size_t index) const { return static_cast<std::size_t>(vessels_[index]); }  // its network index
   std::size_t node_count() const { return nodes_; }  // network nodes of 0D vessels, capacitors, inner nodes
   // Whether any 0D vessel is more than one pi section (then inner nodes hold volume that no
   // network node does: a transport of the network's nodes cannot take it).
@@ -232,6 +233,7 @@ class LumpedVessels {
   struct CentreBatch {
     static constexpr std::size_t width = 8;
     std::size_t n = 0;                 // vessels in the batch
+    std::size_t first = 0;             // the first's index here (its place among vessel_count())
     std::size_t vessel[width] = {};    // their network indices
     double flow[width] = {}, pressure[width] = {}, area[width] = {};
   };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <mpi.h>
@@ -76,7 +77,8 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
   });
 }
 
-void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary) {
+void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary,
+                          std::span<const std::int32_t> entry_vessel) {
   constexpr std::size_t width = 10;  // VesselCycle's eight numbers, the two wave speeds
   // A block of the vessels at a time, so that a rank's rows are a block's, not its whole share's
   // (rank 0's receiving is bounded by gather_rows' rounds). Each vessel placed from its row:
@@ -88,16 +90,28 @@ void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSu
   // Rank 0's rows are copies: every vessel's entry is written in place from its rank's row (each
   // vessel is stepped by one rank), and the 1D vessels' wave speeds kept as they come.
   std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
+  // By entry: this rank's own vessels' entries in the vessels' order, for the blocks.
+  std::vector<std::pair<std::int32_t, std::int32_t>> own;  // (vessel, entry)
+  for (std::size_t k = 0; k < entry_vessel.size(); ++k)
+    if (solver.steps_vessel(static_cast<std::size_t>(entry_vessel[k]))) own.emplace_back(entry_vessel[k], static_cast<std::int32_t>(k));
+  std::ranges::sort(own);
+  auto next_own = own.begin();
+  auto add_row = [&](std::size_t v, const VesselCycle& c) {
+    const WaveSpeeds w = summary.wave_speeds(v);
+    mine.push_back(static_cast<std::int32_t>(v));
+    rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
+                             c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
+  };
   for (std::size_t first = 0; first < n; first += block) {
     mine.clear();
     rows.clear();
-    for (std::size_t v = first; v < std::min(n, first + block); ++v) {
-      if (!solver.steps_vessel(v)) continue;
-      const VesselCycle& c = summary.vessels[v];
-      const WaveSpeeds w = summary.wave_speeds(v);
-      mine.push_back(static_cast<std::int32_t>(v));
-      rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
-                               c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
+    const std::size_t last = std::min(n, first + block);
+    if (entry_vessel.empty()) {
+      for (std::size_t v = first; v < last; ++v)
+        if (solver.steps_vessel(v)) add_row(v, summary.vessels[v]);
+    } else {
+      for (; next_own != own.end() && static_cast<std::size_t>(next_own->first) < last; ++next_own)
+        add_row(static_cast<std::size_t>(next_own->first), summary.vessels[static_cast<std::size_t>(next_own->second)]);
     }
     gather_rows(mine, rows, width, n, [&](std::int32_t vessel, const double* f) {
       const auto v = static_cast<std::size_t>(vessel);

@@ -29,8 +29,11 @@ Eigen::VectorXd boundary_volumes_over_ranks(const PulseSolver& solver);
 void gather_vessel_values(const Network& net, const PulseSolver& solver, std::span<std::vector<double>* const> values);
 
 // Every vessel's cycle results, and the wave speeds of the 1D vessels, from the rank that steps
-// the vessel, into rank 0's `summary` (which holds this rank's own before the call: the ghosts'
-// and other ranks' entries are replaced). Elsewhere the summary is left as it is.
-void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary);
+// the vessel, into rank 0's `summary` (which holds this rank's own before the call, by vessel:
+// the ghosts' and other ranks' entries are replaced). Elsewhere the summary is left as it is;
+// its vessels' results are then each entry_vessel's where that is given (own-sized: the
+// ghosts' entries are not sent), else by vessel.
+void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary,
+                          std::span<const std::int32_t> entry_vessel = {});
 
 }  // namespace hemotree

@@ -28,6 +28,8 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, double analysis_frequency)
     : net_(net), omega_(2 * std::numbers::pi * analysis_frequency),
       one_d_(solver.one_d_vessels()) {
+  by_entry_ = solver.over_ranks() && !solver.leads();
+  lumped_entries_ = solver.lumped().vessel_count();
   const std::size_t n = one_d_.size();
   for (auto* sums : {&p_in_, &p_out_, &u_in_, &u_out_}) sums->assign(n, 0.0);
   first_.assign(4 * n, 0.0);
@@ -37,7 +39,7 @@ CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, 
 }
 
 void CycleStatistics::start_sums() {
-  const std::size_t n = net_.vessel_count();
+  const std::size_t n = by_entry_ ? lumped_entries_ + one_d_.size() : net_.vessel_count();
   constexpr double infinity = std::numeric_limits<double>::infinity();
   VesselCycle start;
   start.systolic_pressure = start.peak_flow = -infinity;
@@ -72,8 +74,8 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
   auto centre_values = [&](std::size_t v, double a, double q) {
     return CentreValues{q / a, solver.viscosity(v, a), std::sqrt(a / std::numbers::pi)};
   };
-  auto add_centre = [&](std::size_t v, const CentreValues& c, double q, double p, double mean_q) {
-    VesselCycle& s = sums_[v];
+  auto add_centre = [&](std::size_t entry, const CentreValues& c, double q, double p, double mean_q) {
+    VesselCycle& s = sums_[entry];
     s.mean_flow += weight * mean_q;
     s.mean_pressure += weight * p;
     s.diastolic_pressure = std::min(s.diastolic_pressure, p);
@@ -92,7 +94,7 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
     parallel_blocks(static_cast<std::int64_t>(one_d_.size()), threads, [&](std::int64_t first, std::int64_t last) {
       for (auto j = static_cast<std::size_t>(first); j < static_cast<std::size_t>(last); ++j) {
         const auto v = static_cast<std::size_t>(one_d_[j]);
-        add_centre(v, centre_values(v, area_[j], q_[j]), q_[j], p_[j], solver.mean_flow(v));
+        add_centre(by_entry_ ? lumped_entries_ + j : v, centre_values(v, area_[j], q_[j]), q_[j], p_[j], solver.mean_flow(v));
         p_in_[j] += phase * p_end_[j];
         u_in_[j] += phase * (q_end_[j] / area_end_[j]);
         p_out_[j] += phase * p_out_end_[j];
@@ -106,7 +108,8 @@ void CycleStatistics::sample(const PulseSolver& solver, double t, double weight)
       [&](const LumpedVessels::CentreBatch& b) {
         CentreValues c[LumpedVessels::CentreBatch::width];
         for (std::size_t i = 0; i < b.n; ++i) c[i] = centre_values(b.vessel[i], b.area[i], b.flow[i]);
-        for (std::size_t i = 0; i < b.n; ++i) add_centre(b.vessel[i], c[i], b.flow[i], b.pressure[i], b.flow[i]);
+        for (std::size_t i = 0; i < b.n; ++i)
+          add_centre(by_entry_ ? b.first + i : b.vessel[i], c[i], b.flow[i], b.pressure[i], b.flow[i]);
       },
       threads);
 }
@@ -171,8 +174,16 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   }
   std::ranges::sort(summary.waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
   duration_ = 0;
-  if (over_ranks) gather_cycle_vessels(net_, solver, summary);  // rank 0's: every vessel's
+  // Rank 0's: every vessel's (by vessel); every other rank's stay its own, by entry.
+  if (over_ranks) gather_cycle_vessels(net_, solver, summary, by_entry_ ? entry_vessels(solver) : std::vector<std::int32_t>());
   return summary;
+}
+
+std::vector<std::int32_t> CycleStatistics::entry_vessels(const PulseSolver& solver) const {
+  std::vector<std::int32_t> vessel(lumped_entries_ + one_d_.size());
+  for (std::size_t e = 0; e < lumped_entries_; ++e) vessel[e] = static_cast<std::int32_t>(solver.lumped().network_vessel(e));
+  std::copy(one_d_.begin(), one_d_.end(), vessel.begin() + static_cast<std::ptrdiff_t>(lumped_entries_));
+  return vessel;
 }
 
 WaveSpeeds CycleSummary::wave_speeds(std::size_t vessel) const {

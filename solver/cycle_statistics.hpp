@@ -97,7 +97,13 @@ class CycleStatistics {
   // sums until close() divides them by the duration, the extremes their extremes so far. The
   // sums become the results where they lie: no second per-vessel array at the cycle's end,
   // the run's largest moment (80 B a vessel on it).
+  // By vessel, alone and on the lead over ranks (which gathers every vessel's); on every other
+  // rank by entry, its own size: its 0D system's vessels in their order, then its 1D vessels
+  // (entry()), and close()'s summary the same.
   std::vector<VesselCycle> sums_;
+  bool by_entry_ = false;
+  std::size_t lumped_entries_ = 0;  // the 0D system's vessels (its halo's and ghosts' too)
+  std::vector<std::int32_t> entry_vessels(const PulseSolver& solver) const;  // each entry's vessel
   // The sums at their starts (0, the extremes at -+infinity): made at a cycle's first sample
   // (or its close, if none), handed over as the results when it closes.
   void start_sums();

@@ -483,8 +483,9 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       last_ = stats_.close(solver_);
       if (series) series->finish();
       has_previous_ = !previous_mean_pressure_.empty();
-      if (has_change()) change_ = cycle_change(previous_mean_pressure_, last_.vessels);
-      if (has_change() && over_ranks_) change_ = lead_change(change_);  // rank 0 alone has the whole cycle
+      // Rank 0 alone has the whole cycle (the others their own vessels', by entry: CycleStatistics).
+      if (has_change()) change_ = writes_ ? cycle_change(previous_mean_pressure_, last_.vessels) : PeriodicityChange{};
+      if (has_change() && over_ranks_) change_ = lead_change(change_);
       // The cycle's results go to the snapshot, and from memory (but their mean pressures,
       // which the balance and the next cycle end read) before the balance; the previous
       // cycle's mean pressures have served.

@@ -3,7 +3,8 @@
 // rank 0 holds every vessel's results, the 1D vessels' wave speeds, every boundary's mean
 // flow, the in- and outflow, the volume change and the mass balance with the bits of the
 // one-process run's statistics (which every rank also takes here, alone); and the probes,
-// each sampled by the rank that steps its vessel, give rank 0 the one-process probes.csv rows. Exit 0 when every
+// each sampled by the rank that steps its vessel, give rank 0 the one-process probes.csv rows;
+// every other rank keeps its own vessels' results alone, by entry. Exit 0 when every
 // rank agrees, 1 otherwise, one line per failure on stderr.
 #include <cstdint>
 #include <cstdio>
@@ -85,6 +86,24 @@ int main(int argc, char** argv) {
       check(same_bits(a.conservation_error, b.conservation_error) && a.inflow_measured == b.inflow_measured,
             "the mass balance differs: " + std::to_string(a.conservation_error) + " and " + std::to_string(b.conservation_error));
       check(a.volume_change != 0 && a.inlet_mean_flow > 0, "nothing moved");
+    } else {
+      // Every other rank holds its own vessels' results alone, by entry: its 0D system's
+      // vessels in their order, then its 1D vessels (64 B an own vessel, not a network's).
+      const LumpedVessels& lumped = mine.lumped();
+      const std::size_t entries = lumped.vessel_count() + mine.one_d_vessels().size();
+      check(b.vessels.size() == entries && entries < net.vessel_count(),
+            "rank " + std::to_string(rank) + " holds " + std::to_string(b.vessels.size()) + " vessels' results, not its " +
+                std::to_string(entries) + " entries");
+      std::size_t differ = 0, own = 0;
+      for (std::size_t e = 0; e < entries && e < b.vessels.size(); ++e) {
+        const std::size_t v = e < lumped.vessel_count() ? lumped.network_vessel(e)
+                                                        : static_cast<std::size_t>(mine.one_d_vessels()[e - lumped.vessel_count()]);
+        if (!mine.steps_vessel(v)) continue;  // a ghost's entry: not its own
+        ++own;
+        differ += !same_bits(a.vessels[v].mean_pressure, b.vessels[e].mean_pressure) + !same_bits(a.vessels[v].peak_flow, b.vessels[e].peak_flow);
+      }
+      check(differ == 0 && own > 0, "rank " + std::to_string(rank) + ": " + std::to_string(differ) + " of its " +
+                                        std::to_string(own) + " own vessels' results differ from the whole run's");
     }
   }
   const int failures = rank_checks::all_failures();
