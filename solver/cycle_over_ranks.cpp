@@ -80,10 +80,11 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
 void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary,
                           std::span<const std::int32_t> entry_vessel) {
   constexpr std::size_t width = 10;  // VesselCycle's eight numbers, the two wave speeds
-  // A block of the vessels at a time, so that a rank's rows are a block's, not its whole share's
-  // (rank 0's receiving is bounded by gather_rows' rounds). Each vessel placed from its row:
-  // the same bits.
-  constexpr std::size_t block = std::size_t{1} << 20;
+  // A block of the vessels at a time, so that a rank's rows are a block's (at most 5 MB), not its
+  // whole share's: 80 B an own vessel would be more than its sums themselves, a share's largest
+  // moment (rank 0's receiving is bounded by gather_rows' rounds). Each vessel placed from its
+  // row: the same bits.
+  constexpr std::size_t block = std::size_t{1} << 16;
   const std::size_t n = net.vessel_count();
   std::vector<std::int32_t> mine;
   std::vector<double> rows;
@@ -102,6 +103,8 @@ void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSu
     rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
                              c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
   };
+  mine.reserve(block);
+  rows.reserve(block * width);
   for (std::size_t first = 0; first < n; first += block) {
     mine.clear();
     rows.clear();
