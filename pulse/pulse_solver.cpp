@@ -13,6 +13,7 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/errors.hpp"
 #include "core/setting_error.hpp"
@@ -125,7 +126,10 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   // those arrays are the set-up's two largest parts, and need not be held at once.
   started_from_steady_ = options.start != StartChoice::rest && steady;
   std::optional<PeriodicInstant> instant;
-  if (started_from_steady_ && options.start == StartChoice::periodic) {
+  // Over ranks the lead alone solves it, whole, and sends every rank its start (below): its
+  // workspace, about 120 B a vessel, was every rank's largest moment.
+  const bool lead = !ranks || ranks->rank == ranks->lead_rank;
+  if (started_from_steady_ && options.start == StartChoice::periodic && lead) {
     // Where the linear periodic state cannot be formed (a harmonic's system singular where
     // the steady one is not: no input is known to reach this, and the default start should
     // not be what fails a run), the run keeps the steady start and says why.
@@ -162,15 +166,18 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   if (started_from_steady_) {
     start_from_steady_flow(*steady);
     started_from_ = StartChoice::steady;
+    bool periodic = false;
     if (instant) {
       try {
         start_from_periodic(*instant);
-        started_from_ = StartChoice::periodic;
+        periodic = true;
       } catch (const InputError& e) {
         periodic_refusal_ = e.what();
       }
-      instant.reset();
     }
+    if (ranks && options.start == StartChoice::periodic) periodic = take_lead_start(ranks->from_lead, periodic, instant);
+    if (periodic) started_from_ = StartChoice::periodic;
+    instant.reset();
   } else {
     start_at_rest();
   }
@@ -631,6 +638,33 @@ void PulseSolver::start_from_periodic(const PeriodicInstant& instant) {
     const double q = (o.end.distal ? 1.0 : -1.0) * periodic.flow_at(v, s, time_);
     state_.capacitor(o.capacitor) = periodic.pressure_at(v, s, time_) - o.outlet.r1 * q;
   }
+}
+
+bool PulseSolver::take_lead_start(const std::function<void(std::vector<double>&)>& from_lead, bool started,
+                                  const std::optional<PeriodicInstant>& instant) {
+  // The lead's outcome, then what its start_from_periodic set: the 0D system's start (its
+  // nodes' pressures and vessels' flows, every one's: each rank takes its own and its ghosts')
+  // and the 1D vessels' coefficients and capacitors (every rank holds every 1D vessel's rows).
+  std::vector<double> outcome{started ? 1.0 : 0.0};
+  from_lead(outcome);
+  if (outcome[0] == 0) return false;
+  const bool lead = instant.has_value();
+  std::vector<double> node_pressure = lead ? instant->node_pressure : std::vector<double>();
+  std::vector<double> middle_flow = lead ? instant->middle_flow : std::vector<double>();
+  from_lead(node_pressure);
+  from_lead(middle_flow);
+  if (!lead) lumped_.start(node_pressure, middle_flow);
+  auto take = [&](double* data, Eigen::Index size) {
+    std::vector<double> values(data, data + size);
+    from_lead(values);
+    if (values.size() != static_cast<std::size_t>(size))  // every rank lays out every 1D element alike
+      throw std::logic_error("PulseSolver::take_lead_start: the lead's 1D state has another size");
+    std::copy(values.begin(), values.end(), data);
+  };
+  take(state_.area.data(), state_.area.size());
+  take(state_.flow.data(), state_.flow.size());
+  take(state_.capacitor.data(), state_.capacitor.size());
+  return true;
 }
 
 void PulseSolver::start_from(const PulseSolver& other) {

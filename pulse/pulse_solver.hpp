@@ -423,6 +423,10 @@ class PulseSolver {
   void start_from_steady_flow(const SteadyFlow& steady);
   // Then the linear periodic state about it at t = 0: pressures and flows along every vessel.
   void start_from_periodic(const PeriodicInstant& instant);
+  // Over ranks, the lead's periodic start (instant: the lead's, none elsewhere) on every rank;
+  // whether it took one (started: the lead's own outcome). Collective.
+  bool take_lead_start(const std::function<void(std::vector<double>&)>& from_lead, bool started,
+                       const std::optional<PeriodicInstant>& instant);
   std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
   void start_at_rest();
   // steady: the network's steady flow, or null where it has none.

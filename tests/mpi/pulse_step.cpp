@@ -3,7 +3,7 @@
 // every vessel above them on the top's rank, and whose 0D vessels are cut into whole subtrees;
 // after every step, and after two compliance balances, each rank's 0D vessels and, on the
 // top's rank, the 1D vessels' whole state are the one-process solver's bits (which every rank
-// also steps here, alone). Exit 0 when
+// also steps here, alone); so is every rank's periodic start, the lead's sent. Exit 0 when
 // every rank agrees, 1 otherwise, one line per failure on stderr.
 #include <cstdint>
 #include <cstdio>
@@ -72,6 +72,33 @@ int main(int argc, char** argv) {
     check(mine.time() == whole.time(), "another time than the whole run's");
     check(moved == net.vessel_count(), "the balance moved " + std::to_string(moved) + " vessels");
     if (rank == 0) std::printf("%zu vessels (%zu 1D), %zu steps of %d substeps\n", net.vessel_count(), one_d, mine.steps(), mine.substeps());
+  }
+  {
+    // The periodic start, which the lead alone solves and sends (PulseSolver::take_lead_start):
+    // every rank's vessels, and the 1D state, the one-process start's bits, and then a step.
+    const Network net = test_networks::tree_with_waves();
+    SolverOptions options = test_networks::options_over_ranks();
+    options.start = StartChoice::periodic;
+    PulseSolver whole(net, options);
+    MpiPulseRanks over_ranks(net, std::vector<double>(net.vessel_count(), 1.0));
+    PulseSolver mine(net, options, &over_ranks.ranks());
+    check(whole.started_from() == StartChoice::periodic && mine.started_from() == StartChoice::periodic,
+          "not started from the periodic state");
+    std::size_t differ = 0;
+    for (int n = 0; n < 2; ++n) {
+      for (std::size_t v = 0; v < net.vessel_count(); ++v) {
+        if (!mine.steps_vessel(v)) continue;
+        for (const double x : {0.0, 0.5, 1.0})
+          differ += !same_bits(mine.pressure_at(v, x), whole.pressure_at(v, x)) + !same_bits(mine.flow_at(v, x), whole.flow_at(v, x));
+      }
+      if (n == 0 || mine.holds_one_d()) {  // at the start every rank holds every 1D vessel's rows
+        differ += mine.state().area != whole.state().area;
+        differ += mine.state().flow != whole.state().flow;
+      }
+      whole.step();
+      mine.step();
+    }
+    check(differ == 0, std::to_string(differ) + " numbers of the periodic start differ from the whole run's");
   }
   const int failures = rank_checks::all_failures();
   if (rank == 0 && failures == 0) std::printf("pulsatile steps over %d ranks: the whole run's bits\n", ranks);
