@@ -150,31 +150,6 @@ std::vector<std::int32_t> steady_outlets(const Network& net) {
 
 namespace {
 
-// The steady flow as the nodal system of the network's node pressures (flow_network.hpp):
-// each vessel an edge of conductance 1/R, each outlet a shunt 1/R to its outflow pressure
-// (b += p_out / R), flows injected at their nodes, prescribed pressures eliminated. The
-// graph, the boundaries and the checks are set once; every solve refactorises (the distended
-// iteration changes the resistances each sweep).
-class SteadySystem {
- public:
-  explicit SteadySystem(const Network& net);
-  SteadyFlow solve(const std::vector<double>& resistance, double inlet_flow) {
-    SteadyFlow s;
-    solve(resistance, inlet_flow, s);
-    return s;
-  }
-  // Into `s`, its arrays kept where they have their size: an iteration's solves then touch no
-  // fresh memory (on the full tree, 90 MB a sweep made afresh were half the iteration's time).
-  void solve(const std::vector<double>& resistance, double inlet_flow, SteadyFlow& s);
-  void set_threads(int threads) { system_->set_threads(threads); }
-
- private:
-  const Network& net_;
-  SteadyRows rows_;
-  std::vector<double> conductance_;         // per vessel
-  std::vector<double> inflow_with_inlet_;   // per node: the rows' inflow and the inlet's
-  std::unique_ptr<FlowNetwork> system_;
-};
 
 // Each condition's row (boundaries/), the tree's inflow left to solve()'s inlet_flow.
 template <class Conditions>
@@ -259,12 +234,22 @@ SteadyRows boundary_rows(const Network& part) {
   return rows;
 }
 
-namespace {
-
-SteadySystem::SteadySystem(const Network& net) : net_(net), rows_(steady_rows(net)) {
+SteadyFlowSolver::SteadyFlowSolver(const Network& net) : net_(net), rows_(steady_rows(net)) {
   system_ = std::make_unique<FlowNetwork>(net.node_count(), net.from, net.to, rows_.prescribed);
   conductance_.resize(net.vessel_count());
 }
+
+SteadyFlowSolver::~SteadyFlowSolver() = default;
+
+SteadyFlow SteadyFlowSolver::solve(const std::vector<double>& resistance, double inlet_flow) {
+  SteadyFlow s;
+  solve(resistance, inlet_flow, s);
+  return s;
+}
+
+void SteadyFlowSolver::set_threads(int threads) { system_->set_threads(threads); }
+
+namespace {
 
 void check_tree_form(const Network& net, SteadyRows& rows) {
   const std::size_t n = net.vessel_count(), nodes = net.node_count();
@@ -357,7 +342,10 @@ void check_node_form(const Network& net, const std::vector<NodeBoundary>& bounda
     throw SettingError("pressure_at", refusal);
 }
 
-void SteadySystem::solve(const std::vector<double>& resistance, double inlet_flow, SteadyFlow& s) {
+
+}  // namespace
+
+void SteadyFlowSolver::solve(const std::vector<double>& resistance, double inlet_flow, SteadyFlow& s) {
   const std::size_t n = net_.vessel_count();
   if (resistance.size() != n)
     throw std::invalid_argument("solve_steady_flow: " + std::to_string(resistance.size()) + " resistances for " +
@@ -378,11 +366,9 @@ void SteadySystem::solve(const std::vector<double>& resistance, double inlet_flo
                  s.node_pressure[static_cast<std::size_t>(net_.to[v])]) / resistance[v];
 }
 
-}  // namespace
-
 SteadyFlow solve_steady_flow(const Network& net, const std::vector<double>& resistance,
                              double inlet_flow, std::vector<Equivalent>* beyond) {
-  SteadyFlow s = SteadySystem(net).solve(resistance, inlet_flow);
+  SteadyFlow s = SteadyFlowSolver(net).solve(resistance, inlet_flow);
   if (beyond) *beyond = reduce_beyond(net, resistance);
   return s;
 }
@@ -397,7 +383,7 @@ SteadyFlow solve_distended_steady_flow(const Network& net, const Blood& blood, s
                                        const ViscosityTable& viscosity, double inlet_flow,
                                        std::vector<double>* resistance, int threads) {
   std::vector<double> r = vessel_resistances(net, blood, {}, threads);
-  SteadySystem system(net);
+  SteadyFlowSolver system(net);
   system.set_threads(threads);
   const DistendedPart whole{{},
                             {},

@@ -221,8 +221,9 @@ SteadyHematocritResult solve_steady_with_phase_separation(const Network& net, co
   std::vector<double> h(net.vessel_count(), blood.hematocrit);
   std::vector<double> previous_flow;
   SteadyHematocritResult result;
+  SteadyFlowSolver system(net);  // its pattern analysed once for every pass
   for (int it = 1; it <= max_iterations; ++it) {
-    SteadyFlow s = solve_steady_flow(net, vessel_resistances(net, blood, h), inlet_flow);
+    SteadyFlow s = system.solve(vessel_resistances(net, blood, h), inlet_flow);
     HematocritPass pass = hematocrit_pass(net, blood, s, h, previous_flow);
     result.iterations = it;
     result.change = pass.change;
