@@ -1,6 +1,6 @@
 // A rank's share of a tree network's steady system over MPI ranks: its nodes, its vessels
 // (each of its nodes' to its parent), each node's shunt and inflow from steady_rows (the
-// inlet's flow added as the one-process SteadySystem adds it), and a solve with given
+// inlet's flow added as the one-process SteadyFlowSolver adds it), and a solve with given
 // resistances by the distributed elimination (distributed/mpi_tree_system.hpp) that leaves the
 // pressures and flows this rank holds, each by the one-process system's arithmetic. The steady
 // flow over ranks solves it once with the rigid resistances, the distended state once a sweep.
