@@ -4,6 +4,8 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <mpi.h>
 #include <petscksp.h>
@@ -50,10 +52,13 @@ void PetscFlowNetwork::make(std::span<const double> local_rhs) {
   const auto local = static_cast<std::size_t>(rows_);
   const auto n = static_cast<PetscInt>(rows_), all = static_cast<PetscInt>(all_rows_);
   std::vector<PetscInt> in_block(local, 1), off_block(local, 0);  // the diagonal, an entry per edge to a free node
+  std::vector<std::pair<PetscInt, PetscInt>> off_diagonal;          // those entries' (row, column)
   for (std::size_t e = 0; e < a_.size(); ++e)
     for (const bool from_a : {true, false}) {
       const auto i = static_cast<std::size_t>(from_a ? a_[e] : b_[e]), j = static_cast<std::size_t>(from_a ? b_[e] : a_[e]);
-      if (mine(i) && !prescribed_[j]) (owner_[j] == rank ? in_block : off_block)[static_cast<std::size_t>(row_[i] - first_row_)] += 1;
+      if (!mine(i) || prescribed_[j]) continue;
+      (owner_[j] == rank ? in_block : off_block)[static_cast<std::size_t>(row_[i] - first_row_)] += 1;
+      off_diagonal.emplace_back(static_cast<PetscInt>(row_[i]), static_cast<PetscInt>(row_[j]));
     }
   PetscObjects& o = *held_;
   o.matrix = petsc_matrix(n, all, std::move(in_block), std::move(off_block));  // (parallel edges counted apart: a little over)
@@ -65,13 +70,7 @@ void PetscFlowNetwork::make(std::span<const double> local_rhs) {
     const auto r = static_cast<PetscInt>(first_row_ + static_cast<std::int64_t>(k));
     petsc_check(MatSetValue(o.matrix, r, r, 0.0, ADD_VALUES), "MatSetValue");
   }
-  for (std::size_t e = 0; e < a_.size(); ++e)
-    for (const bool from_a : {true, false}) {
-      const auto i = static_cast<std::size_t>(from_a ? a_[e] : b_[e]), j = static_cast<std::size_t>(from_a ? b_[e] : a_[e]);
-      if (mine(i) && !prescribed_[j])
-        petsc_check(MatSetValue(o.matrix, static_cast<PetscInt>(row_[i]), static_cast<PetscInt>(row_[j]), 0.0, ADD_VALUES),
-                    "MatSetValue");
-    }
+  for (const auto& [row, column] : off_diagonal) petsc_check(MatSetValue(o.matrix, row, column, 0.0, ADD_VALUES), "MatSetValue");
   const PC preconditioner = petsc_prepare(o, local_rhs, KSPCG);
   petsc_check(VecSet(o.x, 0.0), "VecSet");  // the first solve's start
   petsc_check(PCSetType(preconditioner, PCHYPRE), "PCSetType");

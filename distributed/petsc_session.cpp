@@ -66,23 +66,28 @@ Mat petsc_matrix(PetscInt rows, PetscInt all, std::vector<PetscInt> in_block, st
   return matrix;
 }
 
-void petsc_refill(PetscObjects& o, std::span<const double> local_rhs) {
-  petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-  petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+namespace {
+void assemble(Mat matrix) {
+  petsc_check(MatAssemblyBegin(matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  petsc_check(MatAssemblyEnd(matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+}
+void set_rhs(Vec rhs, std::span<const double> local_rhs) {
   PetscScalar* values = nullptr;
-  petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
+  petsc_check(VecGetArray(rhs, &values), "VecGetArray");
   std::copy(local_rhs.begin(), local_rhs.end(), values);
-  petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+  petsc_check(VecRestoreArray(rhs, &values), "VecRestoreArray");
+}
+}  // namespace
+
+void petsc_refill(PetscObjects& o, std::span<const double> local_rhs) {
+  assemble(o.matrix);
+  set_rhs(o.rhs, local_rhs);
 }
 
 PC petsc_prepare(PetscObjects& o, std::span<const double> local_rhs, KSPType type) {
-  petsc_check(MatAssemblyBegin(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-  petsc_check(MatAssemblyEnd(o.matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  assemble(o.matrix);
   petsc_check(MatCreateVecs(o.matrix, &o.x, &o.rhs), "MatCreateVecs");
-  PetscScalar* values = nullptr;
-  petsc_check(VecGetArray(o.rhs, &values), "VecGetArray");
-  std::copy(local_rhs.begin(), local_rhs.end(), values);
-  petsc_check(VecRestoreArray(o.rhs, &values), "VecRestoreArray");
+  set_rhs(o.rhs, local_rhs);
   petsc_check(KSPCreate(PETSC_COMM_WORLD, &o.solver), "KSPCreate");
   petsc_check(KSPSetOperators(o.solver, o.matrix, o.matrix), "KSPSetOperators");
   petsc_check(KSPSetType(o.solver, type), "KSPSetType");

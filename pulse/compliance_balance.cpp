@@ -41,7 +41,7 @@ std::vector<double> PulseSolver::vessel_volumes() const {
 }
 
 std::size_t PulseSolver::balance_compliances(double period, std::vector<double> mean_pressure) {
-  if (!balances_) return 0;
+  if (!can_balance_) return 0;
   const std::size_t n = net_.vessel_count();
   // Each vessel's volume and dA/dp at its mean area, now: over ranks the lead's whole, every
   // other rank's for its own vessels (what it moves).

@@ -63,6 +63,11 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   threads_ = options.threads;
   friction_k_ = friction_coefficient(blood_.alpha);
   const std::size_t n = net.vessel_count();
+  if (ranks) {  // who leads (leads()): the lead alone solves the periodic start and the balances
+    rank_ = ranks->rank;
+    from_lead_ = ranks->from_lead;
+    lead_rank_ = ranks->lead_rank;
+  }
 
   // Each vessel's tube law (steady/vessel_laws.hpp); a tapered vessel's along it.
   laws_ = vessel_laws(net, blood_, options.external_pressure, options.thick_wall_ratio);
@@ -128,8 +133,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   std::optional<PeriodicInstant> instant;
   // Over ranks the lead alone solves it, whole, and sends every rank its start (below): its
   // workspace, about 120 B a vessel, was every rank's largest moment.
-  const bool lead = !ranks || ranks->rank == ranks->lead_rank;
-  if (started_from_steady_ && options.start == StartChoice::periodic && lead) {
+  if (started_from_steady_ && options.start == StartChoice::periodic && leads()) {
     // Where the linear periodic state cannot be formed (a harmonic's system singular where
     // the steady one is not: no input is known to reach this, and the default start should
     // not be what fails a run), the run keeps the steady start and says why.
@@ -150,8 +154,6 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
     one_d_first_element_.push_back(static_cast<std::int32_t>(j) * elements_per_vessel_);
   if (ranks) {
     take_rank_share(*ranks, options);
-    from_lead_ = ranks->from_lead;
-    lead_rank_ = ranks->lead_rank;
     if (!leads()) std::vector<float>().swap(steady_resistance_);  // the balance is the lead's
   } else
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
@@ -175,7 +177,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
         periodic_refusal_ = e.what();
       }
     }
-    if (ranks && options.start == StartChoice::periodic) periodic = take_lead_start(ranks->from_lead, periodic, instant);
+    if (ranks && options.start == StartChoice::periodic) periodic = take_lead_start(periodic, instant);
     if (periodic) started_from_ = StartChoice::periodic;
     instant.reset();
   } else {
@@ -209,7 +211,7 @@ std::optional<SteadyFlow> PulseSolver::solve_steady_flow() {
     steady = solve_distended_steady_flow(net, blood_, laws_, viscosity_, net.inlet ? net.inlet->waveform.mean_value() : 0.0,
                                          &resistance, threads_);
     steady_resistance_.assign(resistance.begin(), resistance.end());
-    balances_ = true;
+    can_balance_ = true;
   } catch (const InputError& e) {
     steady_refusal_ = e.what();
   }
@@ -640,23 +642,21 @@ void PulseSolver::start_from_periodic(const PeriodicInstant& instant) {
   }
 }
 
-bool PulseSolver::take_lead_start(const std::function<void(std::vector<double>&)>& from_lead, bool started,
-                                  const std::optional<PeriodicInstant>& instant) {
+bool PulseSolver::take_lead_start(bool started, const std::optional<PeriodicInstant>& instant) {
   // The lead's outcome, then what its start_from_periodic set: the 0D system's start (its
   // nodes' pressures and vessels' flows, every one's: each rank takes its own and its ghosts')
   // and the 1D vessels' coefficients and capacitors (every rank holds every 1D vessel's rows).
   std::vector<double> outcome{started ? 1.0 : 0.0};
-  from_lead(outcome);
+  from_lead_(outcome);
   if (outcome[0] == 0) return false;
-  const bool lead = instant.has_value();
-  std::vector<double> node_pressure = lead ? instant->node_pressure : std::vector<double>();
-  std::vector<double> middle_flow = lead ? instant->middle_flow : std::vector<double>();
-  from_lead(node_pressure);
-  from_lead(middle_flow);
-  if (!lead) lumped_.start(node_pressure, middle_flow);
+  std::vector<double> node_pressure = leads() ? instant->node_pressure : std::vector<double>();
+  std::vector<double> middle_flow = leads() ? instant->middle_flow : std::vector<double>();
+  from_lead_(node_pressure);
+  from_lead_(middle_flow);
+  if (!leads()) lumped_.start(node_pressure, middle_flow);
   auto take = [&](double* data, Eigen::Index size) {
     std::vector<double> values(data, data + size);
-    from_lead(values);
+    from_lead_(values);
     if (values.size() != static_cast<std::size_t>(size))  // every rank lays out every 1D element alike
       throw std::logic_error("PulseSolver::take_lead_start: the lead's 1D state has another size");
     std::copy(values.begin(), values.end(), data);

@@ -425,8 +425,7 @@ class PulseSolver {
   void start_from_periodic(const PeriodicInstant& instant);
   // Over ranks, the lead's periodic start (instant: the lead's, none elsewhere) on every rank;
   // whether it took one (started: the lead's own outcome). Collective.
-  bool take_lead_start(const std::function<void(std::vector<double>&)>& from_lead, bool started,
-                       const std::optional<PeriodicInstant>& instant);
+  bool take_lead_start(bool started, const std::optional<PeriodicInstant>& instant);
   std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
   void start_at_rest();
   // steady: the network's steady flow, or null where it has none.
@@ -572,7 +571,7 @@ class PulseSolver {
   // the balance falls back on (before a cycle's mean, or for a lumen closed at it): a
   // linearisation's conductance, in float. Over ranks the lead's alone, as the marks below.
   std::vector<float> steady_resistance_;
-  bool balances_ = false;                  // whether the run has a steady solution (every rank alike)
+  bool can_balance_ = false;               // whether the run has a steady solution (every rank alike)
   std::vector<double> cycle_volume_;       // per vessel, at the last cycle end
   std::vector<double> cycle_capacitor_;    // the capacitors there, per network outlet
   bool cycle_marked_ = false;              // whether the marks are set (every rank alike)
@@ -590,11 +589,11 @@ class PulseSolver {
   int threads_ = 1;
   bool one_d_here_ = true;  // false on a share of a run over ranks (PulseRanks)
   int rank_ = 0, rank_count_ = 1;  // over ranks: this rank's, of how many
-  // Over ranks: PulseRanks::make_whole, and whether this rank steps each vessel and holds each
-  // run outlet's state (the compliance balance's inputs, made whole on every rank).
+  // Over ranks: PulseRanks' make_whole, lead_whole, from_lead and lead_rank (the compliance
+  // balance's inputs go to the lead, its moves come back from it).
   std::function<void(std::vector<double>&, const std::vector<unsigned char>&)> make_whole_, lead_whole_;
   std::function<void(std::vector<double>&)> from_lead_;
-  int lead_rank_ = 0;  // PulseRanks::lead_rank
+  int lead_rank_ = 0;
   // save()'s section "pulse solver", with each boundary's 0D volume and the viscosity factors
   // (whole over ranks).
   // The 1D vessels' evolving state as save() writes it: this rank's, or (spread over ranks) made
@@ -614,6 +613,7 @@ class PulseSolver {
     std::vector<double> ends;  // per 1D vessel (vessel order): proximal (A, Q), distal (A, Q)
   };
   WholeOneD whole_one_d_state() const;
+  // Over ranks: whether this rank steps each vessel and holds each run outlet's state.
   std::vector<unsigned char> steps_vessel_, holds_outlet_;
   double time_ = 0, dt_ = 0;
   std::string dt_reason_;

@@ -99,7 +99,7 @@ class CycleStatistics {
   // the run's largest moment (80 B a vessel on it).
   // By vessel, alone and on the lead over ranks (which gathers every vessel's); on every other
   // rank by entry, its own size: its 0D system's vessels in their order, then its 1D vessels
-  // (entry()), and close()'s summary the same.
+  // (entry_vessels()), and close()'s summary the same.
   std::vector<VesselCycle> sums_;
   bool by_entry_ = false;
   std::size_t lumped_entries_ = 0;  // the 0D system's vessels (its halo's and ghosts' too)

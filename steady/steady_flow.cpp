@@ -150,7 +150,6 @@ std::vector<std::int32_t> steady_outlets(const Network& net) {
 
 namespace {
 
-
 // Each condition's row (boundaries/), the tree's inflow left to solve()'s inlet_flow.
 template <class Conditions>
 void add_rows(const Network& net, const Conditions& conditions, SteadyRows& out) {
@@ -341,7 +340,6 @@ void check_node_form(const Network& net, const std::vector<NodeBoundary>& bounda
   if (const std::string refusal = pressure_reference_refusal(net, boundaries); !refusal.empty())
     throw SettingError("pressure_at", refusal);
 }
-
 
 }  // namespace
 
