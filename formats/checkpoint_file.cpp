@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <unistd.h>
 
@@ -211,27 +211,106 @@ void CheckpointWriter::put(const Eigen::VectorXd& v) {
 }
 
 CheckpointReader::CheckpointReader(std::string bytes, std::string source)
-    : bytes_(std::move(bytes)), source_(std::move(source)) {
-  const std::string_view start(bytes_.data(), std::min(bytes_.size(), magic.size()));
-  if (bytes_.empty()) fail("empty checkpoint (0 bytes): nothing to resume");
+    : bytes_(std::move(bytes)), source_(std::move(source)), size_(bytes_.size()) {
+  check_header();
+  index_sections();
+}
+
+CheckpointReader::CheckpointReader(const std::filesystem::path& file) : source_(file.string()) {
+  fd_ = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) throw IoError("cannot open " + file.string());
+  struct stat st {};
+  if (::fstat(fd_, &st) != 0 || st.st_size < 0) {
+    ::close(fd_);
+    throw IoError("cannot read " + file.string() + ": " + std::strerror(errno));
+  }
+  size_ = static_cast<std::size_t>(st.st_size);
+  try {
+    check_header();
+    index_sections();
+  } catch (...) {
+    ::close(fd_);
+    throw;
+  }
+}
+
+CheckpointReader::~CheckpointReader() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void CheckpointReader::read_at(std::size_t at, void* data, std::size_t size) const {
+  if (size == 0) return;  // an empty matrix's data() is null, which memcpy must not see
+  if (fd_ < 0) {
+    std::memcpy(data, bytes_.data() + at, size);
+    return;
+  }
+  auto* out = static_cast<char*>(data);
+  if (at >= window_at_ && at + size <= window_at_ + window_.size()) {
+    std::memcpy(out, window_.data() + (at - window_at_), size);
+    return;
+  }
+  constexpr std::size_t piece = std::size_t{1} << 20;
+  const bool small = size < piece / 4;
+  char* into = out;
+  std::size_t want = size;
+  if (small) {  // the window moved here: the values after it come from memory
+    window_.resize(std::min(piece, size_ - at));
+    window_at_ = at;
+    into = window_.data();
+    want = window_.size();
+  }
+  for (std::size_t done = 0; done < want;) {
+    const ssize_t n = ::pread(fd_, into + done, want - done, static_cast<off_t>(at + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      window_.clear();
+      throw IoError("cannot read " + source_ + ": " + (n < 0 ? std::strerror(errno) : "it is shorter than it was"));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (small) std::memcpy(out, window_.data(), size);
+}
+
+std::uint64_t CheckpointReader::word_at(std::size_t at) const {
+  std::uint64_t x;
+  read_at(at, &x, word);
+  return x;
+}
+
+void CheckpointReader::check_header() {
+  std::string start(std::min(size_, magic.size()), '\0');
+  read_at(0, start.data(), start.size());
+  if (size_ == 0) fail("empty checkpoint (0 bytes): nothing to resume");
   if (start != magic.substr(0, start.size())) fail("not a hemosolve checkpoint");
-  if (bytes_.size() < header) fail("truncated checkpoint (" + std::to_string(bytes_.size()) + " bytes)");
-  const std::uint64_t version = word_at(bytes_, magic.size());
+  if (size_ < header) fail("truncated checkpoint (" + std::to_string(size_) + " bytes)");
+  const std::uint64_t version = word_at(magic.size());
   if (version >= 1 && version < format_version)
     fail("checkpoint format " + std::to_string(version) + " of an earlier hemosolve; this build reads format " +
          std::to_string(format_version) + " only: start the run afresh");
   if (version != format_version)
     fail("checkpoint format " + std::to_string(version) + ", this build reads format " +
          std::to_string(format_version) + " (a newer hemosolve's, or a damaged file)");
-  index_sections();
 }
 
 // Walks the sections, checking each against its checksum and the whole file against its
-// own, so that nothing is read from a file changed after it was written.
+// own, so that nothing is read from a file changed after it was written. One pass: the
+// file's checksum (FNV-1a, byte by byte) is carried through the sections' bytes in order.
 void CheckpointReader::index_sections() {
-  const std::size_t size = bytes_.size();
-  const bool whole = size >= header + word && word_at(bytes_, size - word) == checksum(bytes_, 0, size - word);
+  const std::size_t size = size_;
   const std::size_t last = size >= header + word ? size - word : header;  // where the sections end
+  Fingerprint file;
+  std::vector<char> piece(std::min<std::size_t>(std::size_t{1} << 20, size));
+  // Adds [begin, end) to the file's checksum (it has every byte before begin) and to `to`.
+  auto hash = [&](std::size_t begin, std::size_t end, Fingerprint* to) {
+    for (std::size_t at = begin; at < end;) {
+      const std::size_t n = std::min(piece.size(), end - at);
+      read_at(at, piece.data(), n);
+      file.add(piece.data(), n);
+      if (to) to->add(piece.data(), n);
+      at += n;
+    }
+  };
+  hash(0, std::min(header, last), nullptr);
   std::size_t at = header;
   std::string before = "the format";  // for a message about what follows it
   auto damaged = [&](const std::string& what) {
@@ -241,25 +320,30 @@ void CheckpointReader::index_sections() {
   while (at < last) {
     // Each length is checked against what is left before it is used.
     if (last - at < word) damaged("the section after " + before + " is cut short");
-    const std::uint64_t name_length = word_at(bytes_, at);
+    const std::uint64_t name_length = word_at(at);
     if (name_length > last - at - word || last - at - word - name_length < word)
       damaged("the section after " + before + " runs past the end");
     const std::size_t name_at = at + word, length_at = name_at + name_length;
-    std::string name = bytes_.substr(name_at, name_length);
-    const std::uint64_t length = word_at(bytes_, length_at);
+    std::string name(name_length, '\0');
+    read_at(name_at, name.data(), name.size());
+    const std::uint64_t length = word_at(length_at);
     const std::size_t begin = length_at + word;
     const std::string described = describe_section(name, sections_.size());
     if (length > last - begin || last - begin - length < word) damaged(described + " runs past the end");
     const std::size_t end = begin + length;
-    if (word_at(bytes_, end) != checksum(bytes_, at, end))
+    Fingerprint section;
+    hash(at, end, &section);
+    const std::uint64_t sum = word_at(end);
+    if (sum != section.value())
       fail(described + " does not match its checksum: the file was changed or damaged after it was written; "
            "it cannot be resumed");
+    file.add(&sum, word);
     before = described;
     sections_.push_back({std::move(name), begin, end});
     at = end + word;
   }
-  if (!whole || at != last)
-    damaged("the file's checksum does not match (the bytes after " + before + " or the checksum itself)");
+  const bool whole = size >= header + word && at == last && word_at(last) == file.value();
+  if (!whole) damaged("the file's checksum does not match (the bytes after " + before + " or the checksum itself)");
   at_ = end_ = header;
 }
 
@@ -270,8 +354,7 @@ void CheckpointReader::fail(const std::string& message) const {
 void CheckpointReader::raw(void* data, std::size_t size) {
   // The checksums held: a section shorter than this build reads was written by another layout.
   if (size > left()) fail("checkpoint of another kind or version (a section ends before this build has read it)");
-  if (size == 0) return;  // an empty matrix's data() is null, which memcpy must not see
-  std::memcpy(data, bytes_.data() + at_, size);
+  read_at(at_, data, size);
   at_ += size;
 }
 
@@ -302,7 +385,8 @@ std::uint64_t CheckpointReader::get_u64() {
 std::string CheckpointReader::get_string() {
   const std::uint64_t size = get_u64();
   if (size > left()) fail("checkpoint of another kind or version (a string runs past its section)");
-  std::string text(bytes_.data() + at_, size);
+  std::string text(size, '\0');
+  read_at(at_, text.data(), size);
   at_ += size;
   return text;
 }
@@ -313,6 +397,20 @@ std::vector<double> CheckpointReader::get_vector() {
   std::vector<double> values(size);
   raw(values.data(), size * sizeof(double));
   return values;
+}
+
+std::uint64_t CheckpointReader::begin_vector() {
+  const std::uint64_t size = get_u64();
+  if (size > left() / sizeof(double)) fail("checkpoint of another kind or version (a vector runs past its section)");
+  return size;
+}
+
+void CheckpointReader::get_part(std::span<double> values) { raw(values.data(), values.size() * sizeof(double)); }
+
+std::uint64_t CheckpointReader::skip_vector() {
+  const std::uint64_t size = begin_vector();
+  at_ += size * sizeof(double);
+  return size;
 }
 
 Eigen::MatrixXd CheckpointReader::get_matrix() {
@@ -349,12 +447,15 @@ void CheckpointReader::get_into(Eigen::VectorXd& v, const char* what) {
   v = std::move(read);
 }
 
-void write_checkpoint_file(const std::filesystem::path& file, const std::string& bytes) {
+namespace {
+// A checkpoint file written whole by write(fd, temp) to a temporary beside it, then promoted.
+template <class Write>
+void write_through_temporary(const std::filesystem::path& file, Write&& write) {
   const std::filesystem::path temp = file.string() + ".tmp";
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw IoError("cannot write " + temp.string() + ": " + std::strerror(errno));
   try {
-    write_all(fd, bytes.data(), bytes.size(), temp);
+    write(fd, temp);
   } catch (...) {
     ::close(fd);
     ::unlink(temp.c_str());
@@ -367,6 +468,27 @@ void write_checkpoint_file(const std::filesystem::path& file, const std::string&
     ::unlink(temp.c_str());
     throw;
   }
+}
+}  // namespace
+
+void write_checkpoint_file(const std::filesystem::path& file, const std::string& bytes) {
+  write_through_temporary(file, [&](int fd, const std::filesystem::path& temp) { write_all(fd, bytes.data(), bytes.size(), temp); });
+}
+
+void CheckpointReader::write_copy(const std::filesystem::path& to) const {
+  if (fd_ < 0) {
+    write_checkpoint_file(to, bytes_);
+    return;
+  }
+  write_through_temporary(to, [&](int fd, const std::filesystem::path& temp) {
+    std::vector<char> piece(std::min<std::size_t>(std::size_t{1} << 20, size_));
+    for (std::size_t at = 0; at < size_;) {
+      const std::size_t n = std::min(piece.size(), size_ - at);
+      read_at(at, piece.data(), n);
+      write_all(fd, piece.data(), n, temp);
+      at += n;
+    }
+  });
 }
 
 void promote_checkpoint_file(const std::filesystem::path& from, const std::filesystem::path& to) {
@@ -384,10 +506,11 @@ void promote_checkpoint_file(const std::filesystem::path& from, const std::files
 }
 
 std::string read_checkpoint_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
   if (!in) throw IoError("cannot open " + file.string());
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw IoError("cannot read " + file.string());
+  std::string bytes(static_cast<std::size_t>(std::max<std::streamoff>(0, in.tellg())), '\0');  // read once, not grown
+  in.seekg(0);
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) throw IoError("cannot read " + file.string());
   if (bytes.empty()) throw InputError(file.string() + ": empty checkpoint (0 bytes): nothing to resume");
   return bytes;
 }

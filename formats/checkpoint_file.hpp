@@ -83,6 +83,18 @@ class CheckpointReader {
   // Checks the whole file before anything is read from it: an empty or truncated file, one
   // of another format, a section whose bytes do not match its checksum (named) are refused.
   CheckpointReader(std::string bytes, std::string source);
+  // The same from the file itself, held open, not in memory: a resume of a full tree's run
+  // would otherwise hold its gigabyte twice (the bytes and the state made from them), on
+  // every rank. IoError where it cannot be opened or read; the file is read in pieces, once
+  // for the checks and once as the values are asked for.
+  explicit CheckpointReader(const std::filesystem::path& file);
+  ~CheckpointReader();
+  CheckpointReader(const CheckpointReader&) = delete;
+  CheckpointReader& operator=(const CheckpointReader&) = delete;
+  const std::string& source() const { return source_; }  // what its messages name
+  // Its bytes as a checkpoint file at `to` (as write_checkpoint_file writes one), copied in
+  // pieces from the file it reads (which may have been removed since: it is held open).
+  void write_copy(const std::filesystem::path& to) const;
   // The next section, which must be this one; the one before must have been read whole.
   void section(std::string_view name);
   double get_double();
@@ -90,6 +102,12 @@ class CheckpointReader {
   bool get_bool() { return get_u64() != 0; }
   std::string get_string();
   std::vector<double> get_vector();
+  // A vector (put or given in parts) read in parts, so that one taken apart into per-item
+  // records, or only partly kept, need not be held whole: its length, then get_part() in
+  // order; or passed over whole (its length returned).
+  std::uint64_t begin_vector();
+  void get_part(std::span<double> values);
+  std::uint64_t skip_vector();
   Eigen::MatrixXd get_matrix();
   Eigen::VectorXd get_eigen_vector();
   // The matrix or vector read must have these dimensions (the run's discretisation).
@@ -105,8 +123,18 @@ class CheckpointReader {
   };
   void raw(void* data, std::size_t size);
   std::size_t left() const { return end_ - at_; }
+  void check_header();
   void index_sections();
-  std::string bytes_, source_;
+  // size bytes at offset `at` (within size_), from memory or the file.
+  void read_at(std::size_t at, void* data, std::size_t size) const;
+  std::uint64_t word_at(std::size_t at) const;
+  std::string bytes_, source_;  // bytes_: in memory; empty where read from a file
+  int fd_ = -1;                 // the file read from, or -1
+  std::size_t size_ = 0;        // of the checkpoint
+  // The file's bytes [window_at_, window_at_ + window_.size()): small values are read from
+  // there, a piece at a time, large ones straight into their place.
+  mutable std::vector<char> window_;
+  mutable std::size_t window_at_ = 0;
   std::vector<Section> sections_;
   std::size_t next_ = 0;          // the section that section() opens next
   std::size_t at_ = 0, end_ = 0;  // where reading is, and the open section's end

@@ -175,11 +175,12 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   std::ranges::sort(summary.waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
   duration_ = 0;
   // Rank 0's: every vessel's (by vessel); every other rank's stay its own, by entry.
-  if (over_ranks) gather_cycle_vessels(net_, solver, summary, by_entry_ ? entry_vessels(solver) : std::vector<std::int32_t>());
+  if (over_ranks) gather_cycle_vessels(net_, solver, summary, entry_vessels(solver));
   return summary;
 }
 
 std::vector<std::int32_t> CycleStatistics::entry_vessels(const PulseSolver& solver) const {
+  if (!by_entry_) return {};
   std::vector<std::int32_t> vessel(lumped_entries_ + one_d_.size());
   for (std::size_t e = 0; e < lumped_entries_; ++e) vessel[e] = static_cast<std::int32_t>(solver.lumped().network_vessel(e));
   std::copy(one_d_.begin(), one_d_.end(), vessel.begin() + static_cast<std::ptrdiff_t>(lumped_entries_));

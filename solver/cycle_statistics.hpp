@@ -87,6 +87,9 @@ class CycleStatistics {
   void sample(const PulseSolver& solver, double t, double weight);
   // Closes the cycle at the solver's state now: returns the statistics.
   CycleSummary close(const PulseSolver& solver);
+  // By entry (over ranks, every rank but the lead): each entry's vessel, close()'s order of
+  // the vessels' results. Empty by vessel.
+  std::vector<std::int32_t> entry_vessels(const PulseSolver& solver) const;
 
  private:
   const Network& net_;
@@ -103,7 +106,6 @@ class CycleStatistics {
   std::vector<VesselCycle> sums_;
   bool by_entry_ = false;
   std::size_t lumped_entries_ = 0;  // the 0D system's vessels (its halo's and ghosts' too)
-  std::vector<std::int32_t> entry_vessels(const PulseSolver& solver) const;  // each entry's vessel
   // The sums at their starts (0, the extremes at -+infinity): made at a cycle's first sample
   // (or its close, if none), handed over as the results when it closes.
   void start_sums();

@@ -57,29 +57,26 @@ void warn_unphysiological(double low, double high, std::int64_t vessel, const Ne
                            : std::string("the boundary flows and pressures are likely wrong for this network")));
 }
 
-// The checkpoint a resume continues from (empty without one); a killed run's checkpoint is
-// not overwritten by a fresh run unless forced.
-struct Checkpoint {
-  std::string bytes, source;
-};
-
-Checkpoint checkpoint_to_resume(const OutputFolder& folder, const RunConfiguration& config) {
-  Checkpoint c;
+// The checkpoint a resume continues from (null without one), checked whole before the run is
+// set up, and read from its file as the run asks (over ranks every rank reads it, from the
+// path rank 0 found: none holds its bytes). A killed run's checkpoint is not overwritten by a
+// fresh run unless forced.
+std::unique_ptr<CheckpointReader> checkpoint_to_resume(const OutputFolder& folder, const RunConfiguration& config) {
+  std::unique_ptr<CheckpointReader> checkpoint;
   if (config.resume) {
     const auto file = folder.latest_checkpoint();
     if (!file)
       throw SettingError("resume", placeholder("resume") + " " + config.out_dir + ": no checkpoint.bin in it or in " +
                                        folder.staging().string() + " (a run writes one when interrupted, or every N "
                                        "cycles with " + placeholder("checkpoint_every") + " N)");
-    c.bytes = read_checkpoint_file(*file);
-    c.source = file->string();
+    checkpoint = std::make_unique<CheckpointReader>(*file);
   }
   if (!config.resume && !config.force && folder.latest_checkpoint() &&
       folder.latest_checkpoint()->parent_path() == folder.staging())
     throw SettingError("force", folder.staging().string() + " holds the checkpoint of a run that was killed: " +
                                     placeholder("resume") + " " + config.out_dir + " continues it; " +
                                     placeholder("force") + " (or removing that folder) starts afresh");
-  return c;
+  return checkpoint;
 }
 
 // The discretisation's size and cost, said before the run and refused above a day a cycle.
@@ -337,18 +334,18 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   const Waveform driving = driving_waveform(net);
   const double period = driving.period;
   std::optional<OutputFolder> folder;  // rank 0's (over ranks its refusal is every rank's)
-  Checkpoint checkpoint;
+  std::unique_ptr<CheckpointReader> checkpoint;  // rank 0's
   on_lead_rank([&] {
     folder.emplace(config.out_dir);
     checkpoint = checkpoint_to_resume(*folder, config);
   });
+  std::string resumed_from = checkpoint ? checkpoint->source() : std::string();
   // Over ranks every rank resumes from rank 0's checkpoint, and knows its folder (no rank but
   // 0 writes there).
   std::string staging = folder ? folder->staging().string() : std::string();
   if (over_ranks) {
     take_lead_text(staging);
-    take_lead_text(checkpoint.bytes);
-    take_lead_text(checkpoint.source);
+    take_lead_text(resumed_from);
   }
   RunResult result;
   // Interrupted where no cycle has ended (before the time loop, or in a settling cycle):
@@ -399,7 +396,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   // The settling cycle at a lower 1D degree (solver/settling_cycle.hpp) takes a solver of its
   // own, built here while the network still has its walls (over ranks on the run's cut).
   std::unique_ptr<PulseSolver> settling;
-  if (checkpoint.bytes.empty())
+  if (resumed_from.empty())
     on_every_rank([&] { settling = low_degree_settling_solver(net, run, config, period, ranks ? &ranks->ranks() : nullptr); });
   // The walls are in the vessels' tube laws now; only a VTK file would write them again.
   if (given_up && !config.vtk && config.frames == 0)
@@ -466,10 +463,13 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   }
   PulsatileRun pulsatile(net, run, config.probes, plan, staging, transport ? &*transport : nullptr);
   if (settling) pulsatile.settle_with(std::move(settling));
-  if (!checkpoint.bytes.empty()) {
-    // Its refusal (another run's, one at the run's end) is every rank's alike.
-    on_every_rank([&] { pulsatile.resume(std::move(checkpoint.bytes), checkpoint.source); });  // not held through the run
-    observer.note("resuming from " + checkpoint.source + " after " + std::to_string(pulsatile.cycles_done()) +
+  if (!resumed_from.empty()) {
+    // Its refusal (another run's, one at the run's end, a file one rank cannot read) is every
+    // rank's alike.
+    on_every_rank([&] {
+      pulsatile.resume(checkpoint ? std::move(checkpoint) : std::make_unique<CheckpointReader>(resumed_from));
+    });
+    observer.note("resuming from " + resumed_from + " after " + std::to_string(pulsatile.cycles_done()) +
                   " cycles (t = " + format_quantity(run.time(), "s") + ")");
   }
   on_lead_rank([&] {

@@ -47,20 +47,43 @@ void put_summary(CheckpointWriter& out, const CycleSummary& c) {
   out.put(c.boundary_mean_flow);
 }
 
-CycleSummary get_summary(CheckpointReader& in, std::size_t vessels) {
-  const std::vector<double> values = in.get_vector();
+// Read vessel by vessel (the section is 80 B a vessel: not held whole besides the results).
+// entries: where given, the vessel of each entry kept (a rank's own, CycleStatistics'
+// entry_vessels()), the results then by entry; else every vessel's, by vessel.
+CycleSummary get_summary(CheckpointReader& in, std::size_t vessels, std::span<const std::int32_t> entries = {}) {
+  const std::uint64_t count = in.begin_vector();
+  if (count != 4 && count != 4 + vessel_fields * vessels) in.fail("cycle results of another network");
   CycleSummary c;
-  if (values.size() != 4 && values.size() != 4 + vessel_fields * vessels) in.fail("cycle results of another network");
-  c.inlet_mean_flow = values[0];
-  c.outlets_mean_flow = values[1];
-  c.volume_change = values[2];
-  c.conservation_error = values[3];
-  c.boundary_mean_flow = in.get_vector();
-  for (std::size_t k = 4; k < values.size(); k += vessel_fields) {
-    c.vessels.push_back(vessel_cycle(&values[k]));
-    const WaveSpeeds speeds{values[k + 8], values[k + 9]};
-    if (!std::isnan(speeds.pressure) || !std::isnan(speeds.velocity)) c.waves.emplace_back(c.vessels.size() - 1, speeds);
+  double f[vessel_fields];
+  in.get_part(std::span<double>(f, 4));
+  c.inlet_mean_flow = f[0];
+  c.outlets_mean_flow = f[1];
+  c.volume_change = f[2];
+  c.conservation_error = f[3];
+  if (count > 4) {
+    // Each kept entry at its place: (vessel, entry) in the vessels' order.
+    std::vector<std::pair<std::int32_t, std::int32_t>> kept;
+    for (std::size_t e = 0; e < entries.size(); ++e) kept.emplace_back(entries[e], static_cast<std::int32_t>(e));
+    std::ranges::sort(kept);
+    const bool all = entries.empty();
+    c.vessels.resize(all ? vessels : entries.size());
+    auto next = kept.begin();
+    for (std::size_t v = 0; v < vessels; ++v) {
+      in.get_part(f);
+      const WaveSpeeds speeds{f[8], f[9]};
+      const bool wave = !std::isnan(speeds.pressure) || !std::isnan(speeds.velocity);
+      if (all) {
+        c.vessels[v] = vessel_cycle(f);
+        if (wave) c.waves.emplace_back(v, speeds);
+      }
+      for (; next != kept.end() && static_cast<std::size_t>(next->first) == v; ++next) {
+        c.vessels[static_cast<std::size_t>(next->second)] = vessel_cycle(f);
+        if (wave) c.waves.emplace_back(static_cast<std::size_t>(next->second), speeds);
+      }
+    }
+    std::ranges::sort(c.waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
   }
+  c.boundary_mean_flow = in.get_vector();
   return c;
 }
 
@@ -210,20 +233,29 @@ std::vector<double> PulsatileRun::last_mean_pressures() const {
   return p;
 }
 
-void PulsatileRun::resume(std::string bytes, const std::string& source) {
-  CheckpointReader in(bytes, source);
+void PulsatileRun::resume(std::unique_ptr<CheckpointReader> checkpoint) {
+  CheckpointReader& in = *checkpoint;
+  const std::string source = in.source();
   in.section("identity");
   if (in.get_u64() != plan_.network_identity) in.fail("written for another network (its fingerprint differs)");
   const std::string options = in.get_string();
   if (options != plan_.state_shaping)
     in.fail("written by a run with other options (there: " + options + "; here: " + plan_.state_shaping + ")");
+  // Over ranks every rank but the one that writes keeps its own vessels' results alone (as a
+  // cycle's end leaves them), and no mean pressures of the cycle before: its own next cycle's
+  // end makes its (the lead alone tests the change).
   in.section("last cycle");
-  last_ = get_summary(in, net_.vessel_count());
+  last_ = get_summary(in, net_.vessel_count(), stats_.entry_vessels(solver_));
   in.section("previous cycle");
-  previous_mean_pressure_ = in.get_vector();
-  if (!previous_mean_pressure_.empty() && previous_mean_pressure_.size() != net_.vessel_count())
-    in.fail("cycle results of another network");
-  has_previous_ = !previous_mean_pressure_.empty();
+  std::uint64_t previous = 0;
+  if (writes_) {
+    previous_mean_pressure_ = in.get_vector();
+    previous = previous_mean_pressure_.size();
+  } else {
+    previous = in.skip_vector();
+  }
+  if (previous != 0 && previous != net_.vessel_count()) in.fail("cycle results of another network");
+  has_previous_ = previous != 0;
   in.section("run");
   done_ = static_cast<int>(in.get_u64());
   balances_ = static_cast<int>(in.get_u64());
@@ -248,7 +280,7 @@ void PulsatileRun::resume(std::string bytes, const std::string& source) {
   in.section("end");
   if (!in.at_end()) in.fail("unexpected bytes after the checkpoint");
   resumed_ = true;
-  if (writes_) resumed_bytes_ = std::move(bytes);  // the snapshot as it is until a cycle ends (written once the folder is open)
+  if (writes_) resumed_from_ = std::move(checkpoint);  // the snapshot as it is until a cycle ends (copied once the folder is open)
   if (!cycles_left()) check_run_end(source);
 }
 
@@ -403,10 +435,10 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
     sample_probes();
     if (transport_) transport_->take_volumes();
     snapshot();
-  } else if (!resumed_bytes_.empty()) {
-    write_checkpoint_file(pending(), resumed_bytes_);
+  } else if (resumed_from_) {
+    resumed_from_->write_copy(pending());
     snapshot_pending_ = true;
-    std::string().swap(resumed_bytes_);
+    resumed_from_.reset();
     set_aside_last_vessels();
   }
   try {

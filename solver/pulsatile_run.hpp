@@ -60,10 +60,11 @@ class PulsatileRun {
                std::filesystem::path folder, FlowTransport* transport = nullptr);
 
   // Continues from a checkpoint instead of starting (InputError for one of another run).
-  // source: the checkpoint file. One at the run's end (no cycle left to run) is taken only
+  // checkpoint: the file's reader (its source() names it), kept where this run writes (until
+  // the folder is open, to copy it there) and let go elsewhere. One at the run's end (no cycle left to run) is taken only
   // from a killed run's staging folder (the run's folder), whose frames of that last cycle
   // are then this run's; a published run that already has its cycles is refused as it is.
-  void resume(std::string checkpoint_bytes, const std::string& source);
+  void resume(std::unique_ptr<CheckpointReader> checkpoint);
   // Progress goes to the observer, as its progress_style() asks; its interrupt requests are
   // polled every 256 steps and answered at the last cycle end.
   RunStatus run(RunObserver& observer);
@@ -161,7 +162,7 @@ class PulsatileRun {
   double measured_step_ = 0;
   std::string breakdown_;
   bool snapshot_pending_ = false;  // pending() holds the last cycle end's checkpoint
-  std::string resumed_bytes_;      // the checkpoint resumed from, until the folder is open (run())
+  std::unique_ptr<CheckpointReader> resumed_from_;  // the checkpoint resumed from, until the folder is open (run())
   FlowTransport* transport_ = nullptr;
   RedCellCycle red_cells_last_;
   double red_cell_change_ = std::numeric_limits<double>::quiet_NaN();

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -355,6 +356,68 @@ TEST(ResumedSolver, RefusesEveryFlippedByte) {
   EXPECT_GT(named, 3 * 200u);
   // Cut anywhere: refused.
   for (std::size_t cut = 0; cut < bytes.size(); cut += 7) EXPECT_THROW(CheckpointReader(bytes.substr(0, cut), "c"), InputError);
+}
+
+// Read from its file (held open, read in pieces) a checkpoint gives the values it gives from
+// memory, and a damaged one the same refusal word for word: cut anywhere, or a byte changed.
+TEST(Checkpoint, ReadFromItsFileAsFromMemory) {
+  CheckpointWriter out;
+  out.section("small");
+  for (int i = 0; i < 40000; ++i) out.put(static_cast<double>(i) / 7);  // across the reader's 1 MiB pieces
+  out.section("large");
+  std::vector<double> large(300000);
+  for (std::size_t i = 0; i < large.size(); ++i) large[i] = std::sin(static_cast<double>(i));
+  out.put(large);
+  out.put(std::string("after"));
+  const std::string bytes = out.bytes();
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "hemotree-checkpoint-file-test.bin";
+  auto write = [&](const std::string& b) { std::ofstream(file, std::ios::binary).write(b.data(), static_cast<std::streamsize>(b.size())); };
+  write(bytes);
+  {
+    CheckpointReader in(file);
+    EXPECT_EQ(in.source(), file.string());
+    in.section("small");
+    for (int i = 0; i < 40000; ++i) ASSERT_EQ(in.get_double(), static_cast<double>(i) / 7);
+    in.section("large");
+    EXPECT_EQ(in.get_vector(), large);
+    EXPECT_EQ(in.get_string(), "after");
+    EXPECT_TRUE(in.at_end());
+    const std::filesystem::path copy = file.string() + ".copy";
+    std::filesystem::remove(file);  // held open: its copy is still whole
+    in.write_copy(copy);
+    EXPECT_EQ(read_checkpoint_file(copy), bytes);
+    std::filesystem::remove(copy);
+  }
+  auto refusal = [](auto&& read) -> std::string {
+    try {
+      read();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  std::size_t compared = 0;
+  auto same = [&](const std::string& b) {
+    write(b);
+    const std::string from_memory = refusal([&] { CheckpointReader in(b, file.string()); });
+    EXPECT_EQ(refusal([&] { CheckpointReader in(file); }), from_memory);
+    EXPECT_NE(from_memory, "accepted");
+    ++compared;
+  };
+  for (std::size_t cut = 0; cut < bytes.size(); cut += bytes.size() / 97) same(bytes.substr(0, cut));
+  for (std::size_t i = 0; i < bytes.size(); i += bytes.size() / 89 + 1) {
+    std::string changed = bytes;
+    changed[i] = static_cast<char>(changed[i] ^ 0x10);
+    same(changed);
+  }
+  for (const std::size_t i : {std::size_t{3}, bytes.size() - 1}) {  // the magic line, the file's checksum
+    std::string changed = bytes;
+    changed[i] = static_cast<char>(changed[i] ^ 0x10);
+    same(changed);
+  }
+  EXPECT_GT(compared, 180u);
+  std::filesystem::remove(file);
+  EXPECT_THROW(CheckpointReader{file}, IoError);  // none there
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, ResumedSolver,

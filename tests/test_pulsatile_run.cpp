@@ -223,7 +223,7 @@ TEST(PulsatileRun, ResumesFromItsCheckpointAsIfNeverStopped) {
   b.write_checkpoint();
   PulseSolver second(f.net, f.options);
   PulsatileRun c(f.net, second, {}, f.plan(second, 4), f.folder);
-  c.resume(read_checkpoint_file(f.folder / "checkpoint.bin"), "checkpoint.bin");
+  c.resume(std::make_unique<CheckpointReader>(f.folder / "checkpoint.bin"));  // from the file
   EXPECT_EQ(c.cycles_done(), 2);
   ASSERT_EQ(c.run(interrupts), RunStatus::complete);
   EXPECT_EQ(c.cycles_done(), 4);
@@ -250,7 +250,7 @@ TEST(PulsatileRun, RefusesItsCheckpointWithAnyByteChanged) {
     std::string changed = bytes;
     changed[i] = static_cast<char>(changed[i] ^ 0x04);
     try {
-      b.resume(changed, "checkpoint.bin");
+      b.resume(std::make_unique<CheckpointReader>(changed, "checkpoint.bin"));
       ADD_FAILURE() << "byte " << i << " of " << bytes.size() << " changed and accepted";
     } catch (const InputError&) {
       ++refused;
@@ -258,7 +258,7 @@ TEST(PulsatileRun, RefusesItsCheckpointWithAnyByteChanged) {
   }
   EXPECT_EQ(refused, bytes.size());
   EXPECT_EQ(b.cycles_done(), 0);
-  b.resume(bytes, "checkpoint.bin");  // the file as written
+  b.resume(std::make_unique<CheckpointReader>(bytes, "checkpoint.bin"));  // the file as written
   EXPECT_EQ(b.cycles_done(), 2);
 }
 
@@ -279,7 +279,7 @@ TEST(PulsatileRun, ResumedAtItsEnd) {
   PulseSolver s1(f.net, f.options);
   PulsatileRun published(f.net, s1, {}, f.plan(s1, 2), staging);
   try {
-    published.resume(bytes, (f.folder / "checkpoint.bin").string());
+    published.resume(std::make_unique<CheckpointReader>(bytes, (f.folder / "checkpoint.bin").string()));
     FAIL() << "resumed a published run that has its cycles";
   } catch (const SettingError& e) {  // the setting by its name; hemosolve's user reads its flag
     EXPECT_NE(std::string(e.what()).find("the run already has its 2 cycles; raise cycles to continue"),
@@ -292,17 +292,21 @@ TEST(PulsatileRun, ResumedAtItsEnd) {
 
   PulseSolver s2(f.net, f.options);
   PulsatileRun fewer(f.net, s2, {}, f.plan(s2, 1), f.folder);
-  EXPECT_THROW(fewer.resume(bytes, (f.folder / "checkpoint.bin").string()), InputError);  // beyond --cycles 1
+  EXPECT_THROW(fewer.resume(std::make_unique<CheckpointReader>(bytes, (f.folder / "checkpoint.bin").string())), InputError);  // beyond --cycles 1
 
   PulseSolver s3(f.net, f.options);
   RunPlan with_frames = f.plan(s3, 2);
   with_frames.frames = 2;
   PulsatileRun framed(f.net, s3, {}, with_frames, f.folder);
-  EXPECT_THROW(framed.resume(bytes, (f.folder / "checkpoint.bin").string()), InputError);  // no frames of it here
+  EXPECT_THROW(framed.resume(std::make_unique<CheckpointReader>(bytes, (f.folder / "checkpoint.bin").string())), InputError);  // no frames of it here
 
   PulseSolver s4(f.net, f.options);
   PulsatileRun killed(f.net, s4, {}, f.plan(s4, 2), f.folder);
-  killed.resume(bytes, (f.folder / "checkpoint.bin").string());
+  // From a file removed once it is read: the run copies the checkpoint it holds open.
+  const std::filesystem::path kept = f.folder / "kept.bin";
+  std::filesystem::copy_file(f.folder / "checkpoint.bin", kept);
+  killed.resume(std::make_unique<CheckpointReader>(kept));
+  std::filesystem::remove(kept);
   EXPECT_FALSE(killed.cycles_left());
   EXPECT_FALSE(killed.keeps_frames());  // none asked for
   EXPECT_EQ(killed.run(interrupts), RunStatus::complete);
