@@ -55,9 +55,13 @@ void LumpedVessels::restore(CheckpointReader& in) {
   in.section(section_name);
   const std::vector<std::int32_t> nodes = network_order_nodes(), edges = network_order_edges();
   auto get = [&](std::vector<double>& values, const std::vector<std::int32_t>& place) {
-    const std::vector<double> given = in.get_vector();
-    if (given.size() != values.size()) in.fail("0D vessels of another network or model");
-    for (std::size_t i = 0; i < place.size(); ++i) values[static_cast<std::size_t>(place[i])] = given[i];
+    if (in.begin_vector() != values.size()) in.fail("0D vessels of another network or model");
+    std::vector<double> part(block);  // read in parts, as save() writes them
+    for (std::size_t i = 0; i < place.size(); i += block) {
+      const std::size_t n = std::min(block, place.size() - i);
+      in.get_part(std::span<double>(part).first(n));
+      for (std::size_t j = 0; j < n; ++j) values[static_cast<std::size_t>(place[i + j])] = part[j];
+    }
   };
   for (auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) get(*v, nodes);
   for (auto* v : {&flow_, &previous_flow_}) get(*v, edges);
@@ -70,36 +74,57 @@ void LumpedVessels::restore(CheckpointReader& in) {
 LumpedVessels::StateShare LumpedVessels::state_share(const LumpedPlaces& places) const {
   StateShare share;
   const std::vector<std::int32_t> node_place = local_node_places(places), edge_place = local_edge_places(places);
-  const std::vector<double>* node_arrays[] = {&volume_, &previous_volume_, &pressure_, &previous_pressure_};
-  const std::vector<double>* edge_arrays[] = {&flow_, &previous_flow_};
-  for (std::size_t k = 0; k < nodes_; ++k) {
-    if (is_ghost_node(k)) continue;  // its rank's
-    share.node_place.push_back(node_place[k]);
-    for (std::size_t a = 0; a < 4; ++a) share.values[a].push_back((*node_arrays[a])[k]);
-  }
-  for (std::size_t e = 0; e < a_.size(); ++e) {
-    if (is_ghost_edge(e)) continue;
-    share.edge_place.push_back(edge_place[e]);
-    for (std::size_t a = 0; a < 2; ++a) share.values[4 + a].push_back((*edge_arrays[a])[e]);
-  }
+  for (std::size_t k = 0; k < nodes_; ++k)
+    if (!is_ghost_node(k)) share.node_place.push_back(node_place[k]);  // a ghost's is its rank's
+  for (std::size_t e = 0; e < a_.size(); ++e)
+    if (!is_ghost_edge(e)) share.edge_place.push_back(edge_place[e]);
   return share;
 }
 
-void LumpedVessels::save_whole(CheckpointWriter& out, const std::array<std::vector<double>, 6>& whole) {
-  out.section(section_name);
-  for (const std::vector<double>& values : whole) out.put(values);
+std::vector<double> LumpedVessels::share_values(std::size_t array) const {
+  const std::vector<double>* arrays[state_arrays] = {&volume_, &previous_volume_, &pressure_, &previous_pressure_, &flow_, &previous_flow_};
+  const std::vector<double>& from = *arrays[array];
+  std::vector<double> values;
+  if (StateShare::per_node(array)) {
+    for (std::size_t k = 0; k < nodes_; ++k)
+      if (!is_ghost_node(k)) values.push_back(from[k]);
+  } else {
+    for (std::size_t e = 0; e < a_.size(); ++e)
+      if (!is_ghost_edge(e)) values.push_back(from[e]);
+  }
+  return values;
 }
+
+void LumpedVessels::begin_whole(CheckpointWriter& out) { out.section(section_name); }
 
 void LumpedVessels::restore_share(CheckpointReader& in, const LumpedPlaces& places) {
   in.section(section_name);
-  const std::vector<std::int32_t> node_place = local_node_places(places), edge_place = local_edge_places(places);
-  auto get = [&](std::vector<double>& values, const std::vector<std::int32_t>& place, std::size_t whole) {
-    const std::vector<double> given = in.get_vector();
-    if (given.size() != whole) in.fail("0D vessels of another network or model");
-    for (std::size_t i = 0; i < place.size(); ++i) values[i] = given[static_cast<std::size_t>(place[i])];
+  // Each node's and edge's value from its place, the arrays read in parts (none held whole):
+  // (place, index here) in the places' order, met as the parts come.
+  auto by_place = [](const std::vector<std::int32_t>& place) {
+    std::vector<std::pair<std::int32_t, std::int32_t>> order(place.size());
+    for (std::size_t i = 0; i < place.size(); ++i) {
+      if (place[i] < 0) throw std::logic_error("LumpedVessels: a node or edge with no place in the whole run's order");
+      order[i] = {place[i], static_cast<std::int32_t>(i)};
+    }
+    std::ranges::sort(order);
+    return order;
   };
-  for (auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) get(*v, node_place, places.nodes);
-  for (auto* v : {&flow_, &previous_flow_}) get(*v, edge_place, places.edges);
+  const auto nodes = by_place(local_node_places(places)), edges = by_place(local_edge_places(places));
+  auto get = [&](std::vector<double>& values, const std::vector<std::pair<std::int32_t, std::int32_t>>& order, std::size_t whole) {
+    if (in.begin_vector() != whole) in.fail("0D vessels of another network or model");
+    std::vector<double> part(block);
+    auto next = order.begin();
+    for (std::size_t i = 0; i < whole; i += block) {
+      const std::size_t n = std::min(block, whole - i);
+      in.get_part(std::span<double>(part).first(n));
+      for (; next != order.end() && static_cast<std::size_t>(next->first) < i + n; ++next)
+        values[static_cast<std::size_t>(next->second)] = part[static_cast<std::size_t>(next->first) - i];
+    }
+    if (next != order.end()) in.fail("0D vessels of another network or model");
+  };
+  for (auto* v : {&volume_, &previous_volume_, &pressure_, &previous_pressure_}) get(*v, nodes, places.nodes);
+  for (auto* v : {&flow_, &previous_flow_}) get(*v, edges, places.edges);
   // A ghost's volume is its own rank's, whose node sums more vessels: here the node's excess
   // at its pressure, as a step leaves it (its sums are its rank's).
   for (std::size_t k = 0; k < nodes_; ++k)

@@ -303,16 +303,20 @@ class LumpedVessels {
   void restore(CheckpointReader& in);
   // Over ranks (one pi section a vessel): this rank's part of the checkpoint the whole run
   // writes, at the places of the whole's order (pulse/lumped_order.hpp's lumped_places): the
-  // places of its own nodes and edges (not its ghosts'), and save()'s six arrays for them
+  // places of its own nodes and edges (not its ghosts'), and for each of save()'s six arrays
   // (per node: volume, previous volume, pressure, previous pressure; per edge: flow, previous
-  // flow), each in the places' order.
+  // flow) its values there, in the places' order (share_values: one array at a time).
+  static constexpr std::size_t state_arrays = 6;
   struct StateShare {
     std::vector<std::int32_t> node_place, edge_place;
-    std::array<std::vector<double>, 6> values;
+    static bool per_node(std::size_t array) { return array < 4; }
+    const std::vector<std::int32_t>& place(std::size_t array) const { return per_node(array) ? node_place : edge_place; }
   };
   StateShare state_share(const LumpedPlaces& places) const;
-  // save()'s section from the six arrays whole, in the whole's order: the one-process bytes.
-  static void save_whole(CheckpointWriter& out, const std::array<std::vector<double>, 6>& whole);
+  std::vector<double> share_values(std::size_t array) const;
+  // save()'s section begun: its six arrays follow whole, in the whole's order, each put in
+  // turn (CheckpointWriter::put): the one-process bytes.
+  static void begin_whole(CheckpointWriter& out);
   // restore() of a rank's share: every node and edge it holds (its ghosts too) from its place
   // in the section the whole run writes.
   void restore_share(CheckpointReader& in, const LumpedPlaces& places);

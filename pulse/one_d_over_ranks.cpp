@@ -99,6 +99,7 @@ void PulseSolver::take_spread_share(const PulseRanks& ranks, const VesselRanks& 
   least_key_ = ranks.least_key;
   make_whole_ = ranks.make_whole;
   lead_whole_ = ranks.lead_whole;
+  lead_places_ = ranks.lead_places;
   std::vector<std::int32_t> vessels, first;
   for (std::size_t j = 0; j < one_d_vessels_.size(); ++j)
     if (steps_vessel_[static_cast<std::size_t>(one_d_vessels_[j])]) {

@@ -263,6 +263,7 @@ void PulseSolver::take_rank_share(const PulseRanks& ranks, const SolverOptions& 
   lumped_.set_link(ranks.link);
   make_whole_ = ranks.make_whole;
   lead_whole_ = ranks.lead_whole;
+  lead_places_ = ranks.lead_places;
   rank_ = ranks.rank;
   rank_count_ = ranks.ranks;
   steps_vessel_.assign(n, 0);

@@ -161,6 +161,10 @@ struct PulseRanks {
   // The same on the top's rank alone (the others' values left as they are): a checkpoint's.
   // (Over MPI the top is rank 0, which writes the results: solver/pulse_ranks_mpi.hpp.)
   std::function<void(std::vector<double>& values, const std::vector<unsigned char>& mine)> lead_whole;
+  // The same from this rank's own items alone: values[i] at item place[i] of count; returns
+  // on the lead every item's (0 where no rank places one), empty elsewhere. Collective.
+  std::function<std::vector<double>(std::span<const double> values, std::span<const std::int32_t> place, std::size_t count)>
+      lead_places;
   // The lead's values (any length) on every rank: what the lead alone computes from the whole,
   // e.g. the compliance balance's moves. Collective.
   std::function<void(std::vector<double>& values)> from_lead;
@@ -589,9 +593,11 @@ class PulseSolver {
   int threads_ = 1;
   bool one_d_here_ = true;  // false on a share of a run over ranks (PulseRanks)
   int rank_ = 0, rank_count_ = 1;  // over ranks: this rank's, of how many
-  // Over ranks: PulseRanks' make_whole, lead_whole, from_lead and lead_rank (the compliance
-  // balance's inputs go to the lead, its moves come back from it).
+  // Over ranks: PulseRanks' make_whole, lead_whole, lead_places, from_lead and lead_rank (the
+  // compliance balance's inputs go to the lead, its moves come back from it; a checkpoint's
+  // arrays go to the lead).
   std::function<void(std::vector<double>&, const std::vector<unsigned char>&)> make_whole_, lead_whole_;
+  std::function<std::vector<double>(std::span<const double>, std::span<const std::int32_t>, std::size_t)> lead_places_;
   std::function<void(std::vector<double>&)> from_lead_;
   int lead_rank_ = 0;
   // save()'s section "pulse solver", with each boundary's 0D volume and the viscosity factors

@@ -40,43 +40,44 @@ void PulseSolver::save_over_ranks(CheckpointWriter* out) const {
     factors = viscosity_factor_.empty() ? std::vector<double>(net_.vessel_count(), 1.0) : viscosity_factor_;
     lead_whole_(factors, steps_vessel_);
   }
-  // The 0D state: each node and edge from the rank that holds it, at its place in the whole's.
-  const LumpedPlaces places = lumped_places(net_, zero_d_);
-  LumpedVessels::StateShare share = lumped_.state_share(places);
-  std::array<std::vector<double>, 6> whole;
-  for (std::size_t a = 0; a < whole.size(); ++a) {
-    const bool per_node = a < 4;
-    const std::vector<std::int32_t>& place = per_node ? share.node_place : share.edge_place;
-    std::vector<double>& values = whole[a];
-    values.assign(per_node ? places.nodes : places.edges, 0.0);
-    std::vector<unsigned char> mine(values.size(), 0);
-    for (std::size_t i = 0; i < place.size(); ++i) {
-      values[static_cast<std::size_t>(place[i])] = share.values[a][i];
-      mine[static_cast<std::size_t>(place[i])] = 1;
-    }
-    std::vector<double>().swap(share.values[a]);
-    lead_whole_(values, mine);
-    if (!out) std::vector<double>().swap(values);
+  // The 0D state's places: each own node and edge at its place in the whole's order.
+  LumpedVessels::StateShare share;
+  std::size_t whole_count[2] = {0, 0};  // nodes, edges
+  {
+    const LumpedPlaces places = lumped_places(net_, zero_d_);
+    share = lumped_.state_share(places);
+    whole_count[0] = places.nodes;
+    whole_count[1] = places.edges;
   }
   // The 1D vessels' state: the top's own, or, spread, from every rank.
   std::optional<WholeOneD> one_d;
   if (one_d_cut_) one_d = whole_one_d_state();
-  if (!out) return;
-  if (one_d) {
-    // The ends by vessel: the k-th 1D vessel in vessel order is first_elements_[k]'s.
-    auto end_state = [&](std::size_t v, bool distal) {
-      const auto k = static_cast<std::size_t>(
-          std::lower_bound(first_elements_.begin(), first_elements_.end(), std::pair{static_cast<std::int32_t>(v), std::int32_t{-1}}) -
-          first_elements_.begin());
-      return EndState{one_d->ends[4 * k + (distal ? 2 : 0)], one_d->ends[4 * k + (distal ? 3 : 1)]};
-    };
-    save_section(*out, boundary_volume, factors, {&one_d->state, &one_d->previous_rate, &one_d->previous_flow, end_state});
-  } else {
-    save_section(*out, boundary_volume, factors,
-                 {&state_, &previous_rate_, &previous_flow_,
-                  [this](std::size_t v, bool distal) { return boundaries_.state_at(vessel_end(v, distal)); }});
+  if (out) {
+    if (one_d) {
+      // The ends by vessel: the k-th 1D vessel in vessel order is first_elements_[k]'s.
+      auto end_state = [&](std::size_t v, bool distal) {
+        const auto k = static_cast<std::size_t>(
+            std::lower_bound(first_elements_.begin(), first_elements_.end(), std::pair{static_cast<std::int32_t>(v), std::int32_t{-1}}) -
+            first_elements_.begin());
+        return EndState{one_d->ends[4 * k + (distal ? 2 : 0)], one_d->ends[4 * k + (distal ? 3 : 1)]};
+      };
+      save_section(*out, boundary_volume, factors, {&one_d->state, &one_d->previous_rate, &one_d->previous_flow, end_state});
+    } else {
+      save_section(*out, boundary_volume, factors,
+                   {&state_, &previous_rate_, &previous_flow_,
+                    [this](std::size_t v, bool distal) { return boundaries_.state_at(vessel_end(v, distal)); }});
+    }
+    LumpedVessels::begin_whole(*out);
   }
-  LumpedVessels::save_whole(*out, whole);
+  one_d.reset();
+  // The 0D arrays one at a time, each whole on the lead alone, written as it comes: every
+  // other rank sends its own values (not a whole array of its own), and the lead holds one
+  // whole array, not six.
+  for (std::size_t a = 0; a < LumpedVessels::state_arrays; ++a) {
+    const std::vector<double> whole =
+        lead_places_(lumped_.share_values(a), share.place(a), whole_count[LumpedVessels::StateShare::per_node(a) ? 0 : 1]);
+    if (out) out->put(whole);
+  }
 }
 
 void PulseSolver::save_section(CheckpointWriter& out, const std::vector<double>& lumped_boundary_volume,
