@@ -220,9 +220,10 @@ CheckpointReader::CheckpointReader(const std::filesystem::path& file) : source_(
   fd_ = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) throw IoError("cannot open " + file.string());
   struct stat st {};
-  if (::fstat(fd_, &st) != 0 || st.st_size < 0) {
+  if (::fstat(fd_, &st) != 0) {
+    const int error = errno;
     ::close(fd_);
-    throw IoError("cannot read " + file.string() + ": " + std::strerror(errno));
+    throw IoError("cannot read " + file.string() + ": " + std::strerror(error));
   }
   size_ = static_cast<std::size_t>(st.st_size);
   try {
@@ -232,6 +233,12 @@ CheckpointReader::CheckpointReader(const std::filesystem::path& file) : source_(
     ::close(fd_);
     throw;
   }
+}
+
+bool CheckpointReader::reads(const std::filesystem::path& file) const {
+  struct stat mine {}, there {};
+  return fd_ >= 0 && ::fstat(fd_, &mine) == 0 && ::stat(file.c_str(), &there) == 0 && mine.st_dev == there.st_dev &&
+         mine.st_ino == there.st_ino;
 }
 
 CheckpointReader::~CheckpointReader() {
@@ -481,13 +488,19 @@ void CheckpointReader::write_copy(const std::filesystem::path& to) const {
     return;
   }
   write_through_temporary(to, [&](int fd, const std::filesystem::path& temp) {
+    // Checked again as it goes: the file's checksum over the bytes copied (index_sections
+    // checked the file's own, which the copy ends with).
+    Fingerprint file;
+    const std::size_t last = size_ - word;
     std::vector<char> piece(std::min<std::size_t>(std::size_t{1} << 20, size_));
     for (std::size_t at = 0; at < size_;) {
       const std::size_t n = std::min(piece.size(), size_ - at);
       read_at(at, piece.data(), n);
+      if (at < last) file.add(piece.data(), std::min(n, last - at));
       write_all(fd, piece.data(), n, temp);
       at += n;
     }
+    if (word_at(last) != file.value()) fail("the file changed after it was checked; it cannot be copied as the run's checkpoint");
   });
 }
 

@@ -86,7 +86,9 @@ class CheckpointReader {
   // The same from the file itself, held open, not in memory: a resume of a full tree's run
   // would otherwise hold its gigabyte twice (the bytes and the state made from them), on
   // every rank. IoError where it cannot be opened or read; the file is read in pieces, once
-  // for the checks and once as the values are asked for.
+  // for the checks and once as the values are asked for. It must not change in place
+  // meanwhile (a run writes its checkpoints to a temporary renamed over the old, and holds
+  // its folder's lock): a copy (write_copy) checks it again, the values read do not.
   explicit CheckpointReader(const std::filesystem::path& file);
   ~CheckpointReader();
   CheckpointReader(const CheckpointReader&) = delete;
@@ -95,6 +97,9 @@ class CheckpointReader {
   // Its bytes as a checkpoint file at `to` (as write_checkpoint_file writes one), copied in
   // pieces from the file it reads (which may have been removed since: it is held open).
   void write_copy(const std::filesystem::path& to) const;
+  // Whether `file` names the very file it reads (the same device and inode: moved there,
+  // say), where it reads one.
+  bool reads(const std::filesystem::path& file) const;
   // The next section, which must be this one; the one before must have been read whole.
   void section(std::string_view name);
   double get_double();

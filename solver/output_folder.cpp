@@ -160,7 +160,7 @@ std::optional<fs::path> OutputFolder::latest_checkpoint() const {
   return std::nullopt;
 }
 
-bool OutputFolder::open(bool keep_frames) {
+bool OutputFolder::open(bool keep_frames, const std::string& keep_checkpoint_as) {
   check_claim("create");
   std::error_code ec;
   // What a run killed while removing a stale folder left (this run holds the lock: no one else's).
@@ -178,6 +178,10 @@ bool OutputFolder::open(bool keep_frames) {
     if (keep_frames && fs::exists(stale_ / "frames", ec) &&
         std::rename((stale_ / "frames").c_str(), (staging_ / "frames").c_str()) != 0)
       throw IoError("cannot move " + (stale_ / "frames").string() + " into " + staging_.string() + ": " +
+                    std::strerror(errno));
+    if (!keep_checkpoint_as.empty() && fs::exists(stale_ / "checkpoint.bin", ec) &&
+        std::rename((stale_ / "checkpoint.bin").c_str(), (staging_ / keep_checkpoint_as).c_str()) != 0)
+      throw IoError("cannot move " + (stale_ / "checkpoint.bin").string() + " into " + staging_.string() + ": " +
                     std::strerror(errno));
     remove_folder(stale_);
   }

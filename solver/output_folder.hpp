@@ -15,6 +15,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
 namespace hemotree {
 
@@ -39,9 +40,12 @@ class OutputFolder {
   // Creates DIR.partial afresh; a stale one (a dead run's) is first renamed aside, then
   // removed, so that a kill meanwhile never leaves half of it looking like a staging folder.
   // keep_frames: the stale folder's frames/ go into the new one (the frames of the killed
-  // run's last cycle, which a resume with no cycle left publishes). Returns true where there
-  // was a stale folder.
-  bool open(bool keep_frames = false);
+  // run's last cycle, which a resume with no cycle left publishes). keep_checkpoint_as: where
+  // given, the stale folder's checkpoint.bin goes into the new one under this name (the
+  // checkpoint a resume continues from, which may be held open: moved, not removed, it leaves
+  // no file of an open descriptor in a folder being removed, which NFS cannot remove).
+  // Returns true where there was a stale folder.
+  bool open(bool keep_frames = false, const std::string& keep_checkpoint_as = {});
   // DIR.partial becomes DIR; the previous results go.
   void publish();
   // A run that produced nothing to keep: DIR.partial goes, DIR stays as it was.

@@ -58,9 +58,9 @@ void warn_unphysiological(double low, double high, std::int64_t vessel, const Ne
 }
 
 // The checkpoint a resume continues from (null without one), checked whole before the run is
-// set up, and read from its file as the run asks (over ranks every rank reads it, from the
-// path rank 0 found: none holds its bytes). A killed run's checkpoint is not overwritten by a
-// fresh run unless forced.
+// set up, and read from its file as the run asks (over ranks every rank opens and checks it
+// too, from the path rank 0 found, which every rank must see, as it sees the network's: none
+// holds its bytes). A killed run's checkpoint is not overwritten by a fresh run unless forced.
 std::unique_ptr<CheckpointReader> checkpoint_to_resume(const OutputFolder& folder, const RunConfiguration& config) {
   std::unique_ptr<CheckpointReader> checkpoint;
   if (config.resume) {
@@ -334,7 +334,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   const Waveform driving = driving_waveform(net);
   const double period = driving.period;
   std::optional<OutputFolder> folder;  // rank 0's (over ranks its refusal is every rank's)
-  std::unique_ptr<CheckpointReader> checkpoint;  // rank 0's
+  std::unique_ptr<CheckpointReader> checkpoint;
   on_lead_rank([&] {
     folder.emplace(config.out_dir);
     checkpoint = checkpoint_to_resume(*folder, config);
@@ -346,6 +346,12 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   if (over_ranks) {
     take_lead_text(staging);
     take_lead_text(resumed_from);
+    // Each rank's own reader, its refusal every rank's (in a step of its own: once the
+    // resume has begun, a rank may be in a collective call with the others).
+    if (!resumed_from.empty())
+      on_every_rank([&] {
+        if (!checkpoint) checkpoint = std::make_unique<CheckpointReader>(resumed_from);
+      });
   }
   RunResult result;
   // Interrupted where no cycle has ended (before the time loop, or in a settling cycle):
@@ -464,16 +470,15 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   PulsatileRun pulsatile(net, run, config.probes, plan, staging, transport ? &*transport : nullptr);
   if (settling) pulsatile.settle_with(std::move(settling));
   if (!resumed_from.empty()) {
-    // Its refusal (another run's, one at the run's end, a file one rank cannot read) is every
-    // rank's alike.
-    on_every_rank([&] {
-      pulsatile.resume(checkpoint ? std::move(checkpoint) : std::make_unique<CheckpointReader>(resumed_from));
-    });
+    // Its refusal (another run's, one at the run's end) is every rank's alike.
+    on_every_rank([&] { pulsatile.resume(std::move(checkpoint)); });
     observer.note("resuming from " + resumed_from + " after " + std::to_string(pulsatile.cycles_done()) +
                   " cycles (t = " + format_quantity(run.time(), "s") + ")");
   }
   on_lead_rank([&] {
-    folder->open(pulsatile.keeps_frames());  // a resume at the run's end keeps the killed run's last frames
+    // A resume at the run's end keeps the killed run's last frames; a resume of a killed run
+    // its checkpoint, as the run's first snapshot.
+    folder->open(pulsatile.keeps_frames(), pulsatile.resumed_snapshot_name());
     if (config.frames > 0) {
       std::error_code ec;
       std::filesystem::create_directories(folder->staging() / "frames", ec);

@@ -49,7 +49,8 @@ void put_summary(CheckpointWriter& out, const CycleSummary& c) {
 
 // Read vessel by vessel (the section is 80 B a vessel: not held whole besides the results).
 // entries: where given, the vessel of each entry kept (a rank's own, CycleStatistics'
-// entry_vessels()), the results then by entry; else every vessel's, by vessel.
+// entry_vessels()), the results then by entry (the waves by vessel, as close() leaves them);
+// else every vessel's, by vessel.
 CycleSummary get_summary(CheckpointReader& in, std::size_t vessels, std::span<const std::int32_t> entries = {}) {
   const std::uint64_t count = in.begin_vector();
   if (count != 4 && count != 4 + vessel_fields * vessels) in.fail("cycle results of another network");
@@ -78,10 +79,9 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels, std::span<co
       }
       for (; next != kept.end() && static_cast<std::size_t>(next->first) == v; ++next) {
         c.vessels[static_cast<std::size_t>(next->second)] = vessel_cycle(f);
-        if (wave) c.waves.emplace_back(static_cast<std::size_t>(next->second), speeds);
+        if (wave && (c.waves.empty() || c.waves.back().first != v)) c.waves.emplace_back(v, speeds);  // by vessel, as close() keys them
       }
     }
-    std::ranges::sort(c.waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
   }
   c.boundary_mean_flow = in.get_vector();
   return c;
@@ -284,6 +284,11 @@ void PulsatileRun::resume(std::unique_ptr<CheckpointReader> checkpoint) {
   if (!cycles_left()) check_run_end(source);
 }
 
+std::string PulsatileRun::resumed_snapshot_name() const {
+  return resumed_from_ && std::filesystem::path(resumed_from_->source()).parent_path() == folder_ ? pending().filename().string()
+                                                                                                   : std::string();
+}
+
 bool PulsatileRun::periodic() const {
   // With red cells carried, their distribution must have settled too: its largest change of
   // a vessel's cycle-mean discharge hematocrit below the same tolerance.
@@ -436,7 +441,9 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
     if (transport_) transport_->take_volumes();
     snapshot();
   } else if (resumed_from_) {
-    resumed_from_->write_copy(pending());
+    // The checkpoint resumed from is the first snapshot: moved here as it is by the folder's
+    // opening (resumed_snapshot_name), or copied from the file held open.
+    if (!resumed_from_->reads(pending())) resumed_from_->write_copy(pending());
     snapshot_pending_ = true;
     resumed_from_.reset();
     set_aside_last_vessels();

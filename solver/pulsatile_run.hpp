@@ -73,6 +73,10 @@ class PulsatileRun {
   // The frames a killed run left in the folder are this run's last cycle's, to be kept by
   // OutputFolder::open(true): resumed at the run's end, with frames asked for.
   bool keeps_frames() const { return resumed_ && !cycles_left() && plan_.frames > 0; }
+  // OutputFolder::open's keep_checkpoint_as: where the checkpoint resumed from lies in the run's
+  // own folder (a killed run's, which the folder's opening removes), the name of the run's
+  // first snapshot, which it is; else empty (run() copies it there from the file it holds).
+  std::string resumed_snapshot_name() const;
 
   int cycles_done() const { return done_; }
   int compliance_balances() const { return balances_; }

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "core/errors.hpp"
+#include "formats/checkpoint_file.hpp"
 #include "solver/output_folder.hpp"
 #include "solver/run_estimate.hpp"
 
@@ -131,6 +132,28 @@ TEST(OutputFolder, KeepsADeadRunsFramesWhenAsked) {
   EXPECT_FALSE(fs::exists(staging / "checkpoint.bin"));
   f.publish();
   EXPECT_EQ(read(out / "frames" / "frames_0000.vtp"), "frame");
+}
+
+// A resume of a killed run holds its checkpoint open: the folder's opening moves it into the new
+// folder under the name asked (the run's first snapshot), the very file the reader reads, before
+// the dead run's folder is removed (NFS cannot remove a folder holding a file still open).
+TEST(OutputFolder, KeepsADeadRunsCheckpointWhenAsked) {
+  Scratch s;
+  const fs::path out = s.dir / "run", staging = out.string() + ".partial";
+  fs::create_directories(staging);
+  CheckpointWriter writer;
+  writer.section("a");
+  writer.put(1.5);
+  write_checkpoint_file(staging / "checkpoint.bin", writer.bytes());
+  CheckpointReader held(staging / "checkpoint.bin");
+  OutputFolder f(out);
+  EXPECT_TRUE(f.open(false, "snapshot.pending"));
+  EXPECT_FALSE(fs::exists(staging / "checkpoint.bin"));
+  EXPECT_TRUE(held.reads(staging / "snapshot.pending"));
+  EXPECT_EQ(read(staging / "snapshot.pending"), writer.bytes());
+  held.write_copy(s.dir / "copy.bin");  // not the same file: a copy
+  EXPECT_FALSE(held.reads(s.dir / "copy.bin"));
+  EXPECT_FALSE(held.reads(s.dir / "none.bin"));
 }
 
 // Many writers started at once: exactly one takes the folder, every other is refused while
