@@ -83,9 +83,9 @@ class CheckpointReader {
   // Checks the whole file before anything is read from it: an empty or truncated file, one
   // of another format, a section whose bytes do not match its checksum (named) are refused.
   CheckpointReader(std::string bytes, std::string source);
-  // The same from the file itself, held open, not in memory: a resume of a full tree's run
-  // would otherwise hold its gigabyte twice (the bytes and the state made from them), on
-  // every rank. IoError where it cannot be opened or read; the file is read in pieces, once
+  // The same from the file itself, held open, not in memory: a resume of the full tree held
+  // its 0.67 GB checkpoint as bytes (twice, at a moment) beside the state made from them, on
+  // every rank (3.5 GB, the run itself 1.8 GB). IoError where it cannot be opened or read; the file is read in pieces, once
   // for the checks and once as the values are asked for. It must not change in place
   // meanwhile (a run writes its checkpoints to a temporary renamed over the old, and holds
   // its folder's lock): a copy (write_copy) checks it again, the values read do not.
