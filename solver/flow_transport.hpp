@@ -280,8 +280,11 @@ class FlowTransport {
   std::vector<std::int32_t> own_cell_places() const;
   std::vector<std::int32_t> own_face_places() const;
   std::vector<std::int32_t> boundary_places() const;
-  // Per vessel, `arrays` arrays one after the other (a tracer's curves): those of the vessels it steps.
-  std::vector<std::int32_t> own_vessel_places(std::size_t arrays) const;
+  // The vessels it steps, increasing; and their places in `arrays` arrays of one number a
+  // vessel one after the other (a tracer's curves), array after array: what it sends of such
+  // arrays is its own vessels' values alone, not an array the network's size.
+  std::vector<std::int32_t> own_vessels() const;
+  std::vector<std::int32_t> own_vessel_places(std::span<const std::int32_t> own, std::size_t arrays) const;
   double rank_sum(double value) const;  // on rank 0 every rank's value, summed in rank order
   void close_cycle_over_ranks(RedCellCycle& c) const;
   // The red cells' state as a checkpoint holds it, in the one-process grid's order: per cell,

@@ -275,13 +275,17 @@ void FlowTransport::save_over_ranks(CheckpointWriter* out) const {
   const std::size_t boundaries = cut_->run_boundaries;
   std::vector<double> turned(face_volume_.size());  // each face as the whole grid has it
   for (std::size_t f = 0; f < turned.size(); ++f) turned[f] = cut_->face_sign[f] * face_volume_[f];
+  const std::vector<std::int32_t> own = own_vessels();
+  std::vector<double> applied;
+  if (!applied_hematocrit_.empty())
+    for (const std::int32_t v : own) applied.push_back(applied_hematocrit_[static_cast<std::size_t>(v)]);
   const RedCellState whole{lead_whole(t.discharge_hematocrit(), cells, cut_->cells),
                            lead_whole(t.volume(), cells, cut_->cells),
                            lead_whole(t.entered_by_boundary(), held, boundaries),
                            lead_whole(t.left_by_boundary(), held, boundaries),
                            t.adjusted(),
                            lead_whole(t.last_outflow(), held, boundaries),
-                           lead_whole(applied_hematocrit_, own_vessel_places(applied_hematocrit_.empty() ? 0 : 1),
+                           lead_whole(applied, own_vessel_places(own, applied_hematocrit_.empty() ? 0 : 1),
                                       applied_hematocrit_.size()),
                            lead_whole(turned, faces, cut_->faces)};
   if (out) {
@@ -289,7 +293,7 @@ void FlowTransport::save_over_ranks(CheckpointWriter* out) const {
     out->put(static_cast<std::uint64_t>(advances_));
     out->put(last_time_);
   }
-  const std::vector<std::int32_t> curves = own_vessel_places(IndicatorCurves::state_arrays);
+  const std::vector<std::int32_t> curves = own_vessel_places(own, IndicatorCurves::state_arrays);
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     const TracerTransport& tracer = tracers_[k];
     const TracerState state{lead_whole(tracer.concentration(), cells, cut_->cells),
@@ -298,17 +302,24 @@ void FlowTransport::save_over_ranks(CheckpointWriter* out) const {
                             lead_whole(tracer.left_by_boundary(), held, boundaries),
                             rank_sum(tracer.injected()),
                             tracer.adjusted(),
-                            lead_whole(curves_[k].state(), curves, curves.size())};
+                            lead_whole(curves_[k].state_of(own), curves, IndicatorCurves::state_arrays * net_.vessel_count())};
     if (out) put_tracer(*out, state);
   }
 }
 
-std::vector<std::int32_t> FlowTransport::own_vessel_places(std::size_t arrays) const {
+std::vector<std::int32_t> FlowTransport::own_vessels() const {
+  std::vector<std::int32_t> own;
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
+    if (solver_.steps_vessel(v)) own.push_back(static_cast<std::int32_t>(v));
+  return own;
+}
+
+std::vector<std::int32_t> FlowTransport::own_vessel_places(std::span<const std::int32_t> own, std::size_t arrays) const {
   const std::size_t n = net_.vessel_count();
-  std::vector<std::int32_t> place(arrays * n, -1);
+  std::vector<std::int32_t> place;
+  place.reserve(arrays * own.size());
   for (std::size_t a = 0; a < arrays; ++a)
-    for (std::size_t v = 0; v < n; ++v)
-      if (solver_.steps_vessel(v)) place[a * n + v] = static_cast<std::int32_t>(a * n + v);
+    for (const std::int32_t v : own) place.push_back(static_cast<std::int32_t>(a * n + static_cast<std::size_t>(v)));
   return place;
 }
 

@@ -53,6 +53,14 @@ std::vector<double> IndicatorCurves::state() const {
   return s;
 }
 
+std::vector<double> IndicatorCurves::state_of(std::span<const std::int32_t> vessels) const {
+  std::vector<double> s;
+  s.reserve(state_arrays * vessels.size());
+  for (const auto* a : {&arrival_, &peak_time_, &peak_, &previous_, &mass_, &moment_})
+    for (const std::int32_t v : vessels) s.push_back((*a)[static_cast<std::size_t>(v)]);
+  return s;
+}
+
 bool IndicatorCurves::restore(std::span<const double> s) {
   const std::size_t n = mass_.size();
   if (s.size() != state_arrays * n) return false;

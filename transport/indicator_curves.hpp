@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -35,6 +36,9 @@ class IndicatorCurves {
   // one after the other.
   static constexpr std::size_t state_arrays = 6;
   std::vector<double> state() const;
+  // The same numbers of these vessels alone: each array's, in turn, for them in their order
+  // (what a rank holding some of the vessels sends of its state).
+  std::vector<double> state_of(std::span<const std::int32_t> vessels) const;
   bool restore(std::span<const double> state);  // false for one of another size
 
   static constexpr double arrival_fraction = 0.01;
