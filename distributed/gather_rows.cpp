@@ -81,6 +81,12 @@ void gather_places(std::span<const double> values, std::span<const std::int32_t>
   gather_rows(items, rows, 1, count, [&](std::int32_t item, const double* row) { into[static_cast<std::size_t>(item)] = row[0]; });
 }
 
+std::vector<double> gather_places(std::span<const double> values, std::span<const std::int32_t> place, std::size_t count) {
+  std::vector<double> whole(world_rank() == 0 ? count : 0, 0.0);
+  gather_places(values, place, count, whole);
+  return whole;
+}
+
 std::vector<double> scatter_values(std::span<const double> whole, const std::vector<std::vector<std::int32_t>>& lists,
                                    std::size_t mine) {
   const bool lead = world_rank() == 0;

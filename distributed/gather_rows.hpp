@@ -32,6 +32,10 @@ void gather_rows(std::span<const std::int32_t> items, std::span<const double> ro
 void gather_places(std::span<const double> values, std::span<const std::int32_t> place, std::size_t count,
                    std::span<double> into);
 
+// The same into a vector made here: on rank 0 every item's value (0 where no rank places
+// one), empty elsewhere. Collective.
+std::vector<double> gather_places(std::span<const double> values, std::span<const std::int32_t> place, std::size_t count);
+
 // Every rank's list of items on rank 0, rank after rank (empty elsewhere): what rank 0 needs to
 // place their rows or send them values. Collective.
 std::vector<std::vector<std::int32_t>> gather_lists(std::span<const std::int32_t> items);

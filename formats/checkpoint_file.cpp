@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <fstream>
+#include <functional>
 #include <stdexcept>
 #include <unistd.h>
 
@@ -27,6 +28,7 @@ constexpr std::string_view magic = "hemotree checkpoint\n";
 constexpr std::uint64_t format_version = 11;
 constexpr std::size_t word = sizeof(std::uint64_t);
 constexpr std::size_t header = magic.size() + word;  // the magic line and the format
+constexpr std::size_t piece_bytes = std::size_t{1} << 20;  // what a reader of the file reads at once
 
 std::uint64_t checksum(const std::string& bytes, std::size_t begin, std::size_t end) {
   Fingerprint f;
@@ -256,12 +258,11 @@ void CheckpointReader::read_at(std::size_t at, void* data, std::size_t size) con
     std::memcpy(out, window_.data() + (at - window_at_), size);
     return;
   }
-  constexpr std::size_t piece = std::size_t{1} << 20;
-  const bool small = size < piece / 4;
+  const bool small = size < piece_bytes / 4;
   char* into = out;
   std::size_t want = size;
   if (small) {  // the window moved here: the values after it come from memory
-    window_.resize(std::min(piece, size_ - at));
+    window_.resize(std::min(piece_bytes, size_ - at));
     window_at_ = at;
     into = window_.data();
     want = window_.size();
@@ -276,6 +277,17 @@ void CheckpointReader::read_at(std::size_t at, void* data, std::size_t size) con
     done += static_cast<std::size_t>(n);
   }
   if (small) std::memcpy(out, window_.data(), size);
+}
+
+void CheckpointReader::for_each_piece(std::size_t begin, std::size_t end,
+                                      const std::function<void(const char*, std::size_t)>& f) const {
+  std::vector<char> piece(std::min(piece_bytes, end - begin));
+  for (std::size_t at = begin; at < end;) {
+    const std::size_t n = std::min(piece.size(), end - at);
+    read_at(at, piece.data(), n);
+    f(piece.data(), n);
+    at += n;
+  }
 }
 
 std::uint64_t CheckpointReader::word_at(std::size_t at) const {
@@ -306,16 +318,12 @@ void CheckpointReader::index_sections() {
   const std::size_t size = size_;
   const std::size_t last = size >= header + word ? size - word : header;  // where the sections end
   Fingerprint file;
-  std::vector<char> piece(std::min<std::size_t>(std::size_t{1} << 20, size));
   // Adds [begin, end) to the file's checksum (it has every byte before begin) and to `to`.
   auto hash = [&](std::size_t begin, std::size_t end, Fingerprint* to) {
-    for (std::size_t at = begin; at < end;) {
-      const std::size_t n = std::min(piece.size(), end - at);
-      read_at(at, piece.data(), n);
-      file.add(piece.data(), n);
-      if (to) to->add(piece.data(), n);
-      at += n;
-    }
+    for_each_piece(begin, end, [&](const char* piece, std::size_t n) {
+      file.add(piece, n);
+      if (to) to->add(piece, n);
+    });
   };
   hash(0, std::min(header, last), nullptr);
   std::size_t at = header;
@@ -492,15 +500,13 @@ void CheckpointReader::write_copy(const std::filesystem::path& to) const {
     // checked the file's own, which the copy ends with).
     Fingerprint file;
     const std::size_t last = size_ - word;
-    std::vector<char> piece(std::min<std::size_t>(std::size_t{1} << 20, size_));
-    for (std::size_t at = 0; at < size_;) {
-      const std::size_t n = std::min(piece.size(), size_ - at);
-      read_at(at, piece.data(), n);
-      if (at < last) file.add(piece.data(), std::min(n, last - at));
-      write_all(fd, piece.data(), n, temp);
-      at += n;
-    }
-    if (word_at(last) != file.value()) fail("the file changed after it was checked; it cannot be copied as the run's checkpoint");
+    for_each_piece(0, last, [&](const char* piece, std::size_t n) {
+      file.add(piece, n);
+      write_all(fd, piece, n, temp);
+    });
+    const std::uint64_t sum = word_at(last);
+    write_all(fd, reinterpret_cast<const char*>(&sum), word, temp);
+    if (sum != file.value()) fail("the file changed after it was checked; it cannot be copied as the run's checkpoint");
   });
 }
 

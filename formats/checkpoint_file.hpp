@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <span>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -133,6 +134,8 @@ class CheckpointReader {
   // size bytes at offset `at` (within size_), from memory or the file.
   void read_at(std::size_t at, void* data, std::size_t size) const;
   std::uint64_t word_at(std::size_t at) const;
+  // f(bytes, n) for [begin, end) in pieces of at most a MiB, in order.
+  void for_each_piece(std::size_t begin, std::size_t end, const std::function<void(const char*, std::size_t)>& f) const;
   std::string bytes_, source_;  // bytes_: in memory; empty where read from a file
   int fd_ = -1;                 // the file read from, or -1
   std::size_t size_ = 0;        // of the checkpoint

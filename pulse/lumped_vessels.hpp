@@ -309,8 +309,10 @@ class LumpedVessels {
   static constexpr std::size_t state_arrays = 6;
   struct StateShare {
     std::vector<std::int32_t> node_place, edge_place;
+    std::size_t whole_nodes = 0, whole_edges = 0;  // the whole run's
     static bool per_node(std::size_t array) { return array < 4; }
     const std::vector<std::int32_t>& place(std::size_t array) const { return per_node(array) ? node_place : edge_place; }
+    std::size_t whole(std::size_t array) const { return per_node(array) ? whole_nodes : whole_edges; }  // an array's length
   };
   StateShare state_share(const LumpedPlaces& places) const;
   std::vector<double> share_values(std::size_t array) const;

@@ -41,14 +41,7 @@ void PulseSolver::save_over_ranks(CheckpointWriter* out) const {
     lead_whole_(factors, steps_vessel_);
   }
   // The 0D state's places: each own node and edge at its place in the whole's order.
-  LumpedVessels::StateShare share;
-  std::size_t whole_count[2] = {0, 0};  // nodes, edges
-  {
-    const LumpedPlaces places = lumped_places(net_, zero_d_);
-    share = lumped_.state_share(places);
-    whole_count[0] = places.nodes;
-    whole_count[1] = places.edges;
-  }
+  const LumpedVessels::StateShare share = lumped_.state_share(lumped_places(net_, zero_d_));
   // The 1D vessels' state: the top's own, or, spread, from every rank.
   std::optional<WholeOneD> one_d;
   if (one_d_cut_) one_d = whole_one_d_state();
@@ -74,8 +67,7 @@ void PulseSolver::save_over_ranks(CheckpointWriter* out) const {
   // other rank sends its own values (not a whole array of its own), and the lead holds one
   // whole array, not six.
   for (std::size_t a = 0; a < LumpedVessels::state_arrays; ++a) {
-    const std::vector<double> whole =
-        lead_places_(lumped_.share_values(a), share.place(a), whole_count[LumpedVessels::StateShare::per_node(a) ? 0 : 1]);
+    const std::vector<double> whole = lead_places_(lumped_.share_values(a), share.place(a), share.whole(a));
     if (out) out->put(whole);
   }
 }

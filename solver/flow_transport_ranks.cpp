@@ -150,9 +150,7 @@ std::vector<std::int32_t> FlowTransport::boundary_places() const {
 
 std::vector<double> FlowTransport::lead_whole(std::span<const double> values, std::span<const std::int32_t> place,
                                               std::size_t whole) const {
-  std::vector<double> all(world_rank() == 0 ? whole : 0);
-  gather_places(values, place, whole, all);
-  return all;
+  return gather_places(values, place, whole);
 }
 
 double FlowTransport::lead_sum(std::span<const double> values, std::span<const std::int32_t> place, std::size_t whole,

@@ -71,16 +71,12 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels, std::span<co
     auto next = kept.begin();
     for (std::size_t v = 0; v < vessels; ++v) {
       in.get_part(f);
-      const WaveSpeeds speeds{f[8], f[9]};
-      const bool wave = !std::isnan(speeds.pressure) || !std::isnan(speeds.velocity);
-      if (all) {
-        c.vessels[v] = vessel_cycle(f);
-        if (wave) c.waves.emplace_back(v, speeds);
-      }
-      for (; next != kept.end() && static_cast<std::size_t>(next->first) == v; ++next) {
+      bool kept_here = all;
+      if (all) c.vessels[v] = vessel_cycle(f);
+      for (; next != kept.end() && static_cast<std::size_t>(next->first) == v; ++next, kept_here = true)
         c.vessels[static_cast<std::size_t>(next->second)] = vessel_cycle(f);
-        if (wave && (c.waves.empty() || c.waves.back().first != v)) c.waves.emplace_back(v, speeds);  // by vessel, as close() keys them
-      }
+      const WaveSpeeds speeds{f[8], f[9]};
+      if (kept_here && (!std::isnan(speeds.pressure) || !std::isnan(speeds.velocity))) c.waves.emplace_back(v, speeds);
     }
   }
   c.boundary_mean_flow = in.get_vector();

@@ -60,9 +60,9 @@ class PulsatileRun {
                std::filesystem::path folder, FlowTransport* transport = nullptr);
 
   // Continues from a checkpoint instead of starting (InputError for one of another run).
-  // checkpoint: the file's reader (its source() names it), kept where this run writes (until
-  // the folder is open, to copy it there) and let go elsewhere. One at the run's end (no cycle left to run) is taken only
-  // from a killed run's staging folder (the run's folder), whose frames of that last cycle
+  // checkpoint: the file's reader (its source() names it), kept where this run writes until
+  // the folder is open (its first snapshot is that file), let go elsewhere. One at the run's
+  // end (no cycle left to run) is taken only from a killed run's staging folder (the run's folder), whose frames of that last cycle
   // are then this run's; a published run that already has its cycles is refused as it is.
   void resume(std::unique_ptr<CheckpointReader> checkpoint);
   // Progress goes to the observer, as its progress_style() asks; its interrupt requests are

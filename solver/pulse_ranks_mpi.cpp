@@ -88,9 +88,7 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDL
     gather_places(values, place, values.size(), values);
   };
   ranks_.lead_places = [](std::span<const double> values, std::span<const std::int32_t> place, std::size_t count) {
-    std::vector<double> whole(world_rank() == 0 ? count : 0, 0.0);
-    gather_places(values, place, count, whole);
-    return whole;
+    return gather_places(values, place, count);
   };
   ranks_.from_lead = [](std::vector<double>& values) { take_lead_values(values); };  // rank 0's, as lead_whole's
   ranks_.make_whole = [](std::vector<double>& values, const std::vector<unsigned char>& mine) {
