@@ -6,6 +6,7 @@
 #include <map>
 #include <numeric>
 #include <numbers>
+#include <type_traits>
 #include <utility>
 
 #include "core/errors.hpp"
@@ -381,9 +382,26 @@ void FlowTransport::step_tracers(double t0, double t1) {
 }
 
 FlowTransport::TracerReport FlowTransport::tracer_report(std::size_t k) const {
-  if (cut_) return reports_.at(k);
+  if (cut_ || cells_after_release_) return reports_.at(k);
   const TracerTransport& t = tracers_[k];
   return {curves_[k].landmarks(solver_.time()), t.amount(*red_cells_), t.entered(), t.left(), t.injected(), t.adjusted()};
+}
+
+void FlowTransport::release_state() {
+  if (!cut_) {
+    reports_.clear();
+    for (std::size_t k = 0; k < tracers_.size(); ++k) reports_.push_back(tracer_report(k));
+  }
+  cells_after_release_ = cell_count();
+  red_cells_.reset();
+  cut_.reset();
+  auto free = [](auto& array) { std::decay_t<decltype(array)>().swap(array); };
+  free(tracers_), free(curves_), free(tracer_boundaries_), free(tracer_face_), free(tracer_inflow_), free(tracer_injected_);
+  free(cycle_cells_), free(cycle_blood_), free(cycle_low_), free(cycle_high_), free(step_sum_), free(step_count_);
+  free(applied_hematocrit_), free(viscosity_scaling_), free(face_volume_), free(now_), free(inflow_hematocrit_);
+  free(vessel_first_cell_), free(vessel_first_face_), free(proximal_sign_), free(lumped_face_), free(one_d_), free(one_d_place_);
+  free(node_boundary_face_), free(node_boundary_);
+  boundary_mark_.resize(0);
 }
 
 std::size_t FlowTransport::cell_at(std::size_t v, double x) const {

@@ -126,7 +126,9 @@ class FlowTransport {
   double hematocrit_at(std::size_t vessel, double x) const;
   double tracer_at(std::size_t k, std::size_t vessel, double x) const;
   // The whole run's cells (over ranks: every rank's).
-  std::size_t cell_count() const { return cut_ ? cut_->cells : red_cells_->grid().cell_count(); }
+  std::size_t cell_count() const {
+    return cells_after_release_ ? *cells_after_release_ : cut_ ? cut_->cells : red_cells_->grid().cell_count();
+  }
   std::size_t advances() const { return advances_; }
   // Over ranks: the exchange of its steps' messages (its traffic); else null.
   const RootExchange* exchange() const { return cut_ ? cut_->roots.exchange.get() : nullptr; }
@@ -137,6 +139,13 @@ class FlowTransport {
     std::size_t steps = 0, rounds = 0;
   };
   const SpreadTraffic* spread_traffic() const { return cut_ && cut_->spread ? &cut_->spread->traffic : nullptr; }
+
+  // After the last step, once the state is saved: the tracers' reports taken (alone as
+  // tracer_report gives them; over ranks take_reports took them) and every array freed (about
+  // 400 B a vessel with red cells and a tracer) before the results are written, which read
+  // the reports, the options and the counts alone. No step or save follows; what the
+  // PulsatileRun kept of the last cycle stays its own.
+  void release_state();
 
   void save(CheckpointWriter& out) const;
   // Over ranks: the one-process run's bytes, written to `out` on rank 0, null elsewhere. Collective.
@@ -264,7 +273,8 @@ class FlowTransport {
   // Numbers out to each neighbouring rank and in from it, of the sizes both sides know.
   void exchange_numbers(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in);
 
-  std::vector<TracerReport> reports_;  // over ranks, rank 0's (take_reports)
+  std::vector<TracerReport> reports_;  // over ranks, rank 0's (take_reports); alone once released
+  std::optional<std::size_t> cells_after_release_;  // release_state()
   // On rank 0 `start` plus each of the whole run's items in turn (per cell or boundary: each
   // rank's values at `place`, -1 none), in the one-process order; elsewhere `start`. Collective.
   double lead_sum(std::span<const double> values, std::span<const std::int32_t> place, std::size_t whole,
