@@ -110,10 +110,10 @@ void FlowTransport::add_node_cells(TransportGrid& grid, std::vector<double>& vol
   // Nodes of 0D vessels: k weighted by the half-vessels they hold.
   const LumpedVessels& lumped = solver_.lumped();
   const std::size_t lumped_nodes = lumped.empty() ? 0 : lumped.network_node_count();
-  std::vector<std::int64_t> network_node(lumped_nodes, -1);
+  std::vector<std::int32_t> network_node(lumped_nodes, -1);
   for (std::size_t n = 0; n < net_.node_count(); ++n)
     if (!lumped.empty() && lumped.node_of(static_cast<std::int64_t>(n)) >= 0)
-      network_node[static_cast<std::size_t>(lumped.node_of(static_cast<std::int64_t>(n)))] = static_cast<std::int64_t>(n);
+      network_node[static_cast<std::size_t>(lumped.node_of(static_cast<std::int64_t>(n)))] = static_cast<std::int32_t>(n);
   std::vector<double> k_sum(lumped_nodes, 0.0), weight(lumped_nodes, 0.0);
   for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
     if (!solver_.is_lumped(v)) continue;

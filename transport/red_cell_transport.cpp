@@ -24,6 +24,7 @@ constexpr double cycle_tolerance = 1e-15;
 RedCellTransport::RedCellTransport(TransportGrid grid, std::vector<double> volume, double hematocrit,
                                    RedCellOptions options)
     : grid_(std::move(grid)), faces_(grid_), options_(options), volume_(std::move(volume)) {
+  grid_.shrink_to_fit();
   const std::size_t cells = grid_.cell_count();
   if (volume_.size() != cells || grid_.fahraeus.size() != cells || grid_.b.size() != grid_.face_count() ||
       grid_.vessel.size() != grid_.face_count() || grid_.diameter.size() != grid_.face_count())

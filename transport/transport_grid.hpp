@@ -29,7 +29,7 @@ struct TransportGrid {
   // Per cell: the network node it is (node cells and junctions), or -1 for a vessel's slice;
   // and the Fahraeus parameter k of its lumen (physics/phase_separation.hpp:
   // H_T = H_D (k + (1 - k) H_D); 1 where the effect is off).
-  std::vector<std::int64_t> node;
+  std::vector<std::int32_t> node;
   std::vector<double> fahraeus;
   // Per face: its two sides. b < 0 is boundary -1 - b (a place in the run's boundary list).
   std::vector<std::int32_t> a, b;
@@ -45,7 +45,7 @@ struct TransportGrid {
   bool is_cut(std::size_t boundary) const { return boundary + cuts >= boundaries; }
   std::size_t cell_count() const { return node.size(); }
   std::size_t face_count() const { return a.size(); }
-  void add_cell(std::int64_t network_node, double fahraeus_k) {
+  void add_cell(std::int32_t network_node, double fahraeus_k) {
     node.push_back(network_node);
     fahraeus.push_back(fahraeus_k);
   }
@@ -54,6 +54,16 @@ struct TransportGrid {
     b.push_back(to_cell);
     vessel.push_back(in_vessel);
     diameter.push_back(lumen_diameter);
+  }
+  // Once every cell and face is added: each array's spare capacity freed (grown by
+  // doubling: 12 MB of the million-vessel tree's grid).
+  void shrink_to_fit() {
+    node.shrink_to_fit();
+    fahraeus.shrink_to_fit();
+    a.shrink_to_fit();
+    b.shrink_to_fit();
+    vessel.shrink_to_fit();
+    diameter.shrink_to_fit();
   }
   static std::int32_t boundary_side(std::size_t boundary) { return -1 - static_cast<std::int32_t>(boundary); }
 };
