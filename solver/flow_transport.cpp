@@ -79,8 +79,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   for (std::size_t b = 0; b < boundaries.size(); ++b) inflow_hematocrit_[b] = boundaries[b].entering_hematocrit(blood);
   solver_volumes(volume);
   red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
-                     RedCellOptions{options_.phase_separation, blood.phase_separation_diameter_scale(),
-                                    !options_.tracers.empty()});
+                     RedCellOptions{options_.phase_separation, blood.phase_separation_diameter_scale()});
   face_volume_.assign(red_cells_->grid().face_count(), 0.0);
   if (cut_ && cut_->spread) place_spread_cut(end_faces);
   else if (ranks) place_cut(*ranks);
@@ -556,7 +555,7 @@ void FlowTransport::close_step() {
   // The cycle's sums per vessel: red cells and blood through its faces, and the step's
   // discharge hematocrit (the faces' mean) for its extremes.
   const TransportGrid& grid = red_cells_->grid();
-  const CarrierStep& cells = red_cells_->cells_step();
+  const std::span<const double> cells = red_cells_->cells_through();
   for (std::size_t f = 0; f < grid.face_count(); ++f) {
     const std::int32_t v = grid.vessel[f];
     const double q = face_volume_[f];
@@ -565,9 +564,9 @@ void FlowTransport::close_step() {
     // Another rank's 1D vessel, its end here. (A 0D vessel in a halo is followed as its own
     // rank follows it, from the same bits: its viscosity enters this rank's rows too.)
     if (cut_ && cut_->spread && !solver_.steps_vessel(vi) && !solver_.is_lumped(vi)) continue;
-    cycle_cells_[vi] += std::abs(cells.face[f]);
+    cycle_cells_[vi] += std::abs(cells[f]);
     cycle_blood_[vi] += std::abs(q);
-    step_sum_[vi] += cells.face[f] / q;
+    step_sum_[vi] += cells[f] / q;
     ++step_count_[vi];
   }
   for (std::size_t v = 0; v < step_count_.size(); ++v) {

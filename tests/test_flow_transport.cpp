@@ -102,8 +102,8 @@ TEST(FlowTransport, ConstantBoundariesSettleOnTheSteadyDistributionOfTheFlows) {
     const TransportGrid& grid = cells.grid();
     std::vector<double> got(net.vessel_count(), -1);
     for (std::size_t f = 0; f < grid.face_count(); ++f)
-      if (grid.vessel[f] >= 0 && cells.blood_step().face[f] != 0)
-        got[static_cast<std::size_t>(grid.vessel[f])] = cells.cells_step().face[f] / cells.blood_step().face[f];
+      if (grid.vessel[f] >= 0 && cells.blood_through()[f] != 0)
+        got[static_cast<std::size_t>(grid.vessel[f])] = cells.cells_through()[f] / cells.blood_through()[f];
     double spread = 0;
     for (std::size_t v = 0; v < net.vessel_count(); ++v) {
       EXPECT_NEAR(got[v], expected[v], 1e-7) << "vessel " << v;
@@ -177,7 +177,7 @@ TEST(FlowTransport, ViscosityFeedbackReachesTheSteadyFlowsAndHematocritsSolvedTo
     const std::int32_t v = grid.vessel[f];
     if (v < 0) continue;
     const auto vi = static_cast<std::size_t>(v);
-    EXPECT_NEAR(cells.cells_step().face[f] / cells.blood_step().face[f], steady.hematocrit[vi], 2e-4) << "vessel " << v;
+    EXPECT_NEAR(cells.cells_through()[f] / cells.blood_through()[f], steady.hematocrit[vi], 2e-4) << "vessel " << v;
     EXPECT_NEAR(solver.mean_flow(vi), steady.flow.flow[vi], 1e-3 * 2e-12) << "vessel " << v;
   }
 }

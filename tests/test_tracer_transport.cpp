@@ -140,7 +140,7 @@ TEST(TracerTransport, CirculationRoundARingSolvesEachCellsBalanceFromTheStepsSta
   for (int i = 0; i < 3; ++i) ring.add_cell(i, 1.0);
   for (int i = 0; i < 3; ++i) ring.add_face(i, (i + 1) % 3, i, 10e-6);
   const double volume = 1e-13, q = 0.5e-13;
-  RedCellTransport cells(ring, std::vector<double>(3, volume), 0.45, RedCellOptions{false, 1, true});
+  RedCellTransport cells(ring, std::vector<double>(3, volume), 0.45, RedCellOptions{false, 1});
   TracerTransport tracer(3, 0, TracerCarrier::blood);
   tracer.restore(std::vector<double>{1, 0, 0}, {}, {}, {}, 0, 0);
   cells.step(std::vector<double>(3, q), {});

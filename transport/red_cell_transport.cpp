@@ -53,15 +53,9 @@ RedCellTransport::RedCellTransport(TransportGrid grid, std::vector<double> volum
     }
     if (inner) candidates_.push_back(static_cast<std::int32_t>(c));
   }
-  // The plasma's and the blood's contents only where tracers ride on them (memory: a full
-  // tree's millions of cells); the blood's face volumes always.
-  for (CarrierStep* c : {&cells_, &plasma_, &blood_}) {
-    if (c != &cells_ && !options_.all_carriers) continue;
-    c->face.assign(grid_.face_count(), 0.0);
-    c->before.assign(cells, 0.0);
-    c->after.assign(cells, 0.0);
-  }
-  blood_.face.assign(grid_.face_count(), 0.0);
+  blood_face_.assign(grid_.face_count(), 0.0);
+  cells_face_.assign(grid_.face_count(), 0.0);
+  cells_before_.assign(cells, 0.0);
 }
 
 void RedCellTransport::set_hematocrit(std::span<const double> discharge) {
@@ -164,7 +158,7 @@ double RedCellTransport::face_hematocrit(std::size_t f, std::span<const double> 
 
 double RedCellTransport::solve_cell(std::size_t c, std::span<const double> face_volume,
                                     std::span<const double> inflow_hematocrit) {
-  double rhs = cells_.before[c], out = 0;
+  double rhs = cells_before_[c], out = 0;
   for (auto i = faces_.start[c]; i < faces_.start[c + 1]; ++i) {
     const auto f = static_cast<std::size_t>(faces_.face[static_cast<std::size_t>(i)]);
     const double q = face_volume[f];
@@ -200,7 +194,7 @@ void RedCellTransport::begin_step(std::span<const double> face_volume) {
     next_volume_[static_cast<std::size_t>(grid_.a[f])] -= face_volume[f];
     if (grid_.b[f] >= 0) next_volume_[static_cast<std::size_t>(grid_.b[f])] += face_volume[f];
   }
-  for (std::size_t c = 0; c < cells; ++c) cells_.before[c] = volume_[c] * tube(c, discharge_[c]);
+  for (std::size_t c = 0; c < cells; ++c) cells_before_[c] = volume_[c] * tube(c, discharge_[c]);
   split_at_nodes(face_volume);
   order_.update(grid_, faces_, face_volume);
   if (grid_.cuts == 0) return;
@@ -249,14 +243,13 @@ void RedCellTransport::solve(std::span<const double> face_volume, std::span<cons
 }
 
 void RedCellTransport::end_step(std::span<const double> face_volume, std::span<const double> inflow_hematocrit) {
-  const std::size_t cells = grid_.cell_count(), faces = grid_.face_count();
+  const std::size_t faces = grid_.face_count();
   // What moved: red cells per face at the new upwind values, and the boundaries' balance.
   for (std::size_t f = 0; f < faces; ++f) {
     const double q = face_volume[f];
     const double cells_through = q == 0 ? 0.0 : q * face_hematocrit(f, face_volume, inflow_hematocrit);
-    cells_.face[f] = cells_through;
-    blood_.face[f] = q;
-    if (options_.all_carriers) plasma_.face[f] = q - cells_through;
+    cells_face_[f] = cells_through;
+    blood_face_[f] = q;
     if (grid_.b[f] >= 0 || q == 0) continue;
     const auto boundary = static_cast<std::size_t>(-1 - grid_.b[f]);
     if (grid_.is_cut(boundary)) continue;  // the other side's cells, not the network's
@@ -267,15 +260,7 @@ void RedCellTransport::end_step(std::span<const double> face_volume, std::span<c
       entered_[boundary] -= cells_through;
     }
   }
-  for (std::size_t c = 0; c < cells; ++c) cells_.after[c] = next_volume_[c] * tube(c, discharge_[c]);
-  if (options_.all_carriers)
-    for (std::size_t c = 0; c < cells; ++c) {
-      plasma_.before[c] = volume_[c] - cells_.before[c];
-      plasma_.after[c] = next_volume_[c] - cells_.after[c];
-      blood_.before[c] = volume_[c];
-      blood_.after[c] = next_volume_[c];
-    }
-  volume_.swap(next_volume_);
+  volume_.swap(next_volume_);  // blood_before() and blood_after() read the two
 }
 
 }  // namespace hemotree

@@ -19,18 +19,6 @@ TracerTransport::TracerTransport(std::size_t cells, std::size_t boundaries, Trac
     : carrier_(carrier), concentration_(cells, 0.0), last_outflow_(boundaries, 0.0), entered_(boundaries, 0.0),
       left_(boundaries, 0.0) {}
 
-const CarrierStep& TracerTransport::carrier_step(const RedCellTransport& red_cells) const {
-  switch (carrier_) {
-    case TracerCarrier::plasma:
-      return red_cells.plasma_step();
-    case TracerCarrier::cells:
-      return red_cells.cells_step();
-    case TracerCarrier::blood:
-      break;
-  }
-  return red_cells.blood_step();
-}
-
 double TracerTransport::carried(const RedCellTransport& red_cells, std::size_t c) const {
   switch (carrier_) {
     case TracerCarrier::plasma:
@@ -56,7 +44,7 @@ double TracerTransport::left() const { return std::accumulate(left_.begin(), lef
 double TracerTransport::inflowing(std::size_t f, const RedCellTransport& red_cells, std::span<const double> inflow,
                                   std::span<const double> injected) const {
   const TransportGrid& grid = red_cells.grid();
-  const double q = red_cells.blood_step().face[f];
+  const double q = red_cells.blood_through()[f];
   double c;
   if (q > 0) {
     c = concentration_[static_cast<std::size_t>(grid.a[f])];
@@ -73,12 +61,12 @@ double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_ce
                                    std::span<const double> inflow, std::span<const double> injected) const {
   const TransportGrid& grid = red_cells.grid();
   const CellFaces& faces = red_cells.faces();
-  const std::span<const double> blood = red_cells.blood_step().face;
-  double rhs = m.before[c] * start_[c], carrier = m.after[c];
+  const std::span<const double> blood = red_cells.blood_through();
+  double rhs = m.before(c) * start_[c], carrier = m.after(c);
   for (auto i = faces.start[c]; i < faces.start[c + 1]; ++i) {
     const auto f = static_cast<std::size_t>(faces.face[static_cast<std::size_t>(i)]);
     if (blood[f] == 0) continue;
-    const double through = std::abs(m.face[f]);
+    const double through = std::abs(m.face(f));
     if ((static_cast<std::size_t>(grid.a[f]) == c) == (blood[f] > 0)) carrier += through;
     else rhs += through * inflowing(f, red_cells, inflow, injected);
   }
@@ -102,14 +90,14 @@ void TracerTransport::begin_step(const RedCellTransport& red_cells, std::span<co
   // rounds of a run over ranks).
   start_.assign(concentration_.begin(), concentration_.end());
   // What the injections add, at the concentrations upstream before they move.
-  const CarrierStep& m = carrier_step(red_cells);
-  for (std::size_t f = 0; f < injected.size(); ++f) injected_ += std::abs(m.face[f]) * injected[f];
+  const CarrierStep m = carrier_step(red_cells);
+  for (std::size_t f = 0; f < injected.size(); ++f) injected_ += std::abs(m.face(f)) * injected[f];
 }
 
 void TracerTransport::solve(const RedCellTransport& red_cells, std::span<const double> inflow,
                             std::span<const double> injected, RedCellTransport::Cells which) {
   const FlowOrder& order = red_cells.order();
-  const CarrierStep& m = carrier_step(red_cells);
+  const CarrierStep m = carrier_step(red_cells);
   const std::size_t cells = concentration_.size(), ordered = cells - order.cyclic;
   for (std::size_t k = 0; k < ordered; ++k) {
     const auto c = static_cast<std::size_t>(order.cells[k]);
@@ -132,9 +120,9 @@ void TracerTransport::solve(const RedCellTransport& red_cells, std::span<const d
 void TracerTransport::end_step(const RedCellTransport& red_cells, std::span<const double> inflow,
                                std::span<const double> injected) {
   const TransportGrid& grid = red_cells.grid();
-  const CarrierStep& m = carrier_step(red_cells);
+  const CarrierStep m = carrier_step(red_cells);
   face_concentration_.assign(grid.face_count(), 0.0);
-  const std::span<const double> blood = red_cells.blood_step().face;
+  const std::span<const double> blood = red_cells.blood_through();
   for (std::size_t f = 0; f < grid.face_count(); ++f) {
     if (blood[f] == 0) continue;
     const double c = inflowing(f, red_cells, inflow, injected);
@@ -143,10 +131,10 @@ void TracerTransport::end_step(const RedCellTransport& red_cells, std::span<cons
     const auto boundary = static_cast<std::size_t>(-1 - grid.b[f]);
     if (grid.is_cut(boundary)) continue;  // the other side's cells, not the network's
     if (blood[f] > 0) {
-      left_[boundary] += std::abs(m.face[f]) * c;
+      left_[boundary] += std::abs(m.face(f)) * c;
       last_outflow_[boundary] = c;
     } else {
-      entered_[boundary] += std::abs(m.face[f]) * (injected.empty() ? c : c - injected[f]);  // an injection there is counted apart
+      entered_[boundary] += std::abs(m.face(f)) * (injected.empty() ? c : c - injected[f]);  // an injection there is counted apart
     }
   }
 }

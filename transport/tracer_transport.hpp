@@ -19,8 +19,6 @@
 
 namespace hemotree {
 
-enum class TracerCarrier { plasma, cells, blood };
-
 class TracerTransport {
  public:
   TracerTransport(std::size_t cells, std::size_t boundaries, TracerCarrier carrier);
@@ -45,8 +43,8 @@ class TracerTransport {
   std::span<const double> concentration() const { return concentration_; }
   // Per face, the last step's tracer over the carrier through it (0 where none passed).
   std::span<const double> face_concentration() const { return face_concentration_; }
-  // The carrier of a step (red cells' CarrierStep for this tracer's carrier).
-  const CarrierStep& carrier_step(const RedCellTransport& red_cells) const;
+  // The carrier of the red cells' last step (their CarrierStep for this tracer's carrier).
+  CarrierStep carrier_step(const RedCellTransport& red_cells) const { return red_cells.carrier_step(carrier_); }
   // Its carrier in a cell now (after the last step, or the volumes set since).
   double carried(const RedCellTransport& red_cells, std::size_t cell) const;
   // Tracer in the network now (concentration x carrier volume), and through the boundaries
