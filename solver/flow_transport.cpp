@@ -397,7 +397,7 @@ void FlowTransport::release_state() {
   auto free = [](auto& array) { std::decay_t<decltype(array)>().swap(array); };
   free(tracers_), free(curves_), free(tracer_boundaries_), free(tracer_face_), free(tracer_inflow_), free(tracer_injected_);
   free(cycle_cells_), free(cycle_blood_), free(cycle_low_), free(cycle_high_), free(step_sum_), free(step_count_);
-  free(applied_hematocrit_), free(viscosity_scaling_), free(face_volume_), free(now_), free(inflow_hematocrit_);
+  free(applied_hematocrit_), free(viscosity_scaling_), free(face_volume_), free(slice_volume_), free(inflow_hematocrit_);
   free(vessel_first_cell_), free(vessel_first_face_), free(proximal_sign_), free(lumped_face_), free(one_d_), free(one_d_place_);
   free(node_boundary_face_), free(node_boundary_);
   boundary_mark_.resize(0);
@@ -441,12 +441,16 @@ void FlowTransport::solver_volumes(std::vector<double>& volume) const {
   if (!lumped.empty())
     for (std::size_t k = 0; k < lumped.network_node_count(); ++k)  // a node across a cut holds none here
       volume[k] = empty_node_cell(k) ? 0.0 : lumped.stored_volume(static_cast<std::int32_t>(k));
+  slice_volumes(volume, 0);
+}
+
+void FlowTransport::slice_volumes(std::span<double> volume, std::size_t first) const {
   const Eigen::MatrixXd& area = solver_.state().area;
   const std::vector<std::int32_t>& one_d = one_d_;
   for (std::size_t i = 0; i < one_d.size(); ++i) {
-    auto cell = static_cast<std::size_t>(vessel_first_cell_[i]);
-    const auto first = solver_.first_element(static_cast<std::size_t>(one_d[i]));
-    for (auto el = first; el < first + solver_.elements_per_vessel(); ++el) {
+    auto cell = static_cast<std::size_t>(vessel_first_cell_[i]) - first;
+    const auto first_element = solver_.first_element(static_cast<std::size_t>(one_d[i]));
+    for (auto el = first_element; el < first_element + solver_.elements_per_vessel(); ++el) {
       const double half = solver_.element_half_length(static_cast<std::size_t>(el));
       for (int s = 0; s < slices_; ++s)
         volume[cell++] = half * slice_integral_.row(s).dot(area.row(el).head(slice_integral_.cols()));
@@ -465,19 +469,19 @@ void FlowTransport::restart() {
 }
 
 void FlowTransport::take_volumes() {
-  now_.assign(red_cells_->volume().begin(), red_cells_->volume().end());
-  solver_volumes(now_);
+  std::vector<double> now(red_cells_->volume().begin(), red_cells_->volume().end());
+  solver_volumes(now);
   // Each tracer's carrier moves with the volumes: what that adds, cell by cell.
-  const std::size_t cells = now_.size();
+  const std::size_t cells = now.size();
   std::vector<std::vector<double>> carried_before(tracers_.size(), std::vector<double>(cells));
   for (std::size_t k = 0; k < tracers_.size(); ++k)
     for (std::size_t c = 0; c < cells; ++c) carried_before[k][c] = tracers_[k].carried(*red_cells_, c);
   // Over ranks, what it adds cell by cell, summed in the one-process order
   // (RedCellTransport::set_volumes' own sum is a share's).
   const double adjusted_before = red_cells_->adjusted();
-  std::vector<double> added(cut_ ? now_.size() : 0);
-  for (std::size_t c = 0; c < added.size(); ++c) added[c] = (now_[c] - red_cells_->volume()[c]) * red_cells_->tube_hematocrit(c);
-  red_cells_->set_volumes(now_);
+  std::vector<double> added(cut_ ? now.size() : 0);
+  for (std::size_t c = 0; c < added.size(); ++c) added[c] = (now[c] - red_cells_->volume()[c]) * red_cells_->tube_hematocrit(c);
+  red_cells_->set_volumes(now);
   if (cut_) red_cells_->set_adjusted(cell_sum(added, adjusted_before));  // rank 0's the whole's
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
     TracerTransport& t = tracers_[k];
@@ -516,12 +520,14 @@ void FlowTransport::face_volumes() {
     face_volume_[static_cast<std::size_t>(node_boundary_face_[j])] =
         -(solver_.boundary_volume(static_cast<std::size_t>(b)) - boundary_mark_(b));
   }
-  // 1D vessels: the proximal face's volume, then each slice's change passed on.
-  now_.resize(cell_count());  // only its 0D nodes and slices are read below
-  solver_volumes(now_);
-  const std::span<const double> held = red_cells_->volume();
+  // 1D vessels: the proximal face's volume, then each slice's change passed on. Their
+  // slices' volumes alone (not the 0D nodes', which no face here reads), from the first.
   const std::vector<std::int32_t>& one_d = one_d_;
   const int cells_per_vessel = solver_.elements_per_vessel() * slices_;
+  const std::size_t first = one_d.empty() ? 0 : static_cast<std::size_t>(vessel_first_cell_.front());
+  slice_volume_.resize(one_d.empty() ? 0 : static_cast<std::size_t>(vessel_first_cell_.back() + cells_per_vessel) - first);
+  slice_volumes(slice_volume_, first);
+  const std::span<const double> held = red_cells_->volume();
   for (std::size_t i = 0; i < one_d.size(); ++i) {
     const auto el = solver_.first_element(static_cast<std::size_t>(one_d[i]));
     double passed = s.faces(el);
@@ -529,7 +535,7 @@ void FlowTransport::face_volumes() {
     face_volume_[face++] = proximal_sign_[i] * passed;
     for (int c = 0; c < cells_per_vessel; ++c) {
       const auto cell = static_cast<std::size_t>(vessel_first_cell_[i] + c);
-      passed -= now_[cell] - held[cell];
+      passed -= slice_volume_[cell - first] - held[cell];
       face_volume_[face++] = passed;
     }
   }

@@ -170,6 +170,8 @@ class FlowTransport {
   double fahraeus(double diameter) const;  // the Fahraeus parameter k of a lumen (1: the effect off)
   // Each 0D node's and 1D slice's volume in the solver now, into its cell's place.
   void solver_volumes(std::vector<double>& volume) const;
+  // The same of the 1D slices alone, slice cell c's at volume[c - first].
+  void slice_volumes(std::span<double> volume, std::size_t first) const;
   void mark();  // the next advance counts from the solver's state now
   std::size_t cell_at(std::size_t vessel, double x) const;
   void step_tracers(double t0, double t1);
@@ -336,7 +338,7 @@ class FlowTransport {
   // The boundaries' volumes at the last advance (the solver's own sums, never cleared).
   Eigen::VectorXd boundary_mark_;
   std::vector<double> face_volume_;  // the last step's, per face (checkpointed: cell_at reads its signs)
-  std::vector<double> now_;          // scratch
+  std::vector<double> slice_volume_;  // scratch: the 1D slices' volumes, from the first slice's cell
   std::optional<RedCellTransport> red_cells_;
   std::size_t advances_ = 0;
   // The cycle in progress, per vessel: red cells and blood through its faces, extremes.
