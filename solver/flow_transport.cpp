@@ -357,13 +357,13 @@ void FlowTransport::tracer_given(std::size_t k, double t0, double t1) {
 void FlowTransport::follow_curve(std::size_t k, double t0, double t1) {
   // Each vessel's curve: the mean over its faces that passed blood of what crossed them.
   const TransportGrid& grid = red_cells_->grid();
-  const std::span<const double> c = tracers_[k].face_concentration();
+  const TracerTransport& tracer = tracers_[k];
   std::fill(step_sum_.begin(), step_sum_.end(), 0.0);
   std::fill(step_count_.begin(), step_count_.end(), 0);
   for (std::size_t f = 0; f < grid.face_count(); ++f) {
     const std::int32_t v = grid.vessel[f];
     if (v < 0 || face_volume_[f] == 0) continue;
-    step_sum_[static_cast<std::size_t>(v)] += c[f];
+    step_sum_[static_cast<std::size_t>(v)] += tracer.inflowing(f, *red_cells_, tracer_inflow_[k], tracer_injected_[k]);
     ++step_count_[static_cast<std::size_t>(v)];
   }
   for (std::size_t v = 0; v < step_sum_.size(); ++v)

@@ -37,8 +37,9 @@ Bolus run_bolus(RedCellTransport& cells, TracerCarrier carrier, int n, double q_
   Bolus b;
   for (int s = 0; s < steps; ++s) {
     cells.step(along(n, q_dt), std::vector<double>{0.45, nan});
-    tracer.step(cells, std::vector<double>{s < bolus ? 1.0 : 0.0, nan}, {});
-    curve.add(0, s, s + 1, tracer.face_concentration()[static_cast<std::size_t>(n)]);
+    const std::vector<double> inflow{s < bolus ? 1.0 : 0.0, nan};
+    tracer.step(cells, inflow, {});
+    curve.add(0, s, s + 1, tracer.inflowing(static_cast<std::size_t>(n), cells, inflow, {}));
     for (const double c : tracer.concentration()) {
       b.lowest = std::min(b.lowest, c);
       b.highest = std::max(b.highest, c);

@@ -121,13 +121,10 @@ void TracerTransport::end_step(const RedCellTransport& red_cells, std::span<cons
                                std::span<const double> injected) {
   const TransportGrid& grid = red_cells.grid();
   const CarrierStep m = carrier_step(red_cells);
-  face_concentration_.assign(grid.face_count(), 0.0);
   const std::span<const double> blood = red_cells.blood_through();
   for (std::size_t f = 0; f < grid.face_count(); ++f) {
-    if (blood[f] == 0) continue;
+    if (blood[f] == 0 || grid.b[f] >= 0) continue;
     const double c = inflowing(f, red_cells, inflow, injected);
-    face_concentration_[f] = c;
-    if (grid.b[f] >= 0) continue;
     const auto boundary = static_cast<std::size_t>(-1 - grid.b[f]);
     if (grid.is_cut(boundary)) continue;  // the other side's cells, not the network's
     if (blood[f] > 0) {

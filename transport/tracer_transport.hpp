@@ -41,8 +41,6 @@ class TracerTransport {
 
   TracerCarrier carrier() const { return carrier_; }
   std::span<const double> concentration() const { return concentration_; }
-  // Per face, the last step's tracer over the carrier through it (0 where none passed).
-  std::span<const double> face_concentration() const { return face_concentration_; }
   // The carrier of the red cells' last step (their CarrierStep for this tracer's carrier).
   CarrierStep carrier_step(const RedCellTransport& red_cells) const { return red_cells.carrier_step(carrier_); }
   // Its carrier in a cell now (after the last step, or the volumes set since).
@@ -74,7 +72,7 @@ class TracerTransport {
                     std::span<const double> inflow, std::span<const double> injected) const;
 
   TracerCarrier carrier_;
-  std::vector<double> concentration_, face_concentration_, last_outflow_;
+  std::vector<double> concentration_, last_outflow_;
   std::vector<double> start_;  // per cell, the concentration the step started from
   std::vector<double> entered_, left_;  // per boundary
   double injected_ = 0, adjusted_ = 0;
