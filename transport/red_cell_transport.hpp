@@ -156,41 +156,23 @@ class RedCellTransport {
 class CarrierStep {
  public:
   CarrierStep(const RedCellTransport& red_cells, TracerCarrier carrier) : red_cells_(red_cells), carrier_(carrier) {}
-  double face(std::size_t f) const {
-    switch (carrier_) {
-      case TracerCarrier::plasma:
-        return red_cells_.blood_through()[f] - red_cells_.cells_through()[f];
-      case TracerCarrier::cells:
-        return red_cells_.cells_through()[f];
-      case TracerCarrier::blood:
-        break;
-    }
-    return red_cells_.blood_through()[f];
-  }
-  double before(std::size_t c) const {
-    switch (carrier_) {
-      case TracerCarrier::plasma:
-        return red_cells_.blood_before(c) - red_cells_.cells_before(c);
-      case TracerCarrier::cells:
-        return red_cells_.cells_before(c);
-      case TracerCarrier::blood:
-        break;
-    }
-    return red_cells_.blood_before(c);
-  }
-  double after(std::size_t c) const {
-    switch (carrier_) {
-      case TracerCarrier::plasma:
-        return red_cells_.blood_after(c) - red_cells_.cells_after(c);
-      case TracerCarrier::cells:
-        return red_cells_.cells_after(c);
-      case TracerCarrier::blood:
-        break;
-    }
-    return red_cells_.blood_after(c);
-  }
+  double face(std::size_t f) const { return of(red_cells_.blood_through()[f], red_cells_.cells_through()[f]); }
+  double before(std::size_t c) const { return of(red_cells_.blood_before(c), red_cells_.cells_before(c)); }
+  double after(std::size_t c) const { return of(red_cells_.blood_after(c), red_cells_.cells_after(c)); }
 
  private:
+  // The carrier's part of blood that holds red cells: the plasma is the rest.
+  double of(double blood, double cells) const {
+    switch (carrier_) {
+      case TracerCarrier::plasma:
+        return blood - cells;
+      case TracerCarrier::cells:
+        return cells;
+      case TracerCarrier::blood:
+        break;
+    }
+    return blood;
+  }
   const RedCellTransport& red_cells_;
   TracerCarrier carrier_;
 };
