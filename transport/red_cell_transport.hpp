@@ -135,7 +135,7 @@ class RedCellTransport {
   CellFaces faces_;
   FlowOrder order_;
   RedCellOptions options_;
-  std::vector<double> volume_, next_volume_, discharge_, next_discharge_;
+  std::vector<double> volume_, next_volume_, discharge_;
   std::vector<double> share_;            // per face: s_f of this step
   std::vector<std::int32_t> candidates_;  // node cells of three vessels and no boundary
   std::vector<double> last_outflow_;     // per boundary: the hematocrit that last left there
