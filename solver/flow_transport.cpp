@@ -6,6 +6,7 @@
 #include <map>
 #include <numeric>
 #include <numbers>
+#include <stdexcept>
 #include <type_traits>
 #include <utility>
 
@@ -81,6 +82,9 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
                      RedCellOptions{options_.phase_separation, blood.phase_separation_diameter_scale()});
   face_volume_.assign(red_cells_->grid().face_count(), 0.0);
+  // A vessel's sums over its faces are taken run by run (close_step, follow_curve).
+  if (!red_cells_->grid().faces_by_vessel())
+    throw std::logic_error("red-cell transport: a vessel's faces are not one after another in the grid");
   if (cut_ && cut_->spread) place_spread_cut(end_faces);
   else if (ranks) place_cut(*ranks);
   const std::size_t vessels = net.vessel_count();
@@ -88,8 +92,6 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   cycle_blood_.assign(vessels, 0.0);
   cycle_low_.assign(vessels, 0.0);
   cycle_high_.assign(vessels, 0.0);
-  step_sum_.assign(vessels, 0.0);
-  step_count_.assign(vessels, 0);
   if (options_.viscosity_feedback) {
     applied_hematocrit_.assign(vessels, blood.hematocrit);
     viscosity_scaling_.reserve(vessels);
@@ -358,18 +360,22 @@ void FlowTransport::follow_curve(std::size_t k, double t0, double t1) {
   // Each vessel's curve: the mean over its faces that passed blood of what crossed them.
   const TransportGrid& grid = red_cells_->grid();
   const TracerTransport& tracer = tracers_[k];
-  std::fill(step_sum_.begin(), step_sum_.end(), 0.0);
-  std::fill(step_count_.begin(), step_count_.end(), 0);
-  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+  for (std::size_t f = 0; f < grid.face_count();) {
+    const std::size_t end = grid.vessel_faces_end(f);
     const std::int32_t v = grid.vessel[f];
-    if (v < 0 || face_volume_[f] == 0) continue;
-    step_sum_[static_cast<std::size_t>(v)] += tracer.inflowing(f, *red_cells_, tracer_inflow_[k], tracer_injected_[k]);
-    ++step_count_[static_cast<std::size_t>(v)];
+    if (v < 0) {
+      f = end;
+      continue;
+    }
+    double sum = 0;
+    int count = 0;
+    for (; f < end; ++f) {
+      if (face_volume_[f] == 0) continue;
+      sum += tracer.inflowing(f, *red_cells_, tracer_inflow_[k], tracer_injected_[k]);
+      ++count;
+    }
+    if (count > 0) curves_[k].add(static_cast<std::size_t>(v), t0, t1, sum / count);
   }
-  for (std::size_t v = 0; v < step_sum_.size(); ++v)
-    if (step_count_[v] > 0) curves_[k].add(v, t0, t1, step_sum_[v] / step_count_[v]);
-  std::fill(step_sum_.begin(), step_sum_.end(), 0.0);
-  std::fill(step_count_.begin(), step_count_.end(), 0);
 }
 
 void FlowTransport::step_tracers(double t0, double t1) {
@@ -396,7 +402,7 @@ void FlowTransport::release_state() {
   cut_.reset();
   auto free = [](auto& array) { std::decay_t<decltype(array)>().swap(array); };
   free(tracers_), free(curves_), free(tracer_boundaries_), free(tracer_face_), free(tracer_inflow_), free(tracer_injected_);
-  free(cycle_cells_), free(cycle_blood_), free(cycle_low_), free(cycle_high_), free(step_sum_), free(step_count_);
+  free(cycle_cells_), free(cycle_blood_), free(cycle_low_), free(cycle_high_);
   free(applied_hematocrit_), free(viscosity_scaling_), free(face_volume_), free(slice_volume_), free(inflow_hematocrit_);
   free(vessel_first_cell_), free(vessel_first_face_), free(proximal_sign_), free(lumped_face_), free(one_d_), free(one_d_place_);
   free(node_boundary_face_), free(node_boundary_);
@@ -562,27 +568,32 @@ void FlowTransport::close_step() {
   // discharge hematocrit (the faces' mean) for its extremes.
   const TransportGrid& grid = red_cells_->grid();
   const std::span<const double> cells = red_cells_->cells_through();
-  for (std::size_t f = 0; f < grid.face_count(); ++f) {
+  for (std::size_t f = 0; f < grid.face_count();) {
+    const std::size_t end = grid.vessel_faces_end(f);
     const std::int32_t v = grid.vessel[f];
-    const double q = face_volume_[f];
-    if (v < 0 || q == 0) continue;
-    const auto vi = static_cast<std::size_t>(v);
     // Another rank's 1D vessel, its end here. (A 0D vessel in a halo is followed as its own
     // rank follows it, from the same bits: its viscosity enters this rank's rows too.)
-    if (cut_ && cut_->spread && !solver_.steps_vessel(vi) && !solver_.is_lumped(vi)) continue;
-    cycle_cells_[vi] += std::abs(cells[f]);
-    cycle_blood_[vi] += std::abs(q);
-    step_sum_[vi] += cells[f] / q;
-    ++step_count_[vi];
-  }
-  for (std::size_t v = 0; v < step_count_.size(); ++v) {
-    if (step_count_[v] == 0) continue;
-    const double h = step_sum_[v] / step_count_[v];
-    cycle_low_[v] = std::min(cycle_low_[v], h);
-    cycle_high_[v] = std::max(cycle_high_[v], h);
-    step_sum_[v] = 0;
-    step_count_[v] = 0;
-    if (options_.viscosity_feedback) follow_viscosities(v, h);
+    if (v < 0 || (cut_ && cut_->spread && !solver_.steps_vessel(static_cast<std::size_t>(v)) &&
+                  !solver_.is_lumped(static_cast<std::size_t>(v)))) {
+      f = end;
+      continue;
+    }
+    const auto vi = static_cast<std::size_t>(v);
+    double sum = 0;
+    int count = 0;
+    for (; f < end; ++f) {
+      const double q = face_volume_[f];
+      if (q == 0) continue;
+      cycle_cells_[vi] += std::abs(cells[f]);
+      cycle_blood_[vi] += std::abs(q);
+      sum += cells[f] / q;
+      ++count;
+    }
+    if (count == 0) continue;
+    const double h = sum / count;
+    cycle_low_[vi] = std::min(cycle_low_[vi], h);
+    cycle_high_[vi] = std::max(cycle_high_[vi], h);
+    if (options_.viscosity_feedback) follow_viscosities(vi, h);
   }
 }
 

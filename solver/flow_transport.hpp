@@ -343,12 +343,10 @@ class FlowTransport {
   std::size_t advances_ = 0;
   // The cycle in progress, per vessel: red cells and blood through its faces, extremes.
   std::vector<double> cycle_cells_, cycle_blood_, cycle_low_, cycle_high_;
-  std::vector<double> step_sum_;
   // The viscosity feedback: per vessel the hematocrit its factor was computed at, the factor.
   std::vector<double> applied_hematocrit_;
   std::vector<HematocritScaling> viscosity_scaling_;  // per vessel
   void follow_viscosities(std::size_t vessel, double hematocrit);  // one vessel's factor
-  std::vector<std::int32_t> step_count_;
   double cycle_content_ = 0, cycle_entered_ = 0, cycle_left_ = 0, cycle_adjusted_ = 0;
   // Tracers: their transport, curves, and where each is given (boundaries, or a face).
   std::vector<TracerTransport> tracers_;

@@ -1,6 +1,19 @@
 #include "transport/transport_grid.hpp"
 
+#include <algorithm>
+
 namespace hemotree {
+
+bool TransportGrid::faces_by_vessel() const {
+  const std::int32_t most = vessel.empty() ? -1 : *std::max_element(vessel.begin(), vessel.end());
+  std::vector<bool> seen(static_cast<std::size_t>(most + 1), false);
+  for (std::size_t f = 0; f < vessel.size(); f = vessel_faces_end(f)) {
+    if (vessel[f] < 0) continue;
+    if (seen[static_cast<std::size_t>(vessel[f])]) return false;
+    seen[static_cast<std::size_t>(vessel[f])] = true;
+  }
+  return true;
+}
 
 CellFaces::CellFaces(const TransportGrid& grid) {
   const std::size_t cells = grid.cell_count();

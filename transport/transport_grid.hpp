@@ -66,6 +66,16 @@ struct TransportGrid {
     diameter.shrink_to_fit();
   }
   static std::int32_t boundary_side(std::size_t boundary) { return -1 - static_cast<std::int32_t>(boundary); }
+  // The faces of face f's vessel from f on end at the returned face: a vessel's faces lie one
+  // after another where the grid is built so (faces_by_vessel), and a vessel's sums over them
+  // need no per-vessel accumulator.
+  std::size_t vessel_faces_end(std::size_t f) const {
+    std::size_t end = f + 1;
+    while (end < vessel.size() && vessel[end] == vessel[f]) ++end;
+    return end;
+  }
+  // Whether every vessel's faces lie one after another (the faces of no vessel, -1, anywhere).
+  bool faces_by_vessel() const;
 };
 
 // Each cell's faces (compressed rows): the faces of cell c are face[start[c] .. start[c + 1]).
