@@ -81,7 +81,7 @@ FlowTransport::FlowTransport(const Network& net, PulseSolver& solver, FlowTransp
   solver_volumes(volume);
   red_cells_.emplace(std::move(grid), std::move(volume), blood.hematocrit,
                      RedCellOptions{options_.phase_separation, blood.phase_separation_diameter_scale()});
-  face_volume_.assign(red_cells_->grid().face_count(), 0.0);
+  face_volume_ = red_cells_->face_volumes();
   // A vessel's sums over its faces are taken run by run (close_step, follow_curve).
   if (!red_cells_->grid().faces_by_vessel())
     throw std::logic_error("red-cell transport: a vessel's faces are not one after another in the grid");
@@ -398,12 +398,13 @@ void FlowTransport::release_state() {
     for (std::size_t k = 0; k < tracers_.size(); ++k) reports_.push_back(tracer_report(k));
   }
   cells_after_release_ = cell_count();
+  face_volume_ = {};
   red_cells_.reset();
   cut_.reset();
   auto free = [](auto& array) { std::decay_t<decltype(array)>().swap(array); };
   free(tracers_), free(curves_), free(tracer_boundaries_), free(tracer_face_), free(tracer_inflow_), free(tracer_injected_);
   free(cycle_cells_), free(cycle_blood_), free(cycle_low_), free(cycle_high_);
-  free(applied_hematocrit_), free(viscosity_scaling_), free(face_volume_), free(slice_volume_), free(inflow_hematocrit_);
+  free(applied_hematocrit_), free(viscosity_scaling_), free(slice_volume_), free(inflow_hematocrit_);
   free(vessel_first_cell_), free(vessel_first_face_), free(proximal_sign_), free(lumped_face_), free(one_d_), free(one_d_place_);
   free(node_boundary_face_), free(node_boundary_);
   boundary_mark_.resize(0);
@@ -685,7 +686,7 @@ void FlowTransport::save(CheckpointWriter& out) const {
                       t.adjusted(),
                       t.last_outflow(),
                       applied_hematocrit_,
-                      face_volume_});
+                      {face_volume_.begin(), face_volume_.end()}});
   out.put(static_cast<std::uint64_t>(advances_));
   out.put(last_time_);
   for (std::size_t k = 0; k < tracers_.size(); ++k) {
@@ -733,7 +734,7 @@ void FlowTransport::restore(CheckpointReader& in) {
     restore_share(s);
   } else {
     red_cells_->restore(s.discharge, s.volume, s.entered, s.left, s.adjusted, s.last_outflow);
-    face_volume_ = std::move(s.faces);
+    std::copy(s.faces.begin(), s.faces.end(), face_volume_.begin());
   }
   advances_ = static_cast<std::size_t>(in.get_u64());
   last_time_ = in.get_double();

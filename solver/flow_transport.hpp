@@ -337,7 +337,9 @@ class FlowTransport {
   std::vector<double> inflow_hematocrit_;  // per boundary (NaN: what last left there)
   // The boundaries' volumes at the last advance (the solver's own sums, never cleared).
   Eigen::VectorXd boundary_mark_;
-  std::vector<double> face_volume_;  // the last step's, per face (checkpointed: cell_at reads its signs)
+  // The last step's blood per face (checkpointed: cell_at reads its signs), the red-cell
+  // transport's own array (RedCellTransport::face_volumes), filled here for each step.
+  std::span<double> face_volume_;
   std::vector<double> slice_volume_;  // scratch: the 1D slices' volumes, from the first slice's cell
   std::optional<RedCellTransport> red_cells_;
   std::size_t advances_ = 0;

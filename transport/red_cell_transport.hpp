@@ -109,6 +109,9 @@ class RedCellTransport {
   // from what is kept, as the step formed them: with tracers, a tree's million cells hold
   // about 50 MB less than with each carrier's three arrays kept.
   std::span<const double> blood_through() const { return blood_face_; }
+  // The same array to fill with the next step's blood per face and hand to step() (or its
+  // parts), so that a caller keeps no copy of its own (until then it holds the last step's).
+  std::span<double> face_volumes() { return blood_face_; }
   std::span<const double> cells_through() const { return cells_face_; }
   double blood_before(std::size_t c) const { return next_volume_[c]; }  // end_step swapped them
   double blood_after(std::size_t c) const { return volume_[c]; }
