@@ -1,6 +1,10 @@
 #include "transport/transport_grid.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <string>
+
+#include "core/errors.hpp"
 
 namespace hemotree {
 
@@ -22,9 +26,16 @@ CellFaces::CellFaces(const TransportGrid& grid) {
     ++start[static_cast<std::size_t>(grid.a[f]) + 1];
     if (grid.b[f] >= 0) ++start[static_cast<std::size_t>(grid.b[f]) + 1];
   }
-  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
-  face.resize(static_cast<std::size_t>(start.back()));
-  std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
+  std::size_t sides = 0;
+  for (std::size_t c = 0; c < cells; ++c) {
+    sides += static_cast<std::size_t>(start[c + 1]);
+    if (sides > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+      throw InputError("transport grid: more than 2^31 sides of faces at its cells (" + std::to_string(cells) +
+                       " cells): run it over more ranks");
+    start[c + 1] = static_cast<std::int32_t>(sides);
+  }
+  face.resize(sides);
+  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
   for (std::size_t f = 0; f < grid.face_count(); ++f) {
     face[static_cast<std::size_t>(fill[static_cast<std::size_t>(grid.a[f])]++)] = static_cast<std::int32_t>(f);
     if (grid.b[f] >= 0) face[static_cast<std::size_t>(fill[static_cast<std::size_t>(grid.b[f])]++)] = static_cast<std::int32_t>(f);

@@ -79,8 +79,9 @@ struct TransportGrid {
 };
 
 // Each cell's faces (compressed rows): the faces of cell c are face[start[c] .. start[c + 1]).
+// 32-bit like the faces' numbers themselves (a grid of more than 2^31 face sides is refused).
 struct CellFaces {
-  std::vector<std::int64_t> start;
+  std::vector<std::int32_t> start;
   std::vector<std::int32_t> face;
   explicit CellFaces(const TransportGrid& grid);
 };
