@@ -107,6 +107,12 @@ double FlowTransport::fahraeus(double diameter) const {
   return options_.fahraeus ? fahraeus_parameter(diameter, solver_.blood().pries_diameter_scale()) : 1.0;
 }
 
+std::int32_t FlowTransport::one_d_place(std::size_t v) const {
+  const auto found = std::lower_bound(one_d_by_vessel_.begin(), one_d_by_vessel_.end(),
+                                      std::pair{static_cast<std::int32_t>(v), std::int32_t{-1}});
+  return found != one_d_by_vessel_.end() && found->first == static_cast<std::int32_t>(v) ? found->second : -1;
+}
+
 void FlowTransport::add_node_cells(TransportGrid& grid, std::vector<double>& volume) const {
   // Nodes of 0D vessels: k weighted by the half-vessels they hold.
   const LumpedVessels& lumped = solver_.lumped();
@@ -143,10 +149,9 @@ FlowTransport::EndSides FlowTransport::add_one_d_cells(TransportGrid& grid, std:
   for (int s = 0; s < slices_; ++s)
     for (int j = 0; j < slice_integral_.cols(); ++j)
       slice_integral_(s, j) = legendre_integral(j, -1 + 2.0 * s / slices_, -1 + 2.0 * (s + 1) / slices_);
-  one_d_place_.assign(net_.vessel_count(), -1);
   for (const std::int32_t vi : one_d_) {
     const auto v = static_cast<std::size_t>(vi);
-    one_d_place_[v] = static_cast<std::int32_t>(vessel_first_cell_.size());
+    one_d_by_vessel_.emplace_back(vi, static_cast<std::int32_t>(vessel_first_cell_.size()));
     vessel_first_cell_.push_back(static_cast<std::int32_t>(grid.cell_count()));
     const int count = per_vessel * slices_;
     for (int s = 0; s < count; ++s) {
@@ -156,6 +161,7 @@ FlowTransport::EndSides FlowTransport::add_one_d_cells(TransportGrid& grid, std:
       volume.push_back(0.0);  // set from the solver's areas (solver_volumes)
     }
   }
+  std::sort(one_d_by_vessel_.begin(), one_d_by_vessel_.end());
   // Junctions of 1D vessels, and what meets each 1D end: (vessel, distal) -> cell or boundary.
   const NetworkBoundaries& ends = solver.network_boundaries();
   EndSides end_side;
@@ -255,8 +261,8 @@ FlowTransport::EndFaces FlowTransport::add_faces(TransportGrid& grid, const std:
   for (std::size_t b = 0; b < boundaries.size(); ++b) {
     const std::int32_t k = lumped.empty() ? -1 : lumped.node_of(boundaries.node(b));
     if (k < 0 || lumped.ghost_node(k)) continue;  // another rank's
-    node_boundary_face_.push_back(static_cast<std::int32_t>(grid.face_count()));
-    node_boundary_.push_back(static_cast<std::int32_t>(b));
+    if (node_boundary_faces_.second == 0) node_boundary_faces_.first = static_cast<std::int32_t>(grid.face_count());
+    ++node_boundary_faces_.second;
     grid.add_face(k, TransportGrid::boundary_side(b), -1, 0.0);
   }
   // The 1D vessels' faces, vessel after vessel in the one-process grid's order. Spread over the
@@ -267,7 +273,7 @@ FlowTransport::EndFaces FlowTransport::add_faces(TransportGrid& grid, const std:
   const int per_vessel = solver_.elements_per_vessel();
   for (const std::int32_t v : spread ? whole_one_d_order() : one_d_) {
     const double d0 = net_.diameter[static_cast<std::size_t>(v)], d1 = net_.diameter_at_to(static_cast<std::size_t>(v));
-    const std::int32_t i = one_d_place_[static_cast<std::size_t>(v)];
+    const std::int32_t i = one_d_place(static_cast<std::size_t>(v));
     if (i < 0) {  // another rank's vessel (spread): its ends at a cell here
       for (const bool distal : {false, true}) {
         const auto found = end_side.find({v, distal});
@@ -316,7 +322,7 @@ void FlowTransport::set_up_tracers() {
       // Over ranks the rank that steps the vessel injects (the top's ghost of a share's root
       // vessel does not: what crosses the cut carries the injection already, or takes it there).
       const auto v = static_cast<std::size_t>(spec.at);
-      if (one_d_place_[v] >= 0) face = vessel_first_face_[static_cast<std::size_t>(one_d_place_[v])];
+      if (one_d_place(v) >= 0) face = vessel_first_face_[static_cast<std::size_t>(one_d_place(v))];
       else if (solver_.is_lumped(v) && solver_.steps_vessel(v))
         face = lumped_face_[static_cast<std::size_t>(lumped.vessel_index(v))];
     } else {
@@ -405,16 +411,15 @@ void FlowTransport::release_state() {
   free(tracers_), free(curves_), free(tracer_boundaries_), free(tracer_face_), free(tracer_inflow_), free(tracer_injected_);
   free(cycle_cells_), free(cycle_blood_), free(cycle_low_), free(cycle_high_);
   free(applied_hematocrit_), free(viscosity_scaling_), free(slice_volume_), free(inflow_hematocrit_);
-  free(vessel_first_cell_), free(vessel_first_face_), free(proximal_sign_), free(lumped_face_), free(one_d_), free(one_d_place_);
-  free(node_boundary_face_), free(node_boundary_);
+  free(vessel_first_cell_), free(vessel_first_face_), free(proximal_sign_), free(lumped_face_), free(one_d_), free(one_d_by_vessel_);
   boundary_mark_.resize(0);
 }
 
 std::size_t FlowTransport::cell_at(std::size_t v, double x) const {
-  if (one_d_place_[v] >= 0) {
+  if (const std::int32_t i = one_d_place(v); i >= 0) {
     const int count = solver_.elements_per_vessel() * slices_;
     const int k = std::clamp(static_cast<int>(x * count), 0, count - 1);
-    return static_cast<std::size_t>(vessel_first_cell_[static_cast<std::size_t>(one_d_place_[v])] + k);
+    return static_cast<std::size_t>(vessel_first_cell_[static_cast<std::size_t>(i)] + k);
   }
   const LumpedVessels& lumped = solver_.lumped();
   const std::int32_t i = lumped.vessel_index(v);
@@ -522,10 +527,12 @@ void FlowTransport::face_volumes() {
     const double passed = lumped.passed_volume(static_cast<std::int32_t>(i));
     face_volume_[face] = cut_ ? cut_->face_sign[face] * passed : passed;
   }
-  for (std::size_t j = 0; j < node_boundary_face_.size(); ++j) {
-    const auto b = static_cast<Eigen::Index>(node_boundary_[j]);
-    face_volume_[static_cast<std::size_t>(node_boundary_face_[j])] =
-        -(solver_.boundary_volume(static_cast<std::size_t>(b)) - boundary_mark_(b));
+  // The boundaries at 0D nodes: faces one after another, each to its boundary.
+  const TransportGrid& grid = red_cells_->grid();
+  const auto [first_boundary_face, boundary_faces] = node_boundary_faces_;
+  for (auto f = static_cast<std::size_t>(first_boundary_face); f < static_cast<std::size_t>(first_boundary_face + boundary_faces); ++f) {
+    const auto b = static_cast<std::size_t>(-1 - grid.b[f]);
+    face_volume_[f] = -(solver_.boundary_volume(b) - boundary_mark_(static_cast<Eigen::Index>(b)));
   }
   // 1D vessels: the proximal face's volume, then each slice's change passed on. Their
   // slices' volumes alone (not the 0D nodes', which no face here reads), from the first.

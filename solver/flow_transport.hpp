@@ -329,11 +329,14 @@ class FlowTransport {
   std::vector<signed char> proximal_sign_;  // +1: the proximal face runs along the vessel
   int slices_ = 1;
   Eigen::MatrixXd slice_integral_;  // slices x modes: int of P_j over each slice of [-1, 1]
-  // 0D vessels: their faces (in LumpedVessels' order); boundaries at 0D nodes: face and boundary.
+  // 0D vessels: their faces (in LumpedVessels' order).
   std::vector<std::int32_t> lumped_face_;
   std::vector<std::int32_t> one_d_;        // the 1D vessels it carries (over ranks the top's rank's)
-  std::vector<std::int32_t> one_d_place_;  // per vessel: its place in one_d_, or -1
-  std::vector<std::int32_t> node_boundary_face_, node_boundary_;
+  // Each 1D vessel's place in one_d_, by vessel (few: looked up, not an array the network's size).
+  std::vector<std::pair<std::int32_t, std::int32_t>> one_d_by_vessel_;
+  std::int32_t one_d_place(std::size_t vessel) const;  // -1: not one of them
+  // The boundaries at 0D nodes: their faces, one after another (first, count), each to its boundary.
+  std::pair<std::int32_t, std::int32_t> node_boundary_faces_{0, 0};
   std::vector<double> inflow_hematocrit_;  // per boundary (NaN: what last left there)
   // The boundaries' volumes at the last advance (the solver's own sums, never cleared).
   Eigen::VectorXd boundary_mark_;

@@ -110,7 +110,7 @@ void FlowTransport::place_spread_cut(const EndFaces& end_faces) {
     for (std::int32_t k = 0; k <= per_vessel; ++k)
       cut.face_place[static_cast<std::size_t>(vessel_first_face_[i] + k)] = one_d_face(one_d_[i], k);
   for (const auto& [end, face] : end_faces)  // another rank's 1D vessel's end
-    if (!zero_d[static_cast<std::size_t>(end.first)] && one_d_place_[static_cast<std::size_t>(end.first)] < 0)
+    if (!zero_d[static_cast<std::size_t>(end.first)] && one_d_place(static_cast<std::size_t>(end.first)) < 0)
       cut.face_place[static_cast<std::size_t>(face.first)] = one_d_face(end.first, end.second ? per_vessel : 0);
   cut.faces = static_cast<std::size_t>(whole.one_d_faces) + one_d.size() * static_cast<std::size_t>(per_vessel + 1);
 
