@@ -354,12 +354,7 @@ void FlowTransport::tracer_given(std::size_t k, double t0, double t1) {
   for (std::size_t b = 0; b < boundaries.size(); ++b)
     if (boundaries.is_outlet(b)) inflow[b] = std::numeric_limits<double>::quiet_NaN();  // an outlet returns what it took
   for (const std::int32_t b : tracer_boundaries_[k]) inflow[static_cast<std::size_t>(b)] = given;
-  std::vector<double>& injected = tracer_injected_[k];
-  injected.clear();
-  if (tracer_face_[k] >= 0) {
-    injected.assign(grid.face_count(), 0.0);
-    injected[static_cast<std::size_t>(tracer_face_[k])] = given;
-  }
+  tracer_injected_[k] = tracer_face_[k] >= 0 ? Injection{static_cast<std::size_t>(tracer_face_[k]), given} : Injection{};
 }
 
 void FlowTransport::follow_curve(std::size_t k, double t0, double t1) {

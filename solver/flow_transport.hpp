@@ -358,7 +358,8 @@ class FlowTransport {
   std::vector<IndicatorCurves> curves_;
   std::vector<std::vector<std::int32_t>> tracer_boundaries_;
   std::vector<std::int32_t> tracer_face_;  // -1: none here (over ranks: another rank's vessel)
-  std::vector<std::vector<double>> tracer_inflow_, tracer_injected_;  // per tracer, of a step
+  std::vector<std::vector<double>> tracer_inflow_;  // per tracer, of a step
+  std::vector<Injection> tracer_injected_;
   double last_time_ = 0;  // the solver's time at the last advance
   std::optional<Cut> cut_;
 };

@@ -157,15 +157,14 @@ TEST(RedCellCut, ATracerInjectedIntoARootVesselStepsInPartsToTheWholeGridsBits) 
     const double given = 1 + 0.5 * std::sin(0.3 * 2 * std::numbers::pi * s / 100);
     std::vector<double> dye_in(4, nan), dye_cut_in(6, nan);
     dye_in[0] = dye_cut_in[0] = given;
-    std::vector<double> whole_injected(9, 0.0), share_injected(7, 0.0);
-    whole_injected[1] = share_injected[0] = 0.5 * given;
+    const Injection whole_injected{1, 0.5 * given}, share_injected{0, 0.5 * given};
 
     whole.step(q.whole, inflow);
     whole_dye.step(whole, dye_in, whole_injected);
     step_both_sides(top, share, q, cut_inflow);
 
     // The dye's two messages: what crosses each cut from either side.
-    const std::vector<double> top_injected;
+    const Injection top_injected;
     top_dye.begin_step(top, dye_cut_in, top_injected);
     share_dye.begin_step(share, dye_cut_in, share_injected);
     top_dye.solve(top, dye_cut_in, top_injected, Cells::before_cuts);

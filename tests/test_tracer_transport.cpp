@@ -119,11 +119,10 @@ TEST(TracerTransport, InjectionAtAFaceIsCountedApart) {
   const int n = 10;
   RedCellTransport cells(vessel(n), std::vector<double>(n, 1e-13), 0.45);
   TracerTransport tracer(static_cast<std::size_t>(n), 2, TracerCarrier::blood);
-  std::vector<double> injected(static_cast<std::size_t>(n) + 1, 0.0);
-  injected[5] = 2.0;  // into slice 5 with the blood crossing face 5
+  const Injection injected{5, 2.0};  // into slice 5 with the blood crossing face 5
   for (int s = 0; s < 30; ++s) {
     cells.step(along(n, 0.5e-13), std::vector<double>{0.45, nan});
-    tracer.step(cells, std::vector<double>{0.0, nan}, s < 4 ? std::span<const double>(injected) : std::span<const double>());
+    tracer.step(cells, std::vector<double>{0.0, nan}, s < 4 ? injected : Injection{});
   }
   EXPECT_NEAR(tracer.injected(), 4 * 0.5e-13 * 2.0, 1e-27);
   EXPECT_EQ(tracer.entered(), 0.0);

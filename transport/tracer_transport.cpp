@@ -42,7 +42,7 @@ double TracerTransport::left() const { return std::accumulate(left_.begin(), lef
 
 // The concentration of the carrier entering through face f into its downstream cell.
 double TracerTransport::inflowing(std::size_t f, const RedCellTransport& red_cells, std::span<const double> inflow,
-                                  std::span<const double> injected) const {
+                                  Injection injected) const {
   const TransportGrid& grid = red_cells.grid();
   const double q = red_cells.blood_through()[f];
   double c;
@@ -54,11 +54,11 @@ double TracerTransport::inflowing(std::size_t f, const RedCellTransport& red_cel
     const auto boundary = static_cast<std::size_t>(-1 - grid.b[f]);
     c = std::isnan(inflow[boundary]) ? last_outflow_[boundary] : inflow[boundary];
   }
-  return injected.empty() ? c : c + injected[f];
+  return f == injected.face ? c + injected.concentration : c;
 }
 
 double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_cells, const CarrierStep& m,
-                                   std::span<const double> inflow, std::span<const double> injected) const {
+                                   std::span<const double> inflow, Injection injected) const {
   const TransportGrid& grid = red_cells.grid();
   const CellFaces& faces = red_cells.faces();
   const std::span<const double> blood = red_cells.blood_through();
@@ -74,28 +74,29 @@ double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_ce
 }
 
 void TracerTransport::step(const RedCellTransport& red_cells, std::span<const double> inflow,
-                           std::span<const double> injected) {
+                           Injection injected) {
   begin_step(red_cells, inflow, injected);
   solve(red_cells, inflow, injected, RedCellTransport::Cells::all);
   end_step(red_cells, inflow, injected);
 }
 
 void TracerTransport::begin_step(const RedCellTransport& red_cells, std::span<const double> inflow,
-                                 std::span<const double> injected) {
+                                 Injection injected) {
   const TransportGrid& grid = red_cells.grid();
-  if (inflow.size() != grid.boundaries || (!injected.empty() && injected.size() != grid.face_count()))
+  if (inflow.size() != grid.boundaries || (injected.face != Injection::none && injected.face >= grid.face_count()))
     throw InputError("tracer transport: a step needs " + std::to_string(grid.boundaries) +
-                     " boundary concentrations and none or one injection per face");
+                     " boundary concentrations, and an injection at one of its " + std::to_string(grid.face_count()) +
+                     " faces or none");
   // The step starts from these, however often a cell is solved (a circulation's sweeps, the
   // rounds of a run over ranks).
   start_.assign(concentration_.begin(), concentration_.end());
   // What the injections add, at the concentrations upstream before they move.
   const CarrierStep m = carrier_step(red_cells);
-  for (std::size_t f = 0; f < injected.size(); ++f) injected_ += std::abs(m.face(f)) * injected[f];
+  if (injected.face != Injection::none) injected_ += std::abs(m.face(injected.face)) * injected.concentration;
 }
 
 void TracerTransport::solve(const RedCellTransport& red_cells, std::span<const double> inflow,
-                            std::span<const double> injected, RedCellTransport::Cells which) {
+                            Injection injected, RedCellTransport::Cells which) {
   const FlowOrder& order = red_cells.order();
   const CarrierStep m = carrier_step(red_cells);
   const std::size_t cells = concentration_.size(), ordered = cells - order.cyclic;
@@ -118,7 +119,7 @@ void TracerTransport::solve(const RedCellTransport& red_cells, std::span<const d
 }
 
 void TracerTransport::end_step(const RedCellTransport& red_cells, std::span<const double> inflow,
-                               std::span<const double> injected) {
+                               Injection injected) {
   const TransportGrid& grid = red_cells.grid();
   const CarrierStep m = carrier_step(red_cells);
   const std::span<const double> blood = red_cells.blood_through();
@@ -131,7 +132,7 @@ void TracerTransport::end_step(const RedCellTransport& red_cells, std::span<cons
       left_[boundary] += std::abs(m.face(f)) * c;
       last_outflow_[boundary] = c;
     } else {
-      entered_[boundary] += std::abs(m.face(f)) * (injected.empty() ? c : c - injected[f]);  // an injection there is counted apart
+      entered_[boundary] += std::abs(m.face(f)) * (f == injected.face ? c - injected.concentration : c);  // an injection there is counted apart
     }
   }
 }

@@ -19,25 +19,33 @@
 
 namespace hemotree {
 
+// A concentration added to the carrier crossing one face in a step (a tracer given inside
+// the network, at a vessel), or none.
+struct Injection {
+  static constexpr std::size_t none = static_cast<std::size_t>(-1);
+  std::size_t face = none;
+  double concentration = 0;
+};
+
 class TracerTransport {
  public:
   TracerTransport(std::size_t cells, std::size_t boundaries, TracerCarrier carrier);
 
   // Advances the tracer over the red-cell transport's last step (call right after it).
   // inflow: per boundary, the concentration of the carrier it lets in (NaN: what last left
-  // there). injected: per face, a concentration added to the carrier crossing it in this step
-  // (empty: none), the injection's amount counted in injected().
-  void step(const RedCellTransport& red_cells, std::span<const double> inflow, std::span<const double> injected);
+  // there). injected: a concentration added to the carrier crossing one face in this step
+  // (or none), the injection's amount counted in injected().
+  void step(const RedCellTransport& red_cells, std::span<const double> inflow, Injection injected);
   // The same step in parts (RedCellTransport's, after its whole step): the cells no cut's
   // inflow reaches, then the rest once the cuts' inflows are given.
-  void begin_step(const RedCellTransport& red_cells, std::span<const double> inflow, std::span<const double> injected);
-  void solve(const RedCellTransport& red_cells, std::span<const double> inflow, std::span<const double> injected,
+  void begin_step(const RedCellTransport& red_cells, std::span<const double> inflow, Injection injected);
+  void solve(const RedCellTransport& red_cells, std::span<const double> inflow, Injection injected,
              RedCellTransport::Cells cells);
-  void end_step(const RedCellTransport& red_cells, std::span<const double> inflow, std::span<const double> injected);
+  void end_step(const RedCellTransport& red_cells, std::span<const double> inflow, Injection injected);
   // The concentration of the carrier crossing face f in the last step (or, between begin_step
   // and end_step, now): its upwind cell's, or its boundary's, and any injection there.
   double inflowing(std::size_t face, const RedCellTransport& red_cells, std::span<const double> inflow,
-                   std::span<const double> injected) const;
+                   Injection injected) const;
 
   TracerCarrier carrier() const { return carrier_; }
   std::span<const double> concentration() const { return concentration_; }
@@ -69,7 +77,7 @@ class TracerTransport {
 
  private:
   double solve_cell(std::size_t cell, const RedCellTransport& red_cells, const CarrierStep& m,
-                    std::span<const double> inflow, std::span<const double> injected) const;
+                    std::span<const double> inflow, Injection injected) const;
 
   TracerCarrier carrier_;
   std::vector<double> concentration_, last_outflow_;
