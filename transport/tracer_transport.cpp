@@ -57,12 +57,12 @@ double TracerTransport::inflowing(std::size_t f, const RedCellTransport& red_cel
   return f == injected.face ? c + injected.concentration : c;
 }
 
-double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_cells, const CarrierStep& m,
+double TracerTransport::solve_cell(std::size_t c, double start, const RedCellTransport& red_cells, const CarrierStep& m,
                                    std::span<const double> inflow, Injection injected) const {
   const TransportGrid& grid = red_cells.grid();
   const CellFaces& faces = red_cells.faces();
   const std::span<const double> blood = red_cells.blood_through();
-  double rhs = m.before(c) * start_[c], carrier = m.after(c);
+  double rhs = m.before(c) * start, carrier = m.after(c);
   for (auto i = faces.start[c]; i < faces.start[c + 1]; ++i) {
     const auto f = static_cast<std::size_t>(faces.face[static_cast<std::size_t>(i)]);
     if (blood[f] == 0) continue;
@@ -70,7 +70,12 @@ double TracerTransport::solve_cell(std::size_t c, const RedCellTransport& red_ce
     if ((static_cast<std::size_t>(grid.a[f]) == c) == (blood[f] > 0)) carrier += through;
     else rhs += through * inflowing(f, red_cells, inflow, injected);
   }
-  return carrier > 0 ? rhs / carrier : start_[c];  // no carrier here or through: unchanged
+  return carrier > 0 ? rhs / carrier : start;  // no carrier here or through: unchanged
+}
+
+double TracerTransport::step_start(std::size_t c, std::size_t k, std::size_t ordered) const {
+  if (start_per_cell_) return start_[c];
+  return k < ordered ? concentration_[c] : start_[k - ordered];
 }
 
 void TracerTransport::step(const RedCellTransport& red_cells, std::span<const double> inflow,
@@ -87,9 +92,18 @@ void TracerTransport::begin_step(const RedCellTransport& red_cells, std::span<co
     throw InputError("tracer transport: a step needs " + std::to_string(grid.boundaries) +
                      " boundary concentrations, and an injection at one of its " + std::to_string(grid.face_count()) +
                      " faces or none");
-  // The step starts from these, however often a cell is solved (a circulation's sweeps, the
-  // rounds of a run over ranks).
-  start_.assign(concentration_.begin(), concentration_.end());
+  // The step starts from these, however often a cell is solved: the cells on a circulation
+  // (its sweeps) and, on a grid with cuts, every cell (the rounds of a run over ranks). A cell
+  // solved once reads its own value, not yet moved (8 B a cell less).
+  const FlowOrder& order = red_cells.order();
+  start_per_cell_ = grid.cuts > 0;
+  if (start_per_cell_) {
+    start_.assign(concentration_.begin(), concentration_.end());
+  } else {
+    start_.resize(order.cyclic);
+    const std::size_t ordered = concentration_.size() - order.cyclic;
+    for (std::size_t k = 0; k < order.cyclic; ++k) start_[k] = concentration_[static_cast<std::size_t>(order.cells[ordered + k])];
+  }
   // What the injections add, at the concentrations upstream before they move.
   const CarrierStep m = carrier_step(red_cells);
   if (injected.face != Injection::none) injected_ += std::abs(m.face(injected.face)) * injected.concentration;
@@ -102,7 +116,7 @@ void TracerTransport::solve(const RedCellTransport& red_cells, std::span<const d
   const std::size_t cells = concentration_.size(), ordered = cells - order.cyclic;
   for (std::size_t k = 0; k < ordered; ++k) {
     const auto c = static_cast<std::size_t>(order.cells[k]);
-    if (red_cells.solves(c, which)) concentration_[c] = solve_cell(c, red_cells, m, inflow, injected);
+    if (red_cells.solves(c, which)) concentration_[c] = solve_cell(c, step_start(c, k, ordered), red_cells, m, inflow, injected);
   }
   if (order.cyclic > 0 && which != RedCellTransport::Cells::before_cuts) {
     double change = std::numeric_limits<double>::infinity();
@@ -110,7 +124,7 @@ void TracerTransport::solve(const RedCellTransport& red_cells, std::span<const d
       change = 0;
       for (std::size_t k = ordered; k < cells; ++k) {
         const auto c = static_cast<std::size_t>(order.cells[k]);
-        const double next = solve_cell(c, red_cells, m, inflow, injected);
+        const double next = solve_cell(c, step_start(c, k, ordered), red_cells, m, inflow, injected);
         change = std::max(change, std::abs(next - concentration_[c]) / std::max(std::abs(next), 1.0));
         concentration_[c] = next;
       }

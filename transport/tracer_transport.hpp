@@ -76,12 +76,17 @@ class TracerTransport {
   const std::vector<double>& last_outflow() const { return last_outflow_; }
 
  private:
-  double solve_cell(std::size_t cell, const RedCellTransport& red_cells, const CarrierStep& m,
+  double solve_cell(std::size_t cell, double start, const RedCellTransport& red_cells, const CarrierStep& m,
                     std::span<const double> inflow, Injection injected) const;
 
   TracerCarrier carrier_;
   std::vector<double> concentration_, last_outflow_;
-  std::vector<double> start_;  // per cell, the concentration the step started from
+  // The concentrations the step started from, of the cells solved more than once: per cell
+  // on a grid with cuts, else the circulation's (the flow order's last `cyclic`) in that order.
+  std::vector<double> start_;
+  bool start_per_cell_ = false;
+  // Cell c's, the k-th in flow order (its first `ordered` solved once without cuts).
+  double step_start(std::size_t c, std::size_t k, std::size_t ordered) const;
   std::vector<double> entered_, left_;  // per boundary
   double injected_ = 0, adjusted_ = 0;
 };
