@@ -7,7 +7,6 @@
 #include <numeric>
 #include <numbers>
 #include <stdexcept>
-#include <type_traits>
 #include <utility>
 
 #include "core/errors.hpp"
@@ -388,26 +387,18 @@ void FlowTransport::step_tracers(double t0, double t1) {
 }
 
 FlowTransport::TracerReport FlowTransport::tracer_report(std::size_t k) const {
-  if (cut_ || cells_after_release_) return reports_.at(k);
   const TracerTransport& t = tracers_[k];
   return {curves_[k].landmarks(solver_.time()), t.amount(*red_cells_), t.entered(), t.left(), t.injected(), t.adjusted()};
 }
 
-void FlowTransport::release_state() {
-  if (!cut_) {
-    reports_.clear();
-    for (std::size_t k = 0; k < tracers_.size(); ++k) reports_.push_back(tracer_report(k));
+FlowTransport::Outcome FlowTransport::take_outcome() {
+  Outcome o{options_.tracers, {}, options_.red_cells, solver_.blood().pries_diameter_scale(), cell_count(), advances_};
+  if (cut_) {
+    o.reports = std::move(reports_);
+  } else {
+    for (std::size_t k = 0; k < tracers_.size(); ++k) o.reports.push_back(tracer_report(k));
   }
-  cells_after_release_ = cell_count();
-  face_volume_ = {};
-  red_cells_.reset();
-  cut_.reset();
-  auto free = [](auto& array) { std::decay_t<decltype(array)>().swap(array); };
-  free(tracers_), free(curves_), free(tracer_boundaries_), free(tracer_face_), free(tracer_inflow_), free(tracer_injected_);
-  free(cycle_cells_), free(cycle_blood_), free(cycle_low_), free(cycle_high_);
-  free(applied_hematocrit_), free(viscosity_scaling_), free(slice_volume_), free(inflow_hematocrit_);
-  free(vessel_first_cell_), free(vessel_first_face_), free(proximal_sign_), free(lumped_face_), free(one_d_), free(one_d_by_vessel_);
-  boundary_mark_.resize(0);
+  return o;
 }
 
 std::size_t FlowTransport::cell_at(std::size_t v, double x) const {

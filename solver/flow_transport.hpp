@@ -112,24 +112,19 @@ class FlowTransport {
   const RedCellTransport& red_cells() const { return *red_cells_; }
   const std::vector<TracerSpec>& tracer_specs() const { return options_.tracers; }
   bool reports_red_cells() const { return options_.red_cells; }
-  const Blood& red_cells_blood() const { return solver_.blood(); }
   // Tracer k's numbers for the report: per vessel its curve's landmarks over the run so far,
   // and its balance (over ranks rank 0's, taken by take_reports before the ranks part).
   struct TracerReport {
     IndicatorCurves::Landmarks landmarks;
     double amount = 0, entered = 0, left = 0, injected = 0, adjusted = 0;
   };
-  TracerReport tracer_report(std::size_t k) const;
   void take_reports();  // over ranks, collective: every rank at the run's end; alone nothing
   // At fraction x along a vessel (probes): the discharge hematocrit, and tracer k's
   // concentration, of the cell there (a 0D vessel: the node its blood came from last).
   double hematocrit_at(std::size_t vessel, double x) const;
   double tracer_at(std::size_t k, std::size_t vessel, double x) const;
   // The whole run's cells (over ranks: every rank's).
-  std::size_t cell_count() const {
-    return cells_after_release_ ? *cells_after_release_ : cut_ ? cut_->cells : red_cells_->grid().cell_count();
-  }
-  std::size_t advances() const { return advances_; }
+  std::size_t cell_count() const { return cut_ ? cut_->cells : red_cells_->grid().cell_count(); }
   // Over ranks: the exchange of its steps' messages (its traffic); else null.
   const RootExchange* exchange() const { return cut_ ? cut_->roots.exchange.get() : nullptr; }
   // Where the 1D vessels are spread: this rank's transport steps, their rounds (each a solve
@@ -140,12 +135,18 @@ class FlowTransport {
   };
   const SpreadTraffic* spread_traffic() const { return cut_ && cut_->spread ? &cut_->spread->traffic : nullptr; }
 
-  // After the last step, once the state is saved: the tracers' reports taken (alone as
-  // tracer_report gives them; over ranks take_reports took them) and every array freed (about
-  // 400 B a vessel with red cells and a tracer) before the results are written, which read
-  // the reports, the options and the counts alone. No step or save follows; what the
-  // PulsatileRun kept of the last cycle stays its own.
-  void release_state();
+  // What the results read of the transport once the run is over and its state saved: the
+  // tracers' reports (over ranks rank 0's, which take_reports took), the options and the
+  // counts, so that the transport can be freed before the results are written (with red
+  // cells and a tracer about 270 B a vessel). It takes the reports: the transport is spent.
+  struct Outcome {
+    std::vector<TracerSpec> tracers;
+    std::vector<TracerReport> reports;  // per tracer
+    bool red_cells = false;             // reported
+    double pries_diameter_scale = 1;    // the blood's (the tube hematocrits)
+    std::size_t cells = 0, advances = 0;
+  };
+  Outcome take_outcome();
 
   void save(CheckpointWriter& out) const;
   // Over ranks: the one-process run's bytes, written to `out` on rank 0, null elsewhere. Collective.
@@ -275,8 +276,8 @@ class FlowTransport {
   // Numbers out to each neighbouring rank and in from it, of the sizes both sides know.
   void exchange_numbers(const std::vector<std::vector<double>>& out, std::vector<std::vector<double>>& in);
 
-  std::vector<TracerReport> reports_;  // over ranks, rank 0's (take_reports); alone once released
-  std::optional<std::size_t> cells_after_release_;  // release_state()
+  std::vector<TracerReport> reports_;  // over ranks, rank 0's (take_reports)
+  TracerReport tracer_report(std::size_t k) const;  // alone
   // On rank 0 `start` plus each of the whole run's items in turn (per cell or boundary: each
   // rank's values at `place`, -1 none), in the one-process order; elsewhere `start`. Collective.
   double lead_sum(std::span<const double> values, std::span<const std::int32_t> place, std::size_t whole,

@@ -269,7 +269,7 @@ SummaryArray boundary_flows(const Network& net, const PulseSolver& run, const Cy
 // The notes and warnings of a run that ended with its numbers: its length, the red cells'
 // unrest, unphysiological pressures, a tracer the run never reached.
 void say_results(const Network& net, const PulseSolver& run, const RunConfiguration& config,
-                 const PulsatileRun& pulsatile, const FlowTransport* transport, double wall, RunObserver& observer) {
+                 const PulsatileRun& pulsatile, const FlowTransport::Outcome* transport, double wall, RunObserver& observer) {
   std::ostringstream m;
   m << plural(pulsatile.cycles_done(), "cycle") << " in " << describe_duration(wall);
   if (pulsatile.has_change())
@@ -279,7 +279,7 @@ void say_results(const Network& net, const PulseSolver& run, const RunConfigurat
   observer.note(m.str());
   // The red cells' own unrest, said plainly: a network can oscillate by itself (docs/transport.md).
   const RedCellCycle& cells = pulsatile.last_red_cells();
-  if (transport && transport->reports_red_cells() && !cells.discharge.empty())
+  if (transport && transport->red_cells && !cells.discharge.empty())
     observer.note(red_cell_line(net, cells, pulsatile.red_cell_change()));
   const CycleSummary& last = pulsatile.last_cycle();
   double low = INFINITY, high = -INFINITY;
@@ -291,7 +291,7 @@ void say_results(const Network& net, const PulseSolver& run, const RunConfigurat
   warn_unphysiological(low, high, net.id[highest], net, "mean pressures", config.words, observer);
   // A tracer whose injection the run never reached has no curves: said, not left to be found.
   for (std::size_t k = 0; transport && k < config.tracers.size(); ++k)
-    if (const FlowTransport::TracerReport moved = transport->tracer_report(k); moved.entered + moved.injected == 0)
+    if (const FlowTransport::TracerReport& moved = transport->reports[k]; moved.entered + moved.injected == 0)
       observer.warn("tracer " + config.tracers[k].name + " never entered the network (its injection starts at t = " +
                     format_quantity(config.tracers[k].start, "s") + ", the run ended at t = " +
                     format_quantity(run.time(), "s") + "): its arrival, peak and transit times are null");
@@ -558,7 +558,14 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   if (status == RunStatus::interrupted || config.checkpoint_every > 0) pulsatile.write_checkpoint();
   pulsatile.discard_snapshot();
   run.release_lumped_state();  // the time loop is over: on the full tree 1.2 GB less while the report is written
-  if (transport) transport->release_state();  // with red cells and a tracer about 400 B a vessel less
+  // The transport is spent: what the results read of it kept, the rest freed (with red cells
+  // and a tracer about 270 B a vessel).
+  std::optional<FlowTransport::Outcome> carried;
+  if (transport) {
+    carried = transport->take_outcome();
+    pulsatile.end_transport();
+    transport.reset();
+  }
   // Both lie in the allocator's heap (a large block is mapped on its own only where the heap
   // has no room left for it), whose freed pages stay resident until given back: the results'
   // tables would be laid on top of them (the million-vessel tree with red cells: 775 MB
@@ -567,8 +574,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   {  // the table (0.9 GB on the full tree) is freed before the last cycle is copied below
     VesselTable results = last.vessels.empty() ? VesselTable()
                                                : vessel_results(net, run, last, analysis_frequency(driving), config.solver.threads);
-    if (transport && !last.vessels.empty())
-      report_transport(net, *transport, pulsatile.last_red_cells(), pulsatile.red_cell_change(),
+    if (carried && !last.vessels.empty())
+      report_transport(net, *carried, pulsatile.last_red_cells(), pulsatile.red_cell_change(),
                        static_cast<double>(plan.transport_every) * dt, results, info);
     if (!last.vessels.empty()) info["statistics"] = group_statistics(net, results, config.solver.threads);
     write_results(dir, {info, results, last, boundary_flows(net, run, last), &pulsatile.probes(), config.solver.threads},
@@ -588,7 +595,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   result.steps_per_cycle = steps_per_cycle;
   result.last_cycle = last;
   const bool with_numbers = result.outcome == RunOutcome::complete || result.outcome == RunOutcome::not_periodic;
-  if (with_numbers) say_results(net, run, config, pulsatile, transport ? &*transport : nullptr, wall, observer);
+  if (with_numbers) say_results(net, run, config, pulsatile, carried ? &*carried : nullptr, wall, observer);
   return result;
 }
 

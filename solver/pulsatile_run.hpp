@@ -105,6 +105,8 @@ class PulsatileRun {
   // Removes the last cycle end's snapshot where it was not made the checkpoint: before the
   // folder is published.
   void discard_snapshot();
+  // The transport is freed (after the checkpoint): nothing here reads it again.
+  void end_transport() { transport_ = nullptr; }
 
  private:
   // The checkpoint of this cycle end, written to folder/snapshot.pending: an interrupt or

@@ -32,18 +32,18 @@ nlohmann::json tracer_block(const TracerSpec& t, const FlowTransport::TracerRepo
 
 }  // namespace
 
-void report_transport(const Network& net, const FlowTransport& transport, const RedCellCycle& cells, double change,
+void report_transport(const Network& net, const FlowTransport::Outcome& transport, const RedCellCycle& cells, double change,
                       double step, VesselTable& results, nlohmann::json& run_info) {
-  const std::size_t tracers = transport.tracer_specs().size();
+  const std::size_t tracers = transport.tracers.size();
   if (tracers > 0) {
     // Transit times are read against the generation (scripts/plot-results).
     const std::vector<std::int32_t> generation = generations_from_inlets(net);
     results.add_number("generation", std::vector<double>(generation.begin(), generation.end()));
     nlohmann::json list = nlohmann::json::array();
     for (std::size_t k = 0; k < tracers; ++k) {
-      const std::string& name = transport.tracer_specs()[k].name;
-      FlowTransport::TracerReport report = transport.tracer_report(k);
-      list.push_back(tracer_block(transport.tracer_specs()[k], report));
+      const std::string& name = transport.tracers[k].name;
+      FlowTransport::TracerReport report = transport.reports[k];
+      list.push_back(tracer_block(transport.tracers[k], report));
       IndicatorCurves::Landmarks& l = report.landmarks;
       results.add_number(name + "_arrival_time", std::move(l.arrival));
       results.add_number(name + "_peak_time", std::move(l.peak_time));
@@ -52,17 +52,17 @@ void report_transport(const Network& net, const FlowTransport& transport, const 
     }
     run_info["tracers"] = list;
   }
-  if (!transport.reports_red_cells() || cells.discharge.empty()) return;
+  if (!transport.red_cells || cells.discharge.empty()) return;
   std::vector<double> tube(net.vessel_count());
-  const double scale = transport.red_cells_blood().pries_diameter_scale();
+  const double scale = transport.pries_diameter_scale;
   for (std::size_t v = 0; v < tube.size(); ++v)
     tube[v] = tube_hematocrit(cells.discharge[v], 0.5 * (net.diameter[v] + net.diameter_at_to(v)), scale);
   results.add_number("discharge_hematocrit", cells.discharge);
   results.add_number("tube_hematocrit", std::move(tube));
   results.add_number("discharge_hematocrit_min", cells.lowest);
   results.add_number("discharge_hematocrit_max", cells.highest);
-  nlohmann::json r = {{"cells", transport.cell_count()},
-                      {"steps", transport.advances()},
+  nlohmann::json r = {{"cells", transport.cells},
+                      {"steps", transport.advances},
                       {"step", step},
                       {"red_cells", cells.red_cells},
                       {"entered", cells.entered},

@@ -18,7 +18,7 @@ namespace hemotree {
 // "tracers" and "red_cell_transport" blocks. cells: the last cycle's red cells (empty before
 // one); change: their largest change from the cycle before (NaN before two); step: the
 // transport's step [s].
-void report_transport(const Network& net, const FlowTransport& transport, const RedCellCycle& cells, double change,
+void report_transport(const Network& net, const FlowTransport::Outcome& transport, const RedCellCycle& cells, double change,
                       double step, VesselTable& results, nlohmann::json& run_info);
 
 // One line on the red cells: their range over the vessels, the widest swing within the
