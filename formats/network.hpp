@@ -88,6 +88,8 @@ struct Network {
   double diameter_at_to(std::size_t vessel) const {
     return is_tapered(vessel) ? distal_diameter[vessel] : diameter[vessel];
   }
+  // The mean of its two ends' reference diameters (a tapered vessel's; `diameter` otherwise).
+  double mean_diameter(std::size_t vessel) const { return 0.5 * (diameter[vessel] + diameter_at_to(vessel)); }
   double volume(std::size_t vessel) const;  // pi/4 l (D0^2 + D0 D1 + D1^2)/3: a cone's frustum [m^3]
   // Vessel index of an id (linear search unless ids equal indices); -1 when absent.
   std::int64_t index_of(std::int64_t vessel_id) const;

@@ -56,7 +56,7 @@ void report_transport(const Network& net, const FlowTransport::Outcome& transpor
   std::vector<double> tube(net.vessel_count());
   const double scale = transport.pries_diameter_scale;
   for (std::size_t v = 0; v < tube.size(); ++v)
-    tube[v] = tube_hematocrit(cells.discharge[v], 0.5 * (net.diameter[v] + net.diameter_at_to(v)), scale);
+    tube[v] = tube_hematocrit(cells.discharge[v], net.mean_diameter(v), scale);
   results.add_number("discharge_hematocrit", cells.discharge);
   results.add_number("tube_hematocrit", std::move(tube));
   results.add_number("discharge_hematocrit_min", cells.lowest);
