@@ -159,6 +159,26 @@ void FlowTransport::step_tracers(double t0, double t1) {
   }
 }
 
+std::size_t FlowTransport::bytes() const {
+  std::size_t total = red_cells_->bytes() + sizeof(double) * static_cast<std::size_t>(slice_integral_.size() + boundary_mark_.size()) +
+                      arrays_bytes(vessel_first_cell_, vessel_first_face_, proximal_sign_, lumped_face_, one_d_, one_d_by_vessel_,
+                                   inflow_hematocrit_, slice_volume_, cycle_cells_, cycle_blood_, cycle_low_, cycle_high_,
+                                   applied_hematocrit_, viscosity_scaling_, tracer_face_, tracer_injected_);
+  for (std::size_t k = 0; k < tracers_.size(); ++k)
+    total += tracers_[k].bytes() + curves_[k].bytes() + arrays_bytes(tracer_boundaries_[k], tracer_inflow_[k]);
+  if (cut_) {
+    const Cut& c = *cut_;
+    total += arrays_bytes(c.cell_place, c.face_place, c.face_sign, c.copies, c.roots.face, c.roots.cell, c.roots.across,
+                          c.roots.far, c.roots.tracer_far, c.roots.ghost);
+    if (c.spread) {
+      total += array_bytes(c.spread->tracer_in);
+      for (const Cut::Links::Neighbour& n : c.spread->neighbours)
+        total += arrays_bytes(n.send_face, n.send_cell, n.receive_face, n.send_volume, n.receive_volume, n.receive_cell);
+    }
+  }
+  return total;
+}
+
 FlowTransport::TracerReport FlowTransport::tracer_report(std::size_t k) const {
   const TracerTransport& t = tracers_[k];
   return {curves_[k].landmarks(solver_.time()), t.amount(*red_cells_), t.entered(), t.left(), t.injected(), t.adjusted()};

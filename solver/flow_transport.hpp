@@ -123,6 +123,9 @@ class FlowTransport {
   // concentration, of the cell there (a 0D vessel: the node its blood came from last).
   double hematocrit_at(std::size_t vessel, double x) const;
   double tracer_at(std::size_t k, std::size_t vessel, double x) const;
+  // The bytes this rank's transport holds: its grid, state, a step's arrays, the cycle's
+  // sums, the tracers and their curves, the places of a cut (docs/transport.md, "Memory").
+  std::size_t bytes() const;
   // The whole run's cells (over ranks: every rank's).
   std::size_t cell_count() const { return cut_ ? cut_->cells : red_cells_->grid().cell_count(); }
   // Over ranks: the exchange of its steps' messages (its traffic); else null.

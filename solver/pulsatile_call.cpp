@@ -465,7 +465,8 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
         1, static_cast<std::size_t>(std::llround(config.transport_step * static_cast<double>(steps_per_cycle))));
     observer.note(std::string(red ? "red cells" : "") + (red && !tracers.empty() ? " and " : "") +
                   (tracers.empty() ? "" : plural(tracers.size(), "tracer")) + " carried on " +
-                  plural(transport->cell_count(), "cell") + ", a transport step every " +
+                  plural(transport->cell_count(), "cell") + " (" + describe_bytes(static_cast<double>(transport->bytes())) +
+                  (over ? " on rank 0)" : ")") + ", a transport step every " +
                   plural(plan.transport_every, "flow step"));
   }
   PulsatileRun pulsatile(net, run, config.probes, plan, staging, transport ? &*transport : nullptr);

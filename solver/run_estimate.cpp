@@ -29,4 +29,12 @@ std::string describe_duration(double seconds) {
   return text;
 }
 
+std::string describe_bytes(double bytes) {
+  char text[64];
+  if (bytes < 1e6) std::snprintf(text, sizeof text, "%.3g kB", bytes / 1e3);
+  else if (bytes < 1e9) std::snprintf(text, sizeof text, "%.3g MB", bytes / 1e6);
+  else std::snprintf(text, sizeof text, "%.3g GB", bytes / 1e9);
+  return text;
+}
+
 }  // namespace hemotree

@@ -32,5 +32,7 @@ inline constexpr double per_transport_cell = 100e-9;  // [s per cell and transpo
 
 // "3.2 s", "4.1 min", "2.5 h", "3.1 days", "2e+06 years".
 std::string describe_duration(double seconds);
+// "284 kB", "29.5 MB", "1.23 GB" (decimal units).
+std::string describe_bytes(double bytes);
 
 }  // namespace hemotree

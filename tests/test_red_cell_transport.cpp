@@ -1,7 +1,8 @@
 // The red-cell transport scheme on its own, fed with flows whose answer is known: a step and
 // a bolus through a vessel whose flow oscillates and reverses (bounds, conservation, no
 // oscillation), a compliant vessel (cell volumes that breathe), a bifurcation against the
-// Pries-Secomb law, and a loop whose flow circulates and reverses over many cycles.
+// Pries-Secomb law, a loop whose flow circulates and reverses over many cycles, and the memory
+// a tree's red cells and a tracer hold.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include "physics/phase_separation.hpp"
 #include "tests/transport_grids.hpp"
 #include "transport/red_cell_transport.hpp"
+#include "transport/tracer_transport.hpp"
 
 namespace hemotree {
 namespace {
@@ -272,6 +274,43 @@ TEST(RedCellTransport, LoopWithCirculatingReversingFlowOverManyCycles) {
   EXPECT_GT(separating_steps, 0u);
   // Over the last cycles what leaves matches what enters (0.5 of the inflow), in the mean.
   EXPECT_NEAR(t.left() / t.entered(), 1.0, 0.01);
+}
+
+// The memory a tree's red cells and a tracer hold (docs/transport.md, "Memory"), counted as
+// the arrays' capacities: a binary tree of 0D vessels, a cell a node and a face a vessel, a
+// boundary face at the root and at each leaf (so about 1 cell, 1.5 faces and 0.5 boundaries
+// a vessel). What the design allows a vessel: the grid 42 B (a cell's node and Fahraeus
+// parameter 12 B, a face's sides, vessel and diameter 20 B), each cell's faces 14 B, the flow
+// order 9.5 B; the state and a step's arrays 84 B (per cell the volume, the next volume, the
+// hematocrit and the red cells before a step; per face the share, the blood and the red
+// cells through it; per boundary three numbers; the nodes where the law may split, 2 B):
+// 149.5 B, and a tracer's 20 B (a concentration a cell, three numbers a boundary). A new
+// array of a double a face adds 12 B and fails this.
+TEST(RedCellTransport, ATreeHoldsItsGridStateAndOneStepsArraysAlone) {
+  const int depth = 14, vessels = (1 << depth) - 1, leaves = 1 << (depth - 1);
+  TransportGrid g;
+  g.boundaries = static_cast<std::size_t>(leaves) + 1;
+  for (int c = 0; c <= vessels; ++c) g.add_cell(c, 0.9);  // cell 0 above the root vessel
+  for (int v = 1; v <= vessels; ++v) g.add_face(v / 2, v, v - 1, 10e-6);  // vessel v - 1 into node v
+  g.add_face(0, TransportGrid::boundary_side(0), -1, 0.0);  // the inlet (flow in: negative)
+  for (int leaf = 0; leaf < leaves; ++leaf) g.add_face(leaves + leaf, TransportGrid::boundary_side(1 + static_cast<std::size_t>(leaf)), -1, 0.0);
+  std::vector<double> faces(g.face_count());
+  for (int v = 1; v <= vessels; ++v) faces[static_cast<std::size_t>(v - 1)] = 1e-14 / (1 << static_cast<int>(std::log2(v)));
+  faces[static_cast<std::size_t>(vessels)] = -1e-14;
+  for (int leaf = 0; leaf < leaves; ++leaf) faces[static_cast<std::size_t>(vessels + 1 + leaf)] = 1e-14 / leaves;
+  RedCellTransport t(g, std::vector<double>(static_cast<std::size_t>(vessels) + 1, 1e-13), 0.45);
+  TracerTransport dye(t.grid().cell_count(), t.grid().boundaries, TracerCarrier::plasma);
+  std::vector<double> inflow(t.grid().boundaries, nan), dye_in(t.grid().boundaries, nan);
+  inflow[0] = 0.45;
+  dye_in[0] = 1;
+  for (int s = 0; s < 3; ++s) {
+    t.step(faces, inflow);
+    dye.step(t, dye_in, Injection{});
+  }
+  EXPECT_GT(t.separating_nodes(), 0u);
+  EXPECT_GT(dye.concentration()[1], 0);
+  EXPECT_LE(static_cast<double>(t.bytes()) / vessels, 149.5 + 0.5) << t.bytes();
+  EXPECT_LE(static_cast<double>(dye.bytes()) / vessels, 20 + 0.5) << dye.bytes();
 }
 
 TEST(RedCellTransport, RefusesWhatItCannotRepresent) {

@@ -17,6 +17,8 @@
 #include <span>
 #include <vector>
 
+#include "core/array_bytes.hpp"
+
 namespace hemotree {
 
 class IndicatorCurves {
@@ -40,6 +42,7 @@ class IndicatorCurves {
   // (what a rank holding some of the vessels sends of its state).
   std::vector<double> state_of(std::span<const std::int32_t> vessels) const;
   bool restore(std::span<const double> state);  // false for one of another size
+  std::size_t bytes() const { return arrays_bytes(arrival_, peak_time_, peak_, previous_, mass_, moment_); }
 
   static constexpr double arrival_fraction = 0.01;
 

@@ -56,6 +56,10 @@ RedCellTransport::RedCellTransport(TransportGrid grid, std::vector<double> volum
   blood_face_.assign(grid_.face_count(), 0.0);
   cells_face_.assign(grid_.face_count(), 0.0);
   cells_before_.assign(cells, 0.0);
+  // The flow order's arrays at their size from the start: what bytes() counts then is held.
+  order_.cells.reserve(cells);
+  order_.pending.reserve(cells);
+  order_.direction.reserve(grid_.face_count());
 }
 
 void RedCellTransport::set_hematocrit(std::span<const double> discharge) {

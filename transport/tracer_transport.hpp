@@ -15,6 +15,7 @@
 #include <span>
 #include <vector>
 
+#include "core/array_bytes.hpp"
 #include "transport/red_cell_transport.hpp"
 
 namespace hemotree {
@@ -61,6 +62,7 @@ class TracerTransport {
   const std::vector<double>& entered_by_boundary() const { return entered_; }
   const std::vector<double>& left_by_boundary() const { return left_; }
   double injected() const { return injected_; }
+  std::size_t bytes() const { return arrays_bytes(concentration_, last_outflow_, start_, entered_, left_); }
   // What the carrier's volumes moved between steps (the flow's compliance balance) added:
   // the caller adds, term by term, (carried after - before) x C of each cell as the volumes
   // move, and sets the total.

@@ -23,6 +23,8 @@
 #include <span>
 #include <vector>
 
+#include "core/array_bytes.hpp"
+
 namespace hemotree {
 
 struct TransportGrid {
@@ -76,6 +78,7 @@ struct TransportGrid {
   }
   // Whether every vessel's faces lie one after another (the faces of no vessel, -1, anywhere).
   bool faces_by_vessel() const;
+  std::size_t bytes() const { return arrays_bytes(node, fahraeus, a, b, vessel, diameter); }
 };
 
 // Each cell's faces (compressed rows): the faces of cell c are face[start[c] .. start[c + 1]).
@@ -84,6 +87,7 @@ struct CellFaces {
   std::vector<std::int32_t> start;
   std::vector<std::int32_t> face;
   explicit CellFaces(const TransportGrid& grid);
+  std::size_t bytes() const { return arrays_bytes(start, face); }
 };
 
 // The cells in an order in which every cell comes after the cells its inflows come from (the
@@ -97,6 +101,7 @@ struct FlowOrder {
   std::vector<std::int32_t> pending;
   std::vector<signed char> direction;
   void update(const TransportGrid& grid, const CellFaces& faces, std::span<const double> volume);
+  std::size_t bytes() const { return arrays_bytes(cells, pending, direction); }
 };
 
 }  // namespace hemotree

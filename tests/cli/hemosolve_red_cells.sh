@@ -25,7 +25,8 @@ JSON
 TRACER=name=dye,start=0.5,duration=0.5
 "$HEMOSOLVE" "$WORK/diamond.json" --red-cells transport --cycles 4 --probe 6 --tracer "$TRACER" --out "$WORK/run" 2>"$WORK/err" \
   && pass "--red-cells transport, pulsatile" || fail "--red-cells transport: $(cat "$WORK/err")"
-grep -q "red cells and 1 tracer carried on" "$WORK/err" && pass "the transport is announced" || fail "no note of the transport"
+grep -q "red cells and 1 tracer carried on [0-9]* cells ([0-9.]* kB), a transport step every" "$WORK/err" \
+  && pass "the transport is announced, with the memory it holds" || fail "no note of the transport: $(grep carried "$WORK/err")"
 "$PY" - "$WORK/run/summary.json" "$WORK/run/vessels.csv" <<'PY' && pass "summary.json and vessels.csv: hematocrits, red-cell balance" || fail "red-cell results"
 import csv, json, sys
 s = json.load(open(sys.argv[1]))
