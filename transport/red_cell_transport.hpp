@@ -121,13 +121,13 @@ class RedCellTransport {
   CarrierStep carrier_step(TracerCarrier carrier) const;
   // Cells where the phase separation law split the red cells in the last step.
   std::size_t separating_nodes() const { return separating_.size(); }
+  std::span<const std::int32_t> separating_cells() const { return separating_; }
   // The bytes it holds: the grid and its order, the state and a step's arrays.
   std::size_t bytes() const {
     return grid_.bytes() + faces_.bytes() + order_.bytes() +
            arrays_bytes(volume_, next_volume_, discharge_, share_, candidates_, last_outflow_, after_cut_, blood_face_,
                         cells_face_, cells_before_, entered_, left_, separating_);
   }
-  std::span<const std::int32_t> separating_cells() const { return separating_; }
 
  private:
   double tube(std::size_t cell, double discharge) const {
