@@ -283,7 +283,8 @@ TEST(RedCellTransport, LoopWithCirculatingReversingFlowOverManyCycles) {
 // parameter 12 B, a face's sides, vessel and diameter 20 B), each cell's faces 14 B, the flow
 // order 9.5 B; the state and a step's arrays 84 B (per cell the volume, the next volume, the
 // hematocrit and the red cells before a step; per face the share, the blood and the red
-// cells through it; per boundary three numbers; the nodes where the law may split, 2 B):
+// cells through it; per boundary three numbers; the nodes where the law may split and those
+// where it did, 2 B each):
 // 149.5 B, and a tracer's 20 B (a concentration a cell, three numbers a boundary). A new
 // array of a double a face adds 12 B and fails this.
 TEST(RedCellTransport, ATreeHoldsItsGridStateAndOneStepsArraysAlone) {
