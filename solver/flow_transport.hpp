@@ -97,6 +97,9 @@ class FlowTransport {
   FlowTransport(const Network& net, PulseSolver& solver, FlowTransportOptions options = {},
                 const TransportRanks* ranks = nullptr);
   void join_ranks();
+  // Not copied or moved: face_volume_ views its own red-cell transport's array.
+  FlowTransport(const FlowTransport&) = delete;
+  FlowTransport& operator=(const FlowTransport&) = delete;
 
   // Moves the red cells by what the solver passed since the last call (over ranks: collective).
   void advance();
