@@ -154,7 +154,10 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
     one_d_first_element_.push_back(static_cast<std::int32_t>(j) * elements_per_vessel_);
   if (ranks) {
     take_rank_share(*ranks, options);
-    if (!leads()) std::vector<float>().swap(steady_resistance_);  // the balance is the lead's
+    if (!leads()) {  // the balance is the lead's
+      std::vector<float>().swap(steady_resistance_);
+      std::vector<double>().swap(outlet_capacitance_);
+    }
   } else
     lumped_ = LumpedVessels(net, laws_, viscosity_, blood_, zero_d_, taper_of_, tapers_, lumped_sections_);
   sectioned_count_ = static_cast<std::size_t>(std::count_if(lumped_sections_.begin(), lumped_sections_.end(), [](std::uint8_t s) { return s > 1; }));

@@ -453,7 +453,7 @@ class PulseSolver {
   double period_ = 1;                      // driving_waveform(net)'s
   // Per run outlet (formats/run_boundaries.hpp), where any is RCR (else empty: a tree's two
   // million capillary outlets have none): its capacitance (an RCR's C, else 0) [m^3/Pa]; the
-  // outlets themselves are in boundaries_.list.
+  // outlets themselves are in boundaries_.list. Over ranks the lead's alone (its balance).
   std::size_t outlet_count_ = 0;
   std::vector<double> outlet_capacitance_;
   bool rcr_outlets_ = false;  // any outlet RCR: the compliance balance moves capacitors

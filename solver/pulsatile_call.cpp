@@ -405,6 +405,7 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
   std::unique_ptr<PulseSolver> settling;
   if (resumed_from.empty())
     on_every_rank([&] { settling = low_degree_settling_solver(net, run, config, period, ranks ? &ranks->ranks() : nullptr); });
+  if (ranks) ranks->end_dealing();
   // The walls are in the vessels' tube laws now; only a VTK file would write them again.
   if (given_up && !config.vtk && config.frames == 0)
     for (std::vector<double>* wall : {&given_up->wall_thickness, &given_up->youngs_modulus}) std::vector<double>().swap(*wall);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <stdexcept>
 
 #include "core/setting_error.hpp"
 #include "distributed/gather_rows.hpp"
@@ -31,9 +32,11 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDL
   ranks_.top_rank = partition_.top_rank;
   ranks_.vessel_ranks = [this](const std::vector<bool>& zero_d, std::span<const double> step_cost) {
     // The run's partition, made once: a settling solver of the same models takes the same.
+    if (dealing_ended_) throw std::logic_error("MpiPulseRanks: a deal after end_dealing");
     if (!dealt_ || dealt_zero_d_ != zero_d) {
       dealt_ = deal(zero_d, step_cost);
       dealt_zero_d_ = zero_d;
+      one_d_spread_ = dealt_->one_d_spread;
     }
     return *dealt_;
   };
@@ -104,6 +107,14 @@ MpiPulseRanks::MpiPulseRanks(const Network& net, std::vector<double> cost, OneDL
     MPI_Allgatherv(pairs.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, MPI_COMM_WORLD);
     for (std::size_t j = 0; j < all.size(); j += 2) values[static_cast<std::size_t>(all[j])] = all[j + 1];
   };
+}
+
+void MpiPulseRanks::end_dealing() {
+  dealing_ended_ = true;
+  std::vector<double>().swap(cost_);
+  std::vector<std::int32_t>().swap(partition_.rank_of_vessel);  // describe() reads the counts alone
+  dealt_.reset();
+  std::vector<bool>().swap(dealt_zero_d_);
 }
 
 VesselRanks MpiPulseRanks::deal(const std::vector<bool>& zero_d, std::span<const double> step_cost) {

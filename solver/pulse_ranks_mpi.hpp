@@ -51,10 +51,16 @@ class MpiPulseRanks {
   MpiPulseRanks& operator=(const MpiPulseRanks&) = delete;
 
   const PulseRanks& ranks() const { return ranks_; }
-  // After the solver is built: the partition (with the 1D vessels kept on the top, or spread),
-  // and the vessels the top's rank holds (0 where spread).
+  // Once every solver of the run is built (the run's and its settling one, which takes the
+  // same deal): what only dealing needed, every vessel's cost and rank (each solver holds its
+  // own vessels' ranks where it needs them), freed on every rank. A deal after it is a logic
+  // error.
+  void end_dealing();
+  // After the solver is built: the partition (with the 1D vessels kept on the top, or spread;
+  // its per-vessel ranks gone after end_dealing), and the vessels the top's rank holds (0
+  // where spread).
   const Partition& partition() const { return partition_; }
-  bool one_d_spread() const { return dealt_ && dealt_->one_d_spread; }
+  bool one_d_spread() const { return one_d_spread_; }
   // Whether the 0D vessels are spread over the ranks (a 0D system with loops), and the
   // solves of its steps on this rank (the run's solver's and a settling solver's): how many,
   // their iterations and preconditioner set-ups, the seconds inside them, PETSc's method.
@@ -98,6 +104,7 @@ class MpiPulseRanks {
   std::unique_ptr<RootExchange> exchange_;
   std::optional<VesselRanks> dealt_;
   std::vector<bool> dealt_zero_d_;
+  bool one_d_spread_ = false, dealing_ended_ = false;
   SpreadTraffic spread_traffic_;
   bool zero_d_spread_ = false;
   std::vector<std::shared_ptr<PetscNodalSystem>> halo_systems_;
