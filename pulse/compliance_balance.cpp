@@ -23,37 +23,60 @@ std::vector<double> PulseSolver::capacitor_pressures() const {
   return p;
 }
 
-std::vector<double> PulseSolver::vessel_volumes() const {
-  std::vector<double> volume(net_.vessel_count(), 0.0);
-  for (std::size_t v = 0; v < volume.size(); ++v) {
-    if (!steps_vessel(v)) continue;  // another rank's (below)
-    if (zero_d_[v]) {  // half at each node's pressure, as the 0D scheme holds it
-      const std::int32_t e = lumped_.vessel_index(v);
-      const TubeLaw tube = law(v);
-      volume[v] = is_tapered(v)              ? lumped_.tapered_volume(e)
-                  : lumped_.sections(e) > 1 ? lumped_.sectioned_volume(e)
-                                            : net_.length[v] * 0.5 * (tube.area(lumped_.pressure_at(e, 0)) + tube.area(lumped_.pressure_at(e, 1)));
-    }
-    for (auto el = first_element(v), end = end_element(v); el < end; ++el) volume[v] += 2 * half_length_(el) * state_.area(el, 0);
+double PulseSolver::vessel_volume(std::size_t v) const {
+  double volume = 0.0;
+  if (zero_d_[v]) {  // half at each node's pressure, as the 0D scheme holds it
+    const std::int32_t e = lumped_.vessel_index(v);
+    const TubeLaw tube = law(v);
+    volume = is_tapered(v)              ? lumped_.tapered_volume(e)
+             : lumped_.sections(e) > 1 ? lumped_.sectioned_volume(e)
+                                       : net_.length[v] * 0.5 * (tube.area(lumped_.pressure_at(e, 0)) + tube.area(lumped_.pressure_at(e, 1)));
   }
-  if (lead_whole_) lead_whole_(volume, steps_vessel_);  // over ranks: each vessel's from its rank, on the lead
+  for (auto el = first_element(v), end = end_element(v); el < end; ++el) volume += 2 * half_length_(el) * state_.area(el, 0);
   return volume;
+}
+
+double PulseSolver::area_per_pressure_at(std::size_t v, double volume) const {
+  return law(v).compliance_per_length(volume / net_.length[v]);
+}
+
+std::vector<double> PulseSolver::vessel_volumes() const {
+  if (!lead_places_) {
+    std::vector<double> volume(net_.vessel_count());
+    for (std::size_t v = 0; v < volume.size(); ++v) volume[v] = vessel_volume(v);
+    return volume;
+  }
+  // Over ranks each rank's own vessels' to the lead, each at its place: nothing the network's
+  // size on the other ranks.
+  std::vector<double> own;
+  std::vector<std::int32_t> place;
+  for (std::size_t v = 0; v < net_.vessel_count(); ++v)
+    if (steps_vessel(v)) {
+      own.push_back(vessel_volume(v));
+      place.push_back(static_cast<std::int32_t>(v));
+    }
+  return lead_places_(own, place, net_.vessel_count());
 }
 
 std::size_t PulseSolver::balance_compliances(double period, std::vector<double> mean_pressure) {
   if (!can_balance_) return 0;
   const std::size_t n = net_.vessel_count();
-  // Each vessel's volume and dA/dp at its mean area, now: over ranks the lead's whole, every
-  // other rank's for its own vessels (what it moves).
+  // Every vessel's volume and dA/dp at its mean area, the lead's alone (over ranks the others
+  // send their vessels' volumes); each rank moves its own vessels by the dA/dp it computes
+  // alike (move_compliances).
   const std::vector<double> volume = vessel_volumes();
-  std::vector<double> area_per_pressure(n);
-  for (std::size_t v = 0; v < n; ++v)
-    if (leads() || steps_vessel(v)) area_per_pressure[v] = law(v).compliance_per_length(volume[v] / net_.length[v]);
+  std::vector<double> area_per_pressure;
+  if (leads()) {
+    area_per_pressure.resize(n);
+    for (std::size_t v = 0; v < n; ++v) area_per_pressure[v] = area_per_pressure_at(v, volume[v]);
+  }
   // A tapered vessel's dA/dp changes along it: each element's at its mean area and centre
-  // (a 0D one's, the mean of its ends'), and the vessel's the mean of those.
+  // (a 0D one's, the mean of its ends'), and the vessel's the mean of those, from its rank.
   std::vector<double> element_area_per_pressure;
   if (!tapers_.empty()) {
     element_area_per_pressure.assign(static_cast<std::size_t>(state_.area.rows()), 0.0);
+    std::vector<double> own;
+    std::vector<std::int32_t> place;
     for (std::size_t v = 0; v < n; ++v) {
       if (!is_tapered(v) || !steps_vessel(v)) continue;
       double sum = 0;
@@ -72,9 +95,17 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
           sum += c / elements_per_vessel_;
         }
       }
-      area_per_pressure[v] = sum;
+      own.push_back(sum);
+      place.push_back(static_cast<std::int32_t>(v));
     }
-    if (lead_whole_) lead_whole_(area_per_pressure, steps_vessel_);  // the tapered vessels' from their ranks
+    if (lead_places_) {
+      const std::vector<double> tapered = lead_places_(own, place, n);  // the tapered vessels' from their ranks
+      if (leads())
+        for (std::size_t v = 0; v < n; ++v)
+          if (is_tapered(v)) area_per_pressure[v] = tapered[v];
+    } else {
+      for (std::size_t k = 0; k < own.size(); ++k) area_per_pressure[static_cast<std::size_t>(place[k])] = own[k];
+    }
   }
   // Without RCR outlets no capacitor is balanced: their arrays stay empty (a tree's two
   // million capillary outlets would hold 15 MB of NaN or 0 in each).
@@ -94,14 +125,11 @@ std::size_t PulseSolver::balance_compliances(double period, std::vector<double> 
     from_lead_(move.node);
     from_lead_(move.capacitor);
   }
-  move_compliances(move, area_per_pressure, element_area_per_pressure);
+  move_compliances(move, element_area_per_pressure);
   move = {};
-  cycle_volume_ = vessel_volumes();
+  cycle_volume_ = vessel_volumes();  // the marks are the lead's (empty elsewhere)
   cycle_capacitor_ = rcr_outlets_ ? capacitor_pressures() : std::vector<double>();
-  if (!leads()) {  // the marks are the lead's
-    std::vector<double>().swap(cycle_volume_);
-    std::vector<double>().swap(cycle_capacitor_);
-  }
+  if (!leads()) std::vector<double>().swap(cycle_capacitor_);
   have_previous_rate_ = false;  // the multistep history belongs to the state before the move
   return n;
 }
@@ -187,16 +215,17 @@ TreePotentials PulseSolver::compliance_moves(double period, std::vector<double> 
   return move;
 }
 
-void PulseSolver::move_compliances(const TreePotentials& move, const std::vector<double>& area_per_pressure,
-                                   const std::vector<double>& element_area_per_pressure) {
-  // Every vessel's pressure shifts linearly between its nodes' moves.
+void PulseSolver::move_compliances(const TreePotentials& move, const std::vector<double>& element_area_per_pressure) {
+  // Every vessel's pressure shifts linearly between its nodes' moves, its area by dA/dp at its
+  // mean area (the value the lead's solve took).
   const int e = elements_per_vessel_;
   for (std::size_t v = 0; v < net_.vessel_count(); ++v) {
     if (zero_d_[v] || !steps_vessel(v)) continue;
     const double y0 = move.node[static_cast<std::size_t>(net_.from[v])], y1 = move.node[static_cast<std::size_t>(net_.to[v])];
+    const double area_per_pressure = is_tapered(v) ? 0.0 : area_per_pressure_at(v, vessel_volume(v));
     for (int k = 0; k < e; ++k) {
       const auto el = first_element(v) + k;
-      const double c = is_tapered(v) ? element_area_per_pressure[static_cast<std::size_t>(el)] : area_per_pressure[v];
+      const double c = is_tapered(v) ? element_area_per_pressure[static_cast<std::size_t>(el)] : area_per_pressure;
       state_.area(el, 0) += c * (y0 + (y1 - y0) * (k + 0.5) / e);
       if (state_.area.cols() > 1 && vessel_degree_[v] >= 1) state_.area(el, 1) += c * (y1 - y0) / (2 * e);
     }

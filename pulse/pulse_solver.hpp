@@ -430,7 +430,11 @@ class PulseSolver {
   // Over ranks, the lead's periodic start (instant: the lead's, none elsewhere) on every rank;
   // whether it took one (started: the lead's own outcome). Collective.
   bool take_lead_start(bool started, const std::optional<PeriodicInstant>& instant);
-  std::vector<double> vessel_volumes() const;  // per vessel, from the mean areas [m^3]
+  // Per vessel, from the mean areas [m^3]; over ranks on the lead alone (empty elsewhere),
+  // each rank sending its own vessels'.
+  std::vector<double> vessel_volumes() const;
+  double vessel_volume(std::size_t vessel) const;  // an own vessel's
+  double area_per_pressure_at(std::size_t vessel, double volume) const;  // dA/dp at its mean area [m^2/Pa]
   void start_at_rest();
   // steady: the network's steady flow, or null where it has none.
   void choose_degrees_and_elements(const SolverOptions& options, const SteadyFlow* steady);
@@ -583,8 +587,7 @@ class PulseSolver {
   // network's volumes), and each rank's own 1D elements and capacitors moved by them.
   TreePotentials compliance_moves(double period, std::vector<double> mean_pressure, const std::vector<double>& volume,
                                   const std::vector<double>& area_per_pressure, const std::vector<double>& capacitor_now);
-  void move_compliances(const TreePotentials& move, const std::vector<double>& area_per_pressure,
-                        const std::vector<double>& element_area_per_pressure);
+  void move_compliances(const TreePotentials& move, const std::vector<double>& element_area_per_pressure);
   Eigen::VectorXd decay_, phi1_, phi2_, next_flow_;  // ETD2: e^(-r h), phi1, phi2 per element; scratch
   Eigen::MatrixXd previous_flow_;
   bool have_previous_rate_ = false;
