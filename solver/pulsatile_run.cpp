@@ -184,7 +184,9 @@ void PulsatileRun::put_run_progress(CheckpointWriter& out, const std::string& pr
 }
 
 void PulsatileRun::set_aside_last_vessels() {
-  if (last_.vessels.empty() || over_ranks_) return;  // over ranks no snapshot holds them: kept
+  // Over ranks the lead's snapshot holds them; every other rank keeps its own vessels' (by
+  // entry: CycleStatistics), which no snapshot of its holds.
+  if (last_.vessels.empty() || !writes_) return;
   std::vector<VesselCycle>().swap(last_.vessels);  // its waves, a few hundred, stay
   std::vector<double>().swap(last_.boundary_mean_flow);
   last_vessels_aside_ = true;
