@@ -354,9 +354,9 @@ void run_linear(const Network& net, const RunConfiguration& config, RunObserver&
   const std::size_t n = net.vessel_count();
   VesselTable results = cycle_table(net, linear.cycle, std::vector<std::uint8_t>(n, 0), {"linear"},
                                     std::vector<std::int64_t>(n, VesselTable::null_integer), linear.wave_travels);
-  results.add_number("womersley", linear.womersley);
-  results.add_number("pwv_elastic", linear.pwv_elastic);
-  results.add_number("pwv_theory", linear.pwv_theory);
+  results.add_number_view("womersley", linear.womersley);
+  results.add_number_view("pwv_elastic", linear.pwv_elastic);
+  results.add_number_view("pwv_theory", linear.pwv_theory);
   nlohmann::json run_info = {{"tool", "hemosolve"},
                              {"version", HEMOTREE_VERSION},
                              {"network", config.network_name},

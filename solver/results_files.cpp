@@ -21,25 +21,31 @@ constexpr double null_number = std::numeric_limits<double>::quiet_NaN();
 hdf5::EnumNames enum_names(const std::vector<std::string>& labels) { return hdf5::EnumNames{labels}; }
 
 void write_vessels(hdf5::File& file, const VesselTable& vessels) {
+  // A column a view spaced apart (a field of the cycle's records) is copied whole, one at a time.
+  std::vector<double> numbers;
+  std::vector<std::int64_t> integers;
   for (const VesselTable::Column& c : vessels.columns()) {
     if (c.name.find('/') != std::string::npos) throw std::logic_error("results.h5: a column named " + c.name);
     const std::string path = "/vessels/" + c.name;
     switch (c.kind) {
-      case VesselTable::Kind::number: file.write(path, std::span<const double>(c.number)); break;
+      case VesselTable::Kind::number: file.write(path, c.numbers(numbers)); break;
       case VesselTable::Kind::integer: {
+        const std::span<const std::int64_t> column = c.integers(integers);
         // With a null, as vessels.csv reads into pandas: reals, NaN for null.
-        if (std::find(c.integer.begin(), c.integer.end(), VesselTable::null_integer) == c.integer.end()) {
-          file.write(path, std::span<const std::int64_t>(c.integer));
+        if (std::find(column.begin(), column.end(), VesselTable::null_integer) == column.end()) {
+          file.write(path, column);
           break;
         }
-        std::vector<double> values(c.integer.size());
-        for (std::size_t v = 0; v < values.size(); ++v)
-          values[v] = c.integer[v] == VesselTable::null_integer ? null_number : static_cast<double>(c.integer[v]);
-        file.write(path, std::span<const double>(values));
+        numbers.resize(column.size());
+        for (std::size_t v = 0; v < numbers.size(); ++v)
+          numbers[v] = column[v] == VesselTable::null_integer ? null_number : static_cast<double>(column[v]);
+        file.write(path, std::span<const double>(numbers));
         break;
       }
       case VesselTable::Kind::text: file.write_enum(path, c.code, enum_names(c.labels)); break;
     }
+    std::vector<double>().swap(numbers);
+    std::vector<std::int64_t>().swap(integers);
   }
 }
 

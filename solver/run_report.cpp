@@ -47,26 +47,26 @@ VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vect
   for (int k = 0; k <= static_cast<int>(VesselClass::capillary); ++k)
     class_names.emplace_back(to_string(static_cast<VesselClass>(k)));
   for (std::size_t v = 0; v < n; ++v) vessel_class[v] = static_cast<std::uint8_t>(net.vessel_class[v]);
-  table.add_integer("id", net.id);
-  table.add_number("diameter", net.diameter);
-  table.add_number("length", net.length);
+  table.add_integer_view("id", net.id);
+  table.add_number_view("diameter", net.diameter);
+  table.add_number_view("length", net.length);
   table.add_text("class", std::move(vessel_class), std::move(class_names));
   table.add_text("model", std::move(model), std::move(model_labels));
   table.add_integer("degree", std::move(degree));
-  auto column = [&](const char* name, auto value) {
-    std::vector<double> x(n);
-    for (std::size_t v = 0; v < n; ++v) x[v] = value(cycle.vessels[v]);
-    table.add_number(name, std::move(x));
-  };
-  column("mean_flow", [](const VesselCycle& c) { return c.mean_flow; });
-  column("mean_pressure", [](const VesselCycle& c) { return c.mean_pressure; });
-  column("systolic_pressure", [](const VesselCycle& c) { return c.systolic_pressure; });
-  column("diastolic_pressure", [](const VesselCycle& c) { return c.diastolic_pressure; });
-  column("pulsatility_index", [](const VesselCycle& c) { return c.pulsatility_index(); });
-  column("peak_flow", [](const VesselCycle& c) { return c.peak_flow; });
-  column("least_flow", [](const VesselCycle& c) { return c.least_flow; });
-  column("mean_wss", [](const VesselCycle& c) { return c.mean_wss; });
-  column("reynolds", [](const VesselCycle& c) { return c.reynolds; });
+  // The cycle's records are read where they lie (the caller keeps them); the pulsatility
+  // index, computed from them, is held.
+  const std::span<const VesselCycle> records(cycle.vessels);
+  table.add_number_view("mean_flow", records, &VesselCycle::mean_flow);
+  table.add_number_view("mean_pressure", records, &VesselCycle::mean_pressure);
+  table.add_number_view("systolic_pressure", records, &VesselCycle::systolic_pressure);
+  table.add_number_view("diastolic_pressure", records, &VesselCycle::diastolic_pressure);
+  std::vector<double> pulsatility(n);
+  for (std::size_t v = 0; v < n; ++v) pulsatility[v] = cycle.vessels[v].pulsatility_index();
+  table.add_number("pulsatility_index", std::move(pulsatility));
+  table.add_number_view("peak_flow", records, &VesselCycle::peak_flow);
+  table.add_number_view("least_flow", records, &VesselCycle::least_flow);
+  table.add_number_view("mean_wss", records, &VesselCycle::mean_wss);
+  table.add_number_view("reynolds", records, &VesselCycle::reynolds);
   const double null = std::numeric_limits<double>::quiet_NaN();
   auto measured = [&](double WaveSpeeds::*speed) {
     std::vector<double> x(n, null);
@@ -193,7 +193,7 @@ nlohmann::json group_statistics(const Network& net, const VesselTable& vessels, 
       if (!column) continue;
       values.clear();
       for (const std::uint32_t v : members)
-        if (std::isfinite(column->number[v])) values.push_back(column->number[v]);
+        if (const double x = column->number_at(v); std::isfinite(x)) values.push_back(x);
       if (values.empty()) continue;
       auto rank = [&](double f) {
         const auto k = static_cast<std::size_t>(std::llround(f * static_cast<double>(values.size() - 1)));
@@ -274,19 +274,21 @@ void write_vessel_table(const std::filesystem::path& file, const VesselTable& ve
 void write_results_vtk(const std::filesystem::path& file, const Network& net, const VesselTable& vessels,
                        std::span<const std::uint8_t> keep) {
   // Every number per vessel but the geometry the PolyData has already (null -> NaN): the real
-  // columns as they are, then the integer ones converted (a deque: the fields point into it).
+  // columns as they are (a view spaced apart copied), then the integer ones converted (a
+  // deque: the fields point into it).
   std::deque<std::vector<double>> converted;
   std::vector<CellField> fields, integer_fields;
   for (const VesselTable::Column& c : vessels.columns()) {
     if (c.name == "id" || c.name == "diameter" || c.name == "length" || c.kind == VesselTable::Kind::text) continue;
     if (c.kind == VesselTable::Kind::number) {
-      fields.push_back({c.name, c.number});
+      fields.push_back({c.name, c.numbers(converted.emplace_back())});
       continue;
     }
-    std::vector<double>& x = converted.emplace_back(c.integer.size());
-    for (std::size_t v = 0; v < x.size(); ++v)
-      x[v] = c.integer[v] == VesselTable::null_integer ? std::numeric_limits<double>::quiet_NaN()
-                                                        : static_cast<double>(c.integer[v]);
+    std::vector<double>& x = converted.emplace_back(vessels.rows());
+    for (std::size_t v = 0; v < x.size(); ++v) {
+      const std::int64_t k = c.integer_at(v);
+      x[v] = k == VesselTable::null_integer ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(k);
+    }
     integer_fields.push_back({c.name, x});
   }
   fields.insert(fields.end(), integer_fields.begin(), integer_fields.end());

@@ -38,7 +38,8 @@ WaveTheory wave_theory(const PulseSolver& solver, const Network& net, std::size_
 
 // The columns every run reports, one row per vessel in the network's order: id, geometry,
 // class, the vessel's model (a label per vessel: model_labels[model[v]]) and degree (null
-// where none), and the cycle's statistics.
+// where none), and the cycle's statistics. The table views the network's columns and the
+// cycle's records: both must outlive it.
 // wave_travels (one flag per vessel, or empty for all): where the measured wave speeds
 // (pwv_pressure, pwv_velocity) are a wave's; null elsewhere.
 VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vector<std::uint8_t> model,
@@ -51,7 +52,8 @@ VesselTable cycle_table(const Network& net, const CycleSummary& cycle, std::vect
 // speak of (--model auto's criteria); its flow is one along it and its ends' pressures differ
 // by its resistive drop, so a phase "lag" between them is no wave's (it read as 100 to
 // 10,000 m/s).
-// threads: the vessels' wave theory in parallel (the same numbers for any count).
+// threads: the vessels' wave theory in parallel (the same numbers for any count). As
+// cycle_table's, the table views the network and the cycle.
 VesselTable vessel_results(const Network& net, const PulseSolver& solver, const CycleSummary& cycle,
                            double analysis_frequency, int threads = 1);
 

@@ -57,10 +57,10 @@ void report_transport(const Network& net, const FlowTransport::Outcome& transpor
   const double scale = transport.pries_diameter_scale;
   for (std::size_t v = 0; v < tube.size(); ++v)
     tube[v] = tube_hematocrit(cells.discharge[v], net.mean_diameter(v), scale);
-  results.add_number("discharge_hematocrit", cells.discharge);
+  results.add_number_view("discharge_hematocrit", cells.discharge);
   results.add_number("tube_hematocrit", std::move(tube));
-  results.add_number("discharge_hematocrit_min", cells.lowest);
-  results.add_number("discharge_hematocrit_max", cells.highest);
+  results.add_number_view("discharge_hematocrit_min", cells.lowest);
+  results.add_number_view("discharge_hematocrit_max", cells.highest);
   nlohmann::json r = {{"cells", transport.cells},
                       {"steps", transport.advances},
                       {"step", step},

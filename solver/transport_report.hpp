@@ -16,8 +16,8 @@ namespace hemotree {
 // _mean_transit_time, and the vessels' generation) and, where the red cells are reported,
 // discharge_hematocrit, tube_hematocrit, discharge_hematocrit_min/_max; to run_info the
 // "tracers" and "red_cell_transport" blocks. cells: the last cycle's red cells (empty before
-// one); change: their largest change from the cycle before (NaN before two); step: the
-// transport's step [s].
+// one, viewed by the table: they must outlive it); change: their largest change from the
+// cycle before (NaN before two); step: the transport's step [s].
 void report_transport(const Network& net, const FlowTransport::Outcome& transport, const RedCellCycle& cells, double change,
                       double step, VesselTable& results, nlohmann::json& run_info);
 

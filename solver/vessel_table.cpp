@@ -28,6 +28,7 @@ void append_integer(std::string& text, std::int64_t x) {
 }  // namespace
 
 void VesselTable::push(Column c) {
+  c.rows = rows_;
   // Quoted once here, not per row: a name or label may hold anything a user typed.
   c.json_name = json_quoted(c.name);
   for (const std::string& label : c.labels) {
@@ -53,6 +54,41 @@ void VesselTable::add_number(std::string name, std::vector<double> values) {
   c.kind = Kind::number;
   c.number = std::move(values);
   push(std::move(c));
+}
+
+void VesselTable::push_view(std::string name, Kind kind, std::size_t size, const std::byte* first, std::size_t stride) {
+  check_size(size, rows_, name);
+  Column c;
+  c.name = std::move(name);
+  c.kind = kind;
+  c.view = first;
+  c.stride = stride;
+  push(std::move(c));
+}
+
+void VesselTable::add_integer_view(std::string name, std::span<const std::int64_t> values) {
+  push_view(std::move(name), Kind::integer, values.size(), reinterpret_cast<const std::byte*>(values.data()),
+            sizeof(std::int64_t));
+}
+
+void VesselTable::add_number_view(std::string name, std::span<const double> values) {
+  push_view(std::move(name), Kind::number, values.size(), reinterpret_cast<const std::byte*>(values.data()), sizeof(double));
+}
+
+std::span<const double> VesselTable::Column::numbers(std::vector<double>& scratch) const {
+  if (!view) return number;
+  if (stride == sizeof(double)) return {reinterpret_cast<const double*>(view), rows};
+  scratch.resize(rows);
+  for (std::size_t r = 0; r < rows; ++r) scratch[r] = number_at(r);
+  return scratch;
+}
+
+std::span<const std::int64_t> VesselTable::Column::integers(std::vector<std::int64_t>& scratch) const {
+  if (!view) return integer;
+  if (stride == sizeof(std::int64_t)) return {reinterpret_cast<const std::int64_t*>(view), rows};
+  scratch.resize(rows);
+  for (std::size_t r = 0; r < rows; ++r) scratch[r] = integer_at(r);
+  return scratch;
 }
 
 void VesselTable::add_text(std::string name, std::vector<std::uint8_t> codes, std::vector<std::string> labels) {
@@ -93,11 +129,11 @@ void VesselTable::append_json_row(std::string& text, std::size_t row) const {
     text += ':';
     switch (c.kind) {
       case Kind::integer:
-        if (c.integer[row] == null_integer) text += "null";
-        else append_integer(text, c.integer[row]);
+        if (const std::int64_t x = c.integer_at(row); x == null_integer) text += "null";
+        else append_integer(text, x);
         break;
       case Kind::number:
-        append_json_number(text, c.number[row]);
+        append_json_number(text, c.number_at(row));
         break;
       case Kind::text:
         text += c.json_labels[c.code[row]];
@@ -113,10 +149,10 @@ void VesselTable::append_csv_row(std::string& text, std::size_t row) const {
     const Column& c = columns_[f];
     switch (c.kind) {
       case Kind::integer:
-        if (c.integer[row] != null_integer) append_integer(text, c.integer[row]);
+        if (const std::int64_t x = c.integer_at(row); x != null_integer) append_integer(text, x);
         break;
       case Kind::number:
-        append_csv_number(text, c.number[row]);  // summary.json's text of the same double
+        append_csv_number(text, c.number_at(row));  // summary.json's text of the same double
         break;
       case Kind::text:
         text += c.csv_labels[c.code[row]];

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <span>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -99,4 +101,36 @@ TEST(Quoting, CsvFieldsQuotedOnlyWhereTheyMustBe) {
   EXPECT_EQ(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
   EXPECT_EQ(csv_field("two\nlines"), "\"two\nlines\"");
   EXPECT_EQ(json_quoted("a\"b\n"), "\"a\\\"b\\n\"");
+}
+
+TEST(VesselTable, AViewReadsTheRecordsWhereTheyLieAsAHeldColumnWould) {
+  // The same values held, viewed whole, and viewed as a field of records 24 bytes apart: the
+  // same rows, and the same whole column (the spaced one copied, the contiguous one itself).
+  struct Record {
+    double a, mean, b;
+  };
+  const std::vector<Record> records{{1, 0.1 + 0.2, 2}, {3, -3.0, 4}, {5, std::numeric_limits<double>::quiet_NaN(), 6}};
+  const std::vector<double> means{0.1 + 0.2, -3.0, std::numeric_limits<double>::quiet_NaN()};
+  const std::vector<std::int64_t> ids{7, -2, VesselTable::null_integer};
+  VesselTable held(3), viewed(3);
+  held.add_integer("id", ids);
+  held.add_number("mean", means);
+  viewed.add_integer_view("id", ids);
+  viewed.add_number_view("mean", std::span<const Record>(records), &Record::mean);
+  for (std::size_t row = 0; row < 3; ++row) {
+    EXPECT_EQ(json_row(viewed, row), json_row(held, row));
+    EXPECT_EQ(appended([&](std::string& text) { viewed.append_csv_row(text, row); }),
+              appended([&](std::string& text) { held.append_csv_row(text, row); }));
+  }
+  EXPECT_EQ(json_row(viewed, 1), R"({"id":-2,"mean":-3.0})");
+  std::vector<double> scratch;
+  const std::span<const double> mean = viewed.find("mean")->numbers(scratch);
+  ASSERT_EQ(mean.size(), 3u);
+  EXPECT_EQ(mean.data(), scratch.data());  // spaced apart: copied
+  EXPECT_EQ(mean[0], 0.1 + 0.2);
+  EXPECT_TRUE(std::isnan(mean[2]));
+  std::vector<std::int64_t> unused;
+  EXPECT_EQ(viewed.find("id")->integers(unused).data(), ids.data());  // contiguous: itself
+  EXPECT_TRUE(unused.empty());
+  EXPECT_THROW(viewed.add_number_view("short", std::span<const double>(means).first(2)), std::invalid_argument);
 }
