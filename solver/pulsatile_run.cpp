@@ -184,9 +184,16 @@ void PulsatileRun::put_run_progress(CheckpointWriter& out, const std::string& pr
 }
 
 void PulsatileRun::set_aside_last_vessels() {
-  // Over ranks the lead's snapshot holds them; every other rank keeps its own vessels' (by
-  // entry: CycleStatistics), which no snapshot of its holds.
-  if (last_.vessels.empty() || !writes_) return;
+  // Over ranks the lead's snapshot holds them. Every other rank has sent its own vessels' (by
+  // entry: CycleStatistics) to the lead, and reads nothing of them again but whether there
+  // were any (has_previous_ at the next cycle end): 64 B an own vessel less through every
+  // cycle after the first.
+  if (!writes_) {
+    if (!last_.vessels.empty()) own_last_vessels_ = last_.vessels.size();
+    std::vector<VesselCycle>().swap(last_.vessels);
+    return;
+  }
+  if (last_.vessels.empty()) return;
   std::vector<VesselCycle>().swap(last_.vessels);  // its waves, a few hundred, stay
   std::vector<double>().swap(last_.boundary_mean_flow);
   last_vessels_aside_ = true;
@@ -244,6 +251,7 @@ void PulsatileRun::resume(std::unique_ptr<CheckpointReader> checkpoint) {
   // end makes its (the lead alone tests the change).
   in.section("last cycle");
   last_ = get_summary(in, net_.vessel_count(), stats_.entry_vessels(solver_));
+  if (!writes_) set_aside_last_vessels();
   in.section("previous cycle");
   std::uint64_t previous = 0;
   if (writes_) {
@@ -519,7 +527,8 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       last_ = CycleSummary{};  // freed before the next is built
       last_ = stats_.close(solver_);
       if (series) series->finish();
-      has_previous_ = !previous_mean_pressure_.empty();
+      // (A rank other than the lead holds no mean pressures to compare, only whether it had a cycle.)
+      has_previous_ = writes_ ? !previous_mean_pressure_.empty() : own_last_vessels_ > 0;
       // Rank 0 alone has the whole cycle (the others their own vessels', by entry: CycleStatistics).
       if (has_change()) change_ = writes_ ? cycle_change(previous_mean_pressure_, last_.vessels) : PeriodicityChange{};
       if (has_change() && over_ranks_) change_ = lead_change(change_);

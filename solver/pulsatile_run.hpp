@@ -133,6 +133,7 @@ class PulsatileRun {
   template <class PerVessel>
   void read_last_vessels(CheckpointStream& in, PerVessel&& per_vessel) const;
   bool last_vessels_aside_ = false;
+  std::size_t own_last_vessels_ = 0;  // over ranks, a rank but the lead: how many it set aside
   std::filesystem::path latest_snapshot() const { return snapshot_pending_ ? pending() : folder_ / "checkpoint.bin"; }
   RunStatus run_cycles(RunObserver& observer);
   std::filesystem::path pending() const { return folder_ / "snapshot.pending"; }
