@@ -113,7 +113,7 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   }
   choose_models(options);
 
-  const std::optional<SteadyFlow> steady = solve_steady_flow();
+  std::optional<SteadyFlow> steady = solve_steady_flow();
   choose_degrees_and_elements(options, steady ? &*steady : nullptr);
   {
     std::vector<std::int32_t> first(n, -1);
@@ -170,6 +170,9 @@ PulseSolver::PulseSolver(const Network& net, const SolverOptions& options, const
   compute_rest_correction();
   if (started_from_steady_) {
     start_from_steady_flow(*steady);
+    // Read no more: freed before the laws' compact form is made beside them (the set-up's
+    // largest moment on a rank of a run over ranks, 16 B a vessel).
+    steady.reset();
     started_from_ = StartChoice::steady;
     bool periodic = false;
     if (instant) {
