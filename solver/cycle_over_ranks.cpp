@@ -77,28 +77,27 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
   });
 }
 
-void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary,
-                          std::span<const std::int32_t> entry_vessel) {
-  constexpr std::size_t width = 10;  // VesselCycle's eight numbers, the two wave speeds
+void gather_cycle_rows(const Network& net, const PulseSolver& solver, const CycleSummary& own,
+                       std::span<const std::int32_t> entry_vessel,
+                       const std::function<void(std::size_t first, std::span<const double> rows)>& block_rows) {
+  constexpr std::size_t width = cycle_row_width;
   // A block of the vessels at a time, so that a rank's rows are a block's (at most 5 MB), not its
   // whole share's: 80 B an own vessel would be more than its sums themselves, a share's largest
-  // moment (rank 0's receiving is bounded by gather_rows' rounds). Each vessel placed from its
-  // row: the same bits.
-  constexpr std::size_t block = std::size_t{1} << 16;
+  // moment; and rank 0 holds a block's rows, not the whole cycle's (64 B a vessel).
   const std::size_t n = net.vessel_count();
+  const std::size_t block = std::clamp<std::size_t>(n, 1, std::size_t{1} << 16);
+  const bool lead = world_rank() == 0;
   std::vector<std::int32_t> mine;
-  std::vector<double> rows;
-  // Rank 0's rows are copies: every vessel's entry is written in place from its rank's row (each
-  // vessel is stepped by one rank), and the 1D vessels' wave speeds kept as they come.
-  std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
+  std::vector<double> rows, placed(lead ? block * width : 0);
   // By entry: this rank's own vessels' entries in the vessels' order, for the blocks.
-  std::vector<std::pair<std::int32_t, std::int32_t>> own;  // (vessel, entry)
+  std::vector<std::pair<std::int32_t, std::int32_t>> own_entries;  // (vessel, entry)
   for (std::size_t k = 0; k < entry_vessel.size(); ++k)
-    if (solver.steps_vessel(static_cast<std::size_t>(entry_vessel[k]))) own.emplace_back(entry_vessel[k], static_cast<std::int32_t>(k));
-  std::ranges::sort(own);
-  auto next_own = own.begin();
+    if (solver.steps_vessel(static_cast<std::size_t>(entry_vessel[k])))
+      own_entries.emplace_back(entry_vessel[k], static_cast<std::int32_t>(k));
+  std::ranges::sort(own_entries);
+  auto next_own = own_entries.begin();
   auto add_row = [&](std::size_t v, const VesselCycle& c) {
-    const WaveSpeeds w = summary.wave_speeds(v);
+    const WaveSpeeds w = own.wave_speeds(v);
     mine.push_back(static_cast<std::int32_t>(v));
     rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
                              c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
@@ -111,21 +110,44 @@ void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSu
     const std::size_t last = std::min(n, first + block);
     if (entry_vessel.empty()) {
       for (std::size_t v = first; v < last; ++v)
-        if (solver.steps_vessel(v)) add_row(v, summary.vessels[v]);
+        if (solver.steps_vessel(v)) add_row(v, own.vessels[v]);
     } else {
-      for (; next_own != own.end() && static_cast<std::size_t>(next_own->first) < last; ++next_own)
-        add_row(static_cast<std::size_t>(next_own->first), summary.vessels[static_cast<std::size_t>(next_own->second)]);
+      for (; next_own != own_entries.end() && static_cast<std::size_t>(next_own->first) < last; ++next_own)
+        add_row(static_cast<std::size_t>(next_own->first), own.vessels[static_cast<std::size_t>(next_own->second)]);
     }
+    // Each vessel is stepped by one rank: every row of the block is placed once.
     gather_rows(mine, rows, width, n, [&](std::int32_t vessel, const double* f) {
-      const auto v = static_cast<std::size_t>(vessel);
-      summary.vessels[v] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
-      if (!solver.is_lumped(v)) waves.emplace_back(v, WaveSpeeds{f[8], f[9]});
+      std::copy_n(f, width, placed.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(vessel) - first) * width));
     });
+    if (lead) block_rows(first, std::span<const double>(placed.data(), (last - first) * width));
   }
+}
+
+void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary,
+                          std::span<const std::int32_t> entry_vessel) {
+  std::vector<VesselCycle> whole;
+  std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
+  if (world_rank() == 0) whole.resize(net.vessel_count());
+  gather_cycle_rows(net, solver, summary, entry_vessel, [&](std::size_t first, std::span<const double> rows) {
+    for (std::size_t k = 0; k * cycle_row_width < rows.size(); ++k) {
+      const double* f = rows.data() + k * cycle_row_width;
+      const std::size_t v = first + k;
+      whole[v] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
+      if (!solver.is_lumped(v)) waves.emplace_back(v, WaveSpeeds{f[8], f[9]});
+    }
+  });
   if (world_rank() != 0) return;
-  // Every 1D vessel's wave speeds (CycleSummary::waves), in the vessels' order.
-  std::ranges::sort(waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
-  summary.waves = std::move(waves);
+  summary.vessels = std::move(whole);
+  summary.waves = std::move(waves);  // in the vessels' order, as they came
+}
+
+std::vector<double> gather_mean_pressures(const Network& net, const PulseSolver& solver, const CycleSummary& own,
+                                          std::span<const std::int32_t> entry_vessel) {
+  std::vector<double> p(world_rank() == 0 ? net.vessel_count() : 0);
+  gather_cycle_rows(net, solver, own, entry_vessel, [&](std::size_t first, std::span<const double> rows) {
+    for (std::size_t k = 0; k * cycle_row_width < rows.size(); ++k) p[first + k] = rows[k * cycle_row_width + 1];
+  });
+  return p;
 }
 
 }  // namespace hemotree

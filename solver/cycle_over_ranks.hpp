@@ -4,6 +4,7 @@
 // MPI_COMM_WORLD: every rank calls each at the same point of the run.
 #pragma once
 
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -28,12 +29,26 @@ Eigen::VectorXd boundary_volumes_over_ranks(const PulseSolver& solver);
 // a frame's), made every vessel's on rank 0 from the rank that steps it; elsewhere left.
 void gather_vessel_values(const Network& net, const PulseSolver& solver, std::span<std::vector<double>* const> values);
 
-// Every vessel's cycle results, and the wave speeds of the 1D vessels, from the rank that steps
-// the vessel, into rank 0's `summary` (which holds this rank's own before the call, by vessel:
-// the ghosts' and other ranks' entries are replaced). Elsewhere the summary is left as it is;
-// its vessels' results are then each entry_vessel's where that is given (own-sized: the
-// ghosts' entries are not sent), else by vessel.
+// Every vessel's cycle results on rank 0 from the rank that steps the vessel, a block of the
+// vessels at a time in the network's order, without any rank holding them all: per vessel of
+// the block [first, first + rows.size() / cycle_row_width) its row, VesselCycle's eight
+// numbers in their order, then its wave speeds (NaN where no wave travels), handed to
+// block(first, rows) on rank 0 alone. own: this rank's results (CycleStatistics::close),
+// by entry where entry_vessel gives each entry's vessel (the ghosts' entries are not sent),
+// else by vessel. Collective.
+constexpr std::size_t cycle_row_width = 10;
+void gather_cycle_rows(const Network& net, const PulseSolver& solver, const CycleSummary& own,
+                       std::span<const std::int32_t> entry_vessel,
+                       const std::function<void(std::size_t first, std::span<const double> rows)>& block);
+
+// The same into rank 0's `summary`, whole: every vessel's results by vessel and every 1D
+// vessel's wave speeds. Elsewhere the summary is left as it is. Collective.
 void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSummary& summary,
                           std::span<const std::int32_t> entry_vessel = {});
+
+// Every vessel's mean pressure of the cycle on rank 0 (what the compliance balance takes),
+// empty elsewhere. Collective.
+std::vector<double> gather_mean_pressures(const Network& net, const PulseSolver& solver, const CycleSummary& own,
+                                          std::span<const std::int32_t> entry_vessel);
 
 }  // namespace hemotree

@@ -28,7 +28,7 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 CycleStatistics::CycleStatistics(const Network& net, const PulseSolver& solver, double analysis_frequency)
     : net_(net), omega_(2 * std::numbers::pi * analysis_frequency),
       one_d_(solver.one_d_vessels()) {
-  by_entry_ = solver.over_ranks() && !solver.leads();
+  by_entry_ = solver.over_ranks();
   lumped_entries_ = solver.lumped().vessel_count();
   const std::size_t n = one_d_.size();
   for (auto* sums : {&p_in_, &p_out_, &u_in_, &u_out_}) sums->assign(n, 0.0);
@@ -128,6 +128,13 @@ void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>
 }
 
 CycleSummary CycleStatistics::close(const PulseSolver& solver) {
+  CycleSummary summary = close_own(solver);
+  // Rank 0's: every vessel's (by vessel); every other rank's stay its own, by entry.
+  if (solver.over_ranks()) gather_cycle_vessels(net_, solver, summary, entry_vessels(solver));
+  return summary;
+}
+
+CycleSummary CycleStatistics::close_own(const PulseSolver& solver) {
   CycleSummary summary;
   if (sums_.empty()) start_sums();  // no sample since the last close
   // In and out: each boundary's volume, in the boundaries' order, to "in" or "out" as it
@@ -174,8 +181,6 @@ CycleSummary CycleStatistics::close(const PulseSolver& solver) {
   }
   std::ranges::sort(summary.waves, {}, &std::pair<std::size_t, WaveSpeeds>::first);
   duration_ = 0;
-  // Rank 0's: every vessel's (by vessel); every other rank's stay its own, by entry.
-  if (over_ranks) gather_cycle_vessels(net_, solver, summary, entry_vessels(solver));
   return summary;
 }
 

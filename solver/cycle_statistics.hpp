@@ -85,10 +85,15 @@ class CycleStatistics {
   // Samples the solver's state at time t, standing for the `weight` seconds before it. The
   // last sample of a cycle is at the state close() sees.
   void sample(const PulseSolver& solver, double t, double weight);
-  // Closes the cycle at the solver's state now: returns the statistics.
+  // Closes the cycle at the solver's state now: returns the statistics (over ranks, rank 0's
+  // every vessel's, gathered: solver/cycle_over_ranks.hpp; every other rank's its own, by entry).
   CycleSummary close(const PulseSolver& solver);
-  // By entry (over ranks, every rank but the lead): each entry's vessel, close()'s order of
-  // the vessels' results. Empty by vessel.
+  // The same without the gathering: over ranks every rank's own vessels' results, by entry, and
+  // on rank 0 the cycle's sums (in- and outflow, boundaries, volume change, mass balance);
+  // gather_cycle_rows then takes the vessels' to rank 0 a block at a time.
+  CycleSummary close_own(const PulseSolver& solver);
+  // By entry (over ranks): each entry's vessel, close_own()'s order of the vessels' results.
+  // Empty by vessel.
   std::vector<std::int32_t> entry_vessels(const PulseSolver& solver) const;
 
  private:
@@ -100,9 +105,9 @@ class CycleStatistics {
   // sums until close() divides them by the duration, the extremes their extremes so far. The
   // sums become the results where they lie: no second per-vessel array at the cycle's end,
   // the run's largest moment (80 B a vessel on it).
-  // By vessel, alone and on the lead over ranks (which gathers every vessel's); on every other
-  // rank by entry, its own size: its 0D system's vessels in their order, then its 1D vessels
-  // (entry_vessels()), and close()'s summary the same.
+  // By vessel alone; over ranks by entry on every rank, the lead too, its own size: its 0D
+  // system's vessels in their order, then its 1D vessels (entry_vessels()), and close_own()'s
+  // summary the same (the lead held the whole network's, 64 B a vessel, until 2026-12-07).
   std::vector<VesselCycle> sums_;
   bool by_entry_ = false;
   std::size_t lumped_entries_ = 0;  // the 0D system's vessels (its halo's and ghosts' too)

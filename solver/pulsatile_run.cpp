@@ -31,10 +31,16 @@ double seconds_since_epoch_start() {
 // A cycle's summary as numbers, for the checkpoint: given vessel by vessel, not assembled,
 // each vessel's wave speeds after its statistics (NaN where none).
 constexpr std::size_t vessel_fields = 10;
+static_assert(vessel_fields == cycle_row_width, "a checkpoint's vessel row is a gathered row");
 VesselCycle vessel_cycle(const double* f) { return {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]}; }
-void put_summary(CheckpointWriter& out, const CycleSummary& c) {
-  out.begin_vector(4 + vessel_fields * c.vessels.size());
+// The section's head: its length, then the cycle's sums; a row per vessel follows, then the
+// boundaries' mean flows.
+void put_summary_head(CheckpointWriter& out, const CycleSummary& c, std::size_t vessels) {
+  out.begin_vector(4 + vessel_fields * vessels);
   out.put_part(std::vector<double>{c.inlet_mean_flow, c.outlets_mean_flow, c.volume_change, c.conservation_error});
+}
+void put_summary(CheckpointWriter& out, const CycleSummary& c) {
+  put_summary_head(out, c, c.vessels.size());
   auto wave = c.waves.begin();
   for (std::size_t k = 0; k < c.vessels.size(); ++k) {
     const VesselCycle& v = c.vessels[k];
@@ -125,16 +131,60 @@ PulsatileRun::PulsatileRun(const Network& net, PulseSolver& solver, std::vector<
 
 void PulsatileRun::begin_snapshot() {
   snapshot_pending_ = false;
-  if (!writes_) return;  // over ranks rank 0's, which holds the whole cycle's results and the top
+  if (!writes_) return;  // over ranks rank 0's, which gathers the cycle's results and holds the top
+  CheckpointWriter& out = open_snapshot();
+  put_summary(out, last_);
+  out.section("previous cycle");
+  out.put(previous_mean_pressure_);
+}
+
+CheckpointWriter& PulsatileRun::open_snapshot() {
   snapshot_.emplace(pending());
   CheckpointWriter& out = *snapshot_;
   out.section("identity");
   out.put(plan_.network_identity);
   out.put(plan_.state_shaping);
   out.section("last cycle");
-  put_summary(out, last_);
-  out.section("previous cycle");
-  out.put(previous_mean_pressure_);
+  return out;
+}
+
+PeriodicityChange PulsatileRun::begin_snapshot_over_ranks(std::vector<double>& mean_pressure) {
+  snapshot_pending_ = false;
+  const std::size_t n = net_.vessel_count();
+  CheckpointWriter* out = nullptr;
+  if (writes_) {
+    out = &open_snapshot();
+    put_summary_head(*out, last_, n);
+    if (plan_.balance_compliances) mean_pressure.assign(n, 0.0);
+  }
+  // Each block's rows as begin_snapshot writes them, each vessel's change as cycle_change
+  // takes it, in the vessels' order.
+  PeriodicityChange worst;
+  const bool compare = !previous_mean_pressure_.empty();
+  std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
+  gather_cycle_rows(net_, solver_, last_, stats_.entry_vessels(solver_), [&](std::size_t first, std::span<const double> rows) {
+    out->put_part(rows);
+    for (std::size_t k = 0; k * vessel_fields < rows.size(); ++k) {
+      const double* f = rows.data() + k * vessel_fields;
+      const std::size_t v = first + k;
+      if (compare) {
+        const double change = std::abs(f[1] - previous_mean_pressure_[v]) / std::abs(f[1]);
+        if (change > worst.change) worst = {change, v};
+      }
+      if (!mean_pressure.empty()) mean_pressure[v] = f[1];
+      if (!solver_.is_lumped(v)) waves.emplace_back(v, WaveSpeeds{f[8], f[9]});
+    }
+  });
+  if (!writes_) return worst;
+  out->put(last_.boundary_mean_flow);
+  out->section("previous cycle");
+  out->put(previous_mean_pressure_);
+  // In the snapshot alone from here, as a plain run's are once written (set_aside_last_vessels).
+  last_.waves = std::move(waves);
+  std::vector<VesselCycle>().swap(last_.vessels);
+  std::vector<double>().swap(last_.boundary_mean_flow);
+  last_vessels_aside_ = true;
+  return worst;
 }
 
 void PulsatileRun::finish_snapshot() {
@@ -250,8 +300,12 @@ void PulsatileRun::resume(std::unique_ptr<CheckpointReader> checkpoint) {
   // cycle's end leaves them), and no mean pressures of the cycle before: its own next cycle's
   // end makes its (the lead alone tests the change).
   in.section("last cycle");
-  last_ = get_summary(in, net_.vessel_count(), stats_.entry_vessels(solver_));
-  if (!writes_) set_aside_last_vessels();
+  if (writes_) {
+    last_ = get_summary(in, net_.vessel_count());  // whole, set aside at the run's start
+  } else {
+    last_ = get_summary(in, net_.vessel_count(), stats_.entry_vessels(solver_));
+    set_aside_last_vessels();
+  }
   in.section("previous cycle");
   std::uint64_t previous = 0;
   if (writes_) {
@@ -525,21 +579,29 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
         previous_mean_pressure_ = mean_pressures(last_.vessels);
       }
       last_ = CycleSummary{};  // freed before the next is built
-      last_ = stats_.close(solver_);
-      if (series) series->finish();
-      // (A rank other than the lead holds no mean pressures to compare, only whether it had a cycle.)
-      has_previous_ = writes_ ? !previous_mean_pressure_.empty() : own_last_vessels_ > 0;
-      // Rank 0 alone has the whole cycle (the others their own vessels', by entry: CycleStatistics).
-      if (has_change()) change_ = writes_ ? cycle_change(previous_mean_pressure_, last_.vessels) : PeriodicityChange{};
-      if (has_change() && over_ranks_) change_ = lead_change(change_);
       // The cycle's results go to the snapshot, and from memory (but their mean pressures,
       // which the balance and the next cycle end read) before the balance; the previous
       // cycle's mean pressures have served.
-      begin_snapshot();
+      std::vector<double> mean_pressure;  // the balance's, the lead's
+      if (over_ranks_) {
+        // Every rank its own vessels' results (by entry: CycleStatistics), which go to the
+        // lead's snapshot a block at a time; the lead alone tests the change.
+        last_ = stats_.close_own(solver_);
+        if (series) series->finish();
+        // (A rank other than the lead holds no mean pressures to compare, only whether it had a cycle.)
+        has_previous_ = writes_ ? !previous_mean_pressure_.empty() : own_last_vessels_ > 0;
+        const PeriodicityChange change = begin_snapshot_over_ranks(mean_pressure);
+        if (has_change()) change_ = lead_change(change);
+      } else {
+        last_ = stats_.close(solver_);
+        if (series) series->finish();
+        has_previous_ = !previous_mean_pressure_.empty();
+        if (has_change()) change_ = cycle_change(previous_mean_pressure_, last_.vessels);
+        begin_snapshot();
+        if (plan_.balance_compliances) mean_pressure = mean_pressures(last_.vessels);
+      }
       std::vector<double>().swap(previous_mean_pressure_);
       if (plan_.balance_compliances) {
-        // (The balance is solved by the lead, which alone holds the whole cycle.)
-        std::vector<double> mean_pressure = solver_.leads() ? mean_pressures(last_.vessels) : std::vector<double>();
         set_aside_last_vessels();
         if (solver_.balance_compliances(period, std::move(mean_pressure)) > 0) ++balances_;
       } else {

@@ -121,6 +121,16 @@ class PulsatileRun {
   }
   void begin_snapshot();
   void finish_snapshot();
+  // The snapshot made, its identity written and its "last cycle" section begun.
+  CheckpointWriter& open_snapshot();
+  // Over ranks, begin_snapshot's bytes on the lead without any rank holding the whole cycle's
+  // results: each rank's own (close_own's) gathered a block of the vessels at a time
+  // (gather_cycle_rows), written as they come, the periodicity change and the balance's mean
+  // pressures (`mean_pressure`, the lead's, where the plan balances) read from them as they
+  // pass; the lead's records then in the snapshot alone (set aside). On a full tree the lead
+  // held 64 B a vessel through each cycle and at each cycle end for them. Returns the lead's
+  // change (nothing elsewhere). Collective.
+  PeriodicityChange begin_snapshot_over_ranks(std::vector<double>& mean_pressure);
   std::optional<CheckpointWriter> snapshot_;  // between the two
   // While a cycle runs, the last cycle's per-vessel results are in its snapshot alone (80 B a
   // vessel on the run's largest moments, the cycle end's balance and the cycles after the

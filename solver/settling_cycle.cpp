@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "solver/cycle_over_ranks.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/decisions_over_ranks.hpp"
 #include "solver/run_estimate.hpp"
@@ -39,9 +40,11 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   if (over_ranks) check_solution_on_every_rank(solver);
   else solver.check_solution();
   solver.release_step_arrays();
-  // The rest freed here; the balance is the lead's, which alone holds the whole cycle.
-  std::vector<double> mean_pressure = mean_pressures(stats.close(solver).vessels);
-  if (!solver.leads()) std::vector<double>().swap(mean_pressure);
+  // The rest freed here; the balance is the lead's, which alone takes every vessel's mean
+  // pressure (over ranks a block at a time from the rank that steps it).
+  const CycleSummary own = stats.close_own(solver);
+  std::vector<double> mean_pressure =
+      over_ranks ? gather_mean_pressures(net, solver, own, stats.entry_vessels(solver)) : mean_pressures(own.vessels);
   solver.balance_compliances(period, std::move(mean_pressure));
   solver.set_time_step(run_step);
   solver.set_coupling_passes(run_passes);
