@@ -253,7 +253,7 @@ class PulseSolver {
   // (330 B a vessel) before the report, which reads the vessels' models, laws and degrees
   // only. The solver takes no step after it; lumped_count() keeps its value.
   void release_lumped_state() {
-    lumped_count_after_release_ = lumped_.vessel_count();
+    if (!lumped_count_after_release_) lumped_count_after_release_ = lumped_.vessel_count();
     lumped_ = LumpedVessels();
   }
   // Between steps: the 0D step's working arrays freed until the next step makes them again

@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "formats/checkpoint_file.hpp"
@@ -81,6 +82,7 @@ class PulsatileRun {
   int cycles_done() const { return done_; }
   int compliance_balances() const { return balances_; }
   const CycleSummary& last_cycle() const { return last_; }
+  CycleSummary take_last_cycle() { return std::move(last_); }  // at the run's end, the report made
   // The red cells over the last cycle (empty without a transport or a cycle), and the
   // largest change of a vessel's discharge hematocrit from the cycle before (NaN before two).
   const RedCellCycle& last_red_cells() const { return red_cells_last_; }
