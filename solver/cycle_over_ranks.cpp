@@ -79,13 +79,14 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
 
 void gather_cycle_rows(const Network& net, const PulseSolver& solver, const CycleSummary& own,
                        std::span<const std::int32_t> entry_vessel,
-                       const std::function<void(std::size_t first, std::span<const double> rows)>& block_rows) {
+                       const std::function<void(std::size_t first, std::span<const double> rows)>& block_rows,
+                       std::size_t block_vessels) {
   constexpr std::size_t width = cycle_row_width;
   // A block of the vessels at a time, so that a rank's rows are a block's (at most 5 MB), not its
   // whole share's: 80 B an own vessel would be more than its sums themselves, a share's largest
   // moment; and rank 0 holds a block's rows, not the whole cycle's (64 B a vessel).
   const std::size_t n = net.vessel_count();
-  const std::size_t block = std::clamp<std::size_t>(n, 1, std::size_t{1} << 16);
+  const std::size_t block = std::clamp<std::size_t>(n, 1, std::max<std::size_t>(block_vessels, 1));
   const bool lead = world_rank() == 0;
   std::vector<std::int32_t> mine;
   std::vector<double> rows, placed(lead ? block * width : 0);

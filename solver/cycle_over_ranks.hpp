@@ -33,13 +33,15 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
 // vessels at a time in the network's order, without any rank holding them all: per vessel of
 // the block [first, first + rows.size() / cycle_row_width) its row, VesselCycle's eight
 // numbers in their order, then its wave speeds (NaN where no wave travels), handed to
-// block(first, rows) on rank 0 alone. own: this rank's results (CycleStatistics::close),
+// block(first, rows) on rank 0 alone. own: this rank's results (CycleStatistics::close_own),
 // by entry where entry_vessel gives each entry's vessel (the ghosts' entries are not sent),
-// else by vessel. Collective.
+// else by vessel. block_vessels: the vessels a block (at most 5 MB of rows by default).
+// Collective.
 constexpr std::size_t cycle_row_width = 10;
 void gather_cycle_rows(const Network& net, const PulseSolver& solver, const CycleSummary& own,
                        std::span<const std::int32_t> entry_vessel,
-                       const std::function<void(std::size_t first, std::span<const double> rows)>& block);
+                       const std::function<void(std::size_t first, std::span<const double> rows)>& block,
+                       std::size_t block_vessels = std::size_t{1} << 16);
 
 // The same into rank 0's `summary`, whole: every vessel's results by vessel and every 1D
 // vessel's wave speeds. Elsewhere the summary is left as it is. Collective.

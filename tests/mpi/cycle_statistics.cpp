@@ -8,6 +8,7 @@
 // rank agrees, 1 otherwise, one line per failure on stderr.
 #include <cstdint>
 #include <cstdio>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "pulse/pulse_solver.hpp"
 #include "rank_checks.hpp"
 #include "tree_with_waves.hpp"
+#include "solver/cycle_over_ranks.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/probes_over_ranks.hpp"
 #include "solver/pulse_ranks_mpi.hpp"
@@ -58,7 +60,33 @@ int main(int argc, char** argv) {
     if (rank == 0)
       check(gathered.rows() == whole_probes.rows() && !gathered.rows().empty(),
             "the probes' rows differ from the whole run's:\n" + gathered.rows().substr(0, 300) + "\n" + whole_probes.rows().substr(0, 300));
-    const CycleSummary a = whole_stats.close(whole), b = stats.close(mine);
+    const CycleSummary a = whole_stats.close(whole), own = stats.close_own(mine);
+    // The rows a block of 7 vessels at a time (the run's blocks are 65,536 vessels: this
+    // tree would be one), as a cycle end writes them into the lead's snapshot: in the
+    // vessels' order, each block after the last, each row the whole run's results.
+    std::size_t next = 0, blocks = 0, rows_differ = 0;
+    bool in_order = true;
+    gather_cycle_rows(net, mine, own, stats.entry_vessels(mine), [&](std::size_t first, std::span<const double> rows) {
+      in_order = in_order && first == next && rows.size() % cycle_row_width == 0 && rows.size() <= 7 * cycle_row_width &&
+                 !rows.empty();
+      next = first + rows.size() / cycle_row_width;
+      ++blocks;
+      for (std::size_t k = 0; k * cycle_row_width < rows.size() && first + k < a.vessels.size(); ++k) {
+        const double* f = rows.data() + k * cycle_row_width;
+        const VesselCycle& x = a.vessels[first + k];
+        const WaveSpeeds w = a.wave_speeds(first + k);
+        rows_differ += !same_bits(f[0], x.mean_flow) + !same_bits(f[1], x.mean_pressure) +
+                       !same_bits(f[2], x.systolic_pressure) + !same_bits(f[3], x.diastolic_pressure) +
+                       !same_bits(f[4], x.peak_flow) + !same_bits(f[5], x.least_flow) + !same_bits(f[6], x.mean_wss) +
+                       !same_bits(f[7], x.reynolds) + !same_bits(f[8], w.pressure) + !same_bits(f[9], w.velocity);
+      }
+    }, 7);
+    if (rank == 0)
+      check(in_order && next == net.vessel_count() && blocks == (net.vessel_count() + 6) / 7 && rows_differ == 0,
+            "the rows in blocks of 7: " + std::to_string(blocks) + " blocks to vessel " + std::to_string(next) + ", " +
+                std::to_string(rows_differ) + " numbers unlike the whole run's");
+    CycleSummary b = own;
+    gather_cycle_vessels(net, mine, b, stats.entry_vessels(mine));
     if (rank == 0) {
       std::size_t differ = 0;
       check(b.vessels.size() == a.vessels.size(), "the vessels' results of " + std::to_string(b.vessels.size()) + " vessels");
