@@ -296,9 +296,9 @@ void PulsatileRun::resume(std::unique_ptr<CheckpointReader> checkpoint) {
   const std::string options = in.get_string();
   if (options != plan_.state_shaping)
     in.fail("written by a run with other options (there: " + options + "; here: " + plan_.state_shaping + ")");
-  // Over ranks every rank but the one that writes keeps its own vessels' results alone (as a
-  // cycle's end leaves them), and no mean pressures of the cycle before: its own next cycle's
-  // end makes its (the lead alone tests the change).
+  // Over ranks every rank but the one that writes keeps only how many of its own vessels'
+  // results there were (as a cycle's end leaves it), and no mean pressures of the cycle
+  // before (the lead alone tests the change).
   in.section("last cycle");
   if (writes_) {
     last_ = get_summary(in, net_.vessel_count());  // whole, set aside at the run's start
