@@ -1,6 +1,6 @@
 // What the ranks of a pulsatile run over ranks decide together (docs/scaling.md, "The
 // pulsatile run over ranks"): each rank meets its own interrupts, clock and failures, and the
-// whole cycle's results are rank 0's alone; every decision the time loop takes on them (stop,
+// whole cycle's results pass through rank 0 alone; every decision the time loop takes on them (stop,
 // go on, balance, break down) must be every rank's at the same step, or a rank would be left
 // waiting in the next exchange. Each call is collective over MPI_COMM_WORLD: every rank makes
 // it at the same point of the run.
@@ -25,7 +25,7 @@ double largest_on_ranks(double value);
 void take_lead_values(std::vector<double>& values);
 // Rank 0's text (any length: a checkpoint's bytes) on every rank.
 void take_lead_text(std::string& text);
-// Rank 0's cycle-to-cycle change (of the whole cycle's results, which it alone holds) on every rank.
+// Rank 0's cycle-to-cycle change (of the whole cycle's results, which it alone sees) on every rank.
 PeriodicityChange lead_change(PeriodicityChange change);
 // PulseSolver::check_solution on every rank's vessels: where any fails, SolutionBreakdown on
 // every rank, the lowest failing rank's (its first vessel in the network's order).
