@@ -75,22 +75,6 @@ void VesselTable::add_number_view(std::string name, std::span<const double> valu
   push_view(std::move(name), Kind::number, values.size(), reinterpret_cast<const std::byte*>(values.data()), sizeof(double));
 }
 
-std::span<const double> VesselTable::Column::numbers(std::vector<double>& scratch) const {
-  if (!view) return number;
-  if (stride == sizeof(double)) return {reinterpret_cast<const double*>(view), rows};
-  scratch.resize(rows);
-  for (std::size_t r = 0; r < rows; ++r) scratch[r] = number_at(r);
-  return scratch;
-}
-
-std::span<const std::int64_t> VesselTable::Column::integers(std::vector<std::int64_t>& scratch) const {
-  if (!view) return integer;
-  if (stride == sizeof(std::int64_t)) return {reinterpret_cast<const std::int64_t*>(view), rows};
-  scratch.resize(rows);
-  for (std::size_t r = 0; r < rows; ++r) scratch[r] = integer_at(r);
-  return scratch;
-}
-
 void VesselTable::add_text(std::string name, std::vector<std::uint8_t> codes, std::vector<std::string> labels) {
   check_size(codes.size(), rows_, name);
   for (const std::uint8_t k : codes)

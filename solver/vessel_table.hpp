@@ -37,15 +37,25 @@ class VesselTable {
     std::vector<std::string> json_labels;
     std::vector<std::string> csv_labels;  // labels as CSV fields, quoted where they must be
 
-    double number_at(std::size_t row) const {
-      return view ? *reinterpret_cast<const double*>(view + row * stride) : number[row];
-    }
-    std::int64_t integer_at(std::size_t row) const {
-      return view ? *reinterpret_cast<const std::int64_t*>(view + row * stride) : integer[row];
-    }
+    double number_at(std::size_t row) const { return at(number, row); }
+    std::int64_t integer_at(std::size_t row) const { return at(integer, row); }
     // The whole column in one piece: its own values where they lie so, else copied into scratch.
-    std::span<const double> numbers(std::vector<double>& scratch) const;
-    std::span<const std::int64_t> integers(std::vector<std::int64_t>& scratch) const;
+    std::span<const double> numbers(std::vector<double>& scratch) const { return whole(number, scratch); }
+    std::span<const std::int64_t> integers(std::vector<std::int64_t>& scratch) const { return whole(integer, scratch); }
+
+   private:
+    template <class T>
+    T at(const std::vector<T>& held, std::size_t row) const {
+      return view ? *reinterpret_cast<const T*>(view + row * stride) : held[row];
+    }
+    template <class T>
+    std::span<const T> whole(const std::vector<T>& held, std::vector<T>& scratch) const {
+      if (!view) return held;
+      if (stride == sizeof(T)) return {reinterpret_cast<const T*>(view), rows};
+      scratch.resize(rows);
+      for (std::size_t r = 0; r < rows; ++r) scratch[r] = at(held, r);
+      return scratch;
+    }
   };
 
   explicit VesselTable(std::size_t rows = 0) : rows_(rows) {}
@@ -68,6 +78,9 @@ class VesselTable {
               records.empty() ? nullptr : reinterpret_cast<const std::byte*>(&(records.front().*field)), sizeof(Record));
   }
 
+  // One row appended to text as a JSON object on one line ({"id":3,...}), numbers in their
+  // shortest text that reads back to the same double; as a CSV line (its newline included),
+  // the same numbers, null an empty field (which pandas and numpy read as NaN).
   void append_json_row(std::string& text, std::size_t row) const;
   void append_csv_row(std::string& text, std::size_t row) const;
 
