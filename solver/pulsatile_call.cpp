@@ -567,10 +567,11 @@ RunResult pulsatile(const Network& net, const RunConfiguration& given, RunObserv
     pulsatile.end_transport();
     transport.reset();
   }
-  // Both lie in the allocator's heap (a large block is mapped on its own only where the heap
+  // It lay in the allocator's heap (a large block is mapped on its own only where the heap
   // has no room left for it), whose freed pages stay resident until given back: the results'
-  // tables would be laid on top of them (the million-vessel tree with red cells: 775 MB
-  // before the results, 283 MB after this).
+  // tables would be laid on top of them. (The 0D state went, and its pages with it, at the
+  // run's end: PulsatileRun::run. Both together, the million-vessel tree with red cells: 775
+  // MB before the results, 283 MB after.)
   return_free_memory();
   {  // the table (0.9 GB on the full tree) is freed before the last cycle is copied below
     VesselTable results = last.vessels.empty() ? VesselTable()
