@@ -28,6 +28,7 @@
 #include "formats/network_io.hpp"
 #include "mpi/session.hpp"
 #include "pulse/pulse_solver.hpp"
+#include "solver/cycle_over_ranks.hpp"
 #include "solver/cycle_statistics.hpp"
 #include "solver/pulse_ranks_mpi.hpp"
 
@@ -81,7 +82,8 @@ int main(int argc, char** argv) {
       sampled_until = solver.time();
     }
   }
-  const CycleSummary cycle = stats.close(solver);
+  CycleSummary cycle = stats.close(solver);
+  if (solver.over_ranks()) gather_cycle_vessels(net, solver, cycle, stats.entry_vessels(solver));  // rank 0's: every vessel's
   MPI_Barrier(MPI_COMM_WORLD);
   const double stepped = seconds_since(stepping);
   const RootExchange* exchange = over_ranks.exchange();  // made at the first step

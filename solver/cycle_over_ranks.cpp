@@ -98,10 +98,9 @@ void gather_cycle_rows(const Network& net, const PulseSolver& solver, const Cycl
   std::ranges::sort(own_entries);
   auto next_own = own_entries.begin();
   auto add_row = [&](std::size_t v, const VesselCycle& c) {
-    const WaveSpeeds w = own.wave_speeds(v);
     mine.push_back(static_cast<std::int32_t>(v));
-    rows.insert(rows.end(), {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
-                             c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity});
+    const auto row = cycle_row(c, own.wave_speeds(v));
+    rows.insert(rows.end(), row.begin(), row.end());
   };
   mine.reserve(block);
   rows.reserve(block * width);
@@ -133,8 +132,8 @@ void gather_cycle_vessels(const Network& net, const PulseSolver& solver, CycleSu
     for (std::size_t k = 0; k * cycle_row_width < rows.size(); ++k) {
       const double* f = rows.data() + k * cycle_row_width;
       const std::size_t v = first + k;
-      whole[v] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
-      if (!solver.is_lumped(v)) waves.emplace_back(v, WaveSpeeds{f[8], f[9]});
+      whole[v] = row_cycle(f);
+      if (!solver.is_lumped(v)) waves.emplace_back(v, row_wave_speeds(f));
     }
   });
   if (world_rank() != 0) return;
@@ -146,7 +145,8 @@ std::vector<double> gather_mean_pressures(const Network& net, const PulseSolver&
                                           std::span<const std::int32_t> entry_vessel) {
   std::vector<double> p(world_rank() == 0 ? net.vessel_count() : 0);
   gather_cycle_rows(net, solver, own, entry_vessel, [&](std::size_t first, std::span<const double> rows) {
-    for (std::size_t k = 0; k * cycle_row_width < rows.size(); ++k) p[first + k] = rows[k * cycle_row_width + 1];
+    for (std::size_t k = 0; k * cycle_row_width < rows.size(); ++k)
+      p[first + k] = row_cycle(rows.data() + k * cycle_row_width).mean_pressure;
   });
   return p;
 }

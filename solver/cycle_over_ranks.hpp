@@ -31,13 +31,11 @@ void gather_vessel_values(const Network& net, const PulseSolver& solver, std::sp
 
 // Every vessel's cycle results on rank 0 from the rank that steps the vessel, a block of the
 // vessels at a time in the network's order, without any rank holding them all: per vessel of
-// the block [first, first + rows.size() / cycle_row_width) its row, VesselCycle's eight
-// numbers in their order, then its wave speeds (NaN where no wave travels), handed to
-// block(first, rows) on rank 0 alone. own: this rank's results (CycleStatistics::close_own),
+// the block [first, first + rows.size() / cycle_row_width) its row (cycle_row), handed to
+// block(first, rows) on rank 0 alone. own: this rank's results (CycleStatistics::close),
 // by entry where entry_vessel gives each entry's vessel (the ghosts' entries are not sent),
 // else by vessel. block_vessels: the vessels a block (at most 5 MB of rows by default).
 // Collective.
-constexpr std::size_t cycle_row_width = 10;
 void gather_cycle_rows(const Network& net, const PulseSolver& solver, const CycleSummary& own,
                        std::span<const std::int32_t> entry_vessel,
                        const std::function<void(std::size_t first, std::span<const double> rows)>& block,

@@ -128,13 +128,6 @@ void CycleStatistics::record_ends(const PulseSolver& solver, std::vector<double>
 }
 
 CycleSummary CycleStatistics::close(const PulseSolver& solver) {
-  CycleSummary summary = close_own(solver);
-  // Rank 0's: every vessel's (by vessel); every other rank's stay its own, by entry.
-  if (solver.over_ranks()) gather_cycle_vessels(net_, solver, summary, entry_vessels(solver));
-  return summary;
-}
-
-CycleSummary CycleStatistics::close_own(const PulseSolver& solver) {
   CycleSummary summary;
   if (sums_.empty()) start_sums();  // no sample since the last close
   // In and out: each boundary's volume, in the boundaries' order, to "in" or "out" as it
@@ -200,12 +193,13 @@ WaveSpeeds CycleSummary::wave_speeds(std::size_t vessel) const {
 PeriodicityChange cycle_change(std::span<const double> previous_mean_pressure,
                                const std::vector<VesselCycle>& current) {
   PeriodicityChange worst;
-  for (std::size_t v = 0; v < current.size(); ++v) {
-    const double change = std::abs(current[v].mean_pressure - previous_mean_pressure[v]) /
-                          std::abs(current[v].mean_pressure);
-    if (change > worst.change) worst = {change, v};
-  }
+  for (std::size_t v = 0; v < current.size(); ++v) worst.compare(v, previous_mean_pressure[v], current[v].mean_pressure);
   return worst;
+}
+
+std::array<double, cycle_row_width> cycle_row(const VesselCycle& c, const WaveSpeeds& w) {
+  return {c.mean_flow, c.mean_pressure, c.systolic_pressure, c.diastolic_pressure, c.peak_flow,
+          c.least_flow, c.mean_wss, c.reynolds, w.pressure, w.velocity};
 }
 
 std::vector<double> mean_pressures(const std::vector<VesselCycle>& cycle) {

@@ -8,6 +8,8 @@
 // and the cycle-to-cycle change that decides when the solution is periodic.
 #pragma once
 
+#include <array>
+#include <cmath>
 #include <complex>
 #include <cstdint>
 #include <limits>
@@ -45,6 +47,16 @@ double phase_velocity(std::complex<double> z0, std::complex<double> z1, double o
 struct WaveSpeeds {
   double pressure = std::numeric_limits<double>::quiet_NaN(), velocity = std::numeric_limits<double>::quiet_NaN();
 };
+
+// A vessel's cycle results as a row of numbers, as a checkpoint holds them and a run over
+// ranks gathers them: VesselCycle's eight in their order, then the wave speeds (NaN where
+// none).
+constexpr std::size_t cycle_row_width = 10;
+std::array<double, cycle_row_width> cycle_row(const VesselCycle& c, const WaveSpeeds& w);
+inline VesselCycle row_cycle(const double* row) {
+  return {row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7]};
+}
+inline WaveSpeeds row_wave_speeds(const double* row) { return {row[8], row[9]}; }
 
 struct CycleSummary {
   std::vector<VesselCycle> vessels;
@@ -85,14 +97,12 @@ class CycleStatistics {
   // Samples the solver's state at time t, standing for the `weight` seconds before it. The
   // last sample of a cycle is at the state close() sees.
   void sample(const PulseSolver& solver, double t, double weight);
-  // Closes the cycle at the solver's state now: returns the statistics (over ranks, rank 0's
-  // every vessel's, gathered: solver/cycle_over_ranks.hpp; every other rank's its own, by entry).
+  // Closes the cycle at the solver's state now: returns the statistics. Over ranks every
+  // rank's own vessels' results, by entry, and on rank 0 the cycle's sums (in- and outflow,
+  // boundaries, volume change, mass balance); solver/cycle_over_ranks.hpp takes the vessels'
+  // to rank 0 (gather_cycle_rows, a block at a time; gather_cycle_vessels, whole).
   CycleSummary close(const PulseSolver& solver);
-  // The same without the gathering: over ranks every rank's own vessels' results, by entry, and
-  // on rank 0 the cycle's sums (in- and outflow, boundaries, volume change, mass balance);
-  // gather_cycle_rows then takes the vessels' to rank 0 a block at a time.
-  CycleSummary close_own(const PulseSolver& solver);
-  // By entry (over ranks): each entry's vessel, close_own()'s order of the vessels' results.
+  // By entry (over ranks): each entry's vessel, close()'s order of the vessels' results.
   // Empty by vessel.
   std::vector<std::int32_t> entry_vessels(const PulseSolver& solver) const;
 
@@ -106,7 +116,7 @@ class CycleStatistics {
   // sums become the results where they lie: no second per-vessel array at the cycle's end,
   // the run's largest moment (80 B a vessel on it).
   // By vessel alone; over ranks by entry on every rank, the lead too, its own size: its 0D
-  // system's vessels in their order, then its 1D vessels (entry_vessels()), and close_own()'s
+  // system's vessels in their order, then its 1D vessels (entry_vessels()), and close()'s
   // summary the same (the lead held the whole network's, 64 B a vessel, until 2026-12-07).
   std::vector<VesselCycle> sums_;
   bool by_entry_ = false;
@@ -132,6 +142,12 @@ class CycleStatistics {
 struct PeriodicityChange {
   double change = 0;
   std::size_t vessel = 0;
+  // Takes a vessel's change, |current - previous| / |current|, where it is the largest yet
+  // (the first such vessel in the order they come).
+  void compare(std::size_t v, double previous, double current) {
+    const double c = std::abs(current - previous) / std::abs(current);
+    if (c > change) *this = {c, v};
+  }
 };
 PeriodicityChange cycle_change(std::span<const double> previous_mean_pressure,
                                const std::vector<VesselCycle>& current);

@@ -29,14 +29,10 @@ double seconds_since_epoch_start() {
 }
 
 // A cycle's summary as numbers, for the checkpoint: given vessel by vessel, not assembled,
-// each vessel's wave speeds after its statistics (NaN where none).
-constexpr std::size_t vessel_fields = 10;
-static_assert(vessel_fields == cycle_row_width, "a checkpoint's vessel row is a gathered row");
-VesselCycle vessel_cycle(const double* f) { return {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]}; }
-// The section's head: its length, then the cycle's sums; a row per vessel follows, then the
-// boundaries' mean flows.
+// a row each (cycle_row). The section's head: its length, then the cycle's sums; a row per
+// vessel follows, then the boundaries' mean flows.
 void put_summary_head(CheckpointWriter& out, const CycleSummary& c, std::size_t vessels) {
-  out.begin_vector(4 + vessel_fields * vessels);
+  out.begin_vector(4 + cycle_row_width * vessels);
   out.put_part(std::vector<double>{c.inlet_mean_flow, c.outlets_mean_flow, c.volume_change, c.conservation_error});
 }
 void put_summary(CheckpointWriter& out, const CycleSummary& c) {
@@ -46,9 +42,7 @@ void put_summary(CheckpointWriter& out, const CycleSummary& c) {
     const VesselCycle& v = c.vessels[k];
     WaveSpeeds speeds;
     if (wave != c.waves.end() && wave->first == k) speeds = (wave++)->second;
-    const double fields[vessel_fields] = {v.mean_flow, v.mean_pressure, v.systolic_pressure, v.diastolic_pressure,
-                                          v.peak_flow, v.least_flow, v.mean_wss, v.reynolds, speeds.pressure, speeds.velocity};
-    out.put_part(fields);
+    out.put_part(cycle_row(v, speeds));
   }
   out.put(c.boundary_mean_flow);
 }
@@ -59,9 +53,9 @@ void put_summary(CheckpointWriter& out, const CycleSummary& c) {
 // else every vessel's, by vessel.
 CycleSummary get_summary(CheckpointReader& in, std::size_t vessels, std::span<const std::int32_t> entries = {}) {
   const std::uint64_t count = in.begin_vector();
-  if (count != 4 && count != 4 + vessel_fields * vessels) in.fail("cycle results of another network");
+  if (count != 4 && count != 4 + cycle_row_width * vessels) in.fail("cycle results of another network");
   CycleSummary c;
-  double f[vessel_fields];
+  double f[cycle_row_width];
   in.get_part(std::span<double>(f, 4));
   c.inlet_mean_flow = f[0];
   c.outlets_mean_flow = f[1];
@@ -78,10 +72,10 @@ CycleSummary get_summary(CheckpointReader& in, std::size_t vessels, std::span<co
     for (std::size_t v = 0; v < vessels; ++v) {
       in.get_part(f);
       bool kept_here = all;
-      if (all) c.vessels[v] = vessel_cycle(f);
+      if (all) c.vessels[v] = row_cycle(f);
       for (; next != kept.end() && static_cast<std::size_t>(next->first) == v; ++next, kept_here = true)
-        c.vessels[static_cast<std::size_t>(next->second)] = vessel_cycle(f);
-      const WaveSpeeds speeds{f[8], f[9]};
+        c.vessels[static_cast<std::size_t>(next->second)] = row_cycle(f);
+      const WaveSpeeds speeds = row_wave_speeds(f);
       if (kept_here && (!std::isnan(speeds.pressure) || !std::isnan(speeds.velocity))) c.waves.emplace_back(v, speeds);
     }
   }
@@ -164,15 +158,13 @@ PeriodicityChange PulsatileRun::begin_snapshot_over_ranks(std::vector<double>& m
   std::vector<std::pair<std::size_t, WaveSpeeds>> waves;
   gather_cycle_rows(net_, solver_, last_, stats_.entry_vessels(solver_), [&](std::size_t first, std::span<const double> rows) {
     out->put_part(rows);
-    for (std::size_t k = 0; k * vessel_fields < rows.size(); ++k) {
-      const double* f = rows.data() + k * vessel_fields;
+    for (std::size_t k = 0; k * cycle_row_width < rows.size(); ++k) {
+      const double* f = rows.data() + k * cycle_row_width;
       const std::size_t v = first + k;
-      if (compare) {
-        const double change = std::abs(f[1] - previous_mean_pressure_[v]) / std::abs(f[1]);
-        if (change > worst.change) worst = {change, v};
-      }
-      if (!mean_pressure.empty()) mean_pressure[v] = f[1];
-      if (!solver_.is_lumped(v)) waves.emplace_back(v, WaveSpeeds{f[8], f[9]});
+      const double p = row_cycle(f).mean_pressure;
+      if (compare) worst.compare(v, previous_mean_pressure_[v], p);
+      if (!mean_pressure.empty()) mean_pressure[v] = p;
+      if (!solver_.is_lumped(v)) waves.emplace_back(v, row_wave_speeds(f));
     }
   });
   if (!writes_) return worst;
@@ -257,13 +249,13 @@ void PulsatileRun::read_last_vessels(CheckpointStream& in, PerVessel&& per_vesse
   in.section("identity");
   in.section("last cycle");
   const std::size_t n = net_.vessel_count();
-  if (in.get_u64() != 4 + vessel_fields * n)
+  if (in.get_u64() != 4 + cycle_row_width * n)
     throw InputError(latest_snapshot().string() + ": cycle results of another network");
-  double f[vessel_fields];
+  double f[cycle_row_width];
   in.get_doubles(std::span<double>(f, 4));  // the totals, which the run kept
   for (std::size_t v = 0; v < n; ++v) {
     in.get_doubles(f);
-    per_vessel(v, vessel_cycle(f));
+    per_vessel(v, row_cycle(f));
   }
 }
 
@@ -587,19 +579,16 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       // which the balance and the next cycle end read) before the balance; the previous
       // cycle's mean pressures have served.
       std::vector<double> mean_pressure;  // the balance's, the lead's
+      last_ = stats_.close(solver_);
+      if (series) series->finish();
+      // (A rank other than the lead holds no mean pressures to compare, only whether it had a cycle.)
+      has_previous_ = writes_ ? !previous_mean_pressure_.empty() : own_last_vessels_ > 0;
       if (over_ranks_) {
         // Every rank its own vessels' results (by entry: CycleStatistics), which go to the
         // lead's snapshot a block at a time; the lead alone tests the change.
-        last_ = stats_.close_own(solver_);
-        if (series) series->finish();
-        // (A rank other than the lead holds no mean pressures to compare, only whether it had a cycle.)
-        has_previous_ = writes_ ? !previous_mean_pressure_.empty() : own_last_vessels_ > 0;
         const PeriodicityChange change = begin_snapshot_over_ranks(mean_pressure);
         if (has_change()) change_ = lead_change(change);
       } else {
-        last_ = stats_.close(solver_);
-        if (series) series->finish();
-        has_previous_ = !previous_mean_pressure_.empty();
         if (has_change()) change_ = cycle_change(previous_mean_pressure_, last_.vessels);
         begin_snapshot();
         if (plan_.balance_compliances) mean_pressure = mean_pressures(last_.vessels);

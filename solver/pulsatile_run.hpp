@@ -126,7 +126,7 @@ class PulsatileRun {
   // The snapshot made, its identity written and its "last cycle" section begun.
   CheckpointWriter& open_snapshot();
   // Over ranks, begin_snapshot's bytes on the lead without any rank holding the whole cycle's
-  // results: each rank's own (close_own's) gathered a block of the vessels at a time
+  // results: each rank's own (close()'s) gathered a block of the vessels at a time
   // (gather_cycle_rows), written as they come, the periodicity change and the balance's mean
   // pressures (`mean_pressure`, the lead's, where the plan balances) read from them as they
   // pass; the lead's records then in the snapshot alone (set aside). On a full tree the lead

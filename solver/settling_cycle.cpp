@@ -42,7 +42,7 @@ Settling settle(const Network& net, PulseSolver& solver, std::size_t steps, RunO
   solver.release_step_arrays();
   // The rest freed here; the balance is the lead's, which alone takes every vessel's mean
   // pressure (over ranks a block at a time from the rank that steps it).
-  const CycleSummary own = stats.close_own(solver);
+  const CycleSummary own = stats.close(solver);
   std::vector<double> mean_pressure =
       over_ranks ? gather_mean_pressures(net, solver, own, stats.entry_vessels(solver)) : mean_pressures(own.vessels);
   solver.balance_compliances(period, std::move(mean_pressure));

@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
     if (rank == 0)
       check(gathered.rows() == whole_probes.rows() && !gathered.rows().empty(),
             "the probes' rows differ from the whole run's:\n" + gathered.rows().substr(0, 300) + "\n" + whole_probes.rows().substr(0, 300));
-    const CycleSummary a = whole_stats.close(whole), own = stats.close_own(mine);
+    const CycleSummary a = whole_stats.close(whole), own = stats.close(mine);
     // The rows a block of 7 vessels at a time (the run's blocks are 65,536 vessels: this
     // tree would be one), as a cycle end writes them into the lead's snapshot: in the
     // vessels' order, each block after the last, each row the whole run's results.
