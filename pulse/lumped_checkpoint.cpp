@@ -72,7 +72,7 @@ void LumpedVessels::restore(CheckpointReader& in) {
 }
 
 LumpedVessels::StateShare LumpedVessels::state_share(const LumpedPlaces& places) const {
-  StateShare share{.whole_nodes = places.nodes, .whole_edges = places.edges};
+  StateShare share{.node_place = {}, .edge_place = {}, .whole_nodes = places.nodes, .whole_edges = places.edges};
   const std::vector<std::int32_t> node_place = local_node_places(places), edge_place = local_edge_places(places);
   for (std::size_t k = 0; k < nodes_; ++k)
     if (!is_ghost_node(k)) share.node_place.push_back(node_place[k]);  // a ghost's is its rank's

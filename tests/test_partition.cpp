@@ -77,8 +77,9 @@ TEST(Partition, ATreeIntoWholeSubtreesWithinTheBoundOfItsPieces) {
     const std::set<std::int32_t> top(p.top.begin(), p.top.end());
     for (std::size_t v = 0; v < net.vessel_count(); ++v)
       for (std::int64_t c = children.offset[v]; c < children.offset[v + 1]; ++c)
-        if (p.rank_of_vessel[static_cast<std::size_t>(children.index[c])] != p.rank_of_vessel[v])
+        if (p.rank_of_vessel[static_cast<std::size_t>(children.index[c])] != p.rank_of_vessel[v]) {
           EXPECT_TRUE(top.count(static_cast<std::int32_t>(v))) << "vessel " << v << " of " << ranks << " ranks";
+        }
     for (const std::int32_t v : p.top) {
       const auto first = static_cast<std::size_t>(children.index[static_cast<std::size_t>(children.offset[static_cast<std::size_t>(v)])]);
       EXPECT_EQ(p.rank_of_vessel[static_cast<std::size_t>(v)], p.top_spread ? p.rank_of_vessel[first] : p.top_rank);
@@ -114,8 +115,9 @@ TEST(Partition, VesselsKeptOnTheTopMoveThereWithThoseAboveThem) {
   }
   for (std::size_t v = 0; v < net.vessel_count(); ++v)
     for (std::int64_t c = children.offset[v]; c < children.offset[v + 1]; ++c)
-      if (p.rank_of_vessel[static_cast<std::size_t>(children.index[c])] != p.rank_of_vessel[v])
+      if (p.rank_of_vessel[static_cast<std::size_t>(children.index[c])] != p.rank_of_vessel[v]) {
         EXPECT_TRUE(top.count(static_cast<std::int32_t>(v))) << "vessel " << v;
+      }
   std::size_t moved = 0;
   for (std::size_t v = 0; v < net.vessel_count(); ++v)
     if (p.rank_of_vessel[v] != plain.rank_of_vessel[v]) {
