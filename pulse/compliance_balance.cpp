@@ -7,6 +7,7 @@
 #include <numbers>
 #include <vector>
 
+#include "core/free_memory.hpp"
 #include "physics/poiseuille.hpp"
 #include "steady/loaded_tree.hpp"
 #include "pulse/pulse_solver.hpp"
@@ -60,6 +61,11 @@ std::vector<double> PulseSolver::vessel_volumes() const {
 
 std::size_t PulseSolver::balance_compliances(double period, std::vector<double> mean_pressure) {
   if (!can_balance_) return 0;
+  // What the cycle end freed before it (the step's arrays, the cycle's sums and records) lies
+  // in the allocator's heap in pieces the balance's arrays and tree do not fit: handed back,
+  // not left resident beside them (the million-vessel tree's peak 477 -> 428 MB, the full
+  // tree's 1.70 -> 1.54 GB).
+  return_free_memory();
   const std::size_t n = net_.vessel_count();
   // Every vessel's volume and dA/dp at its mean area, the lead's alone (over ranks the others
   // send their vessels' volumes); each rank moves its own vessels by the dA/dp it computes

@@ -596,10 +596,6 @@ RunStatus PulsatileRun::run_cycles(RunObserver& observer) {
       std::vector<double>().swap(previous_mean_pressure_);
       if (plan_.balance_compliances) {
         set_aside_last_vessels();
-        // What the cycle end has freed (the cycle's sums and records, the step's arrays) lies
-        // in the allocator's heap in pieces the balance's tree does not fit: handed back, not
-        // left resident beside it (the million-vessel tree's peak 477 -> 428 MB).
-        return_free_memory();
         if (solver_.balance_compliances(period, std::move(mean_pressure)) > 0) ++balances_;
       } else {
         set_aside_last_vessels();
